@@ -1,0 +1,180 @@
+//! The viscoelastic (Kelvin / standard linear solid) layer and the physical ranges of every
+//! parameter of a rolling contact (MODEL.md §1).
+
+use std::fmt;
+
+/// A thin Kelvin layer bonded to a rigid base (MODEL.md eq. 4): locally
+/// v + T_ε ∂v/∂t = (H/E_L)(p + T_σ ∂p/∂t).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Layer {
+    /// E_L, relaxed longitudinal modulus (Pa); the paper takes the tangential modulus equal.
+    pub elastic_modulus: f64,
+    /// H (m).
+    pub thickness: f64,
+    /// ν.
+    pub poisson_ratio: f64,
+    /// T_ε (s), ≥ T_σ.
+    pub retardation_time: f64,
+    /// T_σ (s), > 0.
+    pub relaxation_time: f64,
+}
+
+impl Default for Layer {
+    /// MODEL.md §5: E_L = 3 GPa, H = 100 nm, ν = 0.35, T_ε = 0.5 s, T_σ = 0.1 s.
+    fn default() -> Self {
+        Layer {
+            elastic_modulus: 3e9,
+            thickness: 100e-9,
+            poisson_ratio: 0.35,
+            retardation_time: 0.5,
+            relaxation_time: 0.1,
+        }
+    }
+}
+
+impl Layer {
+    /// k = E_L/H, the relaxed foundation stiffness (Pa/m).
+    pub fn stiffness(&self) -> f64 {
+        self.elastic_modulus / self.thickness
+    }
+
+    /// κ = T_ε/T_σ − 1, the strength of the viscosity: the instantaneous stiffness is k(1 + κ).
+    pub fn kappa(&self) -> f64 {
+        self.retardation_time / self.relaxation_time - 1.0
+    }
+
+    /// G = E/(2(1 + ν)) (eq. 13).
+    pub fn shear_modulus(&self) -> f64 {
+        self.elastic_modulus / (2.0 * (1.0 + self.poisson_ratio))
+    }
+
+    /// τ_a = G/1000, the interfacial shear strength of Adams et al. (eq. 12).
+    pub fn interfacial_shear_strength(&self) -> f64 {
+        self.shear_modulus() / 1000.0
+    }
+
+    /// Every parameter outside its physical range.
+    pub fn violations(&self) -> Vec<ParameterError> {
+        let mut errors: Vec<ParameterError> = [
+            (Parameter::ElasticModulus, self.elastic_modulus),
+            (Parameter::Thickness, self.thickness),
+            (Parameter::PoissonRatio, self.poisson_ratio),
+            (Parameter::RelaxationTime, self.relaxation_time),
+            (Parameter::RetardationTime, self.retardation_time),
+        ]
+        .into_iter()
+        .filter_map(|(parameter, value)| parameter.check(value).err())
+        .collect();
+        let times_valid = errors.iter().all(|e| {
+            !matches!(
+                e.parameter,
+                Parameter::RelaxationTime | Parameter::RetardationTime
+            )
+        });
+        if times_valid && self.retardation_time < self.relaxation_time {
+            errors.push(ParameterError {
+                parameter: Parameter::RetardationTime,
+                value: self.retardation_time,
+                allowed: format!(
+                    "≥ relaxation time T_σ = {} s (T_ε ≥ T_σ; equal means elastic)",
+                    self.relaxation_time
+                ),
+            });
+        }
+        errors
+    }
+}
+
+/// A named input of the model, with its physical range.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Parameter {
+    Radius,
+    Load,
+    Velocity,
+    ElasticModulus,
+    Thickness,
+    PoissonRatio,
+    RetardationTime,
+    RelaxationTime,
+}
+
+impl Parameter {
+    /// The SI unit of the parameter ("" for dimensionless).
+    pub fn unit(self) -> &'static str {
+        match self {
+            Parameter::Radius | Parameter::Thickness => "m",
+            Parameter::Load => "N",
+            Parameter::Velocity => "m/s",
+            Parameter::ElasticModulus => "Pa",
+            Parameter::PoissonRatio => "",
+            Parameter::RetardationTime | Parameter::RelaxationTime => "s",
+        }
+    }
+
+    /// The allowed range, as text.
+    pub fn allowed(self) -> String {
+        let unit = self.unit();
+        match self {
+            Parameter::Velocity => format!("finite and ≥ 0 {unit}"),
+            Parameter::PoissonRatio => "0 ≤ ν < 0.5".to_string(),
+            _ => format!("finite and > 0 {unit}"),
+        }
+    }
+
+    /// Checks one value against the parameter's own range (not the cross-checks, such as
+    /// T_ε ≥ T_σ, that [`Layer::violations`] adds).
+    pub fn check(self, value: f64) -> Result<(), ParameterError> {
+        let ok = value.is_finite()
+            && match self {
+                Parameter::Velocity => value >= 0.0,
+                Parameter::PoissonRatio => (0.0..0.5).contains(&value),
+                _ => value > 0.0,
+            };
+        if ok {
+            Ok(())
+        } else {
+            Err(ParameterError {
+                parameter: self,
+                value,
+                allowed: self.allowed(),
+            })
+        }
+    }
+}
+
+impl fmt::Display for Parameter {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Parameter::Radius => "radius",
+            Parameter::Load => "load",
+            Parameter::Velocity => "velocity",
+            Parameter::ElasticModulus => "elastic modulus",
+            Parameter::Thickness => "thickness",
+            Parameter::PoissonRatio => "Poisson ratio",
+            Parameter::RetardationTime => "retardation time",
+            Parameter::RelaxationTime => "relaxation time",
+        })
+    }
+}
+
+/// A parameter outside its physical range.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ParameterError {
+    pub parameter: Parameter,
+    pub value: f64,
+    /// The allowed range, as text.
+    pub allowed: String,
+}
+
+impl fmt::Display for ParameterError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "{} = {} {} is out of range: allowed {}",
+            self.parameter,
+            self.value,
+            self.parameter.unit(),
+            self.allowed
+        )
+    }
+}

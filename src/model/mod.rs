@@ -1,0 +1,20 @@
+//! The physics core: a rigid sphere rolling over a Kelvin layer bonded to a rigid base
+//! (MODEL.md §1–3, §5, §6). Pure numerics over plain structs in SI units: no I/O, no async,
+//! no serde. Everything else in the crate calls into this module.
+
+mod error;
+pub mod figures;
+mod layer;
+pub mod limits;
+pub mod quadrature;
+pub mod rolling;
+mod special;
+pub mod strip;
+
+pub use error::ModelError;
+pub use layer::{Layer, Parameter, ParameterError};
+pub use quadrature::Quadrature;
+pub use rolling::{solve, Rolling, RollingSolution, SolveOptions};
+
+/// Version of the model's numbers: part of every cache key, bumped whenever a result changes.
+pub const MODEL_VERSION: &str = "1.0.0";

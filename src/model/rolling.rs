@@ -1,0 +1,512 @@
+//! A rigid sphere rolling at constant speed over the Kelvin layer: penetration, contact
+//! region, area, centroid and centre of pressure, friction (MODEL.md §3, eqs. 2–5, 9–12).
+//!
+//! The solution is computed in units of the static half-width r₀ = √(2Rδ₀): there the
+//! contact shape depends only on ξ = V T_σ / r₀ and κ (the similarity law), the load to
+//! carry is P̂ = π/4, and no intermediate quantity can over- or underflow.
+
+use std::f64::consts::{FRAC_PI_2, FRAC_PI_4, PI};
+
+use super::limits::{relaxed, ElasticContact};
+use super::quadrature::StripRule;
+use super::strip::Strip;
+use super::{Layer, ModelError, Parameter, Quadrature};
+
+/// Iterations allowed for the penetration root P(δ) = P.
+const MAX_LOAD_ITERATIONS: u32 = 60;
+/// The load equation is solved to this relative residual: δ then carries an error of a
+/// quarter of it, far below the 1e-9 of the quadrature.
+const LOAD_TOLERANCE: f64 = 1e-14;
+/// A residual still accepted when the bracket has shrunk to rounding: the sum over many
+/// strips is only that exact.
+const LOAD_ROUNDING: f64 = 1e-12;
+/// Largest number of boundary points a solve returns.
+pub const MAX_BOUNDARY_POINTS: usize = 10_001;
+/// Largest pressure grid (points per side).
+pub const MAX_PRESSURE_GRID: usize = 501;
+
+/// One particle rolling over the layer: the inputs of MODEL.md §3.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Rolling {
+    /// R (m).
+    pub radius: f64,
+    /// P (N).
+    pub load: f64,
+    /// V (m/s), ≥ 0; the sphere rolls in +x.
+    pub velocity: f64,
+    pub layer: Layer,
+}
+
+impl Default for Rolling {
+    /// MODEL.md §5: R = 25 nm, P = 1 nN, V = 4 nm/s on the default layer.
+    fn default() -> Self {
+        Rolling {
+            radius: 25e-9,
+            load: 1e-9,
+            velocity: 4e-9,
+            layer: Layer::default(),
+        }
+    }
+}
+
+impl Rolling {
+    /// Every parameter outside its physical range.
+    pub fn violations(&self) -> Vec<super::ParameterError> {
+        let mut errors: Vec<_> = [
+            (Parameter::Radius, self.radius),
+            (Parameter::Load, self.load),
+            (Parameter::Velocity, self.velocity),
+        ]
+        .into_iter()
+        .filter_map(|(parameter, value)| parameter.check(value).err())
+        .collect();
+        errors.extend(self.layer.violations());
+        errors
+    }
+}
+
+/// What to compute besides the integral quantities, and how.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct SolveOptions {
+    pub quadrature: Quadrature,
+    /// Points of the contact boundary to return, spread evenly in θ over −r ≤ y ≤ r
+    /// (0: none).
+    pub boundary_points: usize,
+    /// Pressure on an n × n grid over the square [−r, r]², if asked.
+    pub pressure_grid: Option<usize>,
+}
+
+impl Default for SolveOptions {
+    fn default() -> Self {
+        SolveOptions {
+            quadrature: Quadrature::default(),
+            boundary_points: 41,
+            pressure_grid: None,
+        }
+    }
+}
+
+impl SolveOptions {
+    /// Options that ask only for the integral quantities (used by sweeps).
+    pub fn integrals_only(quadrature: Quadrature) -> Self {
+        SolveOptions {
+            quadrature,
+            boundary_points: 0,
+            pressure_grid: None,
+        }
+    }
+
+    /// The first option outside its offered range.
+    pub fn check(&self) -> Result<(), ModelError> {
+        if !self.quadrature.is_valid() {
+            return Err(ModelError::InvalidQuadrature {
+                size: self.quadrature.size(),
+                allowed: self.quadrature.allowed_sizes(),
+            });
+        }
+        if self.boundary_points > MAX_BOUNDARY_POINTS {
+            return Err(ModelError::InvalidOption {
+                option: "boundary points",
+                value: self.boundary_points,
+                allowed: format!("0 ≤ n ≤ {MAX_BOUNDARY_POINTS}"),
+            });
+        }
+        match self.pressure_grid {
+            Some(n) if !(2..=MAX_PRESSURE_GRID).contains(&n) => Err(ModelError::InvalidOption {
+                option: "pressure grid",
+                value: n,
+                allowed: format!("2 ≤ n ≤ {MAX_PRESSURE_GRID}"),
+            }),
+            _ => Ok(()),
+        }
+    }
+}
+
+/// One point of the contact boundary: at lateral position y, material leaves the contact at
+/// x = exit (trailing edge a(y)) and enters it at x = entry (leading edge b(y)).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BoundaryPoint {
+    pub y: f64,
+    pub exit: f64,
+    pub entry: f64,
+}
+
+/// Contact pressure p(x, y) (Pa) on a grid: `values[j][i]` is p(x[i], y[j]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct PressureGrid {
+    pub x: Vec<f64>,
+    pub y: Vec<f64>,
+    pub values: Vec<Vec<f64>>,
+}
+
+/// How far the answer can be trusted.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Verification {
+    /// |P(δ) − P|/P, with P(δ) recomputed from the returned penetration.
+    pub load_residual: f64,
+    /// Relative change of the contact area when the quadrature is halved: a conservative
+    /// estimate of the quadrature error (the returned area is the finer one).
+    pub quadrature_error_estimate: f64,
+    /// Strips (quadrature nodes) in the half-width.
+    pub quadrature_nodes: usize,
+    /// Iterations of the load equation P(δ) = P.
+    pub iterations: u32,
+    /// Newton steps of all exit-edge roots together.
+    pub exit_root_iterations: u32,
+    /// Whether every root converged (a solution is only returned when it did).
+    pub converged: bool,
+}
+
+/// The rolling contact (MODEL.md §3), in SI units.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RollingSolution {
+    /// δ (m).
+    pub penetration: f64,
+    /// A (m²).
+    pub contact_area: f64,
+    /// √(2Rδ) (m): lateral half-width of the contact, at every speed.
+    pub half_width: f64,
+    /// x_c (m), area centroid, positive in the rolling direction.
+    pub centroid_shift: f64,
+    /// x_p (m), centre of pressure.
+    pub pressure_centre_shift: f64,
+    /// μ_r = x_p/R, the hysteresis (rolling-resistance) coefficient; not part of eq. 12.
+    pub rolling_resistance_coefficient: f64,
+    /// μ = τ_a A / P (eq. 12).
+    pub friction_coefficient: f64,
+    /// The same sphere at V = 0 (closed form).
+    pub static_contact: ElasticContact,
+    pub boundary: Vec<BoundaryPoint>,
+    pub pressure: Option<PressureGrid>,
+    pub verification: Verification,
+}
+
+/// Solves the rolling contact of `rolling` (MODEL.md §3).
+///
+/// Fails, never panics nor returns a non-finite number, on parameters outside their ranges,
+/// scales beyond double precision, or a root that does not converge.
+pub fn solve(rolling: &Rolling, options: &SolveOptions) -> Result<RollingSolution, ModelError> {
+    if let Some(error) = rolling.violations().into_iter().next() {
+        return Err(error.into());
+    }
+    options.check()?;
+    let layer = &rolling.layer;
+    let reference = relaxed(rolling.radius, rolling.load, layer);
+    let r0 = reference.half_width;
+    let xi = rolling.velocity * layer.relaxation_time / r0;
+    let kappa = layer.kappa();
+    for (what, value) in [
+        ("the static contact half-width √(2Rδ₀)", r0),
+        ("V T_σ / r₀", xi),
+    ] {
+        if !value.is_finite() || (value == 0.0 && what != "V T_σ / r₀") {
+            return Err(ModelError::NotRepresentable {
+                what: what.to_string(),
+            });
+        }
+    }
+
+    let rule = StripRule::shared(options.quadrature)?;
+    let shape = Shape::solve(xi, kappa, &rule)?;
+    let coarse = StripRule::shared(options.quadrature.halved())?;
+
+    let section = Section::new(shape.half_width, xi, kappa);
+    let half_width = shape.half_width * r0;
+    let contact_area = shape.integrals.area * r0 * r0;
+    let pressure_centre_shift =
+        section.pressure_moment(&rule, &shape.exit_roots) / shape.integrals.load * r0;
+    let solution = RollingSolution {
+        penetration: half_width * half_width / (2.0 * rolling.radius),
+        contact_area,
+        half_width,
+        centroid_shift: shape.integrals.centroid() * r0,
+        pressure_centre_shift,
+        rolling_resistance_coefficient: pressure_centre_shift / rolling.radius,
+        friction_coefficient: layer.interfacial_shear_strength() * contact_area / rolling.load,
+        static_contact: reference,
+        boundary: section.boundary(options.boundary_points, r0)?,
+        pressure: match options.pressure_grid {
+            Some(n) => Some(section.pressure_grid(n, r0, layer.stiffness() / rolling.radius)?),
+            None => None,
+        },
+        verification: Verification {
+            load_residual: shape.load_residual,
+            quadrature_error_estimate: (section.integrate(&coarse, None)?.area
+                / shape.integrals.area
+                - 1.0)
+                .abs(),
+            quadrature_nodes: rule.len(),
+            iterations: shape.iterations,
+            exit_root_iterations: shape.integrals.exit_root_iterations,
+            converged: true,
+        },
+    };
+    ensure_finite(&solution)?;
+    Ok(solution)
+}
+
+/// Refuses to hand out a non-finite number (serde_json would write it as a silent `null`).
+fn ensure_finite(s: &RollingSolution) -> Result<(), ModelError> {
+    let scalars = [
+        s.penetration,
+        s.contact_area,
+        s.half_width,
+        s.centroid_shift,
+        s.pressure_centre_shift,
+        s.rolling_resistance_coefficient,
+        s.friction_coefficient,
+        s.static_contact.penetration,
+        s.static_contact.contact_area,
+        s.static_contact.friction_coefficient,
+        s.verification.load_residual,
+        s.verification.quadrature_error_estimate,
+    ];
+    let boundary = s.boundary.iter().flat_map(|p| [p.y, p.exit, p.entry]);
+    let pressure = s.pressure.iter().flat_map(|g| {
+        g.x.iter()
+            .chain(&g.y)
+            .chain(g.values.iter().flatten())
+            .copied()
+    });
+    if scalars
+        .into_iter()
+        .chain(boundary)
+        .chain(pressure)
+        .all(f64::is_finite)
+    {
+        Ok(())
+    } else {
+        Err(ModelError::NotRepresentable {
+            what: "a result of this job".to_string(),
+        })
+    }
+}
+
+/// The contact in units of r₀ with its load solved: P̂(r̂) = π/4.
+struct Shape {
+    /// r̂ = √(2Rδ)/r₀ = √(δ/δ₀).
+    half_width: f64,
+    integrals: Integrals,
+    /// Exit root ρ of each strip of the rule.
+    exit_roots: Vec<f64>,
+    load_residual: f64,
+    iterations: u32,
+}
+
+impl Shape {
+    /// Solves ln P̂(e^u) = ln(π/4) for u = ln r̂ by the secant method, guarded by the bracket
+    /// δ ∈ [0.9 δ_∞, 1.05 δ₀] of MODEL.md §3. ln P̂ is nearly linear in u (slope 4 at both
+    /// limits), so the secant converges in a handful of steps; the exit roots of every strip
+    /// are warm-started from the previous step.
+    fn solve(xi: f64, kappa: f64, rule: &StripRule) -> Result<Shape, ModelError> {
+        let target = FRAC_PI_4.ln();
+        let mut rho = vec![f64::NAN; rule.len()];
+        let mut exit_root_iterations = 0;
+        let mut evaluate = |u: f64, rho: &mut [f64]| -> Result<(f64, Integrals), ModelError> {
+            let integrals = Section::new(u.exp(), xi, kappa).integrate(rule, Some(rho))?;
+            exit_root_iterations += integrals.exit_root_iterations;
+            Ok((integrals.load.ln() - target, integrals))
+        };
+        let (mut lo, mut hi) = (
+            0.5 * 0.9_f64.ln() - 0.25 * (1.0 + kappa).ln(),
+            0.5 * 1.05_f64.ln(),
+        );
+        let (mut u_prev, mut f_prev) = (f64::NAN, f64::NAN);
+        let mut u = 0.0_f64; // the static answer, exact at V = 0
+        let mut iterations = 0;
+        loop {
+            iterations += 1;
+            let (f, mut integrals) = evaluate(u, &mut rho)?;
+            if f > 0.0 {
+                hi = hi.min(u);
+            } else {
+                lo = lo.max(u);
+            }
+            let collapsed = hi - lo <= 4.0 * f64::EPSILON * u.abs().max(1.0);
+            if f.abs() <= LOAD_TOLERANCE || collapsed && f.abs() <= LOAD_ROUNDING {
+                integrals.exit_root_iterations = exit_root_iterations;
+                return Ok(Shape {
+                    half_width: u.exp(),
+                    integrals,
+                    exit_roots: rho,
+                    load_residual: f.exp_m1().abs(),
+                    iterations,
+                });
+            }
+            // Secant; the first step assumes the slope 4 of the elastic limits.
+            let slope = if iterations == 1 || f == f_prev {
+                4.0
+            } else {
+                (f - f_prev) / (u - u_prev)
+            };
+            let mut next = u - f / slope;
+            if !(next > lo && next < hi) {
+                next = 0.5 * (lo + hi);
+            }
+            if collapsed || iterations >= MAX_LOAD_ITERATIONS {
+                // Out of iterations, or the bracket collapsed onto a point that does not
+                // carry the load.
+                return Err(ModelError::NoConvergence {
+                    what: "penetration (load equation P(δ) = P)",
+                    iterations,
+                });
+            }
+            (u_prev, f_prev, u) = (u, f, next);
+        }
+    }
+}
+
+/// The contact region of half-width r (in units of r₀), strip by strip.
+#[derive(Clone, Copy, Debug)]
+struct Section {
+    half_width: f64,
+    relaxation_length: f64,
+    kappa: f64,
+}
+
+/// Integrals over the contact, in units of r₀ and k/R.
+#[derive(Clone, Copy, Debug, Default)]
+struct Integrals {
+    /// P̂ = P R/(k r₀⁴).
+    load: f64,
+    /// Â = A/r₀².
+    area: f64,
+    /// ∬ x dA / r₀³.
+    area_moment: f64,
+    exit_root_iterations: u32,
+}
+
+impl Integrals {
+    /// x_c/r₀ = ∬ x dA / A.
+    fn centroid(&self) -> f64 {
+        self.area_moment / self.area
+    }
+}
+
+impl Section {
+    fn new(half_width: f64, relaxation_length: f64, kappa: f64) -> Self {
+        Section {
+            half_width,
+            relaxation_length,
+            kappa,
+        }
+    }
+
+    /// The strip at lateral position y = r sin θ, whose entry edge is b = r cos θ.
+    fn strip(&self, cos_theta: f64) -> Strip {
+        Strip {
+            entry: self.half_width * cos_theta,
+            relaxation_length: self.relaxation_length,
+            kappa: self.kappa,
+        }
+    }
+
+    /// P = 2∫q dy, A = 2∫(b − a) dy and ∬x dA = ∫(b² − a²) dy over the strips of `rule`. `warm`, if given, holds each strip's exit root from a previous call and
+    /// receives the new ones.
+    fn integrate(
+        &self,
+        rule: &StripRule,
+        mut warm: Option<&mut [f64]>,
+    ) -> Result<Integrals, ModelError> {
+        let mut sum = Integrals::default();
+        for i in 0..rule.len() {
+            let strip = self.strip(rule.cos[i]);
+            let guess = warm.as_deref().map(|rho| rho[i]).filter(|r| r.is_finite());
+            let root = strip.exit_root(guess)?;
+            if let Some(rho) = warm.as_deref_mut() {
+                rho[i] = root.rho;
+            }
+            let (w, b, rho) = (rule.weight[i], strip.entry, root.rho);
+            let load = strip.load(rho);
+            sum.load += w * load;
+            sum.area += w * b * (2.0 - rho);
+            sum.area_moment += w * b * b * rho * (2.0 - rho);
+            sum.exit_root_iterations += root.iterations;
+        }
+        let r = self.half_width;
+        sum.load *= 2.0 * r;
+        sum.area *= 2.0 * r;
+        sum.area_moment *= r;
+        Ok(sum)
+    }
+
+    /// ∬ x p dA = 2∫m dy in units of k r₀⁵/R, given each strip's exit root `rho` under `rule`.
+    fn pressure_moment(&self, rule: &StripRule, rho: &[f64]) -> f64 {
+        let sum: f64 = (0..rule.len())
+            .map(|i| {
+                let strip = self.strip(rule.cos[i]);
+                rule.weight[i] * strip.moment(rho[i], strip.load(rho[i]))
+            })
+            .sum();
+        2.0 * self.half_width * sum
+    }
+
+    /// `n` boundary points spread evenly in θ ∈ [−π/2, π/2], y = r sin θ, in metres.
+    fn boundary(&self, n: usize, scale: f64) -> Result<Vec<BoundaryPoint>, ModelError> {
+        (0..n)
+            .map(|j| {
+                let theta = if n == 1 {
+                    0.0
+                } else {
+                    -FRAC_PI_2 + PI * j as f64 / (n - 1) as f64
+                };
+                let (y, exit, entry) = if j == 0 || j + 1 == n && n > 1 {
+                    (theta.sin() * self.half_width, 0.0, 0.0)
+                } else {
+                    let strip = self.strip(theta.cos());
+                    let rho = strip.exit_root(None)?.rho;
+                    (
+                        theta.sin() * self.half_width,
+                        (rho - 1.0) * strip.entry,
+                        strip.entry,
+                    )
+                };
+                Ok(BoundaryPoint {
+                    y: y * scale,
+                    exit: exit * scale,
+                    entry: entry * scale,
+                })
+            })
+            .collect()
+    }
+
+    /// p(x, y) on an n × n grid over [−r, r]², in Pa. `scale` is r₀ (m) and `k_over_r` is k/R.
+    fn pressure_grid(
+        &self,
+        n: usize,
+        scale: f64,
+        k_over_r: f64,
+    ) -> Result<PressureGrid, ModelError> {
+        let r = self.half_width;
+        let axis: Vec<f64> = (0..n)
+            .map(|i| -r + 2.0 * r * i as f64 / (n - 1) as f64)
+            .collect();
+        // p = (k/2R) r₀² p̂ where p̂ is the strip pressure in units of r₀.
+        let unit = 0.5 * k_over_r * scale * scale;
+        let values = axis
+            .iter()
+            .map(|&y| {
+                let chord = r * r - y * y;
+                if chord <= 0.0 {
+                    return Ok(vec![0.0; n]);
+                }
+                let strip = Strip {
+                    entry: chord.sqrt(),
+                    relaxation_length: self.relaxation_length,
+                    kappa: self.kappa,
+                };
+                let rho = strip.exit_root(None)?.rho;
+                Ok(axis
+                    .iter()
+                    .map(|&x| unit * strip.pressure(x, rho))
+                    .collect())
+            })
+            .collect::<Result<Vec<_>, ModelError>>()?;
+        let metres: Vec<f64> = axis.iter().map(|v| v * scale).collect();
+        Ok(PressureGrid {
+            x: metres.clone(),
+            y: metres,
+            values,
+        })
+    }
+}

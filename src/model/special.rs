@@ -1,0 +1,145 @@
+//! Cancellation-free exponential kernels of the strip solution (MODEL.md §3).
+//!
+//! The exit-edge equation and the pressure of a strip contain differences such as
+//! `(sβ + 1) − (β + 1)e^{β(s−1)}` that cancel catastrophically for fast strips (β → 0),
+//! which always occur near the lateral tips |y| → √(2Rδ). Writing them through the
+//! "relative exponentials" below keeps every digit for every β.
+
+/// Below this |z| the kernels are summed as power series instead of through `expm1`.
+/// At the limit the direct formulas lose at most a factor 30 (E₃) to cancellation, so the
+/// series are kept longer for E₃ (`EXPREL3_LIMIT`), which only fast strips evaluate.
+const SERIES_LIMIT: f64 = 0.5;
+const EXPREL3_LIMIT: f64 = 2.0;
+/// Terms of the series; the remainder is below 2²⁶/28! ≈ 2e-22 of the leading term.
+const SERIES_TERMS: usize = 26;
+
+/// 1/(n + m)! for n < SERIES_TERMS, m = 2, 3: the series coefficients, built at compile time.
+const fn inverse_factorials<const M: usize>() -> [f64; SERIES_TERMS] {
+    let mut c = [0.0; SERIES_TERMS];
+    let mut factorial = 1.0;
+    let mut k = 1;
+    while k <= M {
+        factorial *= k as f64;
+        k += 1;
+    }
+    let mut n = 0;
+    while n < SERIES_TERMS {
+        c[n] = 1.0 / factorial;
+        factorial *= (n + M + 1) as f64;
+        n += 1;
+    }
+    c
+}
+
+/// Σ zⁿ/(n+2)!.
+const EXPREL2: [f64; SERIES_TERMS] = inverse_factorials::<2>();
+/// Σ zⁿ/(n+3)!.
+const EXPREL3: [f64; SERIES_TERMS] = inverse_factorials::<3>();
+/// Σ (n+1) zⁿ/(n+2)!.
+const EXPREL_PRIME: [f64; SERIES_TERMS] = {
+    let mut c = EXPREL2;
+    let mut n = 0;
+    while n < SERIES_TERMS {
+        c[n] *= (n + 1) as f64;
+        n += 1;
+    }
+    c
+};
+
+/// Horner sum of Σ cₙ zⁿ over the first `terms` coefficients.
+fn series(z: f64, coefficients: &[f64; SERIES_TERMS], terms: usize) -> f64 {
+    coefficients[..terms]
+        .iter()
+        .rev()
+        .fold(0.0, |acc, c| acc * z + c)
+}
+
+/// Terms enough for |z| < [`SERIES_LIMIT`]: 0.5¹⁶/18! ≈ 2e-21.
+const SHORT_SERIES: usize = 16;
+
+/// `(e^z − 1 − z)/z²` = Σ zⁿ/(n+2)!, continuous at `z = 0` where it equals ½.
+pub fn exprel2(z: f64) -> f64 {
+    if z.abs() < SERIES_LIMIT {
+        series(z, &EXPREL2, SHORT_SERIES)
+    } else {
+        (z.exp_m1() - z) / (z * z)
+    }
+}
+
+/// `(e^z − 1 − z − z²/2)/z³` = Σ zⁿ/(n+3)!, continuous at `z = 0` where it equals 1/6.
+pub fn exprel3(z: f64) -> f64 {
+    if z.abs() < EXPREL3_LIMIT {
+        series(z, &EXPREL3, SERIES_TERMS)
+    } else {
+        (z.exp_m1() - z - 0.5 * z * z) / (z * z * z)
+    }
+}
+
+/// The three kernels a Newton step on the exit edge needs, sharing one exponential:
+/// (`exprel` = (e^z − 1)/z, [`exprel2`], d/dz exprel = `(e^z (z − 1) + 1)/z²` = Σ (n+1) zⁿ/(n+2)!,
+/// which is positive for every z).
+pub fn exprel_kernels(z: f64) -> (f64, f64, f64) {
+    if z.abs() < SERIES_LIMIT {
+        let e2 = series(z, &EXPREL2, SHORT_SERIES);
+        let prime = series(z, &EXPREL_PRIME, SHORT_SERIES);
+        (1.0 + z * e2, e2, prime)
+    } else {
+        let em1 = z.exp_m1();
+        let z2 = z * z;
+        (
+            em1 / z,
+            (em1 - z) / z2,
+            ((em1 + 1.0) * (z - 1.0) + 1.0) / z2,
+        )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Reference values from the definitions evaluated where they do not cancel.
+    #[test]
+    fn kernels_match_their_definitions_on_both_sides_of_the_series_limit() {
+        for z in [
+            -30.0_f64, -5.0, -2.0000001, -1.9999999, -0.7, -0.5000001, -0.4999999, 0.3,
+        ] {
+            let direct1 = z.exp_m1() / z;
+            let direct2 = (z.exp_m1() - z) / (z * z);
+            let direct3 = (z.exp_m1() - z - 0.5 * z * z) / (z * z * z);
+            let direct_prime = (z.exp() * (z - 1.0) + 1.0) / (z * z);
+            let (e1, e2, prime) = exprel_kernels(z);
+            assert!((e1 / direct1 - 1.0).abs() < 1e-14, "exprel({z})");
+            assert!((e2 / direct2 - 1.0).abs() < 1e-13, "exprel2({z})");
+            assert!((exprel2(z) / direct2 - 1.0).abs() < 1e-13, "exprel2({z})");
+            assert!((exprel3(z) / direct3 - 1.0).abs() < 1e-12, "exprel3({z})");
+            assert!((prime / direct_prime - 1.0).abs() < 1e-13, "exprel'({z})");
+        }
+    }
+
+    #[test]
+    fn kernels_take_their_limits_at_zero() {
+        assert_eq!(exprel_kernels(0.0), (1.0, 0.5, 0.5));
+        assert_eq!(exprel2(0.0), 0.5);
+        assert!((exprel3(0.0) - 1.0 / 6.0).abs() < 1e-17);
+        // First-order terms: exprel2 ≈ ½ + z/6, exprel' ≈ ½ + z/3, exprel3 ≈ 1/6 + z/24.
+        let z = 1e-6;
+        let (_, e2, prime) = exprel_kernels(z);
+        assert!((e2 - (0.5 + z / 6.0)).abs() < 1e-13);
+        assert!((prime - (0.5 + z / 3.0)).abs() < 1e-12);
+        assert!((exprel3(z) - (1.0 / 6.0 + z / 24.0)).abs() < 1e-13);
+    }
+
+    #[test]
+    fn the_derivative_kernel_is_the_derivative_of_exprel() {
+        for z in [-40.0_f64, -3.0, -0.5, -1e-3] {
+            let h = 1e-5 * z.abs().max(1.0);
+            let numeric = (z + h).exp_m1() / (z + h) - (z - h).exp_m1() / (z - h);
+            let numeric = numeric / (2.0 * h);
+            assert!(
+                (numeric / exprel_kernels(z).2 - 1.0).abs() < 1e-7,
+                "z = {z}"
+            );
+        }
+    }
+}
