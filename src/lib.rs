@@ -1,1 +1,10 @@
+//! thirdbody: real contact area and friction of hard particles rolling between two surfaces,
+//! one coated with a viscoelastic (Kelvin) layer.
+//!
+//! Data flows one way: a job arrives as JSON ([`job`]), is validated into model inputs,
+//! dispatched by the [`engine`], solved by the [`model`] (pure numerics), and its result goes
+//! back out through the [`job`] wire types.
+
+pub mod engine;
+pub mod job;
 pub mod model;

@@ -4,20 +4,42 @@ use std::fmt;
 
 use super::ParameterError;
 
+/// A solver option whose size is bounded.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum SolveOption {
+    /// Strips (Gauss nodes or midpoint strips) in the half-width.
+    Strips,
+    BoundaryPoints,
+    PressureGrid,
+}
+
+impl fmt::Display for SolveOption {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            SolveOption::Strips => "strips",
+            SolveOption::BoundaryPoints => "boundary points",
+            SolveOption::PressureGrid => "pressure grid",
+        })
+    }
+}
+
+/// A solver option outside what is offered.
+#[derive(Clone, Debug, PartialEq)]
+pub struct OptionError {
+    pub option: SolveOption,
+    pub value: usize,
+    /// The allowed range, as text.
+    pub allowed: String,
+}
+
 /// A failure of the model: bad parameters, an unrepresentable scale, or a root finder that
 /// did not converge within its bound.
 #[derive(Clone, Debug, PartialEq)]
 pub enum ModelError {
     /// A parameter outside its physical range.
     InvalidParameter(ParameterError),
-    /// A quadrature size outside what is offered.
-    InvalidQuadrature { size: usize, allowed: String },
-    /// A solver option (boundary points, pressure grid) outside what is offered.
-    InvalidOption {
-        option: &'static str,
-        value: usize,
-        allowed: String,
-    },
+    /// A solver option (strips, boundary points, pressure grid) outside what is offered.
+    InvalidOption(OptionError),
     /// Valid parameters whose combination over- or underflows double precision.
     NotRepresentable { what: String },
     /// A bracketed root finder ran out of iterations.
@@ -28,17 +50,11 @@ impl fmt::Display for ModelError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             ModelError::InvalidParameter(e) => e.fmt(f),
-            ModelError::InvalidQuadrature { size, allowed } => {
-                write!(
-                    f,
-                    "quadrature size {size} is out of range: allowed {allowed}"
-                )
-            }
-            ModelError::InvalidOption {
-                option,
-                value,
-                allowed,
-            } => write!(f, "{option} = {value} is out of range: allowed {allowed}"),
+            ModelError::InvalidOption(e) => write!(
+                f,
+                "{} = {} is out of range: allowed {}",
+                e.option, e.value, e.allowed
+            ),
             ModelError::NotRepresentable { what } => {
                 write!(f, "{what} is not representable in double precision")
             }

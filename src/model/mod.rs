@@ -11,7 +11,7 @@ pub mod rolling;
 mod special;
 pub mod strip;
 
-pub use error::ModelError;
+pub use error::{ModelError, OptionError, SolveOption};
 pub use layer::{Layer, Parameter, ParameterError};
 pub use quadrature::Quadrature;
 pub use rolling::{solve, Rolling, RollingSolution, SolveOptions};

@@ -11,7 +11,7 @@ use std::sync::{Arc, Mutex, OnceLock};
 
 use nalgebra::DMatrix;
 
-use super::ModelError;
+use super::{ModelError, OptionError, SolveOption};
 
 /// Gauss nodes used when a job does not ask for a number. Against a 1024-node rule, 64 nodes
 /// err by at most 5e-11 (relative, in δ, A, x_c and x_p) over 1e-6 ≤ V T_σ/r₀ ≤ 20 and
@@ -58,11 +58,20 @@ impl Quadrature {
         }
     }
 
-    /// Whether the rule's size is in the offered range.
-    pub fn is_valid(self) -> bool {
-        match self {
+    /// The rule's size, if it is outside the offered range.
+    pub fn check(self) -> Result<(), OptionError> {
+        let valid = match self {
             Quadrature::Gauss { nodes } => (2..=MAX_GAUSS_NODES).contains(&nodes),
             Quadrature::Midpoint { strips } => (1..=MAX_MIDPOINT_STRIPS).contains(&strips),
+        };
+        if valid {
+            Ok(())
+        } else {
+            Err(OptionError {
+                option: SolveOption::Strips,
+                value: self.size(),
+                allowed: self.allowed_sizes(),
+            })
         }
     }
 
@@ -95,12 +104,7 @@ pub struct StripRule {
 impl StripRule {
     /// The rule for `quadrature`, computed once per process and shared (it is pure data).
     pub fn shared(quadrature: Quadrature) -> Result<Arc<StripRule>, ModelError> {
-        if !quadrature.is_valid() {
-            return Err(ModelError::InvalidQuadrature {
-                size: quadrature.size(),
-                allowed: quadrature.allowed_sizes(),
-            });
-        }
+        quadrature.check().map_err(ModelError::InvalidOption)?;
         /// A handful of rules are in use at any time; older ones are dropped beyond this.
         const CACHED_RULES: usize = 16;
         type Cache = Mutex<Vec<(Quadrature, Arc<StripRule>)>>;

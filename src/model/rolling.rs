@@ -10,7 +10,7 @@ use std::f64::consts::{FRAC_PI_2, FRAC_PI_4, PI};
 use super::limits::{relaxed, ElasticContact};
 use super::quadrature::StripRule;
 use super::strip::Strip;
-use super::{Layer, ModelError, Parameter, Quadrature};
+use super::{Layer, ModelError, OptionError, Parameter, Quadrature, SolveOption};
 
 /// Iterations allowed for the penetration root P(δ) = P.
 const MAX_LOAD_ITERATIONS: u32 = 60;
@@ -96,29 +96,27 @@ impl SolveOptions {
         }
     }
 
-    /// The first option outside its offered range.
-    pub fn check(&self) -> Result<(), ModelError> {
-        if !self.quadrature.is_valid() {
-            return Err(ModelError::InvalidQuadrature {
-                size: self.quadrature.size(),
-                allowed: self.quadrature.allowed_sizes(),
-            });
-        }
+    /// Every option outside its offered range.
+    pub fn violations(&self) -> Vec<OptionError> {
+        let mut errors: Vec<OptionError> = self.quadrature.check().err().into_iter().collect();
         if self.boundary_points > MAX_BOUNDARY_POINTS {
-            return Err(ModelError::InvalidOption {
-                option: "boundary points",
+            errors.push(OptionError {
+                option: SolveOption::BoundaryPoints,
                 value: self.boundary_points,
                 allowed: format!("0 ≤ n ≤ {MAX_BOUNDARY_POINTS}"),
             });
         }
-        match self.pressure_grid {
-            Some(n) if !(2..=MAX_PRESSURE_GRID).contains(&n) => Err(ModelError::InvalidOption {
-                option: "pressure grid",
+        if let Some(n) = self
+            .pressure_grid
+            .filter(|n| !(2..=MAX_PRESSURE_GRID).contains(n))
+        {
+            errors.push(OptionError {
+                option: SolveOption::PressureGrid,
                 value: n,
                 allowed: format!("2 ≤ n ≤ {MAX_PRESSURE_GRID}"),
-            }),
-            _ => Ok(()),
+            });
         }
+        errors
     }
 }
 
@@ -189,7 +187,9 @@ pub fn solve(rolling: &Rolling, options: &SolveOptions) -> Result<RollingSolutio
     if let Some(error) = rolling.violations().into_iter().next() {
         return Err(error.into());
     }
-    options.check()?;
+    if let Some(error) = options.violations().into_iter().next() {
+        return Err(ModelError::InvalidOption(error));
+    }
     let layer = &rolling.layer;
     let reference = relaxed(rolling.radius, rolling.load, layer);
     let r0 = reference.half_width;

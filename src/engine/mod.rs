@@ -1,0 +1,151 @@
+//! Runs validated jobs: one rolling solve, or the many of a sweep or figure spread over the
+//! cores, with progress, cancellation and a deadline checked between solves.
+//!
+//! This is the only place that knows how a job maps onto model calls; the CLI calls it
+//! directly and the HTTP service calls it from its blocking pool.
+
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::Mutex;
+use std::thread;
+use std::time::Instant;
+
+use serde::Serialize;
+
+use crate::job::figure::FigureOutput;
+use crate::job::rolling::RollingOutput;
+use crate::job::sweep::SweepOutput;
+use crate::job::{Job, JobError};
+use crate::model::{self, Rolling, RollingSolution, SolveOptions};
+
+/// Shared between a running job and whoever watches it: progress, cancellation, deadline.
+#[derive(Debug)]
+pub struct Control {
+    cancelled: AtomicBool,
+    deadline: Option<Instant>,
+    done: AtomicUsize,
+    threads: usize,
+}
+
+impl Default for Control {
+    /// No deadline, one thread per available core.
+    fn default() -> Self {
+        Control::new(None, thread::available_parallelism().map_or(1, |n| n.get()))
+    }
+}
+
+impl Control {
+    /// A control with an optional `deadline` that lets a job use up to `threads` threads.
+    pub fn new(deadline: Option<Instant>, threads: usize) -> Self {
+        Control {
+            cancelled: AtomicBool::new(false),
+            deadline,
+            done: AtomicUsize::new(0),
+            threads: threads.max(1),
+        }
+    }
+
+    /// Asks the job to stop at its next check (between two solves).
+    pub fn cancel(&self) {
+        self.cancelled.store(true, Ordering::Relaxed);
+    }
+
+    /// Rolling solves finished so far.
+    pub fn done(&self) -> usize {
+        self.done.load(Ordering::Relaxed)
+    }
+
+    fn check(&self) -> Result<(), JobError> {
+        if self.cancelled.load(Ordering::Relaxed) {
+            Err(JobError::Cancelled)
+        } else if self.deadline.is_some_and(|d| Instant::now() >= d) {
+            Err(JobError::DeadlineExceeded)
+        } else {
+            Ok(())
+        }
+    }
+}
+
+/// The answer to any job.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+#[serde(untagged)]
+pub enum Output {
+    Rolling(RollingOutput),
+    Sweep(SweepOutput),
+    Figure(FigureOutput),
+}
+
+/// Runs `job` to completion, or until `control` stops it.
+pub fn run(job: &Job, control: &Control) -> Result<Output, JobError> {
+    Ok(match job {
+        Job::Rolling(j) => {
+            let solution = solve_all(&[j.rolling], &j.options, control)?;
+            Output::Rolling(RollingOutput::new(j, &solution[0]))
+        }
+        Job::Sweep(j) => {
+            let solutions = solve_all(&j.points(), &j.base.options, control)?;
+            Output::Sweep(SweepOutput::new(j, &solutions))
+        }
+        Job::Figure(j) => {
+            let solutions = solve_all(&j.plan.contacts, &j.plan.options, control)?;
+            Output::Figure(FigureOutput::new(j, j.plan.assemble(&solutions)))
+        }
+    })
+}
+
+/// Solves every contact of `points`, in parallel over `control`'s threads, in order.
+/// Stops at the first failure, cancellation or deadline.
+pub fn solve_all(
+    points: &[Rolling],
+    options: &SolveOptions,
+    control: &Control,
+) -> Result<Vec<RollingSolution>, JobError> {
+    let next = AtomicUsize::new(0);
+    let failure: Mutex<Option<JobError>> = Mutex::new(None);
+    let failed = AtomicBool::new(false);
+    let worker = || {
+        let mut solved = Vec::new();
+        while !failed.load(Ordering::Relaxed) {
+            let i = next.fetch_add(1, Ordering::Relaxed);
+            let Some(point) = points.get(i) else { break };
+            match control
+                .check()
+                .and_then(|()| model::solve(point, options).map_err(JobError::from))
+            {
+                Ok(solution) => {
+                    control.done.fetch_add(1, Ordering::Relaxed);
+                    solved.push((i, solution));
+                }
+                Err(e) => {
+                    failed.store(true, Ordering::Relaxed);
+                    failure
+                        .lock()
+                        .unwrap_or_else(|p| p.into_inner())
+                        .get_or_insert(e);
+                }
+            }
+        }
+        solved
+    };
+    let threads = control.threads.min(points.len()).max(1);
+    let mut solved: Vec<(usize, RollingSolution)> = if threads == 1 {
+        worker()
+    } else {
+        thread::scope(|s| {
+            let handles: Vec<_> = (0..threads).map(|_| s.spawn(worker)).collect();
+            handles
+                .into_iter()
+                .flat_map(|h| h.join().unwrap_or_default())
+                .collect()
+        })
+    };
+    if let Some(e) = failure.into_inner().unwrap_or_else(|p| p.into_inner()) {
+        return Err(e);
+    }
+    if solved.len() != points.len() {
+        return Err(JobError::Internal(
+            "a solver thread stopped unexpectedly".to_string(),
+        ));
+    }
+    solved.sort_by_key(|(i, _)| *i);
+    Ok(solved.into_iter().map(|(_, s)| s).collect())
+}

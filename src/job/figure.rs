@@ -1,0 +1,137 @@
+//! The figure job: the data of one of the paper's Figures 3–9 (MODEL.md §5).
+
+use serde::{Deserialize, Serialize};
+use serde_json::{json, Value};
+
+use super::fields::{self, Checker};
+use super::{format_number, JobError, JobKind, Meta};
+use crate::model::figures::{Figure, Plan, FIGURES};
+
+/// Input of a figure job.
+#[derive(Clone, Debug, PartialEq, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct FigureInput {
+    /// The figure's number in the paper, 3 to 9.
+    pub number: i64,
+}
+
+/// A validated figure job.
+#[derive(Clone, Debug)]
+pub struct FigureJob {
+    pub plan: Plan,
+}
+
+impl PartialEq for FigureJob {
+    fn eq(&self, other: &Self) -> bool {
+        self.plan.number == other.plan.number
+    }
+}
+
+impl FigureJob {
+    /// The job for figure `number`, or the error naming the allowed numbers.
+    pub fn new(number: i64) -> Result<FigureJob, JobError> {
+        let Some(plan) = u8::try_from(number).ok().and_then(Plan::new) else {
+            let mut checker = Checker::new("");
+            checker.invalid(
+                "number",
+                json!(number),
+                &format!("{} to {}", FIGURES.start(), FIGURES.end()),
+            );
+            return Err(checker.into_error());
+        };
+        Ok(FigureJob { plan })
+    }
+
+    /// Validates a figure input given as JSON.
+    pub fn from_value(value: Value) -> Result<FigureJob, JobError> {
+        let input: FigureInput = fields::deserialize(value, "")?;
+        FigureJob::new(input.number)
+    }
+
+    /// Rolling solves the figure takes.
+    pub fn size(&self) -> usize {
+        self.plan.contacts.len()
+    }
+
+    pub fn canonical(&self) -> Value {
+        json!({ "number": self.plan.number })
+    }
+}
+
+/// An axis of a figure.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct AxisOutput {
+    pub quantity: &'static str,
+    /// SI unit ("" for a plain number).
+    pub unit: &'static str,
+}
+
+/// One curve.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct SeriesOutput {
+    pub label: String,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub radius: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub load: Option<f64>,
+    pub velocity: f64,
+    /// [x, y] pairs in the units of the axes.
+    pub points: Vec<[f64; 2]>,
+}
+
+/// The answer to a figure job.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct FigureOutput {
+    pub figure: u8,
+    pub title: &'static str,
+    pub x: AxisOutput,
+    pub y: AxisOutput,
+    pub series: Vec<SeriesOutput>,
+    pub meta: Meta,
+}
+
+impl FigureOutput {
+    pub fn new(job: &FigureJob, figure: Figure) -> Self {
+        let axis = |a: crate::model::figures::Axis| AxisOutput {
+            quantity: a.quantity,
+            unit: a.unit,
+        };
+        FigureOutput {
+            figure: figure.number,
+            title: figure.title,
+            x: axis(figure.x),
+            y: axis(figure.y),
+            series: figure
+                .series
+                .into_iter()
+                .map(|s| SeriesOutput {
+                    label: s.label,
+                    radius: s.radius,
+                    load: s.load,
+                    velocity: s.velocity,
+                    points: s.points,
+                })
+                .collect(),
+            meta: Meta::new(JobKind::Figure, job.canonical()),
+        }
+    }
+
+    /// CSV: one line per point, `series,label,<x quantity>,<y quantity>`.
+    pub fn to_csv(&self) -> String {
+        let column = |a: &AxisOutput| {
+            if a.unit.is_empty() {
+                a.quantity.to_string()
+            } else {
+                format!("{} ({})", a.quantity, a.unit)
+            }
+        };
+        let mut csv = format!("series,label,{},{}\n", column(&self.x), column(&self.y));
+        for (i, s) in self.series.iter().enumerate() {
+            for [x, y] in &s.points {
+                let (x, y) = (format_number(*x), format_number(*y));
+                csv.push_str(&format!("{i},\"{}\",{x},{y}\n", s.label));
+            }
+        }
+        csv
+    }
+}

@@ -1,0 +1,79 @@
+//! What every answer says about itself: the model version, the canonical input and its hash,
+//! and the papers behind the numbers.
+
+use serde::Serialize;
+use serde_json::Value;
+use sha2::{Digest, Sha256};
+
+use super::JobKind;
+use crate::model::MODEL_VERSION;
+
+/// A source of the model.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct Reference {
+    /// What the service takes from it.
+    pub role: &'static str,
+    pub citation: &'static str,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub doi: Option<&'static str>,
+}
+
+/// The papers behind the numbers.
+pub const REFERENCES: [Reference; 3] = [
+    Reference {
+        role: "model: three-body contact with particles rolling over a Kelvin layer (eqs. 1–13)",
+        citation: "Contact problem of a system of particles rolling over a viscoelastic layer \
+                   bonded to the rigid half-space. Advances in Mechanical Engineering, 2019",
+        doi: Some("10.1177/1687814019872303"),
+    },
+    Reference {
+        role: "strip method for rolling contact (eq. 10)",
+        citation: "D. J. Haines and E. Ollerton, Contact stress distributions on elliptical \
+                   contact surfaces subjected to radial and tangential forces. Proceedings of \
+                   the Institution of Mechanical Engineers 177 (1963)",
+        doi: None,
+    },
+    Reference {
+        role: "interfacial shear strength τ_a = G/1000 (eq. 12)",
+        citation: "G. G. Adams, S. Müftü and N. Mohd Azhar, A scale-dependent model for \
+                   multi-asperity contact and friction. Journal of Tribology 125 (2003)",
+        doi: None,
+    },
+];
+
+/// The `meta` block of an answer.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Meta {
+    pub model_version: &'static str,
+    /// SHA-256 of the model version, the job kind and the canonical input.
+    pub input_hash: String,
+    /// The input as understood: defaults filled in, SI numbers.
+    pub input: Value,
+    pub references: &'static [Reference],
+}
+
+impl Meta {
+    pub fn new(kind: JobKind, canonical: Value) -> Self {
+        Meta {
+            model_version: MODEL_VERSION,
+            input_hash: input_hash(kind, &canonical),
+            input: canonical,
+            references: &REFERENCES,
+        }
+    }
+}
+
+/// Hex SHA-256 of `model version \n kind \n canonical JSON` (keys sorted, shortest floats).
+pub fn input_hash(kind: JobKind, canonical: &Value) -> String {
+    let mut hasher = Sha256::new();
+    hasher.update(MODEL_VERSION.as_bytes());
+    hasher.update(b"\n");
+    hasher.update(kind.as_str().as_bytes());
+    hasher.update(b"\n");
+    hasher.update(canonical.to_string().as_bytes());
+    hasher
+        .finalize()
+        .iter()
+        .map(|b| format!("{b:02x}"))
+        .collect()
+}

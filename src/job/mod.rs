@@ -1,0 +1,137 @@
+//! Jobs on the wire: the JSON types clients send and receive, their validation into model
+//! inputs, their canonical form and the cache key derived from it.
+//!
+//! The same types serve `thirdbody solve` and the HTTP API. Every input field is optional
+//! and defaults to MODEL.md §5; quantities are SI numbers or strings with units
+//! ([`units`]). Validation reports every bad field at once, each with its value and the
+//! allowed range.
+
+mod error;
+mod fields;
+pub mod figure;
+mod meta;
+pub mod rolling;
+pub mod sweep;
+pub mod units;
+
+use serde::Deserialize;
+use serde_json::Value;
+
+pub use error::{FieldError, JobError};
+pub use figure::FigureJob;
+pub use meta::{Meta, Reference, REFERENCES};
+pub use rolling::RollingJob;
+pub use sweep::SweepJob;
+
+/// A number as text for people and CSV: plain between 1e-3 and 1e6, scientific elsewhere,
+/// always the shortest text that reads back as the same double.
+pub fn format_number(x: f64) -> String {
+    if x == 0.0 || (1e-3..1e6).contains(&x.abs()) || !x.is_finite() {
+        format!("{x}")
+    } else {
+        format!("{x:e}")
+    }
+}
+
+/// Limits on the size of a job, beyond the model's own ranges.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Limits {
+    /// Largest number of points in a sweep (the product of its lists).
+    pub max_sweep_points: usize,
+}
+
+impl Default for Limits {
+    fn default() -> Self {
+        Limits {
+            max_sweep_points: 10_000,
+        }
+    }
+}
+
+/// What a job computes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum JobKind {
+    Rolling,
+    Sweep,
+    Figure,
+}
+
+impl JobKind {
+    pub fn as_str(self) -> &'static str {
+        match self {
+            JobKind::Rolling => "rolling",
+            JobKind::Sweep => "sweep",
+            JobKind::Figure => "figure",
+        }
+    }
+}
+
+/// The envelope `{"kind": ..., "input": {...}}`; a missing input means all defaults.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Envelope {
+    kind: JobKind,
+    #[serde(default)]
+    input: Option<Value>,
+}
+
+/// A validated job, ready for the engine.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Job {
+    Rolling(RollingJob),
+    Sweep(SweepJob),
+    Figure(FigureJob),
+}
+
+impl Job {
+    /// Parses and validates an enveloped job from JSON text.
+    pub fn from_json(text: &[u8], limits: &Limits) -> Result<Job, JobError> {
+        let value: Value = serde_json::from_slice(text).map_err(JobError::from_json)?;
+        Job::from_value(value, limits)
+    }
+
+    /// Validates an enveloped job already parsed as JSON.
+    pub fn from_value(value: Value, limits: &Limits) -> Result<Job, JobError> {
+        let envelope: Envelope = fields::deserialize(value, "")?;
+        let input = envelope
+            .input
+            .unwrap_or_else(|| Value::Object(Default::default()));
+        Ok(match envelope.kind {
+            JobKind::Rolling => Job::Rolling(RollingJob::from_value(input)?),
+            JobKind::Sweep => Job::Sweep(SweepJob::from_value(input, limits)?),
+            JobKind::Figure => Job::Figure(FigureJob::from_value(input)?),
+        })
+    }
+
+    pub fn kind(&self) -> JobKind {
+        match self {
+            Job::Rolling(_) => JobKind::Rolling,
+            Job::Sweep(_) => JobKind::Sweep,
+            Job::Figure(_) => JobKind::Figure,
+        }
+    }
+
+    /// The canonical input: every default filled in, every quantity an SI number.
+    pub fn canonical(&self) -> Value {
+        match self {
+            Job::Rolling(job) => job.canonical(),
+            Job::Sweep(job) => job.canonical(),
+            Job::Figure(job) => job.canonical(),
+        }
+    }
+
+    /// Hash of the canonical input and the model version: equal keys, equal results.
+    pub fn cache_key(&self) -> String {
+        meta::input_hash(self.kind(), &self.canonical())
+    }
+
+    /// The number of rolling solves the job takes (its progress total).
+    pub fn size(&self) -> usize {
+        match self {
+            Job::Rolling(_) => 1,
+            Job::Sweep(job) => job.len(),
+            Job::Figure(job) => job.size(),
+        }
+    }
+}

@@ -1,0 +1,377 @@
+//! The rolling job: one particle rolling over the layer (MODEL.md §3).
+
+use serde::{Deserialize, Serialize};
+use serde_json::{json, Value};
+
+use super::fields::{self, Checker, Quantity};
+use super::units::Dimension;
+use super::{JobError, JobKind, Meta};
+use crate::model::quadrature::{DEFAULT_GAUSS_NODES, DEFAULT_MIDPOINT_STRIPS};
+use crate::model::rolling::{BoundaryPoint, PressureGrid, Verification};
+use crate::model::{
+    Layer, OptionError, Parameter, ParameterError, Quadrature, Rolling, RollingSolution,
+    SolveOption, SolveOptions,
+};
+
+/// Input of a rolling job; every field optional (MODEL.md §5 defaults).
+#[derive(Clone, Debug, Default, PartialEq, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct RollingInput {
+    /// R, particle radius (m).
+    pub radius: Option<Quantity>,
+    /// P, normal load on the particle (N).
+    pub load: Option<Quantity>,
+    /// V, rolling speed (m/s), ≥ 0.
+    pub velocity: Option<Quantity>,
+    pub layer: Option<LayerInput>,
+    pub options: Option<OptionsInput>,
+}
+
+/// The Kelvin layer.
+#[derive(Clone, Debug, Default, PartialEq, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct LayerInput {
+    /// E_L (Pa).
+    pub elastic_modulus: Option<Quantity>,
+    /// H (m).
+    pub thickness: Option<Quantity>,
+    /// ν.
+    pub poisson_ratio: Option<Quantity>,
+    /// T_ε (s).
+    pub retardation_time: Option<Quantity>,
+    /// T_σ (s).
+    pub relaxation_time: Option<Quantity>,
+}
+
+/// How to integrate across the contact and what to return besides the integrals.
+#[derive(Clone, Debug, Default, PartialEq, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct OptionsInput {
+    pub quadrature: Option<QuadratureKind>,
+    /// Gauss nodes (default 64) or midpoint strips (default 40) in the half-width.
+    pub strips: Option<usize>,
+    /// Points of the contact boundary (default 41; 0 for none).
+    pub boundary_points: Option<usize>,
+    /// Return the pressure on an n × n grid.
+    pub pressure_grid: Option<usize>,
+}
+
+/// The y-quadrature: exact to 1e-9 (`gauss`) or the paper's uniform strips (`midpoint`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum QuadratureKind {
+    #[default]
+    Gauss,
+    Midpoint,
+}
+
+impl LayerInput {
+    /// Reads the layer under `checker`, its fields at `prefix.*`.
+    pub fn read(input: Option<&LayerInput>, checker: &mut Checker, prefix: &str) -> Layer {
+        let d = Layer::default();
+        let layer = input.cloned().unwrap_or_default();
+        let mut q = |field: &str, value: &Option<Quantity>, dim, default| {
+            checker.quantity(&format!("{prefix}.{field}"), value.as_ref(), dim, default)
+        };
+        Layer {
+            elastic_modulus: q(
+                "elastic_modulus",
+                &layer.elastic_modulus,
+                Dimension::PRESSURE,
+                d.elastic_modulus,
+            ),
+            thickness: q(
+                "thickness",
+                &layer.thickness,
+                Dimension::LENGTH,
+                d.thickness,
+            ),
+            poisson_ratio: q(
+                "poisson_ratio",
+                &layer.poisson_ratio,
+                Dimension::NONE,
+                d.poisson_ratio,
+            ),
+            retardation_time: q(
+                "retardation_time",
+                &layer.retardation_time,
+                Dimension::TIME,
+                d.retardation_time,
+            ),
+            relaxation_time: q(
+                "relaxation_time",
+                &layer.relaxation_time,
+                Dimension::TIME,
+                d.relaxation_time,
+            ),
+        }
+    }
+
+    /// The canonical form of a layer.
+    pub fn canonical(layer: &Layer) -> Value {
+        json!({
+            "elastic_modulus": si(layer.elastic_modulus),
+            "thickness": si(layer.thickness),
+            "poisson_ratio": si(layer.poisson_ratio),
+            "retardation_time": si(layer.retardation_time),
+            "relaxation_time": si(layer.relaxation_time),
+        })
+    }
+}
+
+/// The field path of a model parameter (layer parameters under `layer`).
+pub fn parameter_field(e: &ParameterError) -> String {
+    match e.parameter {
+        Parameter::Radius => "radius",
+        Parameter::Load => "load",
+        Parameter::Velocity => "velocity",
+        Parameter::ElasticModulus => "layer.elastic_modulus",
+        Parameter::Thickness => "layer.thickness",
+        Parameter::PoissonRatio => "layer.poisson_ratio",
+        Parameter::RetardationTime => "layer.retardation_time",
+        Parameter::RelaxationTime => "layer.relaxation_time",
+    }
+    .to_string()
+}
+
+fn option_field(e: &OptionError) -> &'static str {
+    match e.option {
+        SolveOption::Strips => "options.strips",
+        SolveOption::BoundaryPoints => "options.boundary_points",
+        SolveOption::PressureGrid => "options.pressure_grid",
+    }
+}
+
+/// -0.0 and 0.0 are the same input: one canonical form, one cache key.
+pub(crate) fn si(x: f64) -> f64 {
+    if x == 0.0 {
+        0.0
+    } else {
+        x
+    }
+}
+
+/// A validated rolling job.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RollingJob {
+    pub rolling: Rolling,
+    pub options: SolveOptions,
+}
+
+impl RollingJob {
+    /// Validates a rolling input given as JSON.
+    pub fn from_value(value: Value) -> Result<RollingJob, JobError> {
+        let input: RollingInput = fields::deserialize(value, "")?;
+        let mut checker = Checker::new("");
+        let job = RollingJob::read(&input, &mut checker);
+        checker.finish(job)
+    }
+
+    /// Reads `input` under `checker`: fields that are bad are recorded there (and read as
+    /// NaN here), so a caller can combine these errors with its own.
+    pub fn read(input: &RollingInput, checker: &mut Checker) -> RollingJob {
+        let d = Rolling::default();
+        let rolling = Rolling {
+            radius: checker.quantity("radius", input.radius.as_ref(), Dimension::LENGTH, d.radius),
+            load: checker.quantity("load", input.load.as_ref(), Dimension::FORCE, d.load),
+            velocity: checker.quantity(
+                "velocity",
+                input.velocity.as_ref(),
+                Dimension::SPEED,
+                d.velocity,
+            ),
+            layer: LayerInput::read(input.layer.as_ref(), checker, "layer"),
+        };
+        let o = input.options.clone().unwrap_or_default();
+        let quadrature = match o.quadrature.unwrap_or_default() {
+            QuadratureKind::Gauss => Quadrature::Gauss {
+                nodes: o.strips.unwrap_or(DEFAULT_GAUSS_NODES),
+            },
+            QuadratureKind::Midpoint => Quadrature::Midpoint {
+                strips: o.strips.unwrap_or(DEFAULT_MIDPOINT_STRIPS),
+            },
+        };
+        let options = SolveOptions {
+            quadrature,
+            boundary_points: o
+                .boundary_points
+                .unwrap_or(SolveOptions::default().boundary_points),
+            pressure_grid: o.pressure_grid,
+        };
+        checker.parameters(rolling.violations(), parameter_field);
+        checker.options(options.violations(), option_field);
+        RollingJob { rolling, options }
+    }
+
+    /// The canonical input (a valid input itself).
+    pub fn canonical(&self) -> Value {
+        let r = &self.rolling;
+        let (quadrature, strips) = match self.options.quadrature {
+            Quadrature::Gauss { nodes } => ("gauss", nodes),
+            Quadrature::Midpoint { strips } => ("midpoint", strips),
+        };
+        let mut options = json!({
+            "quadrature": quadrature,
+            "strips": strips,
+            "boundary_points": self.options.boundary_points,
+        });
+        if let Some(n) = self.options.pressure_grid {
+            options["pressure_grid"] = json!(n);
+        }
+        json!({
+            "radius": si(r.radius),
+            "load": si(r.load),
+            "velocity": si(r.velocity),
+            "layer": LayerInput::canonical(&r.layer),
+            "options": options,
+        })
+    }
+}
+
+/// The integral quantities of a rolling contact, shared by rolling answers and sweep points.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct ContactOutput {
+    /// δ (m).
+    pub penetration: f64,
+    /// A (m²).
+    pub contact_area: f64,
+    /// √(2Rδ) (m).
+    pub half_width: f64,
+    /// x_c (m), area centroid ahead of the sphere centre.
+    pub centroid_shift: f64,
+    /// x_p (m), centre of pressure.
+    pub pressure_centre_shift: f64,
+    /// x_p/R.
+    pub rolling_resistance_coefficient: f64,
+    /// μ = τ_a A/P (eq. 12).
+    pub friction_coefficient: f64,
+    /// The same particle at V = 0.
+    #[serde(rename = "static")]
+    pub static_contact: StaticOutput,
+}
+
+/// The particle without rolling.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct StaticOutput {
+    pub penetration: f64,
+    pub contact_area: f64,
+    pub friction_coefficient: f64,
+}
+
+/// How far the answer can be trusted.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct VerificationOutput {
+    /// |P(δ) − P|/P at the returned δ.
+    pub relative_load_residual: f64,
+    /// Relative change of A when the quadrature is halved (conservative error estimate).
+    pub quadrature_error_estimate: f64,
+    pub quadrature_nodes: usize,
+    /// Iterations of the load equation.
+    pub iterations: u32,
+    /// Newton steps of all exit-edge roots.
+    pub exit_root_iterations: u32,
+    pub converged: bool,
+}
+
+impl From<&Verification> for VerificationOutput {
+    fn from(v: &Verification) -> Self {
+        VerificationOutput {
+            relative_load_residual: v.load_residual,
+            quadrature_error_estimate: v.quadrature_error_estimate,
+            quadrature_nodes: v.quadrature_nodes,
+            iterations: v.iterations,
+            exit_root_iterations: v.exit_root_iterations,
+            converged: v.converged,
+        }
+    }
+}
+
+impl From<&RollingSolution> for ContactOutput {
+    fn from(s: &RollingSolution) -> Self {
+        ContactOutput {
+            penetration: s.penetration,
+            contact_area: s.contact_area,
+            half_width: s.half_width,
+            centroid_shift: s.centroid_shift,
+            pressure_centre_shift: s.pressure_centre_shift,
+            rolling_resistance_coefficient: s.rolling_resistance_coefficient,
+            friction_coefficient: s.friction_coefficient,
+            static_contact: StaticOutput {
+                penetration: s.static_contact.penetration,
+                contact_area: s.static_contact.contact_area,
+                friction_coefficient: s.static_contact.friction_coefficient,
+            },
+        }
+    }
+}
+
+/// A point of the contact boundary (m).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct BoundaryOutput {
+    pub y: f64,
+    /// Trailing edge a(y).
+    pub exit: f64,
+    /// Leading edge b(y).
+    pub entry: f64,
+}
+
+impl From<&BoundaryPoint> for BoundaryOutput {
+    fn from(p: &BoundaryPoint) -> Self {
+        BoundaryOutput {
+            y: p.y,
+            exit: p.exit,
+            entry: p.entry,
+        }
+    }
+}
+
+/// p(x, y) (Pa) on a grid: `values[j][i]` = p(x[i], y[j]) (m).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct PressureOutput {
+    pub x: Vec<f64>,
+    pub y: Vec<f64>,
+    pub values: Vec<Vec<f64>>,
+}
+
+impl From<&PressureGrid> for PressureOutput {
+    fn from(g: &PressureGrid) -> Self {
+        PressureOutput {
+            x: g.x.clone(),
+            y: g.y.clone(),
+            values: g.values.clone(),
+        }
+    }
+}
+
+/// The `meta` block of a rolling answer.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct RollingMeta {
+    #[serde(flatten)]
+    pub meta: Meta,
+    pub verification: VerificationOutput,
+}
+
+/// The answer to a rolling job.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct RollingOutput {
+    #[serde(flatten)]
+    pub contact: ContactOutput,
+    pub boundary: Vec<BoundaryOutput>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub pressure: Option<PressureOutput>,
+    pub meta: RollingMeta,
+}
+
+impl RollingOutput {
+    pub fn new(job: &RollingJob, solution: &RollingSolution) -> Self {
+        RollingOutput {
+            contact: solution.into(),
+            boundary: solution.boundary.iter().map(Into::into).collect(),
+            pressure: solution.pressure.as_ref().map(Into::into),
+            meta: RollingMeta {
+                meta: Meta::new(JobKind::Rolling, job.canonical()),
+                verification: (&solution.verification).into(),
+            },
+        }
+    }
+}

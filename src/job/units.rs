@@ -1,0 +1,376 @@
+//! Physical quantities as people type them: SI numbers (`2.5e-8`), or strings with a unit
+//! (`"25 nm"`, `"1.2 nN"`, `"4 nm/s"`, `"3 GPa"`, `"100 ms"`, `"1 mm^2"`, `"1e12 m^-2"`).
+//!
+//! A unit is a product of SI symbols (m, g, s, N, Pa), each with an optional SI prefix and an
+//! integer power (`^2`, `²`, `^-1`, `⁻²`), joined by `/`, `*`, `·` or spaces; `1/m^2` works.
+//! The parser tracks dimensions, so `"radius": "3 GPa"` is refused as a pressure.
+
+use std::fmt;
+
+/// Powers of (metre, kilogram, second).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Dimension([i8; 3]);
+
+impl Dimension {
+    pub const NONE: Dimension = Dimension([0, 0, 0]);
+    pub const LENGTH: Dimension = Dimension([1, 0, 0]);
+    pub const AREA: Dimension = Dimension([2, 0, 0]);
+    pub const PER_AREA: Dimension = Dimension([-2, 0, 0]);
+    pub const TIME: Dimension = Dimension([0, 0, 1]);
+    pub const SPEED: Dimension = Dimension([1, 0, -1]);
+    pub const FORCE: Dimension = Dimension([1, 1, -2]);
+    pub const PRESSURE: Dimension = Dimension([-1, 1, -2]);
+
+    /// The named dimensions, with their SI unit and an example as people type it.
+    const NAMED: [(Dimension, &'static str, &'static str, &'static str); 8] = [
+        (Dimension::NONE, "a plain number", "", "0.35"),
+        (Dimension::LENGTH, "a length", "m", "25 nm"),
+        (Dimension::AREA, "an area", "m²", "1 mm^2"),
+        (Dimension::PER_AREA, "a number per area", "m⁻²", "1e12 m^-2"),
+        (Dimension::TIME, "a time", "s", "100 ms"),
+        (Dimension::SPEED, "a speed", "m/s", "4 nm/s"),
+        (Dimension::FORCE, "a force", "N", "1.2 nN"),
+        (Dimension::PRESSURE, "a pressure", "Pa", "3 GPa"),
+    ];
+
+    fn named(self) -> Option<(&'static str, &'static str, &'static str)> {
+        Self::NAMED
+            .iter()
+            .find(|(d, ..)| *d == self)
+            .map(|(_, name, unit, example)| (*name, *unit, *example))
+    }
+
+    /// The SI unit symbol ("" for plain numbers).
+    pub fn si_unit(self) -> String {
+        match self.named() {
+            Some((_, unit, _)) => unit.to_string(),
+            None => self.to_string(),
+        }
+    }
+
+    /// What a value of this dimension looks like, for error messages.
+    pub fn describe(self) -> String {
+        match self.named() {
+            Some((name, "", _)) => name.to_string(),
+            Some((name, unit, example)) => {
+                format!("{name} (a number in {unit}, or a string such as \"{example}\")")
+            }
+            None => format!("a quantity in {self}"),
+        }
+    }
+
+    fn add(self, other: Dimension, power: i8) -> Dimension {
+        let mut d = self.0;
+        for (d, o) in d.iter_mut().zip(other.0) {
+            *d += o * power;
+        }
+        Dimension(d)
+    }
+}
+
+impl fmt::Display for Dimension {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        if let Some((name, _, _)) = self.named() {
+            return f.write_str(name);
+        }
+        let parts: Vec<String> = ["m", "kg", "s"]
+            .iter()
+            .zip(self.0)
+            .filter(|(_, p)| *p != 0)
+            .map(|(s, p)| {
+                if p == 1 {
+                    s.to_string()
+                } else {
+                    format!("{s}^{p}")
+                }
+            })
+            .collect();
+        f.write_str(&parts.join("·"))
+    }
+}
+
+/// Why a quantity string could not be read.
+#[derive(Clone, Debug, PartialEq)]
+pub enum UnitError {
+    /// No number at the start.
+    NoNumber,
+    /// A unit symbol that is not an SI symbol with an SI prefix.
+    UnknownUnit(String),
+    /// A valid unit of another dimension than the field's.
+    WrongDimension {
+        found: Dimension,
+        expected: Dimension,
+    },
+}
+
+impl fmt::Display for UnitError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            UnitError::NoNumber => f.write_str("does not start with a number"),
+            UnitError::UnknownUnit(u) => write!(
+                f,
+                "has an unknown unit \"{u}\" (SI symbols m, g, s, N, Pa with SI prefixes)"
+            ),
+            UnitError::WrongDimension { found, .. } => write!(f, "is {found}"),
+        }
+    }
+}
+
+/// SI prefixes as powers of ten; both micro signs and `u` are accepted.
+const PREFIXES: [(&str, i32); 22] = [
+    ("Y", 24),
+    ("Z", 21),
+    ("E", 18),
+    ("P", 15),
+    ("T", 12),
+    ("G", 9),
+    ("M", 6),
+    ("k", 3),
+    ("h", 2),
+    ("da", 1),
+    ("", 0),
+    ("d", -1),
+    ("c", -2),
+    ("m", -3),
+    ("u", -6),
+    ("µ", -6),
+    ("μ", -6),
+    ("n", -9),
+    ("p", -12),
+    ("f", -15),
+    ("a", -18),
+    ("z", -21),
+];
+
+/// SI symbols with the power of ten to SI base units and their dimension.
+const SYMBOLS: [(&str, i32, Dimension); 5] = [
+    ("Pa", 0, Dimension::PRESSURE),
+    ("N", 0, Dimension::FORCE),
+    ("m", 0, Dimension::LENGTH),
+    ("g", -3, Dimension([0, 1, 0])),
+    ("s", 0, Dimension::TIME),
+];
+
+/// Reads `text` as a quantity of dimension `expected` and returns its value in SI units;
+/// a number without a unit is taken as SI.
+///
+/// Every unit is a power of ten of SI, so the decimal exponent is shifted before the number
+/// is rounded once: `"100 nm"` gives exactly the double nearest 1e-7, as `1e-7` does, and
+/// both have one canonical form.
+pub fn parse_quantity(text: &str, expected: Dimension) -> Result<f64, UnitError> {
+    let text = text.trim();
+    let split = number_length(text);
+    if split == 0 {
+        return Err(UnitError::NoNumber);
+    }
+    let number = &text[..split];
+    let (mantissa, exponent) = match number.find(['e', 'E']) {
+        Some(i) => (
+            &number[..i],
+            number[i + 1..]
+                .parse::<i32>()
+                .map_err(|_| UnitError::NoNumber)?,
+        ),
+        None => (number, 0),
+    };
+    let unit = text[split..].trim();
+    // A bare number in a string is SI, as a JSON number is.
+    let (power, found) = if unit.is_empty() {
+        (0, expected)
+    } else {
+        parse_unit(unit)?
+    };
+    if found != expected {
+        return Err(UnitError::WrongDimension { found, expected });
+    }
+    format!("{mantissa}e{}", exponent.saturating_add(power))
+        .parse()
+        .map_err(|_| UnitError::NoNumber)
+}
+
+/// Length of the leading decimal number (sign, digits, point, exponent) of `text`.
+fn number_length(text: &str) -> usize {
+    let bytes = text.as_bytes();
+    let digits = |mut i: usize| {
+        while i < bytes.len() && bytes[i].is_ascii_digit() {
+            i += 1;
+        }
+        i
+    };
+    let mut i = usize::from(matches!(bytes.first(), Some(b'+' | b'-')));
+    let start = i;
+    i = digits(i);
+    if bytes.get(i) == Some(&b'.') {
+        i = digits(i + 1);
+    }
+    if i == start || (i == start + 1 && bytes[start] == b'.') {
+        return 0;
+    }
+    if matches!(bytes.get(i), Some(b'e' | b'E')) {
+        let mut j = i + 1;
+        if matches!(bytes.get(j), Some(b'+' | b'-')) {
+            j += 1;
+        }
+        let end = digits(j);
+        if end > j {
+            i = end;
+        }
+    }
+    i
+}
+
+/// Power of ten to SI and dimension of a unit expression ("" is a plain number).
+fn parse_unit(unit: &str) -> Result<(i32, Dimension), UnitError> {
+    let unknown = || UnitError::UnknownUnit(unit.to_string());
+    let (mut ten_power, mut dimension) = (0, Dimension::NONE);
+    let mut sign = 1;
+    let mut token = String::new();
+    let mut terms: Vec<(String, i8)> = Vec::new();
+    for c in unit.chars().chain(std::iter::once(' ')) {
+        match c {
+            '/' | '*' | '·' | ' ' => {
+                if !token.is_empty() {
+                    terms.push((std::mem::take(&mut token), sign));
+                }
+                if c == '/' {
+                    sign = -1;
+                }
+            }
+            _ => token.push(c),
+        }
+    }
+    for (i, (term, sign)) in terms.iter().enumerate() {
+        if i == 0 && term == "1" && *sign == 1 {
+            continue; // "1/m^2"
+        }
+        let (symbol, power) = split_power(term).ok_or_else(unknown)?;
+        let (scale, dim) = parse_symbol(symbol).ok_or_else(unknown)?;
+        let power = power * sign;
+        ten_power += scale * i32::from(power);
+        dimension = dimension.add(dim, power);
+    }
+    Ok((ten_power, dimension))
+}
+
+/// Splits "mm^2", "m²", "m^-2", "m⁻²" into the symbol and its power.
+fn split_power(term: &str) -> Option<(&str, i8)> {
+    if let Some((symbol, power)) = term.split_once('^') {
+        return Some((symbol, power.parse().ok()?));
+    }
+    let superscripts = ['⁻', '¹', '²', '³', '⁴'];
+    let start = term
+        .char_indices()
+        .find(|(_, c)| superscripts.contains(c))
+        .map_or(term.len(), |(i, _)| i);
+    let (symbol, sup) = term.split_at(start);
+    if sup.is_empty() {
+        return Some((symbol, 1));
+    }
+    let (negative, digits) = match sup.strip_prefix('⁻') {
+        Some(rest) => (true, rest),
+        None => (false, sup),
+    };
+    let power = match digits {
+        "¹" => 1,
+        "²" => 2,
+        "³" => 3,
+        "⁴" => 4,
+        _ => return None,
+    };
+    Some((symbol, if negative { -power } else { power }))
+}
+
+/// A prefixed SI symbol such as "nm", "GPa", "ms", "µm": its power of ten and dimension.
+fn parse_symbol(term: &str) -> Option<(i32, Dimension)> {
+    SYMBOLS.iter().find_map(|(symbol, scale, dim)| {
+        let prefix = term.strip_suffix(symbol)?;
+        let (_, prefix_scale) = PREFIXES.iter().find(|(p, _)| *p == prefix)?;
+        Some((prefix_scale + scale, *dim))
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn reads_the_units_people_type() {
+        let cases = [
+            ("25 nm", Dimension::LENGTH, 25e-9),
+            ("25nm", Dimension::LENGTH, 25e-9),
+            ("1.2 nN", Dimension::FORCE, 1.2e-9),
+            ("4 nm/s", Dimension::SPEED, 4e-9),
+            ("4 µm/s", Dimension::SPEED, 4e-6),
+            ("4 um/s", Dimension::SPEED, 4e-6),
+            ("3 GPa", Dimension::PRESSURE, 3e9),
+            ("100 ms", Dimension::TIME, 0.1),
+            ("0.5 s", Dimension::TIME, 0.5),
+            ("1 mm^2", Dimension::AREA, 1e-6),
+            ("1 mm²", Dimension::AREA, 1e-6),
+            ("1e12 m^-2", Dimension::PER_AREA, 1e12),
+            ("1e12 /m^2", Dimension::PER_AREA, 1e12),
+            ("1e12 1/m²", Dimension::PER_AREA, 1e12),
+            ("1e12 m⁻²", Dimension::PER_AREA, 1e12),
+            ("2.5e-8 m", Dimension::LENGTH, 2.5e-8),
+            ("2.5E-8", Dimension::LENGTH, 2.5e-8),
+            ("100 nm", Dimension::LENGTH, 1e-7),
+            ("0.1 s", Dimension::TIME, 0.1),
+            ("1e3 mm", Dimension::LENGTH, 1.0),
+            ("210 kN/mm^2", Dimension::PRESSURE, 210e9),
+            ("0.35", Dimension::NONE, 0.35),
+            (" -4 nm/s ", Dimension::SPEED, -4e-9),
+        ];
+        for (text, dim, expected) in cases {
+            let got = parse_quantity(text, dim).unwrap_or_else(|e| panic!("{text}: {e}"));
+            // Exactly the double nearest the decimal value: one canonical form per quantity.
+            assert_eq!(got, expected, "{text}");
+        }
+    }
+
+    #[test]
+    fn refuses_a_wrong_dimension_and_says_what_it_is() {
+        let err = parse_quantity("3 GPa", Dimension::LENGTH).unwrap_err();
+        assert_eq!(
+            err,
+            UnitError::WrongDimension {
+                found: Dimension::PRESSURE,
+                expected: Dimension::LENGTH
+            }
+        );
+        assert_eq!(err.to_string(), "is a pressure");
+        assert!(parse_quantity("25 nm", Dimension::SPEED).is_err());
+    }
+
+    #[test]
+    fn refuses_unknown_units_and_missing_numbers() {
+        assert!(matches!(
+            parse_quantity("25 furlongs", Dimension::LENGTH),
+            Err(UnitError::UnknownUnit(_))
+        ));
+        assert!(matches!(
+            parse_quantity("25 Nm", Dimension::LENGTH),
+            Err(UnitError::UnknownUnit(_))
+        ));
+        assert_eq!(
+            parse_quantity("nm", Dimension::LENGTH),
+            Err(UnitError::NoNumber)
+        );
+        assert_eq!(
+            parse_quantity("", Dimension::LENGTH),
+            Err(UnitError::NoNumber)
+        );
+        assert_eq!(
+            parse_quantity(".", Dimension::LENGTH),
+            Err(UnitError::NoNumber)
+        );
+    }
+
+    #[test]
+    fn describes_dimensions_for_error_messages() {
+        assert_eq!(
+            Dimension::LENGTH.describe(),
+            "a length (a number in m, or a string such as \"25 nm\")"
+        );
+        assert_eq!(Dimension([1, 1, 0]).to_string(), "m·kg");
+    }
+}
