@@ -1,1 +1,70 @@
-fn main() {}
+//! Speed of the physics core: one rolling solve at 1e-9 relative accuracy (target: < 100 µs
+//! median) and the data of all of the paper's Figures 3–9 (target: < 50 ms).
+//! Results and method: BENCHMARKS.md. Run with `cargo bench --bench solver`.
+
+use std::hint::black_box;
+use std::time::Duration;
+
+use criterion::{criterion_group, criterion_main, Criterion};
+use serde_json::json;
+use thirdbody::engine::{self, Control};
+use thirdbody::job::{Job, Limits};
+use thirdbody::model::{solve, Quadrature, Rolling, SolveOptions};
+
+fn rolling(c: &mut Criterion) {
+    let mut group = c.benchmark_group("rolling");
+    let default = Rolling::default();
+    group.bench_function(
+        "default job (V = 4 nm/s, 64 Gauss nodes, 41 boundary points)",
+        |b| b.iter(|| solve(black_box(&default), &SolveOptions::default()).unwrap()),
+    );
+    group.bench_function("integrals only (as in sweeps)", |b| {
+        let options = SolveOptions::integrals_only(Quadrature::default());
+        b.iter(|| solve(black_box(&default), &options).unwrap())
+    });
+    for velocity in [0.0, 1e-10, 1e-8, 1e-6] {
+        let point = Rolling {
+            velocity,
+            ..default
+        };
+        let options = SolveOptions::integrals_only(Quadrature::default());
+        group.bench_function(format!("integrals only, V = {velocity:e} m/s"), |b| {
+            b.iter(|| solve(black_box(&point), &options).unwrap())
+        });
+    }
+    group.bench_function("paper's midpoint strips, N = 40", |b| {
+        let options = SolveOptions::integrals_only(Quadrature::Midpoint { strips: 40 });
+        b.iter(|| solve(black_box(&default), &options).unwrap())
+    });
+    group.finish();
+}
+
+fn figures(c: &mut Criterion) {
+    let jobs: Vec<Job> = (3..=9)
+        .map(|n| {
+            Job::from_value(
+                json!({"kind": "figure", "input": {"number": n}}),
+                &Limits::default(),
+            )
+            .unwrap()
+        })
+        .collect();
+    let solves: usize = jobs.iter().map(Job::size).sum();
+    let mut group = c.benchmark_group(format!("figures 3-9 ({solves} solves)"));
+    group
+        .sample_size(20)
+        .measurement_time(Duration::from_secs(8));
+    for threads in [1, 2] {
+        group.bench_function(format!("{threads} thread(s)"), |b| {
+            b.iter(|| {
+                for job in &jobs {
+                    black_box(engine::run(job, &Control::new(None, threads)).unwrap());
+                }
+            })
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, rolling, figures);
+criterion_main!(benches);

@@ -60,7 +60,8 @@ fn main() -> ExitCode {
         Ok(text) => {
             // A reader that stops early (`| head`) is not an error of ours.
             let mut out = std::io::stdout().lock();
-            match writeln!(out, "{text}").and_then(|()| out.flush()) {
+            let newline = if text.ends_with('\n') { "" } else { "\n" };
+            match write!(out, "{text}{newline}").and_then(|()| out.flush()) {
                 Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => {
                     eprintln!("thirdbody: cannot write the result: {e}");
                     ExitCode::FAILURE

@@ -18,6 +18,7 @@ use serde::Deserialize;
 use serde_json::Value;
 
 pub use error::{FieldError, JobError};
+pub use fields::Quantity;
 pub use figure::FigureJob;
 pub use meta::{Meta, Reference, REFERENCES};
 pub use rolling::RollingJob;

@@ -263,7 +263,7 @@ pub struct StaticOutput {
 pub struct VerificationOutput {
     /// |P(δ) − P|/P at the returned δ.
     pub relative_load_residual: f64,
-    /// Relative change of A when the quadrature is halved (conservative error estimate).
+    /// Relative change of A when the quadrature is halved (an estimate of its error).
     pub quadrature_error_estimate: f64,
     pub quadrature_nodes: usize,
     /// Iterations of the load equation.

@@ -1,0 +1,105 @@
+//! The `thirdbody` binary as CI pipelines use it: job files in, JSON or CSV out, errors on
+//! standard error with a non-zero status.
+
+use std::io::Write;
+use std::process::{Command, Output, Stdio};
+
+use serde_json::Value;
+
+fn thirdbody(args: &[&str], stdin: Option<&str>) -> Output {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_thirdbody"))
+        .args(args)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    if let Some(text) = stdin {
+        child
+            .stdin
+            .take()
+            .unwrap()
+            .write_all(text.as_bytes())
+            .unwrap();
+    }
+    drop(child.stdin.take());
+    child.wait_with_output().unwrap()
+}
+
+fn json(output: &Output) -> Value {
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    serde_json::from_slice(&output.stdout).unwrap()
+}
+
+#[test]
+fn every_example_job_solves() {
+    let rolling = json(&thirdbody(&["solve", "examples/rolling.json"], None));
+    assert!((rolling["contact_area"].as_f64().unwrap() * 1e18 - 85.234).abs() < 5e-4);
+    assert_eq!(rolling["boundary"].as_array().unwrap().len(), 21);
+
+    let sweep = json(&thirdbody(&["solve", "examples/sweep.json"], None));
+    assert_eq!(sweep["points"].as_array().unwrap().len(), 15);
+
+    let figure = json(&thirdbody(&["solve", "examples/figure.json"], None));
+    assert_eq!(figure["figure"], 6);
+}
+
+#[test]
+fn a_job_can_come_on_standard_input_and_a_sweep_can_leave_as_csv() {
+    let out = json(&thirdbody(
+        &["solve", "-"],
+        Some(r#"{"kind": "rolling", "input": {"velocity": 0}}"#),
+    ));
+    assert_eq!(out["centroid_shift"], 0.0);
+    let csv = thirdbody(
+        &["solve", "-", "--format", "csv"],
+        Some(r#"{"kind": "sweep", "input": {"vary": {"load": ["1 nN", "1.4 nN"]}}}"#),
+    );
+    assert!(csv.status.success());
+    assert_eq!(String::from_utf8_lossy(&csv.stdout).lines().count(), 3);
+}
+
+#[test]
+fn figures_print_as_json_or_csv() {
+    let fig = json(&thirdbody(&["figure", "5"], None));
+    assert_eq!(fig["series"].as_array().unwrap().len(), 5);
+    let csv = thirdbody(&["figure", "9", "--format", "csv"], None);
+    assert!(csv.status.success());
+    let text = String::from_utf8_lossy(&csv.stdout);
+    assert_eq!(
+        text.lines().next(),
+        Some("series,label,radius (m),friction_coefficient")
+    );
+    assert_eq!(text.lines().count(), 1 + 10 * 14);
+}
+
+#[test]
+fn a_bad_job_fails_with_status_2_and_says_which_field() {
+    let out = thirdbody(
+        &["solve", "-"],
+        Some(r#"{"kind": "rolling", "input": {"radius": "3 GPa"}}"#),
+    );
+    assert_eq!(out.status.code(), Some(2));
+    assert!(out.stdout.is_empty());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("radius") && err.contains("is a pressure"),
+        "{err}"
+    );
+
+    let out = thirdbody(&["figure", "12"], None);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("3 to 9"));
+
+    let out = thirdbody(&["solve", "no/such/file.json"], None);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("cannot read"));
+
+    let out = thirdbody(&["solve", "examples/rolling.json", "--format", "csv"], None);
+    assert_ne!(out.status.code(), Some(0));
+}
