@@ -14,11 +14,12 @@ use thirdbody::model::{solve, Quadrature, Rolling, SolveOptions};
 fn rolling(c: &mut Criterion) {
     let mut group = c.benchmark_group("rolling");
     let default = Rolling::default();
-    group.bench_function(
-        "default job (V = 4 nm/s, 64 Gauss nodes, 41 boundary points)",
-        |b| b.iter(|| solve(black_box(&default), &SolveOptions::default()).unwrap()),
-    );
-    group.bench_function("integrals only (as in sweeps)", |b| {
+    // The default job: V = 4 nm/s, 64 Gauss nodes, 41 boundary points.
+    group.bench_function("default_job", |b| {
+        b.iter(|| solve(black_box(&default), &SolveOptions::default()).unwrap())
+    });
+    // As in sweeps: no boundary.
+    group.bench_function("integrals_only", |b| {
         let options = SolveOptions::integrals_only(Quadrature::default());
         b.iter(|| solve(black_box(&default), &options).unwrap())
     });
@@ -28,11 +29,11 @@ fn rolling(c: &mut Criterion) {
             ..default
         };
         let options = SolveOptions::integrals_only(Quadrature::default());
-        group.bench_function(format!("integrals only, V = {velocity:e} m/s"), |b| {
+        group.bench_function(format!("integrals_only_V={velocity:e}"), |b| {
             b.iter(|| solve(black_box(&point), &options).unwrap())
         });
     }
-    group.bench_function("paper's midpoint strips, N = 40", |b| {
+    group.bench_function("midpoint_40_strips", |b| {
         let options = SolveOptions::integrals_only(Quadrature::Midpoint { strips: 40 });
         b.iter(|| solve(black_box(&default), &options).unwrap())
     });
@@ -50,12 +51,13 @@ fn figures(c: &mut Criterion) {
         })
         .collect();
     let solves: usize = jobs.iter().map(Job::size).sum();
-    let mut group = c.benchmark_group(format!("figures 3-9 ({solves} solves)"));
+    println!("figures 3-9: {solves} rolling solves");
+    let mut group = c.benchmark_group("figures_3_to_9");
     group
         .sample_size(20)
         .measurement_time(Duration::from_secs(8));
     for threads in [1, 2] {
-        group.bench_function(format!("{threads} thread(s)"), |b| {
+        group.bench_function(format!("threads_{threads}"), |b| {
             b.iter(|| {
                 for job in &jobs {
                     black_box(engine::run(job, &Control::new(None, threads)).unwrap());
