@@ -21,7 +21,7 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Solve a job {"kind": "rolling" | "sweep" | "figure", "input": {...}} and print the result as JSON.
+    /// Solve a job {"kind": "rolling" | "three_body" | "sweep" | "figure", "input": {...}} and print the result as JSON.
     Solve {
         /// The job file, or - for standard input.
         job: String,
@@ -98,9 +98,9 @@ fn render(output: &Output, format: Format) -> Result<String, JobError> {
             .map_err(|e| JobError::Internal(format!("cannot write the result: {e}"))),
         (Format::Csv, Output::Sweep(s)) => Ok(s.to_csv()),
         (Format::Csv, Output::Figure(f)) => Ok(f.to_csv()),
-        (Format::Csv, Output::Rolling(_)) => Err(JobError::Schema {
+        (Format::Csv, Output::Rolling(_) | Output::ThreeBody(_)) => Err(JobError::Schema {
             field: "--format".to_string(),
-            message: "csv is available for sweeps and figures; use json for a rolling job"
+            message: "csv is available for sweeps and figures; use json for a single job"
                 .to_string(),
         }),
     }

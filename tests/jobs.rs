@@ -3,6 +3,7 @@
 
 use serde_json::{json, Value};
 use thirdbody::engine::{self, Control, Output};
+use thirdbody::job::sweep::{SweepPoint, SweepPoints};
 use thirdbody::job::{FieldError, Job, JobError, Limits};
 use thirdbody::model::limits::relaxed;
 use thirdbody::model::{solve, Layer, Rolling, SolveOptions};
@@ -13,6 +14,16 @@ fn job(value: Value) -> Result<Job, JobError> {
 
 fn run(value: Value) -> Output {
     engine::run(&job(value).unwrap(), &Control::default()).unwrap()
+}
+
+fn rolling_points(value: Value) -> Vec<SweepPoint> {
+    match run(value) {
+        Output::Sweep(out) => match out.points {
+            SweepPoints::Rolling(points) => points,
+            other => panic!("{other:?}"),
+        },
+        other => panic!("{other:?}"),
+    }
 }
 
 fn invalid_fields(value: Value) -> Vec<FieldError> {
@@ -243,18 +254,15 @@ fn the_pressure_grid_is_non_negative_and_carries_the_load() {
 
 #[test]
 fn a_sweep_is_the_product_of_its_lists_in_order_and_equals_single_solves() {
-    let Output::Sweep(out) = run(json!({"kind": "sweep", "input": {
+    let points = rolling_points(json!({"kind": "sweep", "input": {
         "base": {"load": "1.2 nN"},
-        "vary": {"radius": ["25 nm", "150 nm"], "load": ["1 nN", "1.4 nN"], "velocity": [0, "4 nm/s", "10 nm/s"]}}}))
-    else {
-        panic!()
-    };
-    assert_eq!(out.points.len(), 12);
+        "vary": {"radius": ["25 nm", "150 nm"], "load": ["1 nN", "1.4 nN"], "velocity": [0, "4 nm/s", "10 nm/s"]}}}));
+    assert_eq!(points.len(), 12);
     let mut i = 0;
     for radius in [25e-9, 150e-9] {
         for load in [1e-9, 1.4e-9] {
             for velocity in [0.0, 4e-9, 10e-9] {
-                let p = &out.points[i];
+                let p = &points[i];
                 assert_eq!((p.radius, p.load, p.velocity), (radius, load, velocity));
                 let rolling = Rolling {
                     radius,
@@ -270,12 +278,9 @@ fn a_sweep_is_the_product_of_its_lists_in_order_and_equals_single_solves() {
         }
     }
     // Absent lists keep the base value.
-    let Output::Sweep(out) = run(json!({"kind": "sweep", "input": {"base": {"load": "1.2 nN"}}}))
-    else {
-        panic!()
-    };
-    assert_eq!(out.points.len(), 1);
-    assert_eq!(out.points[0].load, 1.2e-9);
+    let points = rolling_points(json!({"kind": "sweep", "input": {"base": {"load": "1.2 nN"}}}));
+    assert_eq!(points.len(), 1);
+    assert_eq!(points[0].load, 1.2e-9);
 
     let csv = {
         let Output::Sweep(out) =

@@ -13,9 +13,10 @@ use serde::Serialize;
 
 use crate::job::figure::FigureOutput;
 use crate::job::rolling::RollingOutput;
-use crate::job::sweep::SweepOutput;
+use crate::job::sweep::{SweepJob, SweepOutput};
+use crate::job::three_body::ThreeBodyOutput;
 use crate::job::{Job, JobError};
-use crate::model::{self, Rolling, RollingSolution, SolveOptions};
+use crate::model::{self, three_body, ModelError};
 
 /// Shared between a running job and whoever watches it: progress, cancellation, deadline.
 #[derive(Debug)]
@@ -70,6 +71,7 @@ impl Control {
 #[serde(untagged)]
 pub enum Output {
     Rolling(RollingOutput),
+    ThreeBody(ThreeBodyOutput),
     Sweep(SweepOutput),
     Figure(FigureOutput),
 }
@@ -78,27 +80,42 @@ pub enum Output {
 pub fn run(job: &Job, control: &Control) -> Result<Output, JobError> {
     Ok(match job {
         Job::Rolling(j) => {
-            let solution = solve_all(&[j.rolling], &j.options, control)?;
+            let solution = parallel_map(&[j.rolling], control, |p| model::solve(p, &j.options))?;
             Output::Rolling(RollingOutput::new(j, &solution[0]))
         }
-        Job::Sweep(j) => {
-            let solutions = solve_all(&j.points(), &j.base.options, control)?;
-            Output::Sweep(SweepOutput::new(j, &solutions))
+        Job::ThreeBody(j) => {
+            let solution =
+                parallel_map(&[j.system], control, |s| three_body::solve(s, &j.options))?;
+            Output::ThreeBody(ThreeBodyOutput::new(j, &solution[0]))
         }
+        Job::Sweep(sweep) => Output::Sweep(match sweep {
+            SweepJob::Rolling(s) => {
+                let options = &s.base.options;
+                let solutions = parallel_map(&s.points(), control, |p| model::solve(p, options))?;
+                SweepOutput::rolling(sweep, s, &solutions)
+            }
+            SweepJob::ThreeBody(s) => {
+                let options = &s.base.options;
+                let solutions =
+                    parallel_map(&s.points(), control, |p| three_body::solve(p, options))?;
+                SweepOutput::three_body(sweep, s, &solutions)
+            }
+        }),
         Job::Figure(j) => {
-            let solutions = solve_all(&j.plan.contacts, &j.plan.options, control)?;
+            let options = &j.plan.options;
+            let solutions = parallel_map(&j.plan.contacts, control, |p| model::solve(p, options))?;
             Output::Figure(FigureOutput::new(j, j.plan.assemble(&solutions)))
         }
     })
 }
 
-/// Solves every contact of `points`, in parallel over `control`'s threads, in order.
+/// Applies `solve` to every item, in parallel over `control`'s threads, results in order.
 /// Stops at the first failure, cancellation or deadline.
-pub fn solve_all(
-    points: &[Rolling],
-    options: &SolveOptions,
+pub fn parallel_map<T: Sync, R: Send>(
+    items: &[T],
     control: &Control,
-) -> Result<Vec<RollingSolution>, JobError> {
+    solve: impl Fn(&T) -> Result<R, ModelError> + Sync,
+) -> Result<Vec<R>, JobError> {
     let next = AtomicUsize::new(0);
     let failure: Mutex<Option<JobError>> = Mutex::new(None);
     let failed = AtomicBool::new(false);
@@ -106,10 +123,10 @@ pub fn solve_all(
         let mut solved = Vec::new();
         while !failed.load(Ordering::Relaxed) {
             let i = next.fetch_add(1, Ordering::Relaxed);
-            let Some(point) = points.get(i) else { break };
+            let Some(item) = items.get(i) else { break };
             match control
                 .check()
-                .and_then(|()| model::solve(point, options).map_err(JobError::from))
+                .and_then(|()| solve(item).map_err(JobError::from))
             {
                 Ok(solution) => {
                     control.done.fetch_add(1, Ordering::Relaxed);
@@ -126,8 +143,8 @@ pub fn solve_all(
         }
         solved
     };
-    let threads = control.threads.min(points.len()).max(1);
-    let mut solved: Vec<(usize, RollingSolution)> = if threads == 1 {
+    let threads = control.threads.min(items.len()).max(1);
+    let mut solved: Vec<(usize, R)> = if threads == 1 {
         worker()
     } else {
         thread::scope(|s| {
@@ -141,7 +158,7 @@ pub fn solve_all(
     if let Some(e) = failure.into_inner().unwrap_or_else(|p| p.into_inner()) {
         return Err(e);
     }
-    if solved.len() != points.len() {
+    if solved.len() != items.len() {
         return Err(JobError::Internal(
             "a solver thread stopped unexpectedly".to_string(),
         ));

@@ -7,7 +7,7 @@ use serde_json::Value;
 
 use super::units::{parse_quantity, Dimension, UnitError};
 use super::{FieldError, JobError};
-use crate::model::{OptionError, ParameterError};
+use crate::model::{OptionError, Parameter, ParameterError, SolveOption};
 
 /// A quantity as sent: an SI number, or a string with a unit.
 #[derive(Clone, Debug, PartialEq, Deserialize, Serialize)]
@@ -23,6 +23,39 @@ impl Quantity {
             Quantity::Number(x) => Value::from(*x),
             Quantity::Text(s) => Value::from(s.as_str()),
         }
+    }
+}
+
+/// The field of a model parameter in the rolling and three-body inputs.
+pub fn parameter_field(parameter: Parameter) -> &'static str {
+    use Parameter::*;
+    match parameter {
+        Radius => "radius",
+        Load => "load",
+        Velocity => "velocity",
+        ElasticModulus => "layer.elastic_modulus",
+        Thickness => "layer.thickness",
+        PoissonRatio => "layer.poisson_ratio",
+        RetardationTime => "layer.retardation_time",
+        RelaxationTime => "layer.relaxation_time",
+        MeanDiameter => "distribution.mean_diameter",
+        StdDiameter => "distribution.std_diameter",
+        MinDiameter => "distribution.min_diameter",
+        MaxDiameter => "distribution.max_diameter",
+        ArealDensity => "distribution.areal_density",
+        NominalArea => "nominal_area",
+        UpperModulus => "upper_surface.elastic_modulus",
+        UpperPoissonRatio => "upper_surface.poisson_ratio",
+        UpperHardness => "upper_surface.hardness",
+        ParticleModulus => "particle.elastic_modulus",
+        ParticlePoissonRatio => "particle.poisson_ratio",
+        AsperityDensity => "asperities.density",
+        TipRadius => "asperities.tip_radius",
+        HeightStd => "asperities.height_std",
+        AsperityHardness => "asperities.hardness",
+        Separation => "operating.separation",
+        TotalLoad => "operating.total_load",
+        ParticleLoad => "operating.particle_load",
     }
 }
 
@@ -135,25 +168,24 @@ impl Checker {
         });
     }
 
-    /// Records the model's range violations; `field_of` names the field of each parameter.
-    pub fn parameters(
-        &mut self,
-        errors: Vec<ParameterError>,
-        field_of: impl Fn(&ParameterError) -> String,
-    ) {
+    /// Records the model's range violations, each at the field of its parameter.
+    pub fn parameters(&mut self, errors: Vec<ParameterError>) {
         for e in errors {
-            self.out_of_range(&field_of(&e), e.value, e.parameter.unit(), &e.allowed);
+            let field = parameter_field(e.parameter);
+            self.out_of_range(field, e.value, e.parameter.unit(), &e.allowed);
         }
     }
 
-    /// Records the model's option violations; `field_of` names the field of each option.
-    pub fn options(
-        &mut self,
-        errors: Vec<OptionError>,
-        field_of: impl Fn(&OptionError) -> &'static str,
-    ) {
+    /// Records the model's option violations, each at the field of its option.
+    pub fn options(&mut self, errors: Vec<OptionError>) {
         for e in errors {
-            self.out_of_range(field_of(&e), e.value as f64, "", &e.allowed);
+            let field = match e.option {
+                SolveOption::Strips => "options.strips",
+                SolveOption::BoundaryPoints => "options.boundary_points",
+                SolveOption::PressureGrid => "options.pressure_grid",
+                SolveOption::DiameterNodes => "options.diameter_nodes",
+            };
+            self.out_of_range(field, e.value as f64, "", &e.allowed);
         }
     }
 

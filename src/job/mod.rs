@@ -12,6 +12,7 @@ pub mod figure;
 mod meta;
 pub mod rolling;
 pub mod sweep;
+pub mod three_body;
 pub mod units;
 
 use serde::Deserialize;
@@ -23,6 +24,7 @@ pub use figure::FigureJob;
 pub use meta::{Meta, Reference, REFERENCES};
 pub use rolling::RollingJob;
 pub use sweep::SweepJob;
+pub use three_body::ThreeBodyJob;
 
 /// A number as text for people and CSV: plain between 1e-3 and 1e6, scientific elsewhere,
 /// always the shortest text that reads back as the same double.
@@ -54,6 +56,7 @@ impl Default for Limits {
 #[serde(rename_all = "snake_case")]
 pub enum JobKind {
     Rolling,
+    ThreeBody,
     Sweep,
     Figure,
 }
@@ -62,6 +65,7 @@ impl JobKind {
     pub fn as_str(self) -> &'static str {
         match self {
             JobKind::Rolling => "rolling",
+            JobKind::ThreeBody => "three_body",
             JobKind::Sweep => "sweep",
             JobKind::Figure => "figure",
         }
@@ -81,6 +85,7 @@ struct Envelope {
 #[derive(Clone, Debug, PartialEq)]
 pub enum Job {
     Rolling(RollingJob),
+    ThreeBody(ThreeBodyJob),
     Sweep(SweepJob),
     Figure(FigureJob),
 }
@@ -100,6 +105,7 @@ impl Job {
             .unwrap_or_else(|| Value::Object(Default::default()));
         Ok(match envelope.kind {
             JobKind::Rolling => Job::Rolling(RollingJob::from_value(input)?),
+            JobKind::ThreeBody => Job::ThreeBody(ThreeBodyJob::from_value(input)?),
             JobKind::Sweep => Job::Sweep(SweepJob::from_value(input, limits)?),
             JobKind::Figure => Job::Figure(FigureJob::from_value(input)?),
         })
@@ -108,6 +114,7 @@ impl Job {
     pub fn kind(&self) -> JobKind {
         match self {
             Job::Rolling(_) => JobKind::Rolling,
+            Job::ThreeBody(_) => JobKind::ThreeBody,
             Job::Sweep(_) => JobKind::Sweep,
             Job::Figure(_) => JobKind::Figure,
         }
@@ -117,6 +124,7 @@ impl Job {
     pub fn canonical(&self) -> Value {
         match self {
             Job::Rolling(job) => job.canonical(),
+            Job::ThreeBody(job) => job.canonical(),
             Job::Sweep(job) => job.canonical(),
             Job::Figure(job) => job.canonical(),
         }
@@ -130,7 +138,7 @@ impl Job {
     /// The number of rolling solves the job takes (its progress total).
     pub fn size(&self) -> usize {
         match self {
-            Job::Rolling(_) => 1,
+            Job::Rolling(_) | Job::ThreeBody(_) => 1,
             Job::Sweep(job) => job.len(),
             Job::Figure(job) => job.size(),
         }

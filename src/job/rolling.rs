@@ -8,10 +8,7 @@ use super::units::Dimension;
 use super::{JobError, JobKind, Meta};
 use crate::model::quadrature::{DEFAULT_GAUSS_NODES, DEFAULT_MIDPOINT_STRIPS};
 use crate::model::rolling::{BoundaryPoint, PressureGrid, Verification};
-use crate::model::{
-    Layer, OptionError, Parameter, ParameterError, Quadrature, Rolling, RollingSolution,
-    SolveOption, SolveOptions,
-};
+use crate::model::{Layer, Quadrature, Rolling, RollingSolution, SolveOptions};
 
 /// Input of a rolling job; every field optional (MODEL.md §5 defaults).
 #[derive(Clone, Debug, Default, PartialEq, Deserialize, Serialize)]
@@ -119,29 +116,6 @@ impl LayerInput {
     }
 }
 
-/// The field path of a model parameter (layer parameters under `layer`).
-pub fn parameter_field(e: &ParameterError) -> String {
-    match e.parameter {
-        Parameter::Radius => "radius",
-        Parameter::Load => "load",
-        Parameter::Velocity => "velocity",
-        Parameter::ElasticModulus => "layer.elastic_modulus",
-        Parameter::Thickness => "layer.thickness",
-        Parameter::PoissonRatio => "layer.poisson_ratio",
-        Parameter::RetardationTime => "layer.retardation_time",
-        Parameter::RelaxationTime => "layer.relaxation_time",
-    }
-    .to_string()
-}
-
-fn option_field(e: &OptionError) -> &'static str {
-    match e.option {
-        SolveOption::Strips => "options.strips",
-        SolveOption::BoundaryPoints => "options.boundary_points",
-        SolveOption::PressureGrid => "options.pressure_grid",
-    }
-}
-
 /// -0.0 and 0.0 are the same input: one canonical form, one cache key.
 pub(crate) fn si(x: f64) -> f64 {
     if x == 0.0 {
@@ -198,8 +172,8 @@ impl RollingJob {
                 .unwrap_or(SolveOptions::default().boundary_points),
             pressure_grid: o.pressure_grid,
         };
-        checker.parameters(rolling.violations(), parameter_field);
-        checker.options(options.violations(), option_field);
+        checker.parameters(rolling.violations());
+        checker.options(options.violations());
         RollingJob { rolling, options }
     }
 

@@ -11,6 +11,8 @@ pub enum SolveOption {
     Strips,
     BoundaryPoints,
     PressureGrid,
+    /// Gauss nodes over the particle diameters (three-body).
+    DiameterNodes,
 }
 
 impl fmt::Display for SolveOption {
@@ -19,6 +21,7 @@ impl fmt::Display for SolveOption {
             SolveOption::Strips => "strips",
             SolveOption::BoundaryPoints => "boundary points",
             SolveOption::PressureGrid => "pressure grid",
+            SolveOption::DiameterNodes => "diameter nodes",
         })
     }
 }
@@ -42,6 +45,9 @@ pub enum ModelError {
     InvalidOption(OptionError),
     /// Valid parameters whose combination over- or underflows double precision.
     NotRepresentable { what: String },
+    /// Valid parameters that ask for something the model cannot do: a load the system cannot
+    /// carry, no particle in contact, a layer pierced through.
+    OutOfModel(String),
     /// A bracketed root finder ran out of iterations.
     NoConvergence { what: &'static str, iterations: u32 },
 }
@@ -58,6 +64,7 @@ impl fmt::Display for ModelError {
             ModelError::NotRepresentable { what } => {
                 write!(f, "{what} is not representable in double precision")
             }
+            ModelError::OutOfModel(why) => f.write_str(why),
             ModelError::NoConvergence { what, iterations } => {
                 write!(f, "the {what} did not converge in {iterations} iterations")
             }

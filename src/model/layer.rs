@@ -96,28 +96,79 @@ pub enum Parameter {
     PoissonRatio,
     RetardationTime,
     RelaxationTime,
+    /// x_a of the three-body model (MODEL.md §4).
+    MeanDiameter,
+    /// σ_a.
+    StdDiameter,
+    MinDiameter,
+    MaxDiameter,
+    /// η_a, particles per unit area.
+    ArealDensity,
+    /// A_n.
+    NominalArea,
+    UpperModulus,
+    UpperPoissonRatio,
+    UpperHardness,
+    ParticleModulus,
+    ParticlePoissonRatio,
+    /// η_s, asperities per unit area.
+    AsperityDensity,
+    /// β_s.
+    TipRadius,
+    /// σ_s.
+    HeightStd,
+    /// H_s.
+    AsperityHardness,
+    /// d.
+    Separation,
+    /// W.
+    TotalLoad,
+    /// Mean load per particle in contact.
+    ParticleLoad,
 }
 
 impl Parameter {
     /// The SI unit of the parameter ("" for dimensionless).
     pub fn unit(self) -> &'static str {
+        use Parameter::*;
         match self {
-            Parameter::Radius | Parameter::Thickness => "m",
-            Parameter::Load => "N",
-            Parameter::Velocity => "m/s",
-            Parameter::ElasticModulus => "Pa",
-            Parameter::PoissonRatio => "",
-            Parameter::RetardationTime | Parameter::RelaxationTime => "s",
+            Radius | Thickness | MeanDiameter | StdDiameter | MinDiameter | MaxDiameter
+            | TipRadius | HeightStd | Separation => "m",
+            Load | TotalLoad | ParticleLoad => "N",
+            Velocity => "m/s",
+            ElasticModulus | UpperModulus | UpperHardness | ParticleModulus | AsperityHardness => {
+                "Pa"
+            }
+            PoissonRatio | UpperPoissonRatio | ParticlePoissonRatio => "",
+            RetardationTime | RelaxationTime => "s",
+            ArealDensity | AsperityDensity => "m^-2",
+            NominalArea => "m^2",
         }
+    }
+
+    /// Whether zero is allowed (else the value must be positive).
+    fn may_be_zero(self) -> bool {
+        use Parameter::*;
+        matches!(self, Velocity | StdDiameter | MinDiameter | Separation)
+    }
+
+    fn is_poisson_ratio(self) -> bool {
+        use Parameter::*;
+        matches!(
+            self,
+            PoissonRatio | UpperPoissonRatio | ParticlePoissonRatio
+        )
     }
 
     /// The allowed range, as text.
     pub fn allowed(self) -> String {
         let unit = self.unit();
-        match self {
-            Parameter::Velocity => format!("finite and ≥ 0 {unit}"),
-            Parameter::PoissonRatio => "0 ≤ ν < 0.5".to_string(),
-            _ => format!("finite and > 0 {unit}"),
+        if self.is_poisson_ratio() {
+            "0 ≤ ν < 0.5".to_string()
+        } else if self.may_be_zero() {
+            format!("finite and ≥ 0 {unit}")
+        } else {
+            format!("finite and > 0 {unit}")
         }
     }
 
@@ -125,10 +176,12 @@ impl Parameter {
     /// T_ε ≥ T_σ, that [`Layer::violations`] adds).
     pub fn check(self, value: f64) -> Result<(), ParameterError> {
         let ok = value.is_finite()
-            && match self {
-                Parameter::Velocity => value >= 0.0,
-                Parameter::PoissonRatio => (0.0..0.5).contains(&value),
-                _ => value > 0.0,
+            && if self.is_poisson_ratio() {
+                (0.0..0.5).contains(&value)
+            } else if self.may_be_zero() {
+                value >= 0.0
+            } else {
+                value > 0.0
             };
         if ok {
             Ok(())
@@ -153,6 +206,24 @@ impl fmt::Display for Parameter {
             Parameter::PoissonRatio => "Poisson ratio",
             Parameter::RetardationTime => "retardation time",
             Parameter::RelaxationTime => "relaxation time",
+            Parameter::MeanDiameter => "mean diameter",
+            Parameter::StdDiameter => "diameter standard deviation",
+            Parameter::MinDiameter => "minimum diameter",
+            Parameter::MaxDiameter => "maximum diameter",
+            Parameter::ArealDensity => "particles per unit area",
+            Parameter::NominalArea => "nominal area",
+            Parameter::UpperModulus => "upper surface elastic modulus",
+            Parameter::UpperPoissonRatio => "upper surface Poisson ratio",
+            Parameter::UpperHardness => "upper surface hardness",
+            Parameter::ParticleModulus => "particle elastic modulus",
+            Parameter::ParticlePoissonRatio => "particle Poisson ratio",
+            Parameter::AsperityDensity => "asperities per unit area",
+            Parameter::TipRadius => "asperity tip radius",
+            Parameter::HeightStd => "asperity height standard deviation",
+            Parameter::AsperityHardness => "asperity hardness",
+            Parameter::Separation => "separation",
+            Parameter::TotalLoad => "total load",
+            Parameter::ParticleLoad => "mean particle load",
         })
     }
 }

@@ -4,12 +4,15 @@
 
 mod error;
 pub mod figures;
+pub mod kelvin_map;
 mod layer;
 pub mod limits;
 pub mod quadrature;
 pub mod rolling;
+mod roots;
 mod special;
 pub mod strip;
+pub mod three_body;
 
 pub use error::{ModelError, OptionError, SolveOption};
 pub use layer::{Layer, Parameter, ParameterError};

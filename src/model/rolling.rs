@@ -246,6 +246,16 @@ pub fn solve(rolling: &Rolling, options: &SolveOptions) -> Result<RollingSolutio
     Ok(solution)
 }
 
+/// The contact at a given penetration δ rather than a given load (the forward map of the
+/// three-body model, MODEL.md §4), as ratios to the static contact at the same δ:
+/// P = π k R δ² Φ_P and A = 2π R δ Φ_A, where Φ_P and Φ_A depend only on
+/// ξ = V T_σ/√(2Rδ) and κ (the similarity law). Φ_P runs from 1 (ξ = 0) to 1 + κ (ξ → ∞);
+/// Φ_A is 1 at both ends and dips in between.
+pub fn penetration_ratios(xi: f64, kappa: f64, rule: &StripRule) -> Result<(f64, f64), ModelError> {
+    let integrals = Section::new(1.0, xi, kappa).integrate(rule, None)?;
+    Ok((integrals.load / FRAC_PI_4, integrals.area / PI))
+}
+
 /// Refuses to hand out a non-finite number (serde_json would write it as a silent `null`).
 fn ensure_finite(s: &RollingSolution) -> Result<(), ModelError> {
     let scalars = [

@@ -1,0 +1,181 @@
+//! One particle squeezed between the upper surface and the layer (MODEL.md §4): the two
+//! contact laws and the split of the interference ω = x − d into ω₁ (upper) and ω₂ (layer)
+//! at which both contacts carry the same force.
+
+use std::f64::consts::PI;
+
+use crate::model::kelvin_map::KelvinMap;
+use crate::model::roots::brent;
+use crate::model::ModelError;
+
+/// How the upper surface takes a particle of radius R = x/2.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum UpperLaw {
+    /// Hertz with the composite modulus E_s1a: F = (4/3)E_s1a R^{1/2} ω₁^{3/2}, A₁ = πRω₁.
+    Elastic { modulus: f64 },
+    /// Fully plastic (Horng): A₁ = 2πRω₁ = πxω₁, F = H₁A₁.
+    Plastic { hardness: f64 },
+}
+
+impl UpperLaw {
+    /// Force (N) at interference ω₁.
+    pub fn force(&self, radius: f64, omega: f64) -> f64 {
+        match *self {
+            UpperLaw::Elastic { modulus } => {
+                4.0 / 3.0 * modulus * radius.sqrt() * omega * omega.sqrt()
+            }
+            UpperLaw::Plastic { hardness } => hardness * self.area(radius, omega),
+        }
+    }
+
+    /// Contact area (m²) at interference ω₁.
+    pub fn area(&self, radius: f64, omega: f64) -> f64 {
+        match self {
+            UpperLaw::Elastic { .. } => PI * radius * omega,
+            UpperLaw::Plastic { .. } => 2.0 * PI * radius * omega,
+        }
+    }
+
+    /// The interference ω₁ that carries `force`: the inverse of [`UpperLaw::force`].
+    pub fn interference(&self, radius: f64, force: f64) -> f64 {
+        match *self {
+            UpperLaw::Elastic { modulus } => {
+                (3.0 * force / (4.0 * modulus * radius.sqrt())).powf(2.0 / 3.0)
+            }
+            UpperLaw::Plastic { hardness } => force / (2.0 * PI * radius * hardness),
+        }
+    }
+}
+
+/// How the layer takes a particle of radius R = x/2 (the particle is rigid there).
+#[derive(Clone, Debug)]
+pub enum LayerLaw {
+    /// The rolling contact of MODEL.md §3 at a given penetration δ = ω₂:
+    /// F = πkRδ²Φ_P(ξ), A₂ = 2πRδΦ_A(ξ), ξ = V T_σ/√(2Rδ). At rest Φ_P = Φ_A = 1.
+    Kelvin {
+        /// k = E_L/H.
+        stiffness: f64,
+        /// λ_σ = V T_σ (0 at rest).
+        relaxation_length: f64,
+        /// The tabulated ratios; `None` at rest.
+        map: Option<KelvinMap>,
+    },
+    /// Hertz with E_s2a: F = (4/3)E_s2a R^{1/2} δ^{3/2}, A₂ = πRδ.
+    Hertz { modulus: f64 },
+}
+
+impl LayerLaw {
+    /// (force, area) at penetration δ.
+    pub fn contact(&self, radius: f64, delta: f64) -> (f64, f64) {
+        match self {
+            LayerLaw::Kelvin {
+                stiffness,
+                relaxation_length,
+                map,
+            } => {
+                let (phi_p, phi_a) = match map {
+                    Some(map) if *relaxation_length > 0.0 => {
+                        let half_width = (2.0 * radius * delta).sqrt();
+                        map.ratios(relaxation_length / half_width)
+                    }
+                    _ => (1.0, 1.0),
+                };
+                (
+                    PI * stiffness * radius * delta * delta * phi_p,
+                    2.0 * PI * radius * delta * phi_a,
+                )
+            }
+            LayerLaw::Hertz { modulus } => (
+                4.0 / 3.0 * modulus * radius.sqrt() * delta * delta.sqrt(),
+                PI * radius * delta,
+            ),
+        }
+    }
+}
+
+/// A particle in equilibrium between the two surfaces.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Squeeze {
+    /// ω₁, into the upper surface (m).
+    pub upper_interference: f64,
+    /// ω₂, into the layer (m).
+    pub layer_penetration: f64,
+    /// F, carried by both contacts (N).
+    pub force: f64,
+    /// A₁ (m²).
+    pub upper_area: f64,
+    /// A₂ (m²).
+    pub layer_area: f64,
+}
+
+/// Splits the interference ω of a particle of diameter x: solves ω₂ + ω₁(F_layer(ω₂)) = ω
+/// for ω₂ ∈ (0, ω) (increasing in ω₂, so one root, bracketed), then takes ω₁ from the
+/// inverse upper law so that it keeps full relative precision even when ω₁ ≪ ω₂.
+pub fn squeeze(
+    upper: &UpperLaw,
+    layer: &LayerLaw,
+    diameter: f64,
+    omega: f64,
+) -> Result<Squeeze, ModelError> {
+    if omega <= 0.0 {
+        return Ok(Squeeze::default());
+    }
+    let radius = 0.5 * diameter;
+    let mismatch = |delta: f64| {
+        let (force, _) = layer.contact(radius, delta);
+        delta + upper.interference(radius, force) - omega
+    };
+    let root = brent(
+        mismatch,
+        (0.0, -omega),
+        (omega, mismatch(omega)),
+        1e-15 * omega,
+        "split of the interference between the upper surface and the layer",
+    )?;
+    let delta = root.x;
+    let (force, layer_area) = layer.contact(radius, delta);
+    let upper_interference = upper.interference(radius, force);
+    Ok(Squeeze {
+        upper_interference,
+        layer_penetration: delta,
+        force,
+        upper_area: upper.area(radius, upper_interference),
+        layer_area,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_upper_law_inverts() {
+        for upper in [
+            UpperLaw::Elastic { modulus: 2.3e11 },
+            UpperLaw::Plastic { hardness: 2e9 },
+        ] {
+            let omega = 3e-11;
+            let force = upper.force(25e-9, omega);
+            assert!((upper.interference(25e-9, force) / omega - 1.0).abs() < 1e-14);
+        }
+    }
+
+    #[test]
+    fn two_hertz_contacts_split_the_interference_in_closed_form() {
+        // Equal forces: ω₁/ω₂ = (E₂/E₁)^{2/3}.
+        let (e1, e2) = (2.3e11, 3.3e9);
+        let s = squeeze(
+            &UpperLaw::Elastic { modulus: e1 },
+            &LayerLaw::Hertz { modulus: e2 },
+            50e-9,
+            2e-9,
+        )
+        .unwrap();
+        let ratio = (e2 / e1).powf(2.0 / 3.0);
+        let delta = 2e-9 / (1.0 + ratio);
+        assert!((s.layer_penetration / delta - 1.0).abs() < 1e-13);
+        assert!((s.upper_interference / (2e-9 - delta) - 1.0).abs() < 1e-13);
+        let upper_force = UpperLaw::Elastic { modulus: e1 }.force(25e-9, s.upper_interference);
+        assert!((upper_force / s.force - 1.0).abs() < 1e-13);
+    }
+}
