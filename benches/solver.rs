@@ -1,5 +1,6 @@
 //! Speed of the physics core: one rolling solve at 1e-9 relative accuracy (target: < 100 µs
-//! median) and the data of all of the paper's Figures 3–9 (target: < 50 ms).
+//! median), the data of all of the paper's Figures 3–9 (target: < 50 ms), and a
+//! `kelvin_layer` three-body job with a given total load (target: < 20 ms median).
 //! Results and method: BENCHMARKS.md. Run with `cargo bench --bench solver`.
 
 use std::hint::black_box;
@@ -9,6 +10,11 @@ use criterion::{criterion_group, criterion_main, Criterion};
 use serde_json::json;
 use thirdbody::engine::{self, Control};
 use thirdbody::job::{Job, Limits};
+use thirdbody::model::kelvin_map::KelvinMap;
+use thirdbody::model::quadrature::StripRule;
+use thirdbody::model::three_body::{
+    self, LayerContact, OperatingPoint, ThreeBody, ThreeBodyOptions,
+};
 use thirdbody::model::{solve, Quadrature, Rolling, SolveOptions};
 
 fn rolling(c: &mut Criterion) {
@@ -68,5 +74,34 @@ fn figures(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, rolling, figures);
+fn three_body(c: &mut Criterion) {
+    let mut group = c.benchmark_group("three_body");
+    let options = ThreeBodyOptions::default();
+    // The default system of MODEL.md §5 carrying W = 1 mN (target: < 20 ms median).
+    let kelvin = ThreeBody::with_defaults(OperatingPoint::TotalLoad(1e-3));
+    group.bench_function("kelvin_layer_total_load", |b| {
+        b.iter(|| three_body::solve(black_box(&kelvin), &options).unwrap())
+    });
+    group.bench_function("kelvin_layer_separation", |b| {
+        let at = ThreeBody {
+            operating: OperatingPoint::Separation(58e-9),
+            ..kelvin
+        };
+        b.iter(|| three_body::solve(black_box(&at), &options).unwrap())
+    });
+    group.bench_function("hertz_total_load", |b| {
+        let hertz = ThreeBody {
+            layer_contact: LayerContact::Hertz,
+            ..kelvin
+        };
+        b.iter(|| three_body::solve(black_box(&hertz), &options).unwrap())
+    });
+    group.bench_function("kelvin_table_build", |b| {
+        let rule = StripRule::shared(Quadrature::default()).unwrap();
+        b.iter(|| KelvinMap::new(black_box(4.0), &rule).unwrap())
+    });
+    group.finish();
+}
+
+criterion_group!(benches, rolling, figures, three_body);
 criterion_main!(benches);

@@ -47,6 +47,12 @@ fn every_example_job_solves() {
 
     let figure = json(&thirdbody(&["solve", "examples/figure.json"], None));
     assert_eq!(figure["figure"], 6);
+
+    let three_body = json(&thirdbody(&["solve", "examples/three_body.json"], None));
+    let load = three_body["loads"]["total"].as_f64().unwrap();
+    assert!((load / 1e-3 - 1.0).abs() < 1e-10);
+    let mu = &three_body["friction_coefficient"];
+    assert!(mu["rolling"].as_f64().unwrap() < mu["static"].as_f64().unwrap());
 }
 
 #[test]

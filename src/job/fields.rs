@@ -137,10 +137,17 @@ impl Checker {
         });
     }
 
-    /// Records a value outside its range, unless the field was already reported.
+    /// Records a value outside its range, unless the field (or the object holding it) was
+    /// already reported: a value read as NaN after an error says nothing new.
     pub fn out_of_range(&mut self, field: &str, value: f64, unit: &str, allowed: &str) {
         let path = self.path(field);
-        if self.errors.iter().any(|e| e.field == path) {
+        let covered = |e: &FieldError| {
+            path == e.field
+                || path
+                    .strip_prefix(e.field.as_str())
+                    .is_some_and(|rest| rest.starts_with('.'))
+        };
+        if self.errors.iter().any(covered) {
             return;
         }
         let sent = self

@@ -170,6 +170,12 @@ impl ThreeBody {
             .filter_map(|(p, v)| p.check(v).err())
             .collect();
         errors.extend(self.layer.violations());
+        let diameters_valid = !errors.iter().any(|e| {
+            matches!(
+                e.parameter,
+                MeanDiameter | StdDiameter | MinDiameter | MaxDiameter
+            )
+        });
         let mut add = |parameter, value, allowed: String| {
             errors.push(ParameterError {
                 parameter,
@@ -177,7 +183,9 @@ impl ThreeBody {
                 allowed,
             })
         };
-        if d.is_single_size() {
+        if !diameters_valid {
+            // Bounds derived from an invalid mean or deviation say nothing more.
+        } else if d.is_single_size() {
             if !(d.min <= d.mean && d.mean <= d.max) {
                 add(
                     MaxDiameter,
