@@ -105,6 +105,25 @@ fn kelvin_layer_at_rest_is_the_closed_form_per_particle() {
 }
 
 #[test]
+fn plastic_upper_contact_carries_the_load_at_its_hardness_and_soft_particles_flatten_more() {
+    let hardness = 2e9;
+    let mut s = system(OperatingPoint::Separation(50e-9));
+    s.upper.contact = three_body::UpperContact::Plastic;
+    s.upper.hardness = Some(hardness);
+    let state = solve3(&s).unwrap().rolling;
+    // F = H₁A₁ for every particle, so the sums obey W_a = H₁ A_s1a exactly.
+    assert!(rel(state.loads.particles, hardness * state.areas.particle_upper) < 1e-12);
+
+    let rigid = solve3(&system(OperatingPoint::TotalLoad(1e-3)))
+        .unwrap()
+        .rolling;
+    let mut soft = system(OperatingPoint::TotalLoad(1e-3));
+    soft.particle.elastic_modulus = Some(70e9);
+    let soft = solve3(&soft).unwrap().rolling;
+    assert!(soft.areas.particle_upper > rigid.areas.particle_upper);
+}
+
+#[test]
 fn particles_of_one_size_give_the_single_particle_friction_of_eq_12() {
     for (velocity, load) in [(4e-9, 1e-9), (10e-9, 1.3e-9), (0.0, 1e-9)] {
         let mut s = system(OperatingPoint::ParticleLoad(load));
@@ -294,6 +313,7 @@ fn a_job_naming_only_the_operating_point_is_valid_and_canonical() {
             < 1e-12
     );
     assert!(!text.to_string().contains("null"));
+    assert_eq!(text["meta"]["references"].as_array().unwrap().len(), 5);
     for key in [
         "separation",
         "particles_in_contact",

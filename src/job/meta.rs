@@ -18,8 +18,9 @@ pub struct Reference {
     pub doi: Option<&'static str>,
 }
 
-/// The papers behind the numbers.
-pub const REFERENCES: [Reference; 3] = [
+/// The papers behind the numbers: the first three behind every job, the last two behind
+/// three-body jobs.
+pub const REFERENCES: [Reference; 5] = [
     Reference {
         role: "model: three-body contact with particles rolling over a Kelvin layer (eqs. 1–13)",
         citation: "Contact problem of a system of particles rolling over a viscoelastic layer \
@@ -39,7 +40,28 @@ pub const REFERENCES: [Reference; 3] = [
                    multi-asperity contact and friction. Journal of Tribology 125 (2003)",
         doi: None,
     },
+    Reference {
+        role: "three-body microcontact model: particles between rough surfaces (eqs. 6–8)",
+        citation: "J. H. Horng's three-body microcontact model for rough surfaces, reference 16 \
+                   of the model paper",
+        doi: None,
+    },
+    Reference {
+        role: "asperity contact: elastic, elastic-plastic and plastic regimes",
+        citation: "Y. Zhao, D. M. Maietta and L. Chang, An asperity microcontact model \
+                   incorporating the transition from elastic deformation to fully plastic \
+                   flow. Journal of Tribology 122 (2000)",
+        doi: None,
+    },
 ];
+
+/// The references behind a job of `kind`.
+fn references(kind: JobKind) -> &'static [Reference] {
+    match kind {
+        JobKind::ThreeBody => &REFERENCES,
+        _ => &REFERENCES[..3],
+    }
+}
 
 /// The `meta` block of an answer.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -58,7 +80,7 @@ impl Meta {
             model_version: MODEL_VERSION,
             input_hash: input_hash(kind, &canonical),
             input: canonical,
-            references: &REFERENCES,
+            references: references(kind),
         }
     }
 }
