@@ -412,8 +412,9 @@ impl Section {
         }
     }
 
-    /// P = 2∫q dy, A = 2∫(b − a) dy and ∬x dA = ∫(b² − a²) dy over the strips of `rule`. `warm`, if given, holds each strip's exit root from a previous call and
-    /// receives the new ones.
+    /// P = 2∫q dy, A = 2∫(b − a) dy and ∬x dA = ∫(b² − a²) dy over the strips of `rule`.
+    /// `warm`, if given, holds each strip's exit root from a previous call and receives the
+    /// new ones.
     fn integrate(
         &self,
         rule: &StripRule,
