@@ -14,8 +14,9 @@ pub mod rolling;
 pub mod sweep;
 pub mod units;
 
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 use serde_json::Value;
+use utoipa::ToSchema;
 
 pub use error::{FieldError, JobError};
 pub use fields::Quantity;
@@ -50,7 +51,7 @@ impl Default for Limits {
 }
 
 /// What a job computes.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, Serialize, ToSchema)]
 #[serde(rename_all = "snake_case")]
 pub enum JobKind {
     Rolling,
@@ -69,12 +70,15 @@ impl JobKind {
 }
 
 /// The envelope `{"kind": ..., "input": {...}}`; a missing input means all defaults.
-#[derive(Deserialize)]
+#[derive(Deserialize, ToSchema)]
 #[serde(deny_unknown_fields)]
-struct Envelope {
-    kind: JobKind,
+pub struct Envelope {
+    pub kind: JobKind,
+    /// The input of the job's kind: a `RollingInput`, `SweepInput` or `FigureInput`.
+    /// Absent, every field takes its default.
     #[serde(default)]
-    input: Option<Value>,
+    #[schema(value_type = Option<Object>)]
+    pub input: Option<Value>,
 }
 
 /// A validated job, ready for the engine.
@@ -98,7 +102,13 @@ impl Job {
         let input = envelope
             .input
             .unwrap_or_else(|| Value::Object(Default::default()));
-        Ok(match envelope.kind {
+        Job::from_input(envelope.kind, input, limits)
+    }
+
+    /// Validates the input of a job of `kind` (the envelope's `input`, or the body of the
+    /// HTTP endpoint of that kind): error paths are relative to the input.
+    pub fn from_input(kind: JobKind, input: Value, limits: &Limits) -> Result<Job, JobError> {
+        Ok(match kind {
             JobKind::Rolling => Job::Rolling(RollingJob::from_value(input)?),
             JobKind::Sweep => Job::Sweep(SweepJob::from_value(input, limits)?),
             JobKind::Figure => Job::Figure(FigureJob::from_value(input)?),

@@ -3,6 +3,7 @@
 
 use serde::{Deserialize, Serialize};
 use serde_json::{json, Value};
+use utoipa::ToSchema;
 
 use super::fields::{self, Checker, Quantity};
 use super::rolling::{si, ContactOutput, RollingInput, RollingJob, VerificationOutput};
@@ -11,15 +12,17 @@ use super::{format_number, JobError, JobKind, Limits, Meta};
 use crate::model::{Parameter, Rolling, RollingSolution, SolveOptions};
 
 /// Input of a sweep: a base rolling input and the lists to vary over it.
-#[derive(Clone, Debug, Default, PartialEq, Deserialize, Serialize)]
+#[derive(Clone, Debug, Default, PartialEq, Deserialize, Serialize, ToSchema)]
 #[serde(deny_unknown_fields)]
 pub struct SweepInput {
+    /// The rolling input every point starts from (its options keep the quadrature only).
     pub base: Option<RollingInput>,
+    /// The lists to vary; the points are their Cartesian product.
     pub vary: Option<VaryInput>,
 }
 
 /// The values to sweep; an absent list keeps the base value.
-#[derive(Clone, Debug, Default, PartialEq, Deserialize, Serialize)]
+#[derive(Clone, Debug, Default, PartialEq, Deserialize, Serialize, ToSchema)]
 #[serde(deny_unknown_fields)]
 pub struct VaryInput {
     /// R values (m).
@@ -166,7 +169,7 @@ fn read_list(
 }
 
 /// One row of a sweep.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
 pub struct SweepPoint {
     /// R (m).
     pub radius: f64,
@@ -176,12 +179,14 @@ pub struct SweepPoint {
     pub velocity: f64,
     #[serde(flatten)]
     pub contact: ContactOutput,
+    /// How far this point's numbers can be trusted.
     pub verification: VerificationOutput,
 }
 
 /// The answer to a sweep.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
 pub struct SweepOutput {
+    /// One row per point: radius outermost, then load, then speed.
     pub points: Vec<SweepPoint>,
     pub meta: Meta,
 }
