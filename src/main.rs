@@ -1,4 +1,5 @@
-//! The `thirdbody` command: solve a job file, or print a figure of the paper.
+//! The `thirdbody` command: solve a job file, print a figure of the paper, or serve the
+//! HTTP API.
 
 use std::io::{Read, Write};
 use std::process::ExitCode;
@@ -6,6 +7,7 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand, ValueEnum};
 
 use thirdbody::engine::{self, Control, Output};
+use thirdbody::http::{self, AppState, LogFormat, ServeArgs};
 use thirdbody::job::{FigureJob, Job, JobError, Limits};
 
 #[derive(Parser)]
@@ -35,6 +37,10 @@ enum Command {
         #[arg(long, value_enum, default_value_t = Format::Json)]
         format: Format,
     },
+    /// Serve the HTTP API (see /docs once it runs); every flag has a THIRDBODY_* variable.
+    Serve(Box<ServeArgs>),
+    /// Print the OpenAPI description of the HTTP API.
+    Openapi,
 }
 
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -43,7 +49,8 @@ enum Format {
     Csv,
 }
 
-/// Exit status for a job that is not valid (as distinct from one that failed to solve).
+/// Exit status for a job that is not valid (as distinct from one that failed to solve), and
+/// for a `serve` setting that is not valid.
 const INVALID_JOB: u8 = 2;
 
 fn main() -> ExitCode {
@@ -51,24 +58,15 @@ fn main() -> ExitCode {
     let (job, format) = match cli.command {
         Command::Solve { job, format } => (read_job(&job), format),
         Command::Figure { number, format } => (FigureJob::new(number).map(Job::Figure), format),
+        Command::Serve(args) => return serve(*args),
+        Command::Openapi => return print(&http::openapi::spec_json()),
     };
     let result = job.and_then(|job| {
         let output = engine::run(&job, &Control::default())?;
         render(&output, format)
     });
     match result {
-        Ok(text) => {
-            // A reader that stops early (`| head`) is not an error of ours.
-            let mut out = std::io::stdout().lock();
-            let newline = if text.ends_with('\n') { "" } else { "\n" };
-            match write!(out, "{text}{newline}").and_then(|()| out.flush()) {
-                Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => {
-                    eprintln!("thirdbody: cannot write the result: {e}");
-                    ExitCode::FAILURE
-                }
-                _ => ExitCode::SUCCESS,
-            }
-        }
+        Ok(text) => print(&text),
         Err(e) => {
             eprintln!("thirdbody: {e}");
             match e {
@@ -78,6 +76,93 @@ fn main() -> ExitCode {
                 _ => ExitCode::FAILURE,
             }
         }
+    }
+}
+
+/// Writes `text` to standard output; a reader that stops early (`| head`) is not an error
+/// of ours.
+fn print(text: &str) -> ExitCode {
+    let mut out = std::io::stdout().lock();
+    let newline = if text.ends_with('\n') { "" } else { "\n" };
+    match write!(out, "{text}{newline}").and_then(|()| out.flush()) {
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => {
+            eprintln!("thirdbody: cannot write the result: {e}");
+            ExitCode::FAILURE
+        }
+        _ => ExitCode::SUCCESS,
+    }
+}
+
+/// `thirdbody serve`: validates the settings, then serves until SIGTERM or Ctrl-C.
+fn serve(args: ServeArgs) -> ExitCode {
+    let config = match args.validate() {
+        Ok(config) => config,
+        Err(e) => {
+            eprintln!("thirdbody serve: invalid setting: {e}");
+            return ExitCode::from(INVALID_JOB);
+        }
+    };
+    init_logging(config.log_format);
+    let runtime = match tokio::runtime::Runtime::new() {
+        Ok(runtime) => runtime,
+        Err(e) => {
+            eprintln!("thirdbody serve: cannot start the runtime: {e}");
+            return ExitCode::FAILURE;
+        }
+    };
+    let served = runtime.block_on(async {
+        let bind = config.bind;
+        let listener = tokio::net::TcpListener::bind(bind)
+            .await
+            .map_err(|e| format!("cannot listen on {bind}: {e}"))?;
+        tracing::info!(address = %bind, "listening; API docs at /docs");
+        http::run(listener, AppState::new(config), shutdown_signal())
+            .await
+            .map_err(|e| format!("the server failed: {e}"))
+    });
+    match served {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("thirdbody serve: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+/// Log lines on standard error, filtered by `RUST_LOG` (default `info`).
+fn init_logging(format: LogFormat) {
+    let filter = tracing_subscriber::EnvFilter::try_from_default_env()
+        .unwrap_or_else(|_| tracing_subscriber::EnvFilter::new("info"));
+    let logs = tracing_subscriber::fmt()
+        .with_env_filter(filter)
+        .with_writer(std::io::stderr);
+    match format {
+        LogFormat::Json => logs.json().flatten_event(true).init(),
+        LogFormat::Text => logs.init(),
+    }
+}
+
+/// Resolves on Ctrl-C or SIGTERM.
+async fn shutdown_signal() {
+    let ctrl_c = async {
+        if tokio::signal::ctrl_c().await.is_err() {
+            std::future::pending::<()>().await;
+        }
+    };
+    #[cfg(unix)]
+    let terminate = async {
+        match tokio::signal::unix::signal(tokio::signal::unix::SignalKind::terminate()) {
+            Ok(mut signal) => {
+                signal.recv().await;
+            }
+            Err(_) => std::future::pending::<()>().await,
+        }
+    };
+    #[cfg(not(unix))]
+    let terminate = std::future::pending::<()>();
+    tokio::select! {
+        () = ctrl_c => {}
+        () = terminate => {}
     }
 }
 

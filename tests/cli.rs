@@ -109,3 +109,24 @@ fn a_bad_job_fails_with_status_2_and_says_which_field() {
     let out = thirdbody(&["solve", "examples/rolling.json", "--format", "csv"], None);
     assert_ne!(out.status.code(), Some(0));
 }
+
+#[test]
+fn openapi_prints_the_committed_spec() {
+    let output = thirdbody(&["openapi"], None);
+    assert!(output.status.success());
+    let committed = std::fs::read_to_string("openapi/openapi.json").unwrap();
+    assert!(
+        String::from_utf8(output.stdout).unwrap() == committed,
+        "openapi/openapi.json is out of date: run `cargo run -- openapi > openapi/openapi.json`"
+    );
+}
+
+#[test]
+fn serve_refuses_a_bad_setting_at_start_up_with_status_2() {
+    let output = thirdbody(&["serve", "--pool-size", "0"], None);
+    assert_eq!(output.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(stderr.contains("--pool-size 0"), "{stderr}");
+    let output = thirdbody(&["serve", "--bind", "nowhere"], None);
+    assert_eq!(output.status.code(), Some(2));
+}

@@ -1,8 +1,10 @@
 //! Runs validated jobs: one rolling solve, or the many of a sweep or figure spread over the
 //! cores, with progress, cancellation and a deadline checked between solves.
 //!
-//! This is the only place that knows how a job maps onto model calls; the CLI calls it
-//! directly and the HTTP service calls it from its blocking pool.
+//! This is the only place that knows how a job maps onto model calls; the CLI calls [`run`]
+//! directly. The HTTP service goes through an [`Engine`]: admission control on a pool of
+//! permits sized to the cores ([`pool`]), a result cache that coalesces identical misses
+//! ([`cache`]) and a store of asynchronous jobs ([`jobs`]).
 
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::Mutex;
@@ -10,6 +12,7 @@ use std::thread;
 use std::time::Instant;
 
 use serde::Serialize;
+use utoipa::ToSchema;
 
 use crate::job::figure::FigureOutput;
 use crate::job::rolling::RollingOutput;
@@ -17,6 +20,14 @@ use crate::job::sweep::{SweepJob, SweepOutput};
 use crate::job::three_body::ThreeBodyOutput;
 use crate::job::{Job, JobError};
 use crate::model::{self, three_body, ModelError};
+
+pub mod cache;
+pub mod jobs;
+pub mod metrics;
+pub mod pool;
+mod service;
+
+pub use service::{CacheStatus, Engine, EngineConfig, EngineError};
 
 /// Shared between a running job and whoever watches it: progress, cancellation, deadline.
 #[derive(Debug)]
@@ -67,7 +78,7 @@ impl Control {
 }
 
 /// The answer to any job.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
 #[serde(untagged)]
 pub enum Output {
     Rolling(RollingOutput),

@@ -4,15 +4,17 @@ use std::fmt;
 
 use serde::Serialize;
 use serde_json::Value;
+use utoipa::ToSchema;
 
 use crate::model::ModelError;
 
 /// One invalid field: where, what was sent, and what is allowed.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
 pub struct FieldError {
     /// Path of the field in the input, e.g. `layer.thickness` or `vary.radius[2]`.
     pub field: String,
-    /// The value as sent.
+    /// The value as sent (any JSON value; `null` when the field's shape was wrong).
+    #[schema(value_type = Object)]
     pub value: Value,
     /// The allowed values.
     pub allowed: String,

@@ -4,13 +4,15 @@
 use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
+use utoipa::ToSchema;
 
 use super::units::{parse_quantity, Dimension, UnitError};
 use super::{FieldError, JobError};
 use crate::model::{OptionError, Parameter, ParameterError, SolveOption};
 
-/// A quantity as sent: an SI number, or a string with a unit.
-#[derive(Clone, Debug, PartialEq, Deserialize, Serialize)]
+/// A quantity as sent: an SI number, or a string with a unit such as `"25 nm"`, `"1.2 nN"`,
+/// `"4 nm/s"`, `"3 GPa"` or `"100 ms"` (its dimension must be the field's).
+#[derive(Clone, Debug, PartialEq, Deserialize, Serialize, ToSchema)]
 #[serde(untagged)]
 pub enum Quantity {
     Number(f64),

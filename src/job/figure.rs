@@ -2,13 +2,14 @@
 
 use serde::{Deserialize, Serialize};
 use serde_json::{json, Value};
+use utoipa::ToSchema;
 
 use super::fields::{self, Checker};
 use super::{format_number, JobError, JobKind, Meta};
 use crate::model::figures::{Figure, Plan, FIGURES};
 
 /// Input of a figure job.
-#[derive(Clone, Debug, PartialEq, Deserialize, Serialize)]
+#[derive(Clone, Debug, PartialEq, Deserialize, Serialize, ToSchema)]
 #[serde(deny_unknown_fields)]
 pub struct FigureInput {
     /// The figure's number in the paper, 3 to 9.
@@ -59,33 +60,43 @@ impl FigureJob {
 }
 
 /// An axis of a figure.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
 pub struct AxisOutput {
+    /// What the axis shows, e.g. `contact_area`.
     pub quantity: &'static str,
     /// SI unit ("" for a plain number).
     pub unit: &'static str,
 }
 
 /// One curve.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
 pub struct SeriesOutput {
+    /// The curve's legend, e.g. `V = 4 nm/s`.
     pub label: String,
+    /// R of the curve (m), when it is fixed along it.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub radius: Option<f64>,
+    /// P of the curve (N), when it is fixed along it.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub load: Option<f64>,
+    /// V of the curve (m/s).
     pub velocity: f64,
     /// [x, y] pairs in the units of the axes.
     pub points: Vec<[f64; 2]>,
 }
 
 /// The answer to a figure job.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
 pub struct FigureOutput {
+    /// The figure's number in the paper, 3 to 9.
     pub figure: u8,
+    /// What the figure shows.
     pub title: &'static str,
+    /// The horizontal axis: its quantity and SI unit.
     pub x: AxisOutput,
+    /// The vertical axis: its quantity and SI unit.
     pub y: AxisOutput,
+    /// The curves.
     pub series: Vec<SeriesOutput>,
     pub meta: Meta,
 }

@@ -4,16 +4,19 @@
 use serde::Serialize;
 use serde_json::Value;
 use sha2::{Digest, Sha256};
+use utoipa::ToSchema;
 
 use super::JobKind;
 use crate::model::MODEL_VERSION;
 
 /// A source of the model.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, ToSchema)]
 pub struct Reference {
     /// What the service takes from it.
     pub role: &'static str,
+    /// Authors, title, journal and year.
     pub citation: &'static str,
+    /// The DOI, where the work has one.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub doi: Option<&'static str>,
 }
@@ -64,13 +67,18 @@ fn references(kind: JobKind) -> &'static [Reference] {
 }
 
 /// The `meta` block of an answer.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
 pub struct Meta {
+    /// Version of the model's numbers (semver): a new version may change results.
     pub model_version: &'static str,
-    /// SHA-256 of the model version, the job kind and the canonical input.
+    /// SHA-256 of the model version, the job kind and the canonical input (hex): the cache
+    /// key, and the HTTP `ETag`.
     pub input_hash: String,
     /// The input as understood: defaults filled in, SI numbers.
+    #[schema(value_type = Object)]
     pub input: Value,
+    /// The papers behind the numbers.
+    #[schema(value_type = Vec<Reference>)]
     pub references: &'static [Reference],
 }
 

@@ -15,8 +15,9 @@ pub mod sweep;
 pub mod three_body;
 pub mod units;
 
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 use serde_json::Value;
+use utoipa::ToSchema;
 
 pub use error::{FieldError, JobError};
 pub use fields::Quantity;
@@ -52,7 +53,7 @@ impl Default for Limits {
 }
 
 /// What a job computes.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, Serialize, ToSchema)]
 #[serde(rename_all = "snake_case")]
 pub enum JobKind {
     Rolling,
@@ -73,12 +74,15 @@ impl JobKind {
 }
 
 /// The envelope `{"kind": ..., "input": {...}}`; a missing input means all defaults.
-#[derive(Deserialize)]
+#[derive(Deserialize, ToSchema)]
 #[serde(deny_unknown_fields)]
-struct Envelope {
-    kind: JobKind,
+pub struct Envelope {
+    pub kind: JobKind,
+    /// The input of the job's kind: a `RollingInput`, `SweepInput` or `FigureInput`.
+    /// Absent, every field takes its default.
     #[serde(default)]
-    input: Option<Value>,
+    #[schema(value_type = Option<Object>)]
+    pub input: Option<Value>,
 }
 
 /// A validated job, ready for the engine.
@@ -103,7 +107,13 @@ impl Job {
         let input = envelope
             .input
             .unwrap_or_else(|| Value::Object(Default::default()));
-        Ok(match envelope.kind {
+        Job::from_input(envelope.kind, input, limits)
+    }
+
+    /// Validates the input of a job of `kind` (the envelope's `input`, or the body of the
+    /// HTTP endpoint of that kind): error paths are relative to the input.
+    pub fn from_input(kind: JobKind, input: Value, limits: &Limits) -> Result<Job, JobError> {
+        Ok(match kind {
             JobKind::Rolling => Job::Rolling(RollingJob::from_value(input)?),
             JobKind::ThreeBody => Job::ThreeBody(ThreeBodyJob::from_value(input)?),
             JobKind::Sweep => Job::Sweep(SweepJob::from_value(input, limits)?),

@@ -2,6 +2,7 @@
 
 use serde::{Deserialize, Serialize};
 use serde_json::{json, Value};
+use utoipa::ToSchema;
 
 use super::fields::{self, Checker, Quantity};
 use super::units::Dimension;
@@ -11,50 +12,53 @@ use crate::model::rolling::{BoundaryPoint, PressureGrid, Verification};
 use crate::model::{Layer, Quadrature, Rolling, RollingSolution, SolveOptions};
 
 /// Input of a rolling job; every field optional (MODEL.md §5 defaults).
-#[derive(Clone, Debug, Default, PartialEq, Deserialize, Serialize)]
+#[derive(Clone, Debug, Default, PartialEq, Deserialize, Serialize, ToSchema)]
 #[serde(deny_unknown_fields)]
 pub struct RollingInput {
-    /// R, particle radius (m).
+    /// R, particle radius (m; default 25 nm).
     pub radius: Option<Quantity>,
-    /// P, normal load on the particle (N).
+    /// P, normal load on the particle (N; default 1 nN).
     pub load: Option<Quantity>,
-    /// V, rolling speed (m/s), ≥ 0.
+    /// V, rolling speed (m/s, ≥ 0; default 4 nm/s).
     pub velocity: Option<Quantity>,
+    /// The viscoelastic layer (default: MODEL.md §5).
     pub layer: Option<LayerInput>,
+    /// Quadrature and extra outputs.
     pub options: Option<OptionsInput>,
 }
 
 /// The Kelvin layer.
-#[derive(Clone, Debug, Default, PartialEq, Deserialize, Serialize)]
+#[derive(Clone, Debug, Default, PartialEq, Deserialize, Serialize, ToSchema)]
 #[serde(deny_unknown_fields)]
 pub struct LayerInput {
-    /// E_L (Pa).
+    /// E_L, relaxed longitudinal modulus (Pa; default 3 GPa).
     pub elastic_modulus: Option<Quantity>,
-    /// H (m).
+    /// H, layer thickness (m; default 100 nm).
     pub thickness: Option<Quantity>,
-    /// ν.
+    /// ν, Poisson ratio (dimensionless; default 0.35).
     pub poisson_ratio: Option<Quantity>,
-    /// T_ε (s).
+    /// T_ε, retardation time (s, ≥ T_σ; default 0.5 s).
     pub retardation_time: Option<Quantity>,
-    /// T_σ (s).
+    /// T_σ, relaxation time (s; default 0.1 s).
     pub relaxation_time: Option<Quantity>,
 }
 
 /// How to integrate across the contact and what to return besides the integrals.
-#[derive(Clone, Debug, Default, PartialEq, Deserialize, Serialize)]
+#[derive(Clone, Debug, Default, PartialEq, Deserialize, Serialize, ToSchema)]
 #[serde(deny_unknown_fields)]
 pub struct OptionsInput {
+    /// The y-quadrature (default `gauss`).
     pub quadrature: Option<QuadratureKind>,
-    /// Gauss nodes (default 64) or midpoint strips (default 40) in the half-width.
+    /// Gauss nodes (default 64) or midpoint strips (default 40) in the half-width (count).
     pub strips: Option<usize>,
     /// Points of the contact boundary (default 41; 0 for none).
     pub boundary_points: Option<usize>,
-    /// Return the pressure on an n × n grid.
+    /// Return the pressure on an n × n grid (points per side; default none).
     pub pressure_grid: Option<usize>,
 }
 
 /// The y-quadrature: exact to 1e-9 (`gauss`) or the paper's uniform strips (`midpoint`).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize, Serialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize, Serialize, ToSchema)]
 #[serde(rename_all = "lowercase")]
 pub enum QuadratureKind {
     #[default]
@@ -203,7 +207,7 @@ impl RollingJob {
 }
 
 /// The integral quantities of a rolling contact, shared by rolling answers and sweep points.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
 pub struct ContactOutput {
     /// δ (m).
     pub penetration: f64,
@@ -215,9 +219,9 @@ pub struct ContactOutput {
     pub centroid_shift: f64,
     /// x_p (m), centre of pressure.
     pub pressure_centre_shift: f64,
-    /// x_p/R.
+    /// x_p/R (dimensionless).
     pub rolling_resistance_coefficient: f64,
-    /// μ = τ_a A/P (eq. 12).
+    /// μ = τ_a A/P (eq. 12; dimensionless).
     pub friction_coefficient: f64,
     /// The same particle at V = 0.
     #[serde(rename = "static")]
@@ -225,25 +229,31 @@ pub struct ContactOutput {
 }
 
 /// The particle without rolling.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
 pub struct StaticOutput {
+    /// δ at V = 0 (m).
     pub penetration: f64,
+    /// A at V = 0 (m²).
     pub contact_area: f64,
+    /// μ at V = 0 (dimensionless).
     pub friction_coefficient: f64,
 }
 
 /// How far the answer can be trusted.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
 pub struct VerificationOutput {
-    /// |P(δ) − P|/P at the returned δ.
+    /// |P(δ) − P|/P at the returned δ (dimensionless).
     pub relative_load_residual: f64,
-    /// Relative change of A when the quadrature is halved (an estimate of its error).
+    /// Relative change of A when the quadrature is halved (an estimate of its error;
+    /// dimensionless).
     pub quadrature_error_estimate: f64,
+    /// Nodes (or strips) of the y-quadrature (count).
     pub quadrature_nodes: usize,
-    /// Iterations of the load equation.
+    /// Iterations of the load equation (count).
     pub iterations: u32,
-    /// Newton steps of all exit-edge roots.
+    /// Newton steps of all exit-edge roots (count).
     pub exit_root_iterations: u32,
+    /// Whether every root finder converged.
     pub converged: bool,
 }
 
@@ -280,12 +290,13 @@ impl From<&RollingSolution> for ContactOutput {
 }
 
 /// A point of the contact boundary (m).
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
 pub struct BoundaryOutput {
+    /// Lateral coordinate y (m).
     pub y: f64,
-    /// Trailing edge a(y).
+    /// Trailing edge a(y) (m).
     pub exit: f64,
-    /// Leading edge b(y).
+    /// Leading edge b(y) (m).
     pub entry: f64,
 }
 
@@ -300,10 +311,13 @@ impl From<&BoundaryPoint> for BoundaryOutput {
 }
 
 /// p(x, y) (Pa) on a grid: `values[j][i]` = p(x[i], y[j]) (m).
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
 pub struct PressureOutput {
+    /// Grid abscissae in the rolling direction (m).
     pub x: Vec<f64>,
+    /// Grid ordinates across it (m).
     pub y: Vec<f64>,
+    /// p(x[i], y[j]) as `values[j][i]` (Pa).
     pub values: Vec<Vec<f64>>,
 }
 
@@ -318,21 +332,25 @@ impl From<&PressureGrid> for PressureOutput {
 }
 
 /// The `meta` block of a rolling answer.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
 pub struct RollingMeta {
     #[serde(flatten)]
     pub meta: Meta,
+    /// How far the numbers can be trusted.
     pub verification: VerificationOutput,
 }
 
 /// The answer to a rolling job.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
 pub struct RollingOutput {
     #[serde(flatten)]
     pub contact: ContactOutput,
+    /// The contact boundary, `options.boundary_points` points over y.
     pub boundary: Vec<BoundaryOutput>,
+    /// The pressure grid, when `options.pressure_grid` asked for one.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub pressure: Option<PressureOutput>,
+    /// Model version, cache key, the input as understood, references, verification.
     pub meta: RollingMeta,
 }
 

@@ -4,6 +4,7 @@
 
 use serde::{Deserialize, Serialize};
 use serde_json::{json, Value};
+use utoipa::ToSchema;
 
 use super::fields::{self, Checker, Quantity};
 use super::rolling::{si, ContactOutput, RollingInput, RollingJob, VerificationOutput};
@@ -17,20 +18,23 @@ use crate::model::three_body::{Diameters, OperatingPoint, ThreeBody, ThreeBodySo
 use crate::model::{Parameter, Rolling, RollingSolution, SolveOptions};
 
 /// Input of a sweep: what is swept, a base input of that kind and the lists to vary.
-#[derive(Clone, Debug, Default, PartialEq, Deserialize, Serialize)]
+#[derive(Clone, Debug, Default, PartialEq, Deserialize, Serialize, ToSchema)]
 #[serde(deny_unknown_fields)]
 pub struct SweepInput {
     /// The kind of the base job: `rolling` (default) or `three_body`.
     pub kind: Option<SweepOf>,
-    /// A rolling or three-body input.
+    /// The input every point starts from: a `RollingInput` or a `ThreeBodyInput` (a rolling
+    /// base keeps only its quadrature options).
+    #[schema(value_type = Option<Object>)]
     pub base: Option<Value>,
-    /// Rolling: {radius, load, velocity}; three-body: {separation | total_load |
-    /// particle_load, velocity, mean_diameter}. An absent list keeps the base value.
+    /// The lists to vary (the points are their Cartesian product): a `RollingVary` or a
+    /// `ThreeBodyVary`. An absent list keeps the base value.
+    #[schema(value_type = Option<Object>)]
     pub vary: Option<Value>,
 }
 
 /// The kind of job a sweep repeats.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize, Serialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize, Serialize, ToSchema)]
 #[serde(rename_all = "snake_case")]
 pub enum SweepOf {
     #[default]
@@ -39,7 +43,7 @@ pub enum SweepOf {
 }
 
 /// The lists of a rolling sweep.
-#[derive(Clone, Debug, Default, PartialEq, Deserialize, Serialize)]
+#[derive(Clone, Debug, Default, PartialEq, Deserialize, Serialize, ToSchema)]
 #[serde(deny_unknown_fields)]
 pub struct RollingVary {
     /// R values (m).
@@ -51,7 +55,7 @@ pub struct RollingVary {
 }
 
 /// The lists of a three-body sweep; at most one operating-point list.
-#[derive(Clone, Debug, Default, PartialEq, Deserialize, Serialize)]
+#[derive(Clone, Debug, Default, PartialEq, Deserialize, Serialize, ToSchema)]
 #[serde(deny_unknown_fields)]
 pub struct ThreeBodyVary {
     /// d values (m).
@@ -402,7 +406,7 @@ fn read_list(
 }
 
 /// One row of a rolling sweep.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
 pub struct SweepPoint {
     /// R (m).
     pub radius: f64,
@@ -416,9 +420,11 @@ pub struct SweepPoint {
 }
 
 /// One row of a three-body sweep.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
 pub struct ThreeBodySweepPoint {
-    /// The operating point as asked.
+    /// The operating point as asked: `{"separation": d}`, `{"total_load": W}` or
+    /// `{"particle_load": P}` (SI).
+    #[schema(value_type = Object)]
     pub operating: Value,
     /// V (m/s).
     pub velocity: f64,
@@ -430,7 +436,7 @@ pub struct ThreeBodySweepPoint {
 }
 
 /// The rows of a sweep.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
 #[serde(untagged)]
 pub enum SweepPoints {
     Rolling(Vec<SweepPoint>),
@@ -438,8 +444,10 @@ pub enum SweepPoints {
 }
 
 /// The answer to a sweep.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
 pub struct SweepOutput {
+    /// One row per point; rolling: radius outermost, then load, then speed; three-body:
+    /// operating point, then speed, then mean diameter.
     pub points: SweepPoints,
     pub meta: Meta,
 }

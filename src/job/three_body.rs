@@ -3,6 +3,7 @@
 
 use serde::{Deserialize, Serialize};
 use serde_json::{json, Value};
+use utoipa::ToSchema;
 
 use super::fields::{self, Checker, Quantity};
 use super::rolling::{si, LayerInput, QuadratureKind};
@@ -16,7 +17,7 @@ use crate::model::three_body::{
 use crate::model::Quadrature;
 
 /// Input of a three-body job; every field optional but the operating point.
-#[derive(Clone, Debug, Default, PartialEq, Deserialize, Serialize)]
+#[derive(Clone, Debug, Default, PartialEq, Deserialize, Serialize, ToSchema)]
 #[serde(deny_unknown_fields)]
 pub struct ThreeBodyInput {
     pub distribution: Option<DistributionInput>,
@@ -36,7 +37,7 @@ pub struct ThreeBodyInput {
 }
 
 /// Particle diameters: a truncated Gaussian, and how many particles per unit area.
-#[derive(Clone, Debug, Default, PartialEq, Deserialize, Serialize)]
+#[derive(Clone, Debug, Default, PartialEq, Deserialize, Serialize, ToSchema)]
 #[serde(deny_unknown_fields)]
 pub struct DistributionInput {
     /// x_a (m), default 50 nm.
@@ -52,7 +53,7 @@ pub struct DistributionInput {
 }
 
 /// The upper surface (default steel, 210 GPa, ν = 0.3, elastic).
-#[derive(Clone, Debug, Default, PartialEq, Deserialize, Serialize)]
+#[derive(Clone, Debug, Default, PartialEq, Deserialize, Serialize, ToSchema)]
 #[serde(deny_unknown_fields)]
 pub struct UpperSurfaceInput {
     /// E₁ (Pa).
@@ -65,7 +66,7 @@ pub struct UpperSurfaceInput {
 }
 
 /// Elastic (Hertz) or plastic contact of the particles with the upper surface.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, Serialize, ToSchema)]
 #[serde(rename_all = "lowercase")]
 pub enum UpperContactKind {
     Elastic,
@@ -73,7 +74,7 @@ pub enum UpperContactKind {
 }
 
 /// The particles' material: rigid unless `elastic_modulus` is given.
-#[derive(Clone, Debug, Default, PartialEq, Deserialize, Serialize)]
+#[derive(Clone, Debug, Default, PartialEq, Deserialize, Serialize, ToSchema)]
 #[serde(deny_unknown_fields)]
 pub struct ParticleInput {
     /// E_a (Pa); absent for rigid particles.
@@ -83,7 +84,7 @@ pub struct ParticleInput {
 }
 
 /// The layer contact law.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, Serialize, ToSchema)]
 #[serde(rename_all = "snake_case")]
 pub enum LayerContactKind {
     /// The rolling contact of MODEL.md §3 at the job's speed (default).
@@ -93,7 +94,7 @@ pub enum LayerContactKind {
 }
 
 /// Asperities of the rough pair.
-#[derive(Clone, Debug, Default, PartialEq, Deserialize, Serialize)]
+#[derive(Clone, Debug, Default, PartialEq, Deserialize, Serialize, ToSchema)]
 #[serde(deny_unknown_fields)]
 pub struct AsperitiesInput {
     /// η_s (m⁻²).
@@ -107,7 +108,7 @@ pub struct AsperitiesInput {
 }
 
 /// The operating point: exactly one field.
-#[derive(Clone, Debug, Default, PartialEq, Deserialize, Serialize)]
+#[derive(Clone, Debug, Default, PartialEq, Deserialize, Serialize, ToSchema)]
 #[serde(deny_unknown_fields)]
 pub struct OperatingInput {
     /// d (m).
@@ -119,7 +120,7 @@ pub struct OperatingInput {
 }
 
 /// Discretisation.
-#[derive(Clone, Debug, Default, PartialEq, Deserialize, Serialize)]
+#[derive(Clone, Debug, Default, PartialEq, Deserialize, Serialize, ToSchema)]
 #[serde(deny_unknown_fields)]
 pub struct ThreeBodyOptionsInput {
     /// Gauss nodes over the diameters (default 48).
@@ -423,7 +424,7 @@ pub fn operating_canonical(operating: OperatingPoint) -> Value {
 }
 
 /// Real contact areas (m²).
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
 pub struct AreasOutput {
     /// A_s1s2, asperity contact of the two surfaces.
     pub surface_surface: f64,
@@ -436,7 +437,7 @@ pub struct AreasOutput {
 }
 
 /// Loads (N).
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
 pub struct LoadsOutput {
     pub asperities: f64,
     pub particles: f64,
@@ -444,7 +445,7 @@ pub struct LoadsOutput {
 }
 
 /// The system at one separation.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
 pub struct StateOutput {
     /// d (m).
     pub separation: f64,
@@ -475,7 +476,7 @@ impl From<&ContactState> for StateOutput {
 }
 
 /// μ = (τ_a A_s2a + τ_s A_s1s2)/W without and with rolling.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
 pub struct FrictionOutput {
     /// V = 0 (the job's separation, or its load re-solved at V = 0).
     #[serde(rename = "static")]
@@ -485,7 +486,7 @@ pub struct FrictionOutput {
 }
 
 /// Per particle in contact.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
 pub struct PerParticleOutput {
     /// A_total/n_a (m², eq. 8).
     pub mean_area: f64,
@@ -494,7 +495,7 @@ pub struct PerParticleOutput {
 }
 
 /// How far the answer can be trusted.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
 pub struct ThreeBodyVerificationOutput {
     pub diameter_nodes: usize,
     pub separation_iterations: u32,
@@ -509,7 +510,7 @@ pub struct ThreeBodyVerificationOutput {
 }
 
 /// The results of a three-body solve, shared by answers and sweep points.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
 pub struct ThreeBodyResult {
     #[serde(flatten)]
     pub state: StateOutput,
@@ -551,7 +552,7 @@ impl From<&ThreeBodySolution> for ThreeBodyVerificationOutput {
 }
 
 /// The `meta` block of a three-body answer.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
 pub struct ThreeBodyMeta {
     #[serde(flatten)]
     pub meta: Meta,
@@ -559,7 +560,7 @@ pub struct ThreeBodyMeta {
 }
 
 /// The answer to a three-body job.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
 pub struct ThreeBodyOutput {
     #[serde(flatten)]
     pub result: ThreeBodyResult,

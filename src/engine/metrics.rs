@@ -1,0 +1,87 @@
+//! The instruments of the compute path, recorded on a recorder owned by whoever runs the
+//! engine rather than on the process-global one of the `metrics` crate: each HTTP service
+//! (and each test server in one test process) then counts only its own solves.
+
+use std::sync::Arc;
+
+use metrics::{Counter, Gauge, Histogram, Key, Label, Metadata, NoopRecorder, Recorder};
+
+/// Seconds spent solving a job, by kind and outcome (its `_count` is the number of solves).
+pub const SOLVE_DURATION: &str = "thirdbody_solve_duration_seconds";
+/// Results found in the cache (coalesced waiters included).
+pub const CACHE_HITS: &str = "thirdbody_cache_hits_total";
+/// Results that had to be solved.
+pub const CACHE_MISSES: &str = "thirdbody_cache_misses_total";
+/// Asynchronous jobs waiting for a permit.
+pub const JOBS_QUEUED: &str = "thirdbody_jobs_queued";
+/// Asynchronous jobs being solved.
+pub const JOBS_RUNNING: &str = "thirdbody_jobs_running";
+/// Work refused, by reason (`overloaded`, `draining`).
+pub const REJECTIONS: &str = "thirdbody_rejections_total";
+
+static METADATA: Metadata<'static> =
+    Metadata::new(module_path!(), metrics::Level::INFO, Some(module_path!()));
+
+/// A handle on a recorder, shared by the engine and the HTTP layer.
+#[derive(Clone)]
+pub struct Metrics {
+    recorder: Arc<dyn Recorder + Send + Sync>,
+}
+
+impl Metrics {
+    /// Records on `recorder`, and describes the engine's metrics there.
+    pub fn new(recorder: Arc<dyn Recorder + Send + Sync>) -> Self {
+        let metrics = Metrics { recorder };
+        metrics.describe();
+        metrics
+    }
+
+    /// Records nothing (the command line's engine).
+    pub fn noop() -> Self {
+        Metrics {
+            recorder: Arc::new(NoopRecorder),
+        }
+    }
+
+    fn describe(&self) {
+        let r = &self.recorder;
+        let unit = Some(metrics::Unit::Seconds);
+        r.describe_histogram(
+            SOLVE_DURATION.into(),
+            unit,
+            "Time spent solving jobs".into(),
+        );
+        r.describe_counter(
+            CACHE_HITS.into(),
+            None,
+            "Results served from the cache".into(),
+        );
+        r.describe_counter(CACHE_MISSES.into(), None, "Results that were solved".into());
+        r.describe_gauge(JOBS_QUEUED.into(), None, "Async jobs waiting".into());
+        r.describe_gauge(JOBS_RUNNING.into(), None, "Async jobs being solved".into());
+        r.describe_counter(REJECTIONS.into(), None, "Work refused, by reason".into());
+    }
+
+    pub fn counter(&self, name: &'static str, labels: &[(&'static str, &str)]) -> Counter {
+        self.recorder
+            .register_counter(&key(name, labels), &METADATA)
+    }
+
+    pub fn gauge(&self, name: &'static str) -> Gauge {
+        self.recorder
+            .register_gauge(&Key::from_name(name), &METADATA)
+    }
+
+    pub fn histogram(&self, name: &'static str, labels: &[(&'static str, &str)]) -> Histogram {
+        self.recorder
+            .register_histogram(&key(name, labels), &METADATA)
+    }
+}
+
+fn key(name: &'static str, labels: &[(&'static str, &str)]) -> Key {
+    let labels: Vec<Label> = labels
+        .iter()
+        .map(|&(k, v)| Label::new(k, v.to_string()))
+        .collect();
+    Key::from_parts(name, labels)
+}

@@ -1,0 +1,288 @@
+//! The service's settings: every limit is a flag with an environment variable, and the whole
+//! set is validated at start-up, so that a bad value is a clear error before the first
+//! request rather than a panic or a surprise later.
+
+use std::fmt;
+use std::net::SocketAddr;
+use std::time::Duration;
+
+use axum::http::HeaderValue;
+use clap::{Parser, ValueEnum};
+
+use crate::engine::EngineConfig;
+use crate::job::Limits;
+
+/// `thirdbody serve`: the flags as typed.
+#[derive(Clone, Debug, Parser)]
+pub struct ServeArgs {
+    /// Address and port to listen on.
+    #[arg(long, env = "THIRDBODY_BIND", default_value = "127.0.0.1:8080")]
+    pub bind: SocketAddr,
+
+    /// Largest request body, in bytes.
+    #[arg(long, env = "THIRDBODY_BODY_LIMIT", default_value_t = 1 << 20)]
+    pub body_limit: usize,
+
+    /// Longest a request may take in all (e.g. 60s).
+    #[arg(long, env = "THIRDBODY_REQUEST_TIMEOUT", default_value = "60s", value_parser = duration)]
+    pub request_timeout: Duration,
+
+    /// Longest a synchronous solve may take before it is stopped with 504 (e.g. 30s, 500ms).
+    #[arg(long, env = "THIRDBODY_SOLVE_DEADLINE", default_value = "30s", value_parser = duration)]
+    pub solve_deadline: Duration,
+
+    /// Longest an asynchronous job may take from its submission.
+    #[arg(long, env = "THIRDBODY_JOB_DEADLINE", default_value = "10m", value_parser = duration)]
+    pub job_deadline: Duration,
+
+    /// Jobs solved at once (one solver thread each); default: the number of cores.
+    #[arg(long, env = "THIRDBODY_POOL_SIZE")]
+    pub pool_size: Option<usize>,
+
+    /// Largest sweep, in points (the product of its lists).
+    #[arg(long, env = "THIRDBODY_MAX_SWEEP_POINTS", default_value_t = Limits::default().max_sweep_points)]
+    pub max_sweep_points: usize,
+
+    /// Asynchronous jobs that may wait for a solver thread; more are refused with 429.
+    #[arg(long, env = "THIRDBODY_MAX_QUEUED_JOBS", default_value_t = 64)]
+    pub max_queued_jobs: usize,
+
+    /// Memory for cached answers, in bytes (0: no caching).
+    #[arg(long, env = "THIRDBODY_CACHE_BYTES", default_value_t = 256 << 20)]
+    pub cache_bytes: u64,
+
+    /// How long an answer stays cached.
+    #[arg(long, env = "THIRDBODY_CACHE_TTL", default_value = "1h", value_parser = duration)]
+    pub cache_ttl: Duration,
+
+    /// How long a finished asynchronous job is kept for its client to collect.
+    #[arg(long, env = "THIRDBODY_JOB_RETENTION", default_value = "15m", value_parser = duration)]
+    pub job_retention: Duration,
+
+    /// Origins allowed to call the API from a browser, comma-separated (`*` for any);
+    /// none by default.
+    #[arg(
+        long = "cors-origin",
+        env = "THIRDBODY_CORS_ORIGINS",
+        value_delimiter = ','
+    )]
+    pub cors_origins: Vec<String>,
+
+    /// Log format.
+    #[arg(long, env = "THIRDBODY_LOG_FORMAT", value_enum, default_value_t = LogFormat::Json)]
+    pub log_format: LogFormat,
+
+    /// On shutdown, how long to keep accepting (answering 503, /readyz failing) so that a
+    /// load balancer sees the instance leave before connections are refused.
+    #[arg(long, env = "THIRDBODY_DRAIN_DELAY", default_value = "0s", value_parser = duration)]
+    pub drain_delay: Duration,
+
+    /// On shutdown, how long in-flight requests and running jobs have to finish before
+    /// they are cancelled.
+    #[arg(long, env = "THIRDBODY_SHUTDOWN_TIMEOUT", default_value = "30s", value_parser = duration)]
+    pub shutdown_timeout: Duration,
+}
+
+/// How log lines are written.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum LogFormat {
+    /// One JSON object per line, with the request id.
+    Json,
+    /// For people at a terminal.
+    Text,
+}
+
+/// Which browser origins may call the API.
+#[derive(Clone, Debug, PartialEq)]
+pub enum CorsOrigins {
+    /// No CORS headers: browsers on other origins cannot read answers.
+    None,
+    Any,
+    List(Vec<HeaderValue>),
+}
+
+/// The validated settings.
+#[derive(Clone, Debug)]
+pub struct Config {
+    pub bind: SocketAddr,
+    pub engine: EngineConfig,
+    pub limits: Limits,
+    pub body_limit: usize,
+    pub request_timeout: Duration,
+    pub cors_origins: CorsOrigins,
+    pub log_format: LogFormat,
+    pub drain_delay: Duration,
+    pub shutdown_timeout: Duration,
+}
+
+/// A setting that cannot work, and why.
+#[derive(Debug, PartialEq)]
+pub struct ConfigError(String);
+
+impl fmt::Display for ConfigError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl std::error::Error for ConfigError {}
+
+/// Most solver threads a pool may have: beyond this a number is a typo, not a machine.
+const MAX_POOL_SIZE: usize = 1024;
+/// Smallest body limit that still fits a sweep of a few lists.
+const MIN_BODY_LIMIT: usize = 1024;
+
+fn duration(text: &str) -> Result<Duration, String> {
+    humantime::parse_duration(text).map_err(|e| format!("{e} (write e.g. 30s, 500ms, 10m)"))
+}
+
+impl ServeArgs {
+    /// Checks every setting and the ones that depend on each other.
+    pub fn validate(self) -> Result<Config, ConfigError> {
+        let fail = |message: String| Err(ConfigError(message));
+        let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+        let pool_size = self.pool_size.unwrap_or(cores);
+        if !(1..=MAX_POOL_SIZE).contains(&pool_size) {
+            return fail(format!(
+                "--pool-size {pool_size}: allowed 1 to {MAX_POOL_SIZE}"
+            ));
+        }
+        if self.body_limit < MIN_BODY_LIMIT {
+            return fail(format!(
+                "--body-limit {}: allowed at least {MIN_BODY_LIMIT} bytes",
+                self.body_limit
+            ));
+        }
+        if self.max_sweep_points == 0 {
+            return fail("--max-sweep-points 0: allowed at least 1".to_string());
+        }
+        for (flag, value) in [
+            ("--request-timeout", self.request_timeout),
+            ("--solve-deadline", self.solve_deadline),
+            ("--job-deadline", self.job_deadline),
+            ("--cache-ttl", self.cache_ttl),
+            ("--job-retention", self.job_retention),
+            ("--shutdown-timeout", self.shutdown_timeout),
+        ] {
+            if value.is_zero() {
+                return fail(format!("{flag} 0s: allowed more than 0"));
+            }
+        }
+        if self.solve_deadline >= self.request_timeout {
+            return fail(format!(
+                "--solve-deadline {} must be shorter than --request-timeout {}, so that a \
+                 slow solve ends with 504 rather than a cut connection",
+                humantime::format_duration(self.solve_deadline),
+                humantime::format_duration(self.request_timeout)
+            ));
+        }
+        Ok(Config {
+            bind: self.bind,
+            engine: EngineConfig {
+                pool_size,
+                solve_deadline: self.solve_deadline,
+                job_deadline: self.job_deadline,
+                max_queued_jobs: self.max_queued_jobs,
+                cache_bytes: self.cache_bytes,
+                cache_ttl: self.cache_ttl,
+                job_retention: self.job_retention,
+            },
+            limits: Limits {
+                max_sweep_points: self.max_sweep_points,
+            },
+            body_limit: self.body_limit,
+            request_timeout: self.request_timeout,
+            cors_origins: cors_origins(&self.cors_origins)?,
+            log_format: self.log_format,
+            drain_delay: self.drain_delay,
+            shutdown_timeout: self.shutdown_timeout,
+        })
+    }
+}
+
+/// Origins are `scheme://host[:port]` exactly as browsers send them, or `*` alone.
+fn cors_origins(origins: &[String]) -> Result<CorsOrigins, ConfigError> {
+    let origins: Vec<&str> = origins
+        .iter()
+        .map(|o| o.trim())
+        .filter(|o| !o.is_empty())
+        .collect();
+    match origins.as_slice() {
+        [] => return Ok(CorsOrigins::None),
+        ["*"] => return Ok(CorsOrigins::Any),
+        _ => {}
+    }
+    origins
+        .iter()
+        .map(|&origin| {
+            let valid = origin.split_once("://").is_some_and(|(scheme, host)| {
+                matches!(scheme, "http" | "https") && !host.is_empty() && !host.contains('/')
+            });
+            match HeaderValue::from_str(origin) {
+                Ok(value) if valid => Ok(value),
+                _ => Err(ConfigError(format!(
+                    "--cors-origin {origin:?}: expected an origin such as \
+                     https://dashboard.example.org or http://localhost:3000 (no path), or * alone"
+                ))),
+            }
+        })
+        .collect::<Result<_, _>>()
+        .map(CorsOrigins::List)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn config(args: &[&str]) -> Result<Config, String> {
+        let args = std::iter::once("serve").chain(args.iter().copied());
+        ServeArgs::try_parse_from(args)
+            .map_err(|e| e.to_string())?
+            .validate()
+            .map_err(|e| e.to_string())
+    }
+
+    #[test]
+    fn no_flags_is_a_working_service_on_localhost_8080() {
+        let config = config(&[]).unwrap();
+        assert_eq!(config.bind.to_string(), "127.0.0.1:8080");
+        assert!(config.engine.pool_size >= 1);
+        assert_eq!(config.limits, Limits::default());
+        assert_eq!(config.cors_origins, CorsOrigins::None);
+    }
+
+    #[test]
+    fn bad_settings_are_named_at_start_up() {
+        for (args, needle) in [
+            (&["--bind", "localhost"][..], "--bind"),
+            (&["--pool-size", "0"], "--pool-size 0"),
+            (&["--body-limit", "10"], "--body-limit 10"),
+            (&["--solve-deadline", "soon"], "30s, 500ms"),
+            (&["--cache-ttl", "0s"], "--cache-ttl 0s"),
+            (
+                &["--solve-deadline", "2m"],
+                "shorter than --request-timeout",
+            ),
+            (&["--cors-origin", "dashboard.example"], "dashboard.example"),
+            (&["--cors-origin", "https://a.example/path"], "no path"),
+            (&["--log-format", "xml"], "xml"),
+        ] {
+            let error = config(args).unwrap_err();
+            assert!(error.contains(needle), "{args:?}: {error}");
+        }
+    }
+
+    #[test]
+    fn cors_origins_are_a_list_or_any() {
+        let list = config(&["--cors-origin", "https://a.example,http://localhost:3000"]).unwrap();
+        assert_eq!(
+            list.cors_origins,
+            CorsOrigins::List(vec![
+                HeaderValue::from_static("https://a.example"),
+                HeaderValue::from_static("http://localhost:3000")
+            ])
+        );
+        let any = config(&["--cors-origin", "*"]).unwrap();
+        assert_eq!(any.cors_origins, CorsOrigins::Any);
+    }
+}

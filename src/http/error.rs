@@ -1,0 +1,377 @@
+//! One error contract: every error response is an RFC 9457 problem
+//! (`application/problem+json`), whether it comes from a job, the engine, a JSON body axum
+//! could not read, or a layer (method not allowed, timeout, panic).
+
+use axum::body::Body;
+use axum::extract::rejection::JsonRejection;
+use axum::extract::{FromRequest, Request};
+use axum::http::{header, HeaderValue, StatusCode};
+use axum::response::{IntoResponse, Response};
+use axum::Json;
+use serde::Serialize;
+use serde_json::Value;
+use utoipa::ToSchema;
+
+use crate::engine::EngineError;
+use crate::job::{FieldError, JobError};
+use crate::model::ModelError;
+
+pub const PROBLEM_JSON: &str = "application/problem+json";
+
+/// Prefix of the problem type URIs: names, not addresses (RFC 9457 §3.1.1 allows a URI
+/// that is not meant to be dereferenced; the types are listed in the OpenAPI spec).
+const TYPE_PREFIX: &str = "tag:thirdbody,2026:problems/";
+
+/// An RFC 9457 problem: the body of every error response.
+#[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
+pub struct Problem {
+    /// The kind of problem: `tag:thirdbody,2026:problems/` followed by one of
+    /// `malformed-json` (400), `invalid-input` (422: a field's shape or value; see `errors`),
+    /// `solve-failed` (422: valid values for which the model cannot produce a number, e.g. a
+    /// root finder that did not converge; change the input), `unsupported-media-type` (415),
+    /// `payload-too-large` (413), `not-found` (404), `cancelled` (409), `overloaded` (429),
+    /// `draining` (503), `deadline-exceeded` (504), `internal` (500); or `about:blank` for a
+    /// status with no more to say than its title.
+    #[serde(rename = "type")]
+    pub problem_type: String,
+    /// A short summary of the kind of problem.
+    pub title: String,
+    /// The HTTP status code.
+    pub status: u16,
+    /// What went wrong in this case.
+    pub detail: String,
+    /// Every invalid field, with its path, the value sent and the allowed values
+    /// (`invalid-input` only).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub errors: Vec<FieldError>,
+}
+
+/// The kinds of problem the service names.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Kind {
+    MalformedJson,
+    InvalidInput,
+    SolveFailed,
+    UnsupportedMediaType,
+    PayloadTooLarge,
+    NotFound,
+    Cancelled,
+    Overloaded,
+    Draining,
+    DeadlineExceeded,
+    Internal,
+    /// `about:blank`: the status says it all.
+    Blank(StatusCode),
+}
+
+impl Kind {
+    fn status(self) -> StatusCode {
+        match self {
+            Kind::MalformedJson => StatusCode::BAD_REQUEST,
+            Kind::InvalidInput | Kind::SolveFailed => StatusCode::UNPROCESSABLE_ENTITY,
+            Kind::UnsupportedMediaType => StatusCode::UNSUPPORTED_MEDIA_TYPE,
+            Kind::PayloadTooLarge => StatusCode::PAYLOAD_TOO_LARGE,
+            Kind::NotFound => StatusCode::NOT_FOUND,
+            Kind::Cancelled => StatusCode::CONFLICT,
+            Kind::Overloaded => StatusCode::TOO_MANY_REQUESTS,
+            Kind::Draining => StatusCode::SERVICE_UNAVAILABLE,
+            Kind::DeadlineExceeded => StatusCode::GATEWAY_TIMEOUT,
+            Kind::Internal => StatusCode::INTERNAL_SERVER_ERROR,
+            Kind::Blank(status) => status,
+        }
+    }
+
+    /// The last segment of the type URI, and the title.
+    fn name(self) -> Option<(&'static str, &'static str)> {
+        Some(match self {
+            Kind::MalformedJson => ("malformed-json", "The body is not valid JSON"),
+            Kind::InvalidInput => ("invalid-input", "The input is not valid"),
+            Kind::SolveFailed => ("solve-failed", "The model cannot solve this input"),
+            Kind::UnsupportedMediaType => ("unsupported-media-type", "Send application/json"),
+            Kind::PayloadTooLarge => ("payload-too-large", "The body is too large"),
+            Kind::NotFound => ("not-found", "Not found"),
+            Kind::Cancelled => ("cancelled", "The job was cancelled"),
+            Kind::Overloaded => ("overloaded", "Every solver thread is busy"),
+            Kind::Draining => ("draining", "The service is shutting down"),
+            Kind::DeadlineExceeded => ("deadline-exceeded", "The solve ran past its deadline"),
+            Kind::Internal => ("internal", "Internal error"),
+            Kind::Blank(_) => return None,
+        })
+    }
+
+    /// Seconds a client should wait before trying again, where waiting helps.
+    fn retry_after(self) -> Option<u32> {
+        match self {
+            // Solves take microseconds to seconds: a permit is soon free.
+            Kind::Overloaded => Some(1),
+            // Another instance should have taken over by then.
+            Kind::Draining => Some(5),
+            _ => None,
+        }
+    }
+}
+
+/// An error on its way to the client.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ApiError {
+    kind: Kind,
+    detail: String,
+    errors: Vec<FieldError>,
+}
+
+impl ApiError {
+    fn new(kind: Kind, detail: impl Into<String>) -> Self {
+        ApiError {
+            kind,
+            detail: detail.into(),
+            errors: Vec::new(),
+        }
+    }
+
+    pub fn not_found(detail: impl Into<String>) -> Self {
+        ApiError::new(Kind::NotFound, detail)
+    }
+
+    pub fn internal(detail: impl Into<String>) -> Self {
+        ApiError::new(Kind::Internal, detail)
+    }
+
+    pub fn draining() -> Self {
+        EngineError::Draining.into()
+    }
+
+    /// A problem that says no more than `status` and `detail`.
+    pub fn from_status(status: StatusCode, detail: impl Into<String>) -> Self {
+        ApiError::new(Kind::Blank(status), detail)
+    }
+
+    pub fn status(&self) -> StatusCode {
+        self.kind.status()
+    }
+
+    /// The problem document.
+    pub fn problem(&self) -> Problem {
+        let status = self.status();
+        let (problem_type, title) = match self.kind.name() {
+            Some((name, title)) => (format!("{TYPE_PREFIX}{name}"), title),
+            None => (
+                "about:blank".to_string(),
+                status.canonical_reason().unwrap_or("Error"),
+            ),
+        };
+        Problem {
+            problem_type,
+            title: title.to_string(),
+            status: status.as_u16(),
+            detail: self.detail.clone(),
+            errors: self.errors.clone(),
+        }
+    }
+}
+
+impl From<JobError> for ApiError {
+    fn from(e: JobError) -> Self {
+        let detail = e.to_string();
+        match e {
+            JobError::Syntax(_) => ApiError::new(Kind::MalformedJson, detail),
+            JobError::Schema { field, .. } => ApiError {
+                kind: Kind::InvalidInput,
+                errors: vec![FieldError {
+                    field,
+                    value: Value::Null,
+                    allowed: "the shape given by the input's schema in /openapi.json".to_string(),
+                    message: detail.clone(),
+                }],
+                detail,
+            },
+            JobError::Invalid(errors) => ApiError {
+                kind: Kind::InvalidInput,
+                detail,
+                errors,
+            },
+            // Validation checks every range first; reaching the model with one is still
+            // the input's fault.
+            JobError::Solve(ModelError::InvalidParameter(_) | ModelError::InvalidOption(_)) => {
+                ApiError::new(Kind::InvalidInput, detail)
+            }
+            // Valid values the model cannot solve: deterministic, so retrying cannot help
+            // and the service is not at fault: the client must change the input.
+            JobError::Solve(_) => ApiError::new(Kind::SolveFailed, detail),
+            JobError::Cancelled => ApiError::new(Kind::Cancelled, detail),
+            JobError::DeadlineExceeded => ApiError::new(Kind::DeadlineExceeded, detail),
+            JobError::Internal(_) => ApiError::new(Kind::Internal, detail),
+        }
+    }
+}
+
+impl From<EngineError> for ApiError {
+    fn from(e: EngineError) -> Self {
+        match e {
+            EngineError::Job(e) => e.into(),
+            EngineError::Overloaded => ApiError::new(
+                Kind::Overloaded,
+                "every solver thread is busy and the job queue is full or not used: \
+                 retry shortly, or submit big work to /v1/jobs",
+            ),
+            EngineError::Draining => ApiError::new(
+                Kind::Draining,
+                "the service is shutting down and takes no new work",
+            ),
+        }
+    }
+}
+
+impl From<JsonRejection> for ApiError {
+    fn from(rejection: JsonRejection) -> Self {
+        let detail = rejection.body_text();
+        match rejection {
+            JsonRejection::JsonSyntaxError(_) => ApiError::new(Kind::MalformedJson, detail),
+            JsonRejection::MissingJsonContentType(_) => ApiError::new(
+                Kind::UnsupportedMediaType,
+                "send the body with Content-Type: application/json",
+            ),
+            r if r.status() == StatusCode::PAYLOAD_TOO_LARGE => {
+                ApiError::new(Kind::PayloadTooLarge, detail)
+            }
+            r => ApiError::from_status(r.status(), detail),
+        }
+    }
+}
+
+impl IntoResponse for ApiError {
+    fn into_response(self) -> Response {
+        let status = self.status();
+        if status.is_server_error() {
+            tracing::error!(status = status.as_u16(), detail = %self.detail, "request failed");
+        }
+        let body = serde_json::to_vec(&self.problem()).unwrap_or_default();
+        let mut response = (status, [(header::CONTENT_TYPE, PROBLEM_JSON)], body).into_response();
+        if let Some(seconds) = self.kind.retry_after() {
+            response
+                .headers_mut()
+                .insert(header::RETRY_AFTER, HeaderValue::from(seconds));
+        }
+        response
+    }
+}
+
+/// A JSON body, any shape (the job layer reads it); what axum cannot read is a problem.
+pub struct JsonBody(pub Value);
+
+impl<S: Send + Sync> FromRequest<S> for JsonBody {
+    type Rejection = ApiError;
+
+    async fn from_request(request: Request, state: &S) -> Result<Self, ApiError> {
+        let Json(value) = Json::<Value>::from_request(request, state).await?;
+        Ok(JsonBody(value))
+    }
+}
+
+/// Turns an error response that is not yet a problem (axum's 405, a timeout, a rejection
+/// with a plain-text body) into one, keeping its status, headers and text.
+pub async fn problem_for_errors(response: Response) -> Response {
+    let status = response.status();
+    let is_problem = response
+        .headers()
+        .get(header::CONTENT_TYPE)
+        .is_some_and(|v| v.as_bytes().starts_with(PROBLEM_JSON.as_bytes()));
+    if !(status.is_client_error() || status.is_server_error()) || is_problem {
+        return response;
+    }
+    let (mut parts, body) = response.into_parts();
+    let text = axum::body::to_bytes(body, 4096)
+        .await
+        .ok()
+        .and_then(|b| String::from_utf8(b.to_vec()).ok())
+        .map(|t| t.trim().to_string())
+        .filter(|t| !t.is_empty());
+    let detail = text.unwrap_or_else(|| status.canonical_reason().unwrap_or("").to_string());
+    let problem = ApiError::from_status(status, detail).problem();
+    parts.headers.remove(header::CONTENT_LENGTH);
+    parts
+        .headers
+        .insert(header::CONTENT_TYPE, HeaderValue::from_static(PROBLEM_JSON));
+    let body = serde_json::to_vec(&problem).unwrap_or_default();
+    Response::from_parts(parts, Body::from(body))
+}
+
+/// The answer to a request whose handler panicked.
+pub fn panic_response(_panic: Box<dyn std::any::Any + Send + 'static>) -> Response {
+    ApiError::internal("the request handler panicked").into_response()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::ParameterError;
+
+    fn kind_of(e: JobError) -> (u16, String) {
+        let problem = ApiError::from(e).problem();
+        (problem.status, problem.problem_type)
+    }
+
+    #[test]
+    fn job_errors_map_to_their_statuses() {
+        let t = |name: &str| format!("{TYPE_PREFIX}{name}");
+        let no_convergence = ModelError::NoConvergence {
+            what: "load equation",
+            iterations: 100,
+        };
+        let invalid = ModelError::InvalidParameter(ParameterError {
+            parameter: crate::model::Parameter::Radius,
+            value: -1.0,
+            allowed: "> 0".to_string(),
+        });
+        for (error, status, name) in [
+            (JobError::Syntax("x".into()), 400, "malformed-json"),
+            (JobError::Invalid(vec![]), 422, "invalid-input"),
+            (JobError::Solve(invalid), 422, "invalid-input"),
+            (JobError::Solve(no_convergence), 422, "solve-failed"),
+            (JobError::Cancelled, 409, "cancelled"),
+            (JobError::DeadlineExceeded, 504, "deadline-exceeded"),
+            (JobError::Internal("x".into()), 500, "internal"),
+        ] {
+            assert_eq!(kind_of(error), (status, t(name)));
+        }
+    }
+
+    #[test]
+    fn a_schema_error_names_its_field() {
+        let problem = ApiError::from(JobError::Schema {
+            field: "layer.thickness".into(),
+            message: "invalid type".into(),
+        })
+        .problem();
+        assert_eq!(problem.errors.len(), 1);
+        assert_eq!(problem.errors[0].field, "layer.thickness");
+    }
+
+    #[test]
+    fn refusals_say_when_to_retry() {
+        let overloaded = ApiError::from(EngineError::Overloaded).into_response();
+        assert_eq!(overloaded.status(), StatusCode::TOO_MANY_REQUESTS);
+        assert_eq!(overloaded.headers()[header::RETRY_AFTER], "1");
+        let draining = ApiError::draining().into_response();
+        assert_eq!(draining.status(), StatusCode::SERVICE_UNAVAILABLE);
+        assert!(draining.headers().contains_key(header::RETRY_AFTER));
+    }
+
+    #[tokio::test]
+    async fn plain_error_responses_become_problems_and_others_pass() {
+        let plain = (StatusCode::METHOD_NOT_ALLOWED, [(header::ALLOW, "GET")], "").into_response();
+        let mapped = problem_for_errors(plain).await;
+        assert_eq!(mapped.status(), StatusCode::METHOD_NOT_ALLOWED);
+        assert_eq!(mapped.headers()[header::CONTENT_TYPE], PROBLEM_JSON);
+        assert_eq!(mapped.headers()[header::ALLOW], "GET");
+        let body = axum::body::to_bytes(mapped.into_body(), 4096)
+            .await
+            .unwrap();
+        let problem: Value = serde_json::from_slice(&body).unwrap();
+        assert_eq!(problem["type"], "about:blank");
+        assert_eq!(problem["title"], "Method Not Allowed");
+
+        let ok = problem_for_errors(StatusCode::NOT_MODIFIED.into_response()).await;
+        assert_eq!(ok.status(), StatusCode::NOT_MODIFIED);
+        assert!(!ok.headers().contains_key(header::CONTENT_TYPE));
+    }
+}

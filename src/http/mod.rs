@@ -1,0 +1,212 @@
+//! The HTTP service: `thirdbody serve`. JSON in and out through the job layer, compute
+//! through the [`Engine`], one error contract ([`error`]), the spec generated from the
+//! routes ([`openapi`]).
+//!
+//! [`app`] builds the router for a state; [`run`] serves it on a listener until a shutdown
+//! signal, then drains. Tests and the binary start the service the same way.
+
+pub mod config;
+pub mod error;
+mod observe;
+pub mod openapi;
+pub mod routes;
+
+use std::future::{Future, IntoFuture};
+use std::sync::Arc;
+use std::time::Duration;
+
+use axum::extract::DefaultBodyLimit;
+use axum::http::{header, HeaderName, Method, StatusCode};
+use axum::{middleware, Router};
+use metrics_exporter_prometheus::{PrometheusBuilder, PrometheusHandle};
+use tokio::net::TcpListener;
+use tokio_util::sync::CancellationToken;
+use tower::util::option_layer;
+use tower_http::catch_panic::CatchPanicLayer;
+use tower_http::cors::{AllowOrigin, CorsLayer};
+use tower_http::request_id::{MakeRequestUuid, PropagateRequestIdLayer, SetRequestIdLayer};
+use tower_http::timeout::TimeoutLayer;
+use tower_http::trace::{DefaultOnResponse, TraceLayer};
+use tower_http::LatencyUnit;
+use utoipa_swagger_ui::SwaggerUi;
+
+pub use config::{Config, ConfigError, CorsOrigins, LogFormat, ServeArgs};
+pub use error::ApiError;
+
+use crate::engine::metrics::Metrics;
+use crate::engine::Engine;
+
+const X_REQUEST_ID: HeaderName = HeaderName::from_static("x-request-id");
+/// How often metrics histograms are drained and expired jobs forgotten.
+const HOUSEKEEPING_INTERVAL: Duration = Duration::from_secs(5);
+
+/// What every handler shares: the settings, the engine and the metrics.
+#[derive(Clone)]
+pub struct AppState {
+    inner: Arc<Inner>,
+}
+
+struct Inner {
+    config: Config,
+    engine: Arc<Engine>,
+    prometheus: PrometheusHandle,
+}
+
+impl AppState {
+    /// A service with its own engine and its own metrics registry.
+    pub fn new(config: Config) -> Self {
+        let recorder = PrometheusBuilder::new()
+            .set_buckets(&observe::BUCKETS)
+            .expect("the buckets are not empty")
+            .build_recorder();
+        let prometheus = recorder.handle();
+        let engine = Engine::new(config.engine.clone(), Metrics::new(Arc::new(recorder)));
+        AppState {
+            inner: Arc::new(Inner {
+                config,
+                engine,
+                prometheus,
+            }),
+        }
+    }
+
+    pub fn config(&self) -> &Config {
+        &self.inner.config
+    }
+
+    pub fn engine(&self) -> &Arc<Engine> {
+        &self.inner.engine
+    }
+
+    /// The metrics in the Prometheus text format.
+    pub fn render_metrics(&self) -> String {
+        self.inner.prometheus.render()
+    }
+}
+
+/// The service's router, with every layer: request id, tracing, metrics, CORS, problem
+/// responses for every error, panic guard, request timeout and body limit.
+pub fn app(state: AppState) -> Router {
+    let (api, spec) = openapi::router().split_for_parts();
+    let config = state.config();
+    // Outermost last: each request passes the request id, tracing and metrics first, and
+    // each response leaves through the problem mapping (inside CORS, so that errors carry
+    // CORS headers too).
+    api.merge(SwaggerUi::new("/docs").url("/openapi.json", spec))
+        .route_layer(middleware::from_fn(observe::tag_route))
+        .fallback(not_found)
+        .layer(DefaultBodyLimit::max(config.body_limit))
+        .layer(TimeoutLayer::with_status_code(
+            StatusCode::REQUEST_TIMEOUT,
+            config.request_timeout,
+        ))
+        .layer(CatchPanicLayer::custom(error::panic_response))
+        .layer(middleware::map_response(error::problem_for_errors))
+        .layer(option_layer(cors(&config.cors_origins)))
+        .layer(middleware::from_fn_with_state(
+            state.clone(),
+            observe::record_request,
+        ))
+        .layer(PropagateRequestIdLayer::new(X_REQUEST_ID))
+        .layer(
+            TraceLayer::new_for_http()
+                .make_span_with(observe::request_span)
+                .on_response(
+                    DefaultOnResponse::new()
+                        .level(tracing::Level::INFO)
+                        .latency_unit(LatencyUnit::Micros),
+                ),
+        )
+        .layer(SetRequestIdLayer::new(X_REQUEST_ID, MakeRequestUuid))
+        .with_state(state)
+}
+
+async fn not_found() -> ApiError {
+    ApiError::not_found("no such route: see /docs or /openapi.json")
+}
+
+/// CORS for a dashboard on another origin: it may POST JSON and read the headers that
+/// carry meaning (the job's `Location`, `ETag`, `X-Cache`, `Retry-After`, the request id).
+fn cors(origins: &CorsOrigins) -> Option<CorsLayer> {
+    let allow = match origins {
+        CorsOrigins::None => return None,
+        CorsOrigins::Any => AllowOrigin::any(),
+        CorsOrigins::List(list) => AllowOrigin::list(list.iter().cloned()),
+    };
+    Some(
+        CorsLayer::new()
+            .allow_origin(allow)
+            .allow_methods([Method::GET, Method::POST, Method::DELETE])
+            .allow_headers([
+                header::CONTENT_TYPE,
+                header::ACCEPT,
+                header::IF_NONE_MATCH,
+                X_REQUEST_ID,
+            ])
+            .expose_headers([
+                header::LOCATION,
+                header::ETAG,
+                header::RETRY_AFTER,
+                routes::X_CACHE,
+                X_REQUEST_ID,
+            ])
+            .max_age(Duration::from_secs(3600)),
+    )
+}
+
+/// Serves `state` on `listener` until `shutdown` resolves, then drains: `/readyz` and new
+/// work answer 503 and queued jobs are cancelled; after the drain delay the listener
+/// closes; in-flight requests and running jobs then have the shutdown timeout to finish,
+/// after which what is left is cancelled.
+pub async fn run(
+    listener: TcpListener,
+    state: AppState,
+    shutdown: impl Future<Output = ()> + Send + 'static,
+) -> std::io::Result<()> {
+    let stop_accepting = CancellationToken::new();
+    let housekeeping = tokio::spawn(housekeeping(state.clone()));
+    let server = axum::serve(listener, app(state.clone()))
+        .with_graceful_shutdown(stop_accepting.clone().cancelled_owned())
+        .into_future();
+    let mut server = tokio::spawn(server);
+    tokio::select! {
+        result = &mut server => {
+            housekeeping.abort();
+            return result?;
+        }
+        () = shutdown => {}
+    }
+    let config = state.config();
+    let engine = state.engine();
+    tracing::info!("shutting down: draining");
+    engine.begin_drain();
+    tokio::time::sleep(config.drain_delay).await;
+    stop_accepting.cancel();
+    let drained = tokio::time::timeout(config.shutdown_timeout, async {
+        let served = (&mut server).await;
+        engine.jobs_finished().await;
+        served
+    })
+    .await;
+    housekeeping.abort();
+    match drained {
+        Ok(served) => served?,
+        Err(_) => {
+            tracing::warn!("the drain ran out of time: cancelling what is left");
+            engine.cancel_running_jobs();
+            server.abort();
+            Ok(())
+        }
+    }
+}
+
+/// Periodic chores: drain the metrics histograms (they buffer samples until rendered) and
+/// forget expired jobs.
+async fn housekeeping(state: AppState) {
+    let mut tick = tokio::time::interval(HOUSEKEEPING_INTERVAL);
+    loop {
+        tick.tick().await;
+        state.inner.prometheus.run_upkeep();
+        state.engine().purge_expired_jobs();
+    }
+}

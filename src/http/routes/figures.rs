@@ -1,0 +1,44 @@
+//! `GET /v1/figures/{n}`: the data behind one of the paper's figures; JSON or CSV.
+
+use axum::extract::{Path, State};
+use axum::http::HeaderMap;
+use axum::response::Response;
+
+use crate::http::error::ApiError;
+use crate::http::openapi::{Busy, NotFound, NotModified, SolveErrors};
+use crate::http::AppState;
+use crate::job::figure::FigureOutput;
+use crate::job::{FigureJob, Job};
+
+/// The data of Figure n of the paper.
+///
+/// Figures 3 to 9 (MODEL.md §5): the contact region, and contact area and friction
+/// against load and radius, with and without rolling. With `Accept: text/csv` the answer is
+/// CSV, one line per point.
+#[utoipa::path(
+    get,
+    path = "/v1/figures/{n}",
+    tag = "figures",
+    params(("n" = u8, Path, description = "The figure's number in the paper, 3 to 9")),
+    responses(
+        (status = 200, description = "The figure's axes and series", content(
+            (FigureOutput = "application/json"), (String = "text/csv")),
+            headers(("etag" = String, description = "The cache key, quoted (suffixed .csv for CSV)"),
+                    ("x-cache" = String, description = "hit or miss"))),
+        NotModified, NotFound, Busy, SolveErrors,
+    )
+)]
+pub async fn figure(
+    State(state): State<AppState>,
+    Path(n): Path<String>,
+    headers: HeaderMap,
+) -> Result<Response, ApiError> {
+    let job = n
+        .parse()
+        .ok()
+        .and_then(|number| FigureJob::new(number).ok())
+        .ok_or_else(|| {
+            ApiError::not_found(format!("there is no figure {n}: figures are 3 to 9"))
+        })?;
+    super::answer(&state, Job::Figure(job), &headers).await
+}

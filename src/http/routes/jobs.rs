@@ -1,0 +1,245 @@
+//! `/v1/jobs`: asynchronous jobs. Submit, poll or follow the progress as server-sent events,
+//! cancel; a finished job is kept for the retention time, then forgotten (404).
+
+use std::sync::Arc;
+use std::time::Duration;
+
+use axum::extract::{Path, State};
+use axum::http::{header, StatusCode};
+use axum::response::sse::{Event, KeepAlive, Sse};
+use axum::response::{IntoResponse, Response};
+use axum::Json;
+use futures_util::stream::{self, Stream};
+use serde::{Serialize, Serializer};
+use serde_json::value::RawValue;
+use tokio::sync::watch;
+use utoipa::ToSchema;
+use uuid::Uuid;
+
+use crate::engine::cache::Solved;
+use crate::engine::jobs::{JobEntry, JobState, JobStatus};
+use crate::engine::Output;
+use crate::http::error::{ApiError, JsonBody, Problem};
+use crate::http::openapi::{BadBody, Busy, NotFound};
+use crate::http::AppState;
+use crate::job::{Envelope, Job, JobKind};
+
+/// How often a progress stream looks at a running job's count of solves.
+const PROGRESS_INTERVAL: Duration = Duration::from_millis(100);
+/// How long `DELETE` waits for the solver to stop (it checks between solves, which take
+/// microseconds to milliseconds).
+const CANCEL_WAIT: Duration = Duration::from_secs(5);
+
+/// Solves done out of the job's total.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, ToSchema)]
+pub struct Progress {
+    /// Rolling solves done (count).
+    pub done: usize,
+    /// Rolling solves the job takes (count).
+    pub total: usize,
+}
+
+/// An asynchronous job as clients see it.
+#[derive(Debug, Serialize, ToSchema)]
+pub struct JobView {
+    /// The job's id (a UUID); its URL is `/v1/jobs/{id}`.
+    pub id: Uuid,
+    pub kind: JobKind,
+    pub status: JobStatus,
+    pub progress: Progress,
+    /// The answer, once `succeeded`: the output of the job's kind.
+    #[serde(skip_serializing_if = "Option::is_none", serialize_with = "rendered")]
+    #[schema(value_type = Option<Output>)]
+    pub result: Option<Arc<Solved>>,
+    /// Why it failed, once `failed`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub problem: Option<Problem>,
+}
+
+/// Writes a result as the JSON it was rendered to once, not serialized again.
+fn rendered<S: Serializer>(solved: &Option<Arc<Solved>>, s: S) -> Result<S::Ok, S::Error> {
+    let raw: Option<&RawValue> = solved
+        .as_ref()
+        .map(|solved| serde_json::from_slice(&solved.json))
+        .transpose()
+        .map_err(serde::ser::Error::custom)?;
+    raw.serialize(s)
+}
+
+impl JobView {
+    /// The job now; with `full`, its result too once it has one.
+    fn of(entry: &JobEntry, full: bool) -> JobView {
+        let state = entry.state();
+        let (result, problem) = match &state {
+            JobState::Succeeded(solved) if full => (Some(solved.clone()), None),
+            JobState::Failed(e) => (None, Some(ApiError::from(e.clone()).problem())),
+            _ => (None, None),
+        };
+        JobView {
+            id: entry.id,
+            kind: entry.kind,
+            status: state.status(),
+            progress: Progress {
+                done: entry.done(),
+                total: entry.total,
+            },
+            result,
+            problem,
+        }
+    }
+}
+
+fn find(state: &AppState, id: &str) -> Result<Arc<JobEntry>, ApiError> {
+    id.parse()
+        .ok()
+        .and_then(|id| state.engine().job(id))
+        .ok_or_else(|| ApiError::not_found(format!("no job {id} (never submitted, or expired)")))
+}
+
+/// Submit a job to run in the background.
+///
+/// The body is a job envelope, as `thirdbody solve` takes: `{"kind": "sweep", "input":
+/// {...}}`. The answer is `202` with the job's URL in `Location`; poll it, or follow
+/// `/v1/jobs/{id}/events`. A job already in the cache is `succeeded` at once.
+#[utoipa::path(
+    post,
+    path = "/v1/jobs",
+    tag = "jobs",
+    request_body(content = Envelope, content_type = "application/json"),
+    responses(
+        (status = 202, description = "Accepted: queued, running, or already succeeded",
+            body = JobView, headers(
+                ("location" = String, description = "The job's URL, /v1/jobs/{id}"),
+                ("retry-after" = u32, description = "Seconds to wait before polling"))),
+        BadBody, Busy,
+    )
+)]
+pub async fn submit(
+    State(state): State<AppState>,
+    JsonBody(envelope): JsonBody,
+) -> Result<Response, ApiError> {
+    let job = Job::from_value(envelope, &state.config().limits)?;
+    let entry = state.engine().submit(job)?;
+    let location = format!("/v1/jobs/{}", entry.id);
+    let view = JobView::of(&entry, true);
+    let headers = [
+        (header::LOCATION, location),
+        (header::RETRY_AFTER, "1".into()),
+    ];
+    Ok((StatusCode::ACCEPTED, headers, Json(view)).into_response())
+}
+
+/// A job's status, progress, and result or problem.
+#[utoipa::path(
+    get,
+    path = "/v1/jobs/{id}",
+    tag = "jobs",
+    params(("id" = Uuid, Path, description = "The job's id")),
+    responses((status = 200, description = "The job", body = JobView), NotFound)
+)]
+pub async fn status(
+    State(state): State<AppState>,
+    Path(id): Path<String>,
+) -> Result<Json<JobView>, ApiError> {
+    Ok(Json(JobView::of(&*find(&state, &id)?, true)))
+}
+
+/// Cancel a job.
+///
+/// A queued job is cancelled at once, a running one at the solver's next check (between two
+/// rolling solves); the answer is the job once it stopped. A finished job is left as it
+/// is.
+#[utoipa::path(
+    delete,
+    path = "/v1/jobs/{id}",
+    tag = "jobs",
+    params(("id" = Uuid, Path, description = "The job's id")),
+    responses((status = 200, description = "The job after the cancel", body = JobView), NotFound)
+)]
+pub async fn cancel(
+    State(state): State<AppState>,
+    Path(id): Path<String>,
+) -> Result<Json<JobView>, ApiError> {
+    let entry = find(&state, &id)?;
+    entry.cancel();
+    let mut states = entry.subscribe();
+    // Still running after the wait: the answer says so, and the job stops soon after.
+    let _ = tokio::time::timeout(CANCEL_WAIT, states.wait_for(|s| s.status().is_finished())).await;
+    Ok(Json(JobView::of(&entry, true)))
+}
+
+/// Follow a job as server-sent events.
+///
+/// `progress` events (the job without its result) whenever its status or count changes,
+/// at most every 100 ms; then one `completion` event, the job with its result or problem,
+/// and the stream ends.
+#[utoipa::path(
+    get,
+    path = "/v1/jobs/{id}/events",
+    tag = "jobs",
+    params(("id" = Uuid, Path, description = "The job's id")),
+    responses(
+        (status = 200, description = "A text/event-stream of `progress` events and one \
+            `completion` event, each with a JobView as data",
+            content_type = "text/event-stream", body = String),
+        NotFound,
+    )
+)]
+pub async fn events(
+    State(state): State<AppState>,
+    Path(id): Path<String>,
+) -> Result<Sse<impl Stream<Item = Result<Event, axum::Error>>>, ApiError> {
+    let entry = find(&state, &id)?;
+    let watcher = Watcher {
+        states: entry.subscribe(),
+        entry,
+        last: None,
+        finished: false,
+    };
+    let events = stream::unfold(watcher, |mut w| async move {
+        let event = w.next().await?;
+        Some((event, w))
+    });
+    Ok(Sse::new(events).keep_alive(KeepAlive::default()))
+}
+
+/// Turns a job's changes into events.
+struct Watcher {
+    entry: Arc<JobEntry>,
+    states: watch::Receiver<JobState>,
+    /// The status and count last sent.
+    last: Option<(JobStatus, usize)>,
+    finished: bool,
+}
+
+impl Watcher {
+    /// The next event, or `None` after the completion.
+    async fn next(&mut self) -> Option<Result<Event, axum::Error>> {
+        if self.finished {
+            return None;
+        }
+        let mut tick = tokio::time::interval(PROGRESS_INTERVAL);
+        loop {
+            let status = self.entry.state().status();
+            let now = (status, self.entry.done());
+            if status.is_finished() {
+                self.finished = true;
+                return Some(self.event("completion", true));
+            }
+            if self.last != Some(now) {
+                self.last = Some(now);
+                return Some(self.event("progress", false));
+            }
+            tokio::select! {
+                _ = self.states.changed() => {}
+                _ = tick.tick() => {}
+            }
+        }
+    }
+
+    fn event(&self, name: &str, full: bool) -> Result<Event, axum::Error> {
+        Event::default()
+            .event(name)
+            .json_data(JobView::of(&self.entry, full))
+    }
+}

@@ -1,0 +1,68 @@
+//! Operations: liveness, readiness (fails while draining) and Prometheus metrics.
+
+use axum::extract::State;
+use axum::http::header;
+use axum::response::IntoResponse;
+use axum::Json;
+use serde::Serialize;
+use utoipa::ToSchema;
+
+use crate::http::error::ApiError;
+use crate::http::openapi::Draining;
+use crate::http::AppState;
+
+/// A probe's answer.
+#[derive(Serialize, ToSchema)]
+pub struct Health {
+    /// `ok` (alive) or `ready` (taking work).
+    pub status: &'static str,
+}
+
+/// Liveness: the process answers requests.
+#[utoipa::path(
+    get,
+    path = "/healthz",
+    tag = "operations",
+    responses((status = 200, description = "Alive", body = Health))
+)]
+pub async fn healthz() -> Json<Health> {
+    Json(Health { status: "ok" })
+}
+
+/// Readiness: the service takes new work; 503 once it is shutting down.
+#[utoipa::path(
+    get,
+    path = "/readyz",
+    tag = "operations",
+    responses((status = 200, description = "Ready", body = Health), Draining)
+)]
+pub async fn readyz(State(state): State<AppState>) -> Result<Json<Health>, ApiError> {
+    if state.engine().is_draining() {
+        Err(ApiError::draining())
+    } else {
+        Ok(Json(Health { status: "ready" }))
+    }
+}
+
+/// Metrics in the Prometheus text format.
+///
+/// `http_requests_total` and `http_request_duration_seconds` by method, route and status;
+/// `thirdbody_solve_duration_seconds` by job kind and outcome (its `_count` is the number of
+/// solves); `thirdbody_cache_hits_total`, `thirdbody_cache_misses_total`;
+/// `thirdbody_jobs_queued`, `thirdbody_jobs_running`; `thirdbody_rejections_total` by reason.
+#[utoipa::path(
+    get,
+    path = "/metrics",
+    tag = "operations",
+    responses((status = 200, description = "Prometheus text exposition format",
+        content_type = "text/plain; version=0.0.4", body = String))
+)]
+pub async fn metrics(State(state): State<AppState>) -> impl IntoResponse {
+    (
+        [(
+            header::CONTENT_TYPE,
+            "text/plain; version=0.0.4; charset=utf-8",
+        )],
+        state.render_metrics(),
+    )
+}

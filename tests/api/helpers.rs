@@ -1,0 +1,192 @@
+//! Starting a server the way the binary does, and reading what it answers.
+
+use std::future::Future;
+use std::time::Duration;
+
+use clap::Parser;
+use reqwest::{Client, Response, StatusCode};
+use serde_json::Value;
+use thirdbody::http::{self, AppState, ServeArgs};
+use tokio::net::TcpListener;
+use tokio::sync::oneshot;
+use tokio::task::JoinHandle;
+
+/// Generous bound on any wait in a test: reached only when something hangs.
+pub const PATIENCE: Duration = Duration::from_secs(120);
+
+/// A running server.
+pub struct TestApp {
+    pub base: String,
+    pub client: Client,
+    shutdown: Option<oneshot::Sender<()>>,
+    pub server: JoinHandle<std::io::Result<()>>,
+}
+
+/// The settings `thirdbody serve` would have with these flags.
+pub fn state(flags: &[&str]) -> AppState {
+    let args = std::iter::once("serve").chain(flags.iter().copied());
+    let config = ServeArgs::try_parse_from(args)
+        .expect("valid flags")
+        .validate()
+        .expect("valid settings");
+    AppState::new(config)
+}
+
+/// Serves on 127.0.0.1, port 0, with `flags`.
+pub async fn spawn_app(flags: &[&str]) -> TestApp {
+    let listener = TcpListener::bind("127.0.0.1:0").await.unwrap();
+    let base = format!("http://{}", listener.local_addr().unwrap());
+    let (tx, rx) = oneshot::channel::<()>();
+    let shutdown = async {
+        let _ = rx.await;
+    };
+    let server = tokio::spawn(http::run(listener, state(flags), shutdown));
+    TestApp {
+        base,
+        client: Client::new(),
+        shutdown: Some(tx),
+        server,
+    }
+}
+
+impl TestApp {
+    pub fn url(&self, path: &str) -> String {
+        format!("{}{path}", self.base)
+    }
+
+    pub async fn get(&self, path: &str) -> Response {
+        self.client.get(self.url(path)).send().await.unwrap()
+    }
+
+    pub async fn post(&self, path: &str, body: &Value) -> Response {
+        self.client
+            .post(self.url(path))
+            .json(body)
+            .send()
+            .await
+            .unwrap()
+    }
+
+    /// Sends the shutdown signal (SIGTERM for the binary).
+    pub fn shut_down(&mut self) {
+        if let Some(tx) = self.shutdown.take() {
+            let _ = tx.send(());
+        }
+    }
+
+    /// The value of the metric line `name{labels...}` (labels in any order), 0 if absent.
+    pub async fn metric(&self, name: &str, labels: &[(&str, &str)]) -> f64 {
+        let text = self.get("/metrics").await.text().await.unwrap();
+        text.lines()
+            .filter(|line| !line.starts_with('#'))
+            .filter_map(|line| line.rsplit_once(' '))
+            .find(|(series, _)| {
+                let (metric, rest) = series.split_once('{').unwrap_or((series, ""));
+                metric == name
+                    && labels
+                        .iter()
+                        .all(|(k, v)| rest.contains(&format!("{k}=\"{v}\"")))
+            })
+            .map_or(0.0, |(_, value)| value.parse().unwrap())
+    }
+
+    /// Submits an asynchronous job; returns its URL.
+    pub async fn submit(&self, job: &Value) -> String {
+        let response = self.post("/v1/jobs", job).await;
+        assert_eq!(response.status(), StatusCode::ACCEPTED);
+        let location = response.headers()["location"].to_str().unwrap().to_string();
+        assert!(location.starts_with("/v1/jobs/"), "{location}");
+        location
+    }
+
+    /// Polls the job at `location` until `done` holds for it; returns it then.
+    pub async fn wait_for_job(&self, location: &str, done: impl Fn(&Value) -> bool) -> Value {
+        within(async {
+            loop {
+                let job: Value = self.get(location).await.json().await.unwrap();
+                if done(&job) {
+                    return job;
+                }
+                tokio::time::sleep(Duration::from_millis(10)).await;
+            }
+        })
+        .await
+    }
+}
+
+/// `future`, or a panic if it hangs.
+pub async fn within<T>(future: impl Future<Output = T>) -> T {
+    tokio::time::timeout(PATIENCE, future)
+        .await
+        .expect("the test hung")
+}
+
+/// A sweep of `n`³ points, long enough to hold a solver thread for the length of a test.
+pub fn long_sweep(n: usize) -> Value {
+    let radii: Vec<String> = (0..n).map(|i| format!("{} nm", 25 + i)).collect();
+    let loads: Vec<String> = (0..n).map(|i| format!("{} pN", 1000 + i)).collect();
+    let speeds: Vec<String> = (0..n).map(|i| format!("{} nm/s", 1 + i)).collect();
+    serde_json::json!({"kind": "sweep", "input": {"vary": {
+        "radius": radii, "load": loads, "velocity": speeds}}})
+}
+
+/// Reads a `text/event-stream` body event by event.
+pub struct Events {
+    response: Response,
+    buffer: String,
+}
+
+impl Events {
+    pub fn new(response: Response) -> Self {
+        assert_eq!(response.status(), StatusCode::OK);
+        assert_eq!(response.headers()["content-type"], "text/event-stream");
+        Events {
+            response,
+            buffer: String::new(),
+        }
+    }
+
+    /// The next event's name and data (keep-alive comments skipped); `None` at the end.
+    pub async fn next(&mut self) -> Option<(String, Value)> {
+        within(async {
+            loop {
+                if let Some(end) = self.buffer.find("\n\n") {
+                    let block: String = self.buffer.drain(..end + 2).collect();
+                    let field = |name: &str| {
+                        block
+                            .lines()
+                            .find_map(|l| l.strip_prefix(name))
+                            .map(|v| v.trim_start().to_string())
+                    };
+                    if let (Some(event), Some(data)) = (field("event:"), field("data:")) {
+                        return Some((event, serde_json::from_str(&data).unwrap()));
+                    }
+                    continue;
+                }
+                match self.response.chunk().await {
+                    Ok(Some(bytes)) => self.buffer.push_str(std::str::from_utf8(&bytes).unwrap()),
+                    _ => return None,
+                }
+            }
+        })
+        .await
+    }
+}
+
+/// The problem document of an error response, checked for its status and content type.
+pub async fn problem(response: Response, status: u16) -> Value {
+    assert_eq!(response.status().as_u16(), status);
+    assert_eq!(
+        response.headers()["content-type"],
+        "application/problem+json"
+    );
+    let problem: Value = response.json().await.unwrap();
+    assert_eq!(problem["status"], status);
+    assert!(problem["title"].is_string() && problem["detail"].is_string());
+    problem
+}
+
+/// The type URI of the problem named `name`.
+pub fn problem_type(name: &str) -> String {
+    format!("tag:thirdbody,2026:problems/{name}")
+}

@@ -1,0 +1,9 @@
+//! The HTTP service end to end: real HTTP against servers on port 0 (one per test, each with
+//! its own engine, cache and metrics), plus in-process router tests with `oneshot`.
+
+mod errors;
+mod helpers;
+mod in_process;
+mod jobs;
+mod ops;
+mod solve;

@@ -1,0 +1,156 @@
+//! The synchronous endpoints: answers equal the engine's, the cache and its validators.
+
+use futures_util::future::join_all;
+use serde_json::{json, Value};
+use thirdbody::engine::{self, Control};
+use thirdbody::job::{FigureJob, Job, Limits};
+
+use crate::helpers::spawn_app;
+
+/// The engine's answer to `job`, as JSON text read back the way the client reads the
+/// service's (serde_json's default float parsing may differ from the exact value in the
+/// last bit: both sides go through it).
+pub fn engine_answer(job: Job) -> Value {
+    let output = engine::run(&job, &Control::default()).unwrap();
+    serde_json::from_str(&serde_json::to_string(&output).unwrap()).unwrap()
+}
+
+#[tokio::test]
+async fn rolling_answers_the_model_section_3_reference_row() {
+    let app = spawn_app(&[]).await;
+    let response = app.post("/v1/rolling", &json!({})).await;
+    assert_eq!(response.status(), 200);
+    assert_eq!(response.headers()["x-cache"], "miss");
+    let etag = response.headers()["etag"].to_str().unwrap().to_string();
+    let body: Value = response.json().await.unwrap();
+    // MODEL.md §3, R = 25 nm, P = 1 nN, V = 4 nm/s: A = 85.234 nm², μ = 0.09470.
+    let area = body["contact_area"].as_f64().unwrap() * 1e18;
+    assert!((area - 85.234).abs() < 5e-4, "{area}");
+    let mu = body["friction_coefficient"].as_f64().unwrap();
+    assert!((mu - 0.09470).abs() < 5e-6, "{mu}");
+    assert_eq!(
+        etag,
+        format!("\"{}\"", body["meta"]["input_hash"].as_str().unwrap())
+    );
+    let job = Job::from_value(json!({"kind": "rolling"}), &Limits::default()).unwrap();
+    assert_eq!(body, engine_answer(job));
+}
+
+#[tokio::test]
+async fn the_same_job_again_is_a_cache_hit_whatever_its_units_and_if_none_match_is_304() {
+    let app = spawn_app(&[]).await;
+    let first = app.post("/v1/rolling", &json!({"radius": 2.5e-8})).await;
+    assert_eq!(first.headers()["x-cache"], "miss");
+    let etag = first.headers()["etag"].clone();
+    let first = first.text().await.unwrap();
+
+    // The same input in other units has the same canonical form, so the same key.
+    let second = app.post("/v1/rolling", &json!({"radius": "25 nm"})).await;
+    assert_eq!(second.headers()["x-cache"], "hit");
+    assert_eq!(second.headers()["etag"], etag);
+    assert_eq!(second.text().await.unwrap(), first);
+
+    let not_modified = app
+        .client
+        .post(app.url("/v1/rolling"))
+        .header("if-none-match", etag.clone())
+        .json(&json!({"radius": "25 nm"}))
+        .send()
+        .await
+        .unwrap();
+    assert_eq!(not_modified.status(), 304);
+    assert_eq!(not_modified.headers()["etag"], etag);
+    assert!(not_modified.bytes().await.unwrap().is_empty());
+
+    let other = app
+        .client
+        .post(app.url("/v1/rolling"))
+        .header("if-none-match", "\"another\"")
+        .json(&json!({"radius": "26 nm"}))
+        .send()
+        .await
+        .unwrap();
+    assert_eq!(other.status(), 200);
+    assert_eq!(app.metric("thirdbody_cache_hits_total", &[]).await, 2.0);
+    assert_eq!(app.metric("thirdbody_cache_misses_total", &[]).await, 2.0);
+}
+
+#[tokio::test]
+async fn a_hundred_identical_concurrent_requests_are_solved_once() {
+    let app = spawn_app(&[]).await;
+    let input = json!({"radius": "31 nm", "velocity": "7 nm/s"});
+    let responses = join_all((0..100).map(|_| app.post("/v1/rolling", &input))).await;
+    let mut misses = 0;
+    let mut bodies = Vec::new();
+    for response in responses {
+        assert_eq!(response.status(), 200);
+        misses += usize::from(response.headers()["x-cache"] == "miss");
+        bodies.push(response.text().await.unwrap());
+    }
+    assert_eq!(misses, 1);
+    assert!(bodies.iter().all(|b| *b == bodies[0]));
+    let solves = app
+        .metric(
+            "thirdbody_solve_duration_seconds_count",
+            &[("kind", "rolling")],
+        )
+        .await;
+    assert_eq!(solves, 1.0);
+    assert_eq!(app.metric("thirdbody_cache_hits_total", &[]).await, 99.0);
+}
+
+#[tokio::test]
+async fn a_sweep_answers_json_or_csv_with_one_row_per_point() {
+    let app = spawn_app(&[]).await;
+    let job: Value = serde_json::from_str(include_str!("../../examples/sweep.json")).unwrap();
+    let input = &job["input"];
+    let response = app.post("/v1/sweeps", input).await;
+    assert_eq!(response.status(), 200);
+    let json_etag = response.headers()["etag"].clone();
+    let body: Value = response.json().await.unwrap();
+    assert_eq!(body["points"].as_array().unwrap().len(), 15);
+    assert_eq!(
+        body,
+        engine_answer(Job::from_value(job.clone(), &Limits::default()).unwrap())
+    );
+
+    let csv = app
+        .client
+        .post(app.url("/v1/sweeps"))
+        .header("accept", "text/csv")
+        .json(input)
+        .send()
+        .await
+        .unwrap();
+    assert_eq!(csv.status(), 200);
+    assert!(csv.headers()["content-type"]
+        .to_str()
+        .unwrap()
+        .starts_with("text/csv"));
+    assert_eq!(csv.headers()["x-cache"], "hit");
+    assert_ne!(csv.headers()["etag"], json_etag);
+    let text = csv.text().await.unwrap();
+    assert_eq!(text.lines().count(), 16);
+    assert!(text.starts_with("radius,load,velocity,"));
+}
+
+#[tokio::test]
+async fn a_figure_answers_json_or_csv() {
+    let app = spawn_app(&[]).await;
+    let response = app.get("/v1/figures/6").await;
+    assert_eq!(response.status(), 200);
+    let body: Value = response.json().await.unwrap();
+    assert_eq!(body["figure"], 6);
+    assert_eq!(body, engine_answer(Job::Figure(FigureJob::new(6).unwrap())));
+
+    let csv = app
+        .client
+        .get(app.url("/v1/figures/3"))
+        .header("accept", "text/csv")
+        .send()
+        .await
+        .unwrap();
+    assert_eq!(csv.status(), 200);
+    let text = csv.text().await.unwrap();
+    assert!(text.starts_with("series,label,"), "{text}");
+}
