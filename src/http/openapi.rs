@@ -11,7 +11,7 @@ use utoipa_axum::router::OpenApiRouter;
 use utoipa_axum::routes;
 
 use super::error::{Problem, PROBLEM_JSON};
-use super::routes::{figures, jobs, ops, rolling, sweeps};
+use super::routes::{figures, jobs, ops, rolling, sweeps, three_body};
 use super::AppState;
 
 #[derive(OpenApi)]
@@ -37,6 +37,7 @@ struct ApiDoc;
 pub fn router() -> OpenApiRouter<AppState> {
     OpenApiRouter::with_openapi(ApiDoc::openapi())
         .routes(routes!(rolling::solve))
+        .routes(routes!(three_body::solve))
         .routes(routes!(sweeps::solve))
         .routes(routes!(jobs::submit))
         .routes(routes!(jobs::status, jobs::cancel))

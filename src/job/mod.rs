@@ -78,7 +78,8 @@ impl JobKind {
 #[serde(deny_unknown_fields)]
 pub struct Envelope {
     pub kind: JobKind,
-    /// The input of the job's kind: a `RollingInput`, `SweepInput` or `FigureInput`.
+    /// The input of the job's kind: a `RollingInput`, `ThreeBodyInput`, `SweepInput` or
+    /// `FigureInput`.
     /// Absent, every field takes its default.
     #[serde(default)]
     #[schema(value_type = Option<Object>)]

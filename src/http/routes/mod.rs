@@ -7,6 +7,7 @@ pub mod jobs;
 pub mod ops;
 pub mod rolling;
 pub mod sweeps;
+pub mod three_body;
 
 use axum::http::{header, HeaderMap, HeaderName, HeaderValue, StatusCode};
 use axum::response::{IntoResponse, Response};
