@@ -35,7 +35,13 @@ impl FromRequest<AppState> for SolveRequest {
     type Rejection = ApiError;
 
     async fn from_request(request: Request, state: &AppState) -> Result<Self, ApiError> {
-        let headers = request.headers().clone();
+        // Only the headers that choose the answer's form are kept.
+        let mut headers = HeaderMap::new();
+        for name in [header::ACCEPT, header::IF_NONE_MATCH] {
+            for value in request.headers().get_all(&name) {
+                headers.append(name.clone(), value.clone());
+            }
+        }
         let JsonBody(input) = JsonBody::from_request(request, state).await?;
         Ok(SolveRequest {
             state: state.clone(),
