@@ -1,5 +1,6 @@
--- wrk: POST rolling jobs that all differ (the load varies by a part in 1e9 per request), so
--- every request misses the cache and is solved. `-- OFFSET` keeps runs apart.
+-- wrk: POST rolling jobs that all differ (the load changes by a part in 1e9 per request),
+dofile("loadtest/summary.lua")
+-- so every request misses the cache and is solved. `-- OFFSET` keeps runs apart.
 local counter = 0
 local offset = 0
 

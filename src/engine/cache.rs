@@ -98,6 +98,10 @@ impl ResultCache {
         E: Clone + Send + Sync + 'static,
         F: Future<Output = Result<Arc<Solved>, E>>,
     {
+        // A plain lookup first: most calls are hits, and it costs less than the entry API.
+        if let Some(solved) = self.cache.get(&key).await {
+            return Ok((solved, false));
+        }
         let entry = self
             .cache
             .entry(key)

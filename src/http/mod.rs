@@ -87,7 +87,7 @@ impl AppState {
 /// The service's router, with every layer: request id, tracing, metrics, CORS, problem
 /// responses for every error, panic guard, request timeout and body limit.
 pub fn app(state: AppState) -> Router {
-    let (api, spec) = openapi::router().split_for_parts();
+    let (api, spec) = openapi::router_and_spec();
     let config = state.config();
     // Outermost last: each request passes the request id, tracing and metrics first, and
     // each response leaves through the problem mapping (inside CORS, so that errors carry

@@ -8,13 +8,8 @@ use crate::helpers::{long_sweep, problem, problem_type, spawn_app, within};
 async fn malformed_json_is_400() {
     let app = spawn_app(&[]).await;
     let response = app
-        .client
-        .post(app.url("/v1/rolling"))
-        .header("content-type", "application/json")
-        .body("{\"radius\": ")
-        .send()
-        .await
-        .unwrap();
+        .post_raw("/v1/rolling", "application/json", "{\"radius\": ".into())
+        .await;
     let malformed = problem(response, 400).await;
     assert_eq!(malformed["type"], problem_type("malformed-json"));
 }
@@ -22,14 +17,7 @@ async fn malformed_json_is_400() {
 #[tokio::test]
 async fn a_body_that_is_not_json_is_415() {
     let app = spawn_app(&[]).await;
-    let response = app
-        .client
-        .post(app.url("/v1/sweeps"))
-        .header("content-type", "text/plain")
-        .body("{}")
-        .send()
-        .await
-        .unwrap();
+    let response = app.post_raw("/v1/sweeps", "text/plain", "{}".into()).await;
     let unsupported = problem(response, 415).await;
     assert_eq!(unsupported["type"], problem_type("unsupported-media-type"));
 }
@@ -39,13 +27,8 @@ async fn a_body_over_the_limit_is_413() {
     let app = spawn_app(&["--body-limit", "1024"]).await;
     let padding = " ".repeat(2048);
     let response = app
-        .client
-        .post(app.url("/v1/rolling"))
-        .header("content-type", "application/json")
-        .body(format!("{{{padding}}}"))
-        .send()
-        .await
-        .unwrap();
+        .post_raw("/v1/rolling", "application/json", format!("{{{padding}}}"))
+        .await;
     let too_large = problem(response, 413).await;
     assert_eq!(too_large["type"], problem_type("payload-too-large"));
 }
@@ -136,7 +119,7 @@ async fn a_full_pool_is_429_at_once_and_a_full_job_queue_too() {
     assert_eq!(app.metric("thirdbody_jobs_queued", &[]).await, 1.0);
     assert_eq!(app.metric("thirdbody_jobs_running", &[]).await, 1.0);
     for job in [queued, running] {
-        app.client.delete(app.url(&job)).send().await.unwrap();
+        app.delete(&job).await;
     }
 }
 
@@ -172,11 +155,6 @@ async fn a_solve_past_its_deadline_is_504() {
     let response = app.post("/v1/sweeps", &input).await;
     let late = problem(response, 504).await;
     assert_eq!(late["type"], problem_type("deadline-exceeded"));
-    let stopped = app
-        .metric(
-            "thirdbody_solve_duration_seconds_count",
-            &[("outcome", "deadline_exceeded")],
-        )
-        .await;
+    let stopped = app.solves(&[("outcome", "deadline_exceeded")]).await;
     assert_eq!(stopped, 1.0);
 }

@@ -4,7 +4,7 @@ use std::future::Future;
 use std::time::Duration;
 
 use clap::Parser;
-use reqwest::{Client, Response, StatusCode};
+use reqwest::{Client, Method, Response, StatusCode};
 use serde_json::Value;
 use thirdbody::http::{self, AppState, ServeArgs};
 use tokio::net::TcpListener;
@@ -54,14 +54,42 @@ impl TestApp {
         format!("{}{path}", self.base)
     }
 
+    /// Sends `method path` with `headers`, and `body` as JSON if any.
+    pub async fn send(
+        &self,
+        method: Method,
+        path: &str,
+        headers: &[(&str, &str)],
+        body: Option<&Value>,
+    ) -> Response {
+        let mut request = self.client.request(method, self.url(path));
+        for (name, value) in headers {
+            request = request.header(*name, *value);
+        }
+        if let Some(body) = body {
+            request = request.json(body);
+        }
+        request.send().await.unwrap()
+    }
+
     pub async fn get(&self, path: &str) -> Response {
-        self.client.get(self.url(path)).send().await.unwrap()
+        self.send(Method::GET, path, &[], None).await
     }
 
     pub async fn post(&self, path: &str, body: &Value) -> Response {
+        self.send(Method::POST, path, &[], Some(body)).await
+    }
+
+    pub async fn delete(&self, path: &str) -> Response {
+        self.send(Method::DELETE, path, &[], None).await
+    }
+
+    /// POSTs `body` as it is, with `content_type`.
+    pub async fn post_raw(&self, path: &str, content_type: &str, body: String) -> Response {
         self.client
             .post(self.url(path))
-            .json(body)
+            .header("content-type", content_type)
+            .body(body)
             .send()
             .await
             .unwrap()
@@ -88,6 +116,12 @@ impl TestApp {
                         .all(|(k, v)| rest.contains(&format!("{k}=\"{v}\"")))
             })
             .map_or(0.0, |(_, value)| value.parse().unwrap())
+    }
+
+    /// Solves done so far with these labels (`kind`, `outcome`).
+    pub async fn solves(&self, labels: &[(&str, &str)]) -> f64 {
+        self.metric("thirdbody_solve_duration_seconds_count", labels)
+            .await
     }
 
     /// Submits an asynchronous job; returns its URL.
@@ -143,6 +177,18 @@ impl Events {
         Events {
             response,
             buffer: String::new(),
+        }
+    }
+
+    /// The `progress` events up to the `completion` event, and that event.
+    pub async fn until_completion(&mut self) -> (Vec<Value>, Value) {
+        let mut progress = Vec::new();
+        loop {
+            match self.next().await.expect("a completion event") {
+                (name, job) if name == "progress" => progress.push(job),
+                (name, job) if name == "completion" => return (progress, job),
+                (name, _) => panic!("unexpected event {name}"),
+            }
         }
     }
 

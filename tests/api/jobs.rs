@@ -54,16 +54,9 @@ async fn a_job_streams_progress_then_its_completion() {
         (name.as_str(), &first["status"]),
         ("progress", &json!("queued"))
     );
-    app.client.delete(app.url(&blocker)).send().await.unwrap();
-    let mut progress = vec![first];
-    let completion = loop {
-        let (name, job) = events.next().await.expect("a completion event");
-        match name.as_str() {
-            "progress" => progress.push(job),
-            "completion" => break job,
-            other => panic!("unexpected event {other}"),
-        }
-    };
+    app.delete(&blocker).await;
+    let (mut progress, completion) = events.until_completion().await;
+    progress.insert(0, first);
     assert!(
         events.next().await.is_none(),
         "the stream ends after completion"
@@ -88,7 +81,7 @@ async fn a_running_job_is_cancelled_at_the_solvers_next_check() {
     let location = app.submit(&long_sweep(100)).await;
     app.wait_for_job(&location, |j| j["status"] == "running")
         .await;
-    let response = app.client.delete(app.url(&location)).send().await.unwrap();
+    let response = app.delete(&location).await;
     assert_eq!(response.status(), 200);
     let job: Value = response.json().await.unwrap();
     assert_eq!(job["status"], "cancelled");
@@ -96,12 +89,7 @@ async fn a_running_job_is_cancelled_at_the_solvers_next_check() {
     assert!(job.get("result").is_none() && job.get("problem").is_none());
     let again: Value = app.get(&location).await.json().await.unwrap();
     assert_eq!(again["status"], "cancelled");
-    let cancelled = app
-        .metric(
-            "thirdbody_solve_duration_seconds_count",
-            &[("outcome", "cancelled")],
-        )
-        .await;
+    let cancelled = app.solves(&[("outcome", "cancelled")]).await;
     assert_eq!(cancelled, 1.0);
 }
 
@@ -121,11 +109,7 @@ async fn a_finished_job_expires_after_the_retention_time() {
     let app = spawn_app(&["--job-retention", "2s"]).await;
     let location = app.submit(&json!({"kind": "rolling"})).await;
     let mut events = Events::new(app.get(&format!("{location}/events")).await);
-    while let Some((name, _)) = events.next().await {
-        if name == "completion" {
-            break;
-        }
-    }
+    events.until_completion().await;
     tokio::time::sleep(Duration::from_millis(2500)).await;
     let gone = problem(app.get(&location).await, 404).await;
     assert!(gone["detail"].as_str().unwrap().contains("expired"));

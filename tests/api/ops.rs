@@ -1,5 +1,6 @@
 //! Operations: probes, metrics, request ids, CORS, the spec, graceful drain.
 
+use reqwest::Method;
 use serde_json::{json, Value};
 use thirdbody::http::openapi;
 
@@ -17,12 +18,13 @@ async fn probes_answer_and_requests_carry_an_id() {
     );
     assert_eq!(app.get("/readyz").await.status(), 200);
     let echoed = app
-        .client
-        .get(app.url("/healthz"))
-        .header("x-request-id", "abc-123")
-        .send()
-        .await
-        .unwrap();
+        .send(
+            Method::GET,
+            "/healthz",
+            &[("x-request-id", "abc-123")],
+            None,
+        )
+        .await;
     assert_eq!(echoed.headers()["x-request-id"], "abc-123");
 }
 
@@ -68,14 +70,17 @@ async fn metrics_count_requests_by_route_and_status() {
 async fn a_dashboard_on_an_allowed_origin_may_post_and_read_the_location() {
     let app = spawn_app(&["--cors-origin", "https://dashboard.example"]).await;
     let preflight = app
-        .client
-        .request(reqwest::Method::OPTIONS, app.url("/v1/jobs"))
-        .header("origin", "https://dashboard.example")
-        .header("access-control-request-method", "POST")
-        .header("access-control-request-headers", "content-type")
-        .send()
-        .await
-        .unwrap();
+        .send(
+            Method::OPTIONS,
+            "/v1/jobs",
+            &[
+                ("origin", "https://dashboard.example"),
+                ("access-control-request-method", "POST"),
+                ("access-control-request-headers", "content-type"),
+            ],
+            None,
+        )
+        .await;
     assert_eq!(preflight.status(), 200);
     let h = preflight.headers();
     assert_eq!(
@@ -92,13 +97,13 @@ async fn a_dashboard_on_an_allowed_origin_may_post_and_read_the_location() {
         .contains("content-type"));
 
     let posted = app
-        .client
-        .post(app.url("/v1/jobs"))
-        .header("origin", "https://dashboard.example")
-        .json(&json!({"kind": "rolling"}))
-        .send()
-        .await
-        .unwrap();
+        .send(
+            Method::POST,
+            "/v1/jobs",
+            &[("origin", "https://dashboard.example")],
+            Some(&json!({"kind": "rolling"})),
+        )
+        .await;
     assert_eq!(posted.status(), 202);
     let exposed = posted.headers()["access-control-expose-headers"]
         .to_str()
@@ -109,12 +114,13 @@ async fn a_dashboard_on_an_allowed_origin_may_post_and_read_the_location() {
     }
 
     let stranger = app
-        .client
-        .get(app.url("/healthz"))
-        .header("origin", "https://elsewhere.example")
-        .send()
-        .await
-        .unwrap();
+        .send(
+            Method::GET,
+            "/healthz",
+            &[("origin", "https://elsewhere.example")],
+            None,
+        )
+        .await;
     assert!(!stranger
         .headers()
         .contains_key("access-control-allow-origin"));
@@ -152,7 +158,7 @@ async fn on_shutdown_a_running_job_finishes_before_the_server_exits() {
     let location = app.submit(&long_sweep(25)).await;
     let mut events = Events::new(app.get(&format!("{location}/events")).await);
     assert_eq!(events.next().await.unwrap().1["status"], "queued");
-    app.client.delete(app.url(&blocker)).send().await.unwrap();
+    app.delete(&blocker).await;
     loop {
         let (_, job) = events.next().await.unwrap();
         if job["status"] == "running" {
@@ -161,12 +167,7 @@ async fn on_shutdown_a_running_job_finishes_before_the_server_exits() {
         assert_eq!(job["status"], "queued");
     }
     app.shut_down();
-    let completion = loop {
-        let (name, job) = events.next().await.expect("a completion event");
-        if name == "completion" {
-            break job;
-        }
-    };
+    let (_, completion) = events.until_completion().await;
     assert_eq!(completion["status"], "succeeded");
     assert_eq!(completion["progress"]["done"], 15625);
     within(&mut app.server).await.unwrap().unwrap();

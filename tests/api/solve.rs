@@ -1,6 +1,7 @@
 //! The synchronous endpoints: answers equal the engine's, the cache and its validators.
 
 use futures_util::future::join_all;
+use reqwest::Method;
 use serde_json::{json, Value};
 use thirdbody::engine::{self, Control};
 use thirdbody::job::{FigureJob, Job, Limits};
@@ -51,25 +52,25 @@ async fn the_same_job_again_is_a_cache_hit_whatever_its_units_and_if_none_match_
     assert_eq!(second.text().await.unwrap(), first);
 
     let not_modified = app
-        .client
-        .post(app.url("/v1/rolling"))
-        .header("if-none-match", etag.clone())
-        .json(&json!({"radius": "25 nm"}))
-        .send()
-        .await
-        .unwrap();
+        .send(
+            Method::POST,
+            "/v1/rolling",
+            &[("if-none-match", etag.to_str().unwrap())],
+            Some(&json!({"radius": "25 nm"})),
+        )
+        .await;
     assert_eq!(not_modified.status(), 304);
     assert_eq!(not_modified.headers()["etag"], etag);
     assert!(not_modified.bytes().await.unwrap().is_empty());
 
     let other = app
-        .client
-        .post(app.url("/v1/rolling"))
-        .header("if-none-match", "\"another\"")
-        .json(&json!({"radius": "26 nm"}))
-        .send()
-        .await
-        .unwrap();
+        .send(
+            Method::POST,
+            "/v1/rolling",
+            &[("if-none-match", "\"another\"")],
+            Some(&json!({"radius": "26 nm"})),
+        )
+        .await;
     assert_eq!(other.status(), 200);
     assert_eq!(app.metric("thirdbody_cache_hits_total", &[]).await, 2.0);
     assert_eq!(app.metric("thirdbody_cache_misses_total", &[]).await, 2.0);
@@ -89,12 +90,7 @@ async fn a_hundred_identical_concurrent_requests_are_solved_once() {
     }
     assert_eq!(misses, 1);
     assert!(bodies.iter().all(|b| *b == bodies[0]));
-    let solves = app
-        .metric(
-            "thirdbody_solve_duration_seconds_count",
-            &[("kind", "rolling")],
-        )
-        .await;
+    let solves = app.solves(&[("kind", "rolling")]).await;
     assert_eq!(solves, 1.0);
     assert_eq!(app.metric("thirdbody_cache_hits_total", &[]).await, 99.0);
 }
@@ -115,13 +111,13 @@ async fn a_sweep_answers_json_or_csv_with_one_row_per_point() {
     );
 
     let csv = app
-        .client
-        .post(app.url("/v1/sweeps"))
-        .header("accept", "text/csv")
-        .json(input)
-        .send()
-        .await
-        .unwrap();
+        .send(
+            Method::POST,
+            "/v1/sweeps",
+            &[("accept", "text/csv")],
+            Some(input),
+        )
+        .await;
     assert_eq!(csv.status(), 200);
     assert!(csv.headers()["content-type"]
         .to_str()
@@ -144,12 +140,13 @@ async fn a_figure_answers_json_or_csv() {
     assert_eq!(body, engine_answer(Job::Figure(FigureJob::new(6).unwrap())));
 
     let csv = app
-        .client
-        .get(app.url("/v1/figures/3"))
-        .header("accept", "text/csv")
-        .send()
-        .await
-        .unwrap();
+        .send(
+            Method::GET,
+            "/v1/figures/3",
+            &[("accept", "text/csv")],
+            None,
+        )
+        .await;
     assert_eq!(csv.status(), 200);
     let text = csv.text().await.unwrap();
     assert!(text.starts_with("series,label,"), "{text}");

@@ -22,9 +22,7 @@ use crate::job::{FigureJob, Job};
     params(("n" = u8, Path, description = "The figure's number in the paper, 3 to 9")),
     responses(
         (status = 200, description = "The figure's axes and series", content(
-            (FigureOutput = "application/json"), (String = "text/csv")),
-            headers(("etag" = String, description = "The cache key, quoted (suffixed .csv for CSV)"),
-                    ("x-cache" = String, description = "hit or miss"))),
+            (FigureOutput = "application/json"), (String = "text/csv"))),
         NotModified, NotFound, Busy, SolveErrors,
     )
 )]

@@ -4,16 +4,17 @@
 use std::sync::Arc;
 use std::time::Duration;
 
-use axum::extract::{Path, State};
+use axum::extract::{FromRequestParts, Path, State};
+use axum::http::request::Parts;
 use axum::http::{header, StatusCode};
 use axum::response::sse::{Event, KeepAlive, Sse};
 use axum::response::{IntoResponse, Response};
 use axum::Json;
 use futures_util::stream::{self, Stream};
-use serde::{Serialize, Serializer};
+use serde::{Deserialize, Serialize, Serializer};
 use serde_json::value::RawValue;
 use tokio::sync::watch;
-use utoipa::ToSchema;
+use utoipa::{IntoParams, ToSchema};
 use uuid::Uuid;
 
 use crate::engine::cache::Solved;
@@ -89,11 +90,28 @@ impl JobView {
     }
 }
 
-fn find(state: &AppState, id: &str) -> Result<Arc<JobEntry>, ApiError> {
-    id.parse()
-        .ok()
-        .and_then(|id| state.engine().job(id))
-        .ok_or_else(|| ApiError::not_found(format!("no job {id} (never submitted, or expired)")))
+/// The job named in the path; 404 when the id is unknown, expired or not a UUID.
+#[derive(Deserialize, IntoParams)]
+#[into_params(parameter_in = Path)]
+pub struct JobId {
+    /// The job's id, as in its `Location`.
+    id: Uuid,
+}
+
+/// Extracts the job of the path.
+pub struct FoundJob(Arc<JobEntry>);
+
+impl FromRequestParts<AppState> for FoundJob {
+    type Rejection = ApiError;
+
+    async fn from_request_parts(parts: &mut Parts, state: &AppState) -> Result<Self, ApiError> {
+        let Path(JobId { id }) = Path::from_request_parts(parts, state)
+            .await
+            .map_err(|_| ApiError::not_found("no such job: its id is a UUID"))?;
+        state.engine().job(id).map(FoundJob).ok_or_else(|| {
+            ApiError::not_found(format!("no job {id} (never submitted, or expired)"))
+        })
+    }
 }
 
 /// Submit a job to run in the background.
@@ -134,14 +152,11 @@ pub async fn submit(
     get,
     path = "/v1/jobs/{id}",
     tag = "jobs",
-    params(("id" = Uuid, Path, description = "The job's id")),
+    params(JobId),
     responses((status = 200, description = "The job", body = JobView), NotFound)
 )]
-pub async fn status(
-    State(state): State<AppState>,
-    Path(id): Path<String>,
-) -> Result<Json<JobView>, ApiError> {
-    Ok(Json(JobView::of(&*find(&state, &id)?, true)))
+pub async fn status(FoundJob(entry): FoundJob) -> Json<JobView> {
+    Json(JobView::of(&entry, true))
 }
 
 /// Cancel a job.
@@ -153,19 +168,15 @@ pub async fn status(
     delete,
     path = "/v1/jobs/{id}",
     tag = "jobs",
-    params(("id" = Uuid, Path, description = "The job's id")),
+    params(JobId),
     responses((status = 200, description = "The job after the cancel", body = JobView), NotFound)
 )]
-pub async fn cancel(
-    State(state): State<AppState>,
-    Path(id): Path<String>,
-) -> Result<Json<JobView>, ApiError> {
-    let entry = find(&state, &id)?;
+pub async fn cancel(FoundJob(entry): FoundJob) -> Json<JobView> {
     entry.cancel();
     let mut states = entry.subscribe();
     // Still running after the wait: the answer says so, and the job stops soon after.
     let _ = tokio::time::timeout(CANCEL_WAIT, states.wait_for(|s| s.status().is_finished())).await;
-    Ok(Json(JobView::of(&entry, true)))
+    Json(JobView::of(&entry, true))
 }
 
 /// Follow a job as server-sent events.
@@ -177,7 +188,7 @@ pub async fn cancel(
     get,
     path = "/v1/jobs/{id}/events",
     tag = "jobs",
-    params(("id" = Uuid, Path, description = "The job's id")),
+    params(JobId),
     responses(
         (status = 200, description = "A text/event-stream of `progress` events and one \
             `completion` event, each with a JobView as data",
@@ -186,10 +197,8 @@ pub async fn cancel(
     )
 )]
 pub async fn events(
-    State(state): State<AppState>,
-    Path(id): Path<String>,
-) -> Result<Sse<impl Stream<Item = Result<Event, axum::Error>>>, ApiError> {
-    let entry = find(&state, &id)?;
+    FoundJob(entry): FoundJob,
+) -> Sse<impl Stream<Item = Result<Event, axum::Error>>> {
     let watcher = Watcher {
         states: entry.subscribe(),
         entry,
@@ -200,7 +209,7 @@ pub async fn events(
         let event = w.next().await?;
         Some((event, w))
     });
-    Ok(Sse::new(events).keep_alive(KeepAlive::default()))
+    Sse::new(events).keep_alive(KeepAlive::default())
 }
 
 /// Turns a job's changes into events.

@@ -1,6 +1,6 @@
 //! The routes, one module per resource. A synchronous endpoint of a job kind is a thin
-//! handler over [`solve`]: validate the body as that kind's input, run it through the
-//! engine, answer with the cached or fresh result.
+//! handler over [`SolveRequest::solve`]: validate the body as that kind's input, run it
+//! through the engine, answer with the cached or fresh result.
 
 pub mod figures;
 pub mod jobs;
@@ -9,11 +9,12 @@ pub mod rolling;
 pub mod sweeps;
 pub mod three_body;
 
+use axum::extract::{FromRequest, Request};
 use axum::http::{header, HeaderMap, HeaderName, HeaderValue, StatusCode};
 use axum::response::{IntoResponse, Response};
 use serde_json::Value;
 
-use super::error::ApiError;
+use super::error::{ApiError, JsonBody};
 use super::AppState;
 use crate::engine::cache::Solved;
 use crate::engine::CacheStatus;
@@ -23,15 +24,40 @@ use crate::job::{Job, JobKind};
 /// same time), `miss` when this request solved it.
 pub const X_CACHE: HeaderName = HeaderName::from_static("x-cache");
 
-/// Validates `input` as a job of `kind`, solves it and answers it.
-pub async fn solve(
-    state: &AppState,
-    kind: JobKind,
+/// A request to a synchronous endpoint: the job's input as the JSON body, and the headers
+/// that choose the answer's form (`Accept`, `If-None-Match`).
+pub struct SolveRequest {
+    state: AppState,
+    headers: HeaderMap,
     input: Value,
-    headers: &HeaderMap,
-) -> Result<Response, ApiError> {
-    let job = Job::from_input(kind, input, &state.config().limits)?;
-    answer(state, job, headers).await
+}
+
+impl FromRequest<AppState> for SolveRequest {
+    type Rejection = ApiError;
+
+    async fn from_request(request: Request, state: &AppState) -> Result<Self, ApiError> {
+        // Only the headers that choose the answer's form are kept.
+        let mut headers = HeaderMap::new();
+        for name in [header::ACCEPT, header::IF_NONE_MATCH] {
+            for value in request.headers().get_all(&name) {
+                headers.append(name.clone(), value.clone());
+            }
+        }
+        let JsonBody(input) = JsonBody::from_request(request, state).await?;
+        Ok(SolveRequest {
+            state: state.clone(),
+            headers,
+            input,
+        })
+    }
+}
+
+impl SolveRequest {
+    /// Validates the input as a job of `kind`, solves it and answers it.
+    pub async fn solve(self, kind: JobKind) -> Result<Response, ApiError> {
+        let job = Job::from_input(kind, self.input, &self.state.config().limits)?;
+        answer(&self.state, job, &self.headers).await
+    }
 }
 
 /// Solves a validated job and answers it, in JSON or (if asked and offered) CSV.

@@ -1,12 +1,10 @@
 //! `POST /v1/rolling`: one particle rolling over the layer, solved now.
 
-use axum::extract::State;
-use axum::http::HeaderMap;
 use axum::response::Response;
 
-use crate::http::error::{ApiError, JsonBody};
+use super::SolveRequest;
+use crate::http::error::ApiError;
 use crate::http::openapi::{BadBody, Busy, NotModified, SolveErrors};
-use crate::http::AppState;
 use crate::job::rolling::{RollingInput, RollingOutput};
 use crate::job::JobKind;
 
@@ -22,16 +20,10 @@ use crate::job::JobKind;
     request_body(content = RollingInput, content_type = "application/json"),
     responses(
         (status = 200, description = "The contact: penetration, area, shifts, friction; \
-            the same at V = 0; the boundary; meta", body = RollingOutput,
-            headers(("etag" = String, description = "The cache key, quoted"),
-                    ("x-cache" = String, description = "hit or miss"))),
+            the same at V = 0; the boundary; meta", body = RollingOutput),
         NotModified, BadBody, Busy, SolveErrors,
     )
 )]
-pub async fn solve(
-    State(state): State<AppState>,
-    headers: HeaderMap,
-    JsonBody(input): JsonBody,
-) -> Result<Response, ApiError> {
-    super::solve(&state, JobKind::Rolling, input, &headers).await
+pub async fn solve(request: SolveRequest) -> Result<Response, ApiError> {
+    request.solve(JobKind::Rolling).await
 }

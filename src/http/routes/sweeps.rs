@@ -1,12 +1,10 @@
 //! `POST /v1/sweeps`: a sweep over radius, load and speed, solved now; JSON or CSV.
 
-use axum::extract::State;
-use axum::http::HeaderMap;
 use axum::response::Response;
 
-use crate::http::error::{ApiError, JsonBody};
+use super::SolveRequest;
+use crate::http::error::ApiError;
 use crate::http::openapi::{BadBody, Busy, NotModified, SolveErrors};
-use crate::http::AppState;
 use crate::job::sweep::{SweepInput, SweepOutput};
 use crate::job::JobKind;
 
@@ -22,16 +20,10 @@ use crate::job::JobKind;
     request_body(content = SweepInput, content_type = "application/json"),
     responses(
         (status = 200, description = "One row per point", content(
-            (SweepOutput = "application/json"), (String = "text/csv")),
-            headers(("etag" = String, description = "The cache key, quoted (suffixed .csv for CSV)"),
-                    ("x-cache" = String, description = "hit or miss"))),
+            (SweepOutput = "application/json"), (String = "text/csv"))),
         NotModified, BadBody, Busy, SolveErrors,
     )
 )]
-pub async fn solve(
-    State(state): State<AppState>,
-    headers: HeaderMap,
-    JsonBody(input): JsonBody,
-) -> Result<Response, ApiError> {
-    super::solve(&state, JobKind::Sweep, input, &headers).await
+pub async fn solve(request: SolveRequest) -> Result<Response, ApiError> {
+    request.solve(JobKind::Sweep).await
 }
