@@ -1,13 +1,11 @@
 //! `POST /v1/three-body`: a population of particles between the upper surface and the
 //! layer, solved now.
 
-use axum::extract::State;
-use axum::http::HeaderMap;
 use axum::response::Response;
 
-use crate::http::error::{ApiError, JsonBody};
+use super::SolveRequest;
+use crate::http::error::ApiError;
 use crate::http::openapi::{BadBody, Busy, NotModified, SolveErrors};
-use crate::http::AppState;
 use crate::job::three_body::{ThreeBodyInput, ThreeBodyOutput};
 use crate::job::JobKind;
 
@@ -25,16 +23,10 @@ use crate::job::JobKind;
     responses(
         (status = 200, description = "The system at its operating point: separation, \
             particles in contact, areas, loads, friction with and without rolling, \
-            per-particle means; meta", body = ThreeBodyOutput,
-            headers(("etag" = String, description = "The cache key, quoted"),
-                    ("x-cache" = String, description = "hit or miss"))),
+            per-particle means; meta", body = ThreeBodyOutput),
         NotModified, BadBody, Busy, SolveErrors,
     )
 )]
-pub async fn solve(
-    State(state): State<AppState>,
-    headers: HeaderMap,
-    JsonBody(input): JsonBody,
-) -> Result<Response, ApiError> {
-    super::solve(&state, JobKind::ThreeBody, input, &headers).await
+pub async fn solve(request: SolveRequest) -> Result<Response, ApiError> {
+    request.solve(JobKind::ThreeBody).await
 }
