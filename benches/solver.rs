@@ -1,5 +1,6 @@
 //! Speed of the physics core: one rolling solve at 1e-9 relative accuracy (target: < 100 µs
-//! median) and the data of all of the paper's Figures 3–9 (target: < 50 ms).
+//! median) and the data of all of the paper's Figures 3–9 (target: < 50 ms); and the work the
+//! HTTP service adds to a solve.
 //! Results and method: BENCHMARKS.md. Run with `cargo bench --bench solver`.
 
 use std::hint::black_box;
@@ -7,8 +8,9 @@ use std::time::Duration;
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use serde_json::json;
+use thirdbody::engine::cache::Solved;
 use thirdbody::engine::{self, Control};
-use thirdbody::job::{Job, Limits};
+use thirdbody::job::{Job, JobKind, Limits};
 use thirdbody::model::{solve, Quadrature, Rolling, SolveOptions};
 
 fn rolling(c: &mut Criterion) {
@@ -68,5 +70,29 @@ fn figures(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, rolling, figures);
+/// What the HTTP service does for one uncached rolling request besides HTTP itself:
+/// validation and cache key, the engine's run (solve and answer), the JSON rendered once.
+fn service(c: &mut Criterion) {
+    let mut group = c.benchmark_group("service");
+    let input = json!({"load": "1 nN"});
+    let limits = Limits::default();
+    group.bench_function("validate_and_key", |b| {
+        b.iter(|| {
+            let job = Job::from_input(JobKind::Rolling, black_box(input.clone()), &limits);
+            black_box(job.unwrap().cache_key())
+        })
+    });
+    let job = Job::from_input(JobKind::Rolling, input.clone(), &limits).unwrap();
+    let control = Control::new(None, 1);
+    group.bench_function("engine_run_default_job", |b| {
+        b.iter(|| black_box(engine::run(black_box(&job), &control).unwrap()))
+    });
+    let output = engine::run(&job, &control).unwrap();
+    group.bench_function("render_json", |b| {
+        b.iter(|| black_box(Solved::new(job.cache_key(), output.clone()).unwrap()))
+    });
+    group.finish();
+}
+
+criterion_group!(benches, rolling, figures, service);
 criterion_main!(benches);
