@@ -1,6 +1,7 @@
 //! Speed of the physics core: one rolling solve at 1e-9 relative accuracy (target: < 100 µs
-//! median), the data of all of the paper's Figures 3–9 (target: < 50 ms), and a
-//! `kelvin_layer` three-body job with a given total load (target: < 20 ms median).
+//! median), the data of all of the paper's Figures 3–9 (target: < 50 ms), a `kelvin_layer`
+//! three-body job with a given total load (target: < 20 ms median); and the work the HTTP
+//! service adds to a solve.
 //! Results and method: BENCHMARKS.md. Run with `cargo bench --bench solver`.
 
 use std::hint::black_box;
@@ -8,8 +9,9 @@ use std::time::Duration;
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use serde_json::json;
+use thirdbody::engine::cache::Solved;
 use thirdbody::engine::{self, Control};
-use thirdbody::job::{Job, Limits};
+use thirdbody::job::{Job, JobKind, Limits};
 use thirdbody::model::kelvin_map::KelvinMap;
 use thirdbody::model::quadrature::StripRule;
 use thirdbody::model::three_body::{
@@ -103,5 +105,29 @@ fn three_body(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, rolling, figures, three_body);
+/// What the HTTP service does for one uncached rolling request besides HTTP itself:
+/// validation and cache key, the engine's run (solve and answer), the JSON rendered once.
+fn service(c: &mut Criterion) {
+    let mut group = c.benchmark_group("service");
+    let input = json!({"load": "1 nN"});
+    let limits = Limits::default();
+    group.bench_function("validate_and_key", |b| {
+        b.iter(|| {
+            let job = Job::from_input(JobKind::Rolling, black_box(input.clone()), &limits);
+            black_box(job.unwrap().cache_key())
+        })
+    });
+    let job = Job::from_input(JobKind::Rolling, input.clone(), &limits).unwrap();
+    let control = Control::new(None, 1);
+    group.bench_function("engine_run_default_job", |b| {
+        b.iter(|| black_box(engine::run(black_box(&job), &control).unwrap()))
+    });
+    let output = engine::run(&job, &control).unwrap();
+    group.bench_function("render_json", |b| {
+        b.iter(|| black_box(Solved::new(job.cache_key(), output.clone()).unwrap()))
+    });
+    group.finish();
+}
+
+criterion_group!(benches, rolling, figures, three_body, service);
 criterion_main!(benches);

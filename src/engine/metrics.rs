@@ -44,22 +44,26 @@ impl Metrics {
     }
 
     fn describe(&self) {
+        self.describe_seconds(SOLVE_DURATION, "Time spent solving jobs");
+        self.describe_counter(CACHE_HITS, "Results served from the cache");
+        self.describe_counter(CACHE_MISSES, "Results that were solved");
         let r = &self.recorder;
-        let unit = Some(metrics::Unit::Seconds);
-        r.describe_histogram(
-            SOLVE_DURATION.into(),
-            unit,
-            "Time spent solving jobs".into(),
-        );
-        r.describe_counter(
-            CACHE_HITS.into(),
-            None,
-            "Results served from the cache".into(),
-        );
-        r.describe_counter(CACHE_MISSES.into(), None, "Results that were solved".into());
         r.describe_gauge(JOBS_QUEUED.into(), None, "Async jobs waiting".into());
         r.describe_gauge(JOBS_RUNNING.into(), None, "Async jobs being solved".into());
-        r.describe_counter(REJECTIONS.into(), None, "Work refused, by reason".into());
+        self.describe_counter(REJECTIONS, "Work refused, by reason");
+    }
+
+    /// Gives a counter its help text.
+    pub fn describe_counter(&self, name: &'static str, help: &'static str) {
+        self.recorder
+            .describe_counter(name.into(), None, help.into());
+    }
+
+    /// Gives a histogram of durations its help text.
+    pub fn describe_seconds(&self, name: &'static str, help: &'static str) {
+        let unit = Some(metrics::Unit::Seconds);
+        self.recorder
+            .describe_histogram(name.into(), unit, help.into());
     }
 
     pub fn counter(&self, name: &'static str, labels: &[(&'static str, &str)]) -> Counter {

@@ -107,10 +107,6 @@ impl Engine {
         })
     }
 
-    pub fn config(&self) -> &EngineConfig {
-        &self.config
-    }
-
     pub fn metrics(&self) -> &Metrics {
         &self.metrics
     }
@@ -164,7 +160,7 @@ impl Engine {
         self.tracker.spawn(
             async move {
                 let state = engine.run_job(&task_entry, job).await;
-                tracing::info!(status = ?state.status(), "job finished");
+                tracing::info!(status = state.status().as_str(), "job finished");
                 task_entry.set_state(state);
             }
             .instrument(span),

@@ -60,7 +60,9 @@ impl AppState {
             .expect("the buckets are not empty")
             .build_recorder();
         let prometheus = recorder.handle();
-        let engine = Engine::new(config.engine.clone(), Metrics::new(Arc::new(recorder)));
+        let metrics = Metrics::new(Arc::new(recorder));
+        observe::describe(&metrics);
+        let engine = Engine::new(config.engine.clone(), metrics);
         AppState {
             inner: Arc::new(Inner {
                 config,

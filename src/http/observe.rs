@@ -9,6 +9,7 @@ use axum::response::Response;
 use tracing::Span;
 
 use super::AppState;
+use crate::engine::metrics::Metrics;
 
 /// Requests answered, by method, route and status.
 pub const HTTP_REQUESTS: &str = "http_requests_total";
@@ -19,6 +20,18 @@ pub const HTTP_DURATION: &str = "http_request_duration_seconds";
 pub const BUCKETS: [f64; 14] = [
     1e-5, 2.5e-5, 5e-5, 1e-4, 2.5e-4, 5e-4, 1e-3, 5e-3, 0.01, 0.05, 0.1, 0.5, 1.0, 10.0,
 ];
+
+/// Gives the request metrics their help texts.
+pub fn describe(metrics: &Metrics) {
+    metrics.describe_counter(
+        HTTP_REQUESTS,
+        "Requests answered, by method, route and status",
+    );
+    metrics.describe_seconds(
+        HTTP_DURATION,
+        "Time to the response head, by method and route",
+    );
+}
 
 /// The span of a request, named by the request id that `SetRequestId` put (or the client
 /// sent), so that every log line of the request carries it.
