@@ -50,6 +50,7 @@ async fn the_spec_is_served_from_the_routes() {
     let paths = spec["paths"].as_object().unwrap();
     for path in [
         "/v1/rolling",
+        "/v1/three-body",
         "/v1/sweeps",
         "/v1/jobs",
         "/v1/jobs/{id}",

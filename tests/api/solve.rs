@@ -38,6 +38,48 @@ async fn rolling_answers_the_model_section_3_reference_row() {
 }
 
 #[tokio::test]
+async fn three_body_answers_the_engine_and_carries_its_total_load() {
+    let app = spawn_app(&[]).await;
+    let input = json!({"operating": {"total_load": "1 mN"}});
+    let response = app.post("/v1/three-body", &input).await;
+    assert_eq!(response.status(), 200);
+    assert_eq!(response.headers()["x-cache"], "miss");
+    let body: Value = response.json().await.unwrap();
+    let load = body["loads"]["total"].as_f64().unwrap();
+    assert!((load / 1e-3 - 1.0).abs() < 1e-10, "{load}");
+    let mu = &body["friction_coefficient"];
+    assert!(mu["rolling"].as_f64().unwrap() < mu["static"].as_f64().unwrap());
+    let job = Job::from_value(
+        json!({"kind": "three_body", "input": input}),
+        &Limits::default(),
+    )
+    .unwrap();
+    assert_eq!(body, engine_answer(job));
+
+    // A load the system cannot carry is a solve failure that says why.
+    let response = app
+        .post(
+            "/v1/three-body",
+            &json!({"operating": {"total_load": "1 kN"}}),
+        )
+        .await;
+    assert_eq!(response.status(), 422);
+    let problem: Value = response.json().await.unwrap();
+    assert!(
+        problem["detail"]
+            .as_str()
+            .unwrap()
+            .contains("cannot be carried"),
+        "{problem}"
+    );
+    // No operating point: invalid input naming the field.
+    let response = app.post("/v1/three-body", &json!({})).await;
+    assert_eq!(response.status(), 422);
+    let problem: Value = response.json().await.unwrap();
+    assert_eq!(problem["errors"][0]["field"], "operating");
+}
+
+#[tokio::test]
 async fn the_same_job_again_is_a_cache_hit_whatever_its_units_and_if_none_match_is_304() {
     let app = spawn_app(&[]).await;
     let first = app.post("/v1/rolling", &json!({"radius": 2.5e-8})).await;
