@@ -130,3 +130,83 @@ fn serve_refuses_a_bad_setting_at_start_up_with_status_2() {
     let output = thirdbody(&["serve", "--bind", "nowhere"], None);
     assert_eq!(output.status.code(), Some(2));
 }
+
+/// `ENV` settings of the Dockerfile's run stage, as (name, value) pairs.
+fn dockerfile_env() -> Vec<(String, String)> {
+    let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/Dockerfile")).unwrap();
+    let joined = text.replace("\\\n", " ");
+    joined
+        .lines()
+        .filter_map(|l| l.trim().strip_prefix("ENV "))
+        .flat_map(|l| l.split_whitespace().map(str::to_string).collect::<Vec<_>>())
+        .map(|pair| {
+            let (k, v) = pair.split_once('=').unwrap();
+            (k.to_string(), v.to_string())
+        })
+        .collect()
+}
+
+fn get(port: u16, path: &str) -> Option<String> {
+    use std::io::Read;
+    let mut stream = std::net::TcpStream::connect(("127.0.0.1", port)).ok()?;
+    write!(
+        stream,
+        "GET {path} HTTP/1.1\r\nHost: localhost\r\nConnection: close\r\n\r\n"
+    )
+    .ok()?;
+    let mut answer = String::new();
+    stream.read_to_string(&mut answer).ok()?;
+    Some(answer)
+}
+
+#[test]
+fn the_container_configuration_starts_a_service_that_drains_on_sigterm() {
+    let env = dockerfile_env();
+    let names: Vec<&str> = env.iter().map(|(k, _)| k.as_str()).collect();
+    assert!(names.contains(&"THIRDBODY_BIND") && names.contains(&"THIRDBODY_LOG_FORMAT"));
+    let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/Dockerfile")).unwrap();
+    assert!(text.contains("ENTRYPOINT [\"thirdbody\"]") && text.contains("CMD [\"serve\"]"));
+    let bind = &env.iter().find(|(k, _)| k == "THIRDBODY_BIND").unwrap().1;
+    assert!(text.contains(&format!("EXPOSE {}", bind.rsplit(':').next().unwrap())));
+
+    // The same settings, listening on a free loopback port instead of 0.0.0.0:8080.
+    let port = std::net::TcpListener::bind("127.0.0.1:0")
+        .unwrap()
+        .local_addr()
+        .unwrap()
+        .port();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_thirdbody"))
+        .arg("serve")
+        .envs(env.iter().map(|(k, v)| (k.as_str(), v.as_str())))
+        .env("THIRDBODY_BIND", format!("127.0.0.1:{port}"))
+        .env("THIRDBODY_DRAIN_DELAY", "0s")
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut health = None;
+    for _ in 0..200 {
+        health = get(port, "/healthz");
+        if health.is_some() {
+            break;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(25));
+    }
+    let health = health.expect("the service answers /healthz");
+    assert!(health.starts_with("HTTP/1.1 200"), "{health}");
+    assert!(get(port, "/readyz").unwrap().starts_with("HTTP/1.1 200"));
+    let status = Command::new("kill")
+        .args(["-TERM", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(status.success());
+    let out = child.wait_with_output().unwrap();
+    assert!(out.status.success(), "exit after SIGTERM: {:?}", out.status);
+    // JSON log lines, as the container asks.
+    let logs = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        logs.lines()
+            .any(|l| l.starts_with('{') && l.contains("listening")),
+        "{logs}"
+    );
+}

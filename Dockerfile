@@ -1,0 +1,32 @@
+# thirdbody: the HTTP service in a container.
+#
+#   docker build -t thirdbody .
+#   docker run --rm -p 8080:8080 thirdbody
+#
+# Build stage: the same toolchain as CI, dependencies fetched by cargo (crates.io only; the
+# API docs assets are vendored in a crate, nothing is downloaded at run time).
+FROM rust:1.95-slim-bookworm AS build
+WORKDIR /src
+COPY Cargo.toml Cargo.lock ./
+COPY src src
+COPY benches benches
+COPY openapi openapi
+RUN cargo build --release --locked --bin thirdbody
+
+# Run stage: the binary alone, as an unprivileged user.
+FROM debian:bookworm-slim
+RUN useradd --system --uid 10001 --no-create-home thirdbody
+COPY --from=build /src/target/release/thirdbody /usr/local/bin/thirdbody
+USER thirdbody
+# Every setting is a flag with an environment variable (`thirdbody serve --help`); these are
+# the ones a container needs: listen on all interfaces, JSON logs for the log collector, and
+# a shutdown bound below the orchestrator's grace period (deploy/kubernetes.yaml: 30 s).
+ENV THIRDBODY_BIND=0.0.0.0:8080 \
+    THIRDBODY_LOG_FORMAT=json \
+    THIRDBODY_SHUTDOWN_TIMEOUT=25s \
+    THIRDBODY_DRAIN_DELAY=2s
+EXPOSE 8080
+# SIGTERM drains: /readyz turns 503, in-flight requests and running jobs finish, then exit.
+STOPSIGNAL SIGTERM
+ENTRYPOINT ["thirdbody"]
+CMD ["serve"]
