@@ -175,7 +175,7 @@ fn the_container_configuration_starts_a_service_that_drains_on_sigterm() {
         .local_addr()
         .unwrap()
         .port();
-    let mut child = Command::new(env!("CARGO_BIN_EXE_thirdbody"))
+    let child = Command::new(env!("CARGO_BIN_EXE_thirdbody"))
         .arg("serve")
         .envs(env.iter().map(|(k, v)| (k.as_str(), v.as_str())))
         .env("THIRDBODY_BIND", format!("127.0.0.1:{port}"))
