@@ -19,6 +19,9 @@ use super::pool::Pool;
 use super::{run, Control};
 use crate::job::{Job, JobError};
 
+/// Memory for the map from input text to cache key (bytes): a few thousand typical inputs.
+const INPUT_KEYS_BYTES: u64 = 16 << 20;
+
 /// The limits of an engine.
 #[derive(Clone, Debug, PartialEq)]
 pub struct EngineConfig {
@@ -76,6 +79,9 @@ pub struct Engine {
     config: EngineConfig,
     pool: Pool,
     cache: ResultCache,
+    /// The text of valid inputs (their kind and compact JSON with sorted keys) → their
+    /// cache key, so that a repeated request is answered without being validated again.
+    input_keys: moka::future::Cache<String, String>,
     jobs: JobStore,
     /// The tasks of asynchronous jobs, waited for on shutdown.
     tracker: TaskTracker,
@@ -94,6 +100,13 @@ impl Engine {
         Arc::new(Engine {
             pool: Pool::new(config.pool_size),
             cache: ResultCache::new(config.cache_bytes, config.cache_ttl),
+            input_keys: moka::future::Cache::builder()
+                .max_capacity(INPUT_KEYS_BYTES)
+                .weigher(|input: &String, key: &String| {
+                    u32::try_from(input.len() + key.len()).unwrap_or(u32::MAX)
+                })
+                .time_to_live(config.cache_ttl)
+                .build(),
             jobs: JobStore::new(config.job_retention),
             tracker: TaskTracker::new(),
             draining: AtomicBool::new(false),
@@ -109,6 +122,27 @@ impl Engine {
 
     pub fn metrics(&self) -> &Metrics {
         &self.metrics
+    }
+
+    /// The cached answer to an input seen before (`text`: its kind and compact JSON), found
+    /// without validating the input again; `None` if it was not seen or its answer expired.
+    /// Refused while draining, like every other call for an answer.
+    pub async fn cached_input(&self, text: &str) -> Result<Option<Arc<Solved>>, EngineError> {
+        self.admit()?;
+        let Some(key) = self.input_keys.get(text).await else {
+            return Ok(None);
+        };
+        let solved = self.cache.get(&key).await;
+        if solved.is_some() {
+            self.cache_hits.increment(1);
+        }
+        Ok(solved)
+    }
+
+    /// Remembers that the input `text` (as for [`Engine::cached_input`]) is a valid job
+    /// with cache key `key`.
+    pub async fn remember_input(&self, text: String, key: String) {
+        self.input_keys.insert(text, key).await;
     }
 
     /// Solves `job` now, or takes its answer from the cache. Identical concurrent calls

@@ -127,6 +127,8 @@ async fn a_full_pool_is_429_at_once_and_a_full_job_queue_too() {
 async fn a_draining_service_is_503_for_new_work_and_readiness() {
     let mut app = spawn_app(&["--drain-delay", "10m"]).await;
     assert_eq!(app.get("/readyz").await.status(), 200);
+    // Seen and cached before the drain: refused all the same, not answered from the cache.
+    assert_eq!(app.post("/v1/rolling", &json!({})).await.status(), 200);
     app.shut_down();
     within(async {
         while app.get("/readyz").await.status() != 503 {

@@ -38,6 +38,40 @@ async fn rolling_answers_the_model_section_3_reference_row() {
 }
 
 #[tokio::test]
+async fn a_repeated_input_is_a_hit_whatever_its_key_order_and_spacing() {
+    let app = spawn_app(&[]).await;
+    let first = app
+        .post_raw(
+            "/v1/rolling",
+            "application/json",
+            r#"{"radius": "25 nm", "load": "1 nN"}"#.to_string(),
+        )
+        .await;
+    assert_eq!(first.headers()["x-cache"], "miss");
+    let first = first.text().await.unwrap();
+    for body in [
+        r#"{"load":"1 nN","radius":"25 nm"}"#,
+        "{ \"radius\" : \"25 nm\",\n \"load\": \"1 nN\" }",
+    ] {
+        let again = app
+            .post_raw("/v1/rolling", "application/json", body.to_string())
+            .await;
+        assert_eq!(again.headers()["x-cache"], "hit", "{body}");
+        assert_eq!(again.text().await.unwrap(), first);
+    }
+    assert_eq!(app.metric("thirdbody_cache_hits_total", &[]).await, 2.0);
+    // The same text as another kind is another job.
+    let sweep = app
+        .post_raw(
+            "/v1/sweeps",
+            "application/json",
+            r#"{"load":"1 nN","radius":"25 nm"}"#.to_string(),
+        )
+        .await;
+    assert_eq!(sweep.status(), 422, "a sweep has no field radius");
+}
+
+#[tokio::test]
 async fn three_body_answers_the_engine_and_carries_its_total_load() {
     let app = spawn_app(&[]).await;
     let input = json!({"operating": {"total_load": "1 mN"}});

@@ -53,9 +53,17 @@ impl FromRequest<AppState> for SolveRequest {
 }
 
 impl SolveRequest {
-    /// Validates the input as a job of `kind`, solves it and answers it.
+    /// Validates the input as a job of `kind`, solves it and answers it. An input seen
+    /// before (the same JSON up to key order and spacing) whose answer is cached is answered
+    /// at once: validation and the cache key cost more than the lookup.
     pub async fn solve(self, kind: JobKind) -> Result<Response, ApiError> {
+        let engine = self.state.engine();
+        let text = format!("{}\n{}", kind.as_str(), self.input);
+        if let Some(solved) = engine.cached_input(&text).await? {
+            return Ok(respond(&solved, CacheStatus::Hit, &self.headers));
+        }
         let job = Job::from_input(kind, self.input, &self.state.config().limits)?;
+        engine.remember_input(text, job.cache_key()).await;
         answer(&self.state, job, &self.headers).await
     }
 }
