@@ -66,6 +66,29 @@ pub enum QuadratureKind {
     Midpoint,
 }
 
+impl QuadratureKind {
+    /// The rule a job asks for: its kind (default Gauss) with `strips` nodes or strips
+    /// (default 64 Gauss nodes, or the paper's 40 midpoint strips).
+    pub fn rule(kind: Option<QuadratureKind>, strips: Option<usize>) -> Quadrature {
+        match kind.unwrap_or_default() {
+            QuadratureKind::Gauss => Quadrature::Gauss {
+                nodes: strips.unwrap_or(DEFAULT_GAUSS_NODES),
+            },
+            QuadratureKind::Midpoint => Quadrature::Midpoint {
+                strips: strips.unwrap_or(DEFAULT_MIDPOINT_STRIPS),
+            },
+        }
+    }
+
+    /// The canonical `quadrature` and `strips` of a rule.
+    pub fn canonical(rule: Quadrature) -> (&'static str, usize) {
+        match rule {
+            Quadrature::Gauss { nodes } => ("gauss", nodes),
+            Quadrature::Midpoint { strips } => ("midpoint", strips),
+        }
+    }
+}
+
 impl LayerInput {
     /// Reads the layer under `checker`, its fields at `prefix.*`.
     pub fn read(input: Option<&LayerInput>, checker: &mut Checker, prefix: &str) -> Layer {
@@ -161,14 +184,7 @@ impl RollingJob {
             layer: LayerInput::read(input.layer.as_ref(), checker, "layer"),
         };
         let o = input.options.clone().unwrap_or_default();
-        let quadrature = match o.quadrature.unwrap_or_default() {
-            QuadratureKind::Gauss => Quadrature::Gauss {
-                nodes: o.strips.unwrap_or(DEFAULT_GAUSS_NODES),
-            },
-            QuadratureKind::Midpoint => Quadrature::Midpoint {
-                strips: o.strips.unwrap_or(DEFAULT_MIDPOINT_STRIPS),
-            },
-        };
+        let quadrature = QuadratureKind::rule(o.quadrature, o.strips);
         let options = SolveOptions {
             quadrature,
             boundary_points: o
@@ -184,10 +200,7 @@ impl RollingJob {
     /// The canonical input (a valid input itself).
     pub fn canonical(&self) -> Value {
         let r = &self.rolling;
-        let (quadrature, strips) = match self.options.quadrature {
-            Quadrature::Gauss { nodes } => ("gauss", nodes),
-            Quadrature::Midpoint { strips } => ("midpoint", strips),
-        };
+        let (quadrature, strips) = QuadratureKind::canonical(self.options.quadrature);
         let mut options = json!({
             "quadrature": quadrature,
             "strips": strips,

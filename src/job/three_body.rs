@@ -9,12 +9,10 @@ use super::fields::{self, Checker, Quantity};
 use super::rolling::{si, LayerInput, QuadratureKind};
 use super::units::Dimension;
 use super::{JobError, JobKind, Meta};
-use crate::model::quadrature::{DEFAULT_GAUSS_NODES, DEFAULT_MIDPOINT_STRIPS};
 use crate::model::three_body::{
     Asperities, ContactState, Diameters, LayerContact, OperatingPoint, Particle, ThreeBody,
     ThreeBodyOptions, ThreeBodySolution, UpperContact, UpperSurface, DEFAULT_DIAMETER_NODES,
 };
-use crate::model::Quadrature;
 
 /// Input of a three-body job; every field optional but the operating point.
 #[derive(Clone, Debug, Default, PartialEq, Deserialize, Serialize, ToSchema)]
@@ -271,14 +269,7 @@ impl ThreeBodyJob {
         let operating = read_operating(input.operating.as_ref(), checker);
         let layer = LayerInput::read(input.layer.as_ref(), checker, "layer");
         let o = input.options.clone().unwrap_or_default();
-        let quadrature = match o.quadrature.unwrap_or_default() {
-            QuadratureKind::Gauss => Quadrature::Gauss {
-                nodes: o.strips.unwrap_or(DEFAULT_GAUSS_NODES),
-            },
-            QuadratureKind::Midpoint => Quadrature::Midpoint {
-                strips: o.strips.unwrap_or(DEFAULT_MIDPOINT_STRIPS),
-            },
-        };
+        let quadrature = QuadratureKind::rule(o.quadrature, o.strips);
         let options = ThreeBodyOptions {
             diameter_nodes: o.diameter_nodes.unwrap_or(DEFAULT_DIAMETER_NODES),
             quadrature,
@@ -322,10 +313,7 @@ impl ThreeBodyJob {
         if let Some(e) = s.particle.elastic_modulus {
             particle["elastic_modulus"] = json!(si(e));
         }
-        let (quadrature, strips) = match self.options.quadrature {
-            Quadrature::Gauss { nodes } => ("gauss", nodes),
-            Quadrature::Midpoint { strips } => ("midpoint", strips),
-        };
+        let (quadrature, strips) = QuadratureKind::canonical(self.options.quadrature);
         let mut canonical = json!({
             "distribution": {
                 "mean_diameter": si(d.mean),
