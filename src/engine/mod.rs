@@ -18,7 +18,7 @@ use crate::job::figure::FigureOutput;
 use crate::job::rolling::RollingOutput;
 use crate::job::sweep::{SweepJob, SweepOutput};
 use crate::job::three_body::ThreeBodyOutput;
-use crate::job::{Job, JobError};
+use crate::job::{Job, JobError, Meta};
 use crate::model::{self, three_body, ModelError};
 
 pub mod cache;
@@ -89,33 +89,38 @@ pub enum Output {
 
 /// Runs `job` to completion, or until `control` stops it.
 pub fn run(job: &Job, control: &Control) -> Result<Output, JobError> {
+    run_with_meta(job, job.meta(), control)
+}
+
+/// [`run`] for a caller that already holds the job's [`Meta`] (its cache key).
+pub fn run_with_meta(job: &Job, meta: Meta, control: &Control) -> Result<Output, JobError> {
     Ok(match job {
         Job::Rolling(j) => {
             let solution = parallel_map(&[j.rolling], control, |p| model::solve(p, &j.options))?;
-            Output::Rolling(RollingOutput::new(j, &solution[0]))
+            Output::Rolling(RollingOutput::new(&solution[0], meta))
         }
         Job::ThreeBody(j) => {
             let solution =
                 parallel_map(&[j.system], control, |s| three_body::solve(s, &j.options))?;
-            Output::ThreeBody(ThreeBodyOutput::new(j, &solution[0]))
+            Output::ThreeBody(ThreeBodyOutput::new(&solution[0], meta))
         }
         Job::Sweep(sweep) => Output::Sweep(match sweep {
             SweepJob::Rolling(s) => {
                 let options = &s.base.options;
                 let solutions = parallel_map(&s.points(), control, |p| model::solve(p, options))?;
-                SweepOutput::rolling(sweep, s, &solutions)
+                SweepOutput::rolling(s, &solutions, meta)
             }
             SweepJob::ThreeBody(s) => {
                 let options = &s.base.options;
                 let solutions =
                     parallel_map(&s.points(), control, |p| three_body::solve(p, options))?;
-                SweepOutput::three_body(sweep, s, &solutions)
+                SweepOutput::three_body(s, &solutions, meta)
             }
         }),
         Job::Figure(j) => {
             let options = &j.plan.options;
             let solutions = parallel_map(&j.plan.contacts, control, |p| model::solve(p, options))?;
-            Output::Figure(FigureOutput::new(j, j.plan.assemble(&solutions)))
+            Output::Figure(FigureOutput::new(j.plan.assemble(&solutions), meta))
         }
     })
 }

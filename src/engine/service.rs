@@ -16,8 +16,8 @@ use super::cache::{ResultCache, Solved};
 use super::jobs::{JobEntry, JobState, JobStatus, JobStore};
 use super::metrics::{self as names, Metrics};
 use super::pool::Pool;
-use super::{run, Control};
-use crate::job::{Job, JobError};
+use super::{run_with_meta, Control};
+use crate::job::{Job, JobError, Meta};
 
 /// Memory for the map from input text to cache key (bytes): a few thousand typical inputs.
 const INPUT_KEYS_BYTES: u64 = 16 << 20;
@@ -145,16 +145,21 @@ impl Engine {
         self.input_keys.insert(text, key).await;
     }
 
-    /// Solves `job` now, or takes its answer from the cache. Identical concurrent calls
-    /// share one solve. With no solver thread free the call is refused at once.
-    pub async fn solve(&self, job: Job) -> Result<(Arc<Solved>, CacheStatus), EngineError> {
+    /// Solves `job`, whose [`Meta`] is `meta` (computed once by the caller: it holds the
+    /// cache key), now, or takes its answer from the cache. Identical concurrent calls share
+    /// one solve. With no solver thread free the call is refused at once.
+    pub async fn solve(
+        &self,
+        job: Job,
+        meta: Meta,
+    ) -> Result<(Arc<Solved>, CacheStatus), EngineError> {
         self.admit()?;
-        let key = job.cache_key();
+        let key = meta.input_hash.clone();
         let solve = async {
             let permit = self.pool.try_acquire().ok_or(EngineError::Overloaded)?;
             let deadline = Instant::now() + self.config.solve_deadline;
             let control = Arc::new(Control::new(Some(deadline), 1));
-            Ok(self.execute(permit, job, key.clone(), control).await?)
+            Ok(self.execute(permit, job, meta, control).await?)
         };
         let (solved, fresh) = self
             .cache
@@ -265,14 +270,15 @@ impl Engine {
         &self,
         permit: OwnedSemaphorePermit,
         job: Job,
-        key: String,
+        meta: Meta,
         control: Arc<Control>,
     ) -> Result<Arc<Solved>, JobError> {
         self.cache_misses.increment(1);
         let kind = job.kind();
         let start = Instant::now();
         let result = Pool::run(permit, control, move |control| {
-            Solved::new(key, run(&job, control)?).map(Arc::new)
+            let key = meta.input_hash.clone();
+            Solved::new(key, run_with_meta(&job, meta, control)?).map(Arc::new)
         })
         .await;
         let outcome = match &result {
@@ -292,8 +298,8 @@ impl Engine {
 
     /// The life of an asynchronous job after its submission; returns its final state.
     async fn run_job(&self, entry: &JobEntry, job: Job) -> JobState {
-        let key = job.cache_key();
-        let permit = match self.cache.get(&key).await {
+        let meta = job.meta();
+        let permit = match self.cache.get(&meta.input_hash).await {
             Some(hit) => {
                 self.cache_hits.increment(1);
                 Err(JobState::Succeeded(hit))
@@ -311,7 +317,7 @@ impl Engine {
         };
         entry.set_state(JobState::Running);
         self.jobs_running.increment(1.0);
-        let result = self.execute(permit, job, key, entry.control()).await;
+        let result = self.execute(permit, job, meta, entry.control()).await;
         self.jobs_running.decrement(1.0);
         match result {
             Ok(solved) => {

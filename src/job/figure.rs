@@ -5,7 +5,7 @@ use serde_json::{json, Value};
 use utoipa::ToSchema;
 
 use super::fields::{self, Checker};
-use super::{format_number, JobError, JobKind, Meta};
+use super::{format_number, JobError, Meta};
 use crate::model::figures::{Figure, Plan, FIGURES};
 
 /// Input of a figure job.
@@ -102,7 +102,8 @@ pub struct FigureOutput {
 }
 
 impl FigureOutput {
-    pub fn new(job: &FigureJob, figure: Figure) -> Self {
+    /// The answer with `meta`, the job's [`Meta`] (see [`super::Job::meta`]).
+    pub fn new(figure: Figure, meta: Meta) -> Self {
         let axis = |a: crate::model::figures::Axis| AxisOutput {
             quantity: a.quantity,
             unit: a.unit,
@@ -123,7 +124,7 @@ impl FigureOutput {
                     points: s.points,
                 })
                 .collect(),
-            meta: Meta::new(JobKind::Figure, job.canonical()),
+            meta,
         }
     }
 

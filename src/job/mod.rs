@@ -141,9 +141,16 @@ impl Job {
         }
     }
 
+    /// The `meta` block of the job's answer: model version, canonical input and its hash.
+    /// Computing it costs a few µs, so a caller that needs both the key and the answer
+    /// computes it once and passes it on.
+    pub fn meta(&self) -> Meta {
+        Meta::new(self.kind(), self.canonical())
+    }
+
     /// Hash of the canonical input and the model version: equal keys, equal results.
     pub fn cache_key(&self) -> String {
-        meta::input_hash(self.kind(), &self.canonical())
+        self.meta().input_hash
     }
 
     /// The number of rolling solves the job takes (its progress total).

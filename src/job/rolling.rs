@@ -6,7 +6,7 @@ use utoipa::ToSchema;
 
 use super::fields::{self, Checker, Quantity};
 use super::units::Dimension;
-use super::{JobError, JobKind, Meta};
+use super::{JobError, Meta};
 use crate::model::quadrature::{DEFAULT_GAUSS_NODES, DEFAULT_MIDPOINT_STRIPS};
 use crate::model::rolling::{BoundaryPoint, PressureGrid, Verification};
 use crate::model::{Layer, Quadrature, Rolling, RollingSolution, SolveOptions};
@@ -368,13 +368,14 @@ pub struct RollingOutput {
 }
 
 impl RollingOutput {
-    pub fn new(job: &RollingJob, solution: &RollingSolution) -> Self {
+    /// The answer with `meta`, the job's [`Meta`] (see [`super::Job::meta`]).
+    pub fn new(solution: &RollingSolution, meta: Meta) -> Self {
         RollingOutput {
             contact: solution.into(),
             boundary: solution.boundary.iter().map(Into::into).collect(),
             pressure: solution.pressure.as_ref().map(Into::into),
             meta: RollingMeta {
-                meta: Meta::new(JobKind::Rolling, job.canonical()),
+                meta,
                 verification: (&solution.verification).into(),
             },
         }

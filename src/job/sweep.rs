@@ -13,7 +13,7 @@ use super::three_body::{
     ThreeBodyVerificationOutput,
 };
 use super::units::Dimension;
-use super::{format_number, JobError, JobKind, Limits, Meta};
+use super::{format_number, JobError, Limits, Meta};
 use crate::model::three_body::{Diameters, OperatingPoint, ThreeBody, ThreeBodySolution};
 use crate::model::{Parameter, Rolling, RollingSolution, SolveOptions};
 
@@ -454,7 +454,7 @@ pub struct SweepOutput {
 
 impl SweepOutput {
     /// A rolling sweep's answer; `solutions` are those of [`RollingSweep::points`], in order.
-    pub fn rolling(job: &SweepJob, sweep: &RollingSweep, solutions: &[RollingSolution]) -> Self {
+    pub fn rolling(sweep: &RollingSweep, solutions: &[RollingSolution], meta: Meta) -> Self {
         let points = sweep
             .points()
             .iter()
@@ -469,16 +469,12 @@ impl SweepOutput {
             .collect();
         SweepOutput {
             points: SweepPoints::Rolling(points),
-            meta: Meta::new(JobKind::Sweep, job.canonical()),
+            meta,
         }
     }
 
     /// A three-body sweep's answer; `solutions` follow [`ThreeBodySweep::points`].
-    pub fn three_body(
-        job: &SweepJob,
-        sweep: &ThreeBodySweep,
-        solutions: &[ThreeBodySolution],
-    ) -> Self {
+    pub fn three_body(sweep: &ThreeBodySweep, solutions: &[ThreeBodySolution], meta: Meta) -> Self {
         let points = sweep
             .points()
             .iter()
@@ -493,7 +489,7 @@ impl SweepOutput {
             .collect();
         SweepOutput {
             points: SweepPoints::ThreeBody(points),
-            meta: Meta::new(JobKind::Sweep, job.canonical()),
+            meta,
         }
     }
 

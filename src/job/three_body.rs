@@ -8,7 +8,7 @@ use utoipa::ToSchema;
 use super::fields::{self, Checker, Quantity};
 use super::rolling::{si, LayerInput, QuadratureKind};
 use super::units::Dimension;
-use super::{JobError, JobKind, Meta};
+use super::{JobError, Meta};
 use crate::model::three_body::{
     Asperities, ContactState, Diameters, LayerContact, OperatingPoint, Particle, ThreeBody,
     ThreeBodyOptions, ThreeBodySolution, UpperContact, UpperSurface, DEFAULT_DIAMETER_NODES,
@@ -556,11 +556,12 @@ pub struct ThreeBodyOutput {
 }
 
 impl ThreeBodyOutput {
-    pub fn new(job: &ThreeBodyJob, solution: &ThreeBodySolution) -> Self {
+    /// The answer with `meta`, the job's [`Meta`] (see [`super::Job::meta`]).
+    pub fn new(solution: &ThreeBodySolution, meta: Meta) -> Self {
         ThreeBodyOutput {
             result: solution.into(),
             meta: ThreeBodyMeta {
-                meta: Meta::new(JobKind::ThreeBody, job.canonical()),
+                meta,
                 verification: solution.into(),
             },
         }

@@ -18,7 +18,7 @@ use super::error::{ApiError, JsonBody};
 use super::AppState;
 use crate::engine::cache::Solved;
 use crate::engine::CacheStatus;
-use crate::job::{Job, JobKind};
+use crate::job::{Job, JobKind, Meta};
 
 /// `hit` when the answer came from the cache (or from an identical request solved at the
 /// same time), `miss` when this request solved it.
@@ -63,14 +63,26 @@ impl SolveRequest {
             return Ok(respond(&solved, CacheStatus::Hit, &self.headers));
         }
         let job = Job::from_input(kind, self.input, &self.state.config().limits)?;
-        engine.remember_input(text, job.cache_key()).await;
-        answer(&self.state, job, &self.headers).await
+        let meta = job.meta();
+        engine.remember_input(text, meta.input_hash.clone()).await;
+        solve_and_answer(&self.state, job, meta, &self.headers).await
     }
 }
 
 /// Solves a validated job and answers it, in JSON or (if asked and offered) CSV.
 pub async fn answer(state: &AppState, job: Job, headers: &HeaderMap) -> Result<Response, ApiError> {
-    let (solved, cache) = state.engine().solve(job).await?;
+    let meta = job.meta();
+    solve_and_answer(state, job, meta, headers).await
+}
+
+/// [`answer`] for a job whose [`Meta`] (and so cache key) the caller already computed.
+async fn solve_and_answer(
+    state: &AppState,
+    job: Job,
+    meta: Meta,
+    headers: &HeaderMap,
+) -> Result<Response, ApiError> {
+    let (solved, cache) = state.engine().solve(job, meta).await?;
     Ok(respond(&solved, cache, headers))
 }
 
