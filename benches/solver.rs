@@ -9,9 +9,8 @@ use std::time::Duration;
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use serde_json::json;
-use thirdbody::engine::cache::Solved;
-use thirdbody::engine::{self, Control};
-use thirdbody::job::{Job, JobKind, Limits};
+use thirdbody::engine::{self, cache::Solved};
+use thirdbody::job::{Control, Job, Kind, Limits, RollingJob, Work};
 use thirdbody::model::kelvin_map::KelvinMap;
 use thirdbody::model::quadrature::StripRule;
 use thirdbody::model::three_body::{
@@ -58,7 +57,13 @@ fn figures(c: &mut Criterion) {
             .unwrap()
         })
         .collect();
-    let solves: usize = jobs.iter().map(Job::size).sum();
+    let solves: usize = jobs
+        .iter()
+        .map(|job| match job.work() {
+            Work::Known(n) => n,
+            Work::Unknown => 0,
+        })
+        .sum();
     println!("figures 3-9: {solves} rolling solves");
     let mut group = c.benchmark_group("figures_3_to_9");
     group
@@ -113,18 +118,21 @@ fn service(c: &mut Criterion) {
     let limits = Limits::default();
     group.bench_function("validate_and_key", |b| {
         b.iter(|| {
-            let job = Job::from_input(JobKind::Rolling, black_box(input.clone()), &limits);
+            let job = Job::from_input(RollingJob::NAME, black_box(input.clone()), &limits);
             black_box(job.unwrap().cache_key())
         })
     });
-    let job = Job::from_input(JobKind::Rolling, input.clone(), &limits).unwrap();
+    let job = Job::from_input(RollingJob::NAME, input.clone(), &limits).unwrap();
     let control = Control::new(None, 1);
     group.bench_function("engine_run_default_job", |b| {
         b.iter(|| black_box(engine::run(black_box(&job), &control).unwrap()))
     });
-    let output = engine::run(&job, &control).unwrap();
     group.bench_function("render_json", |b| {
-        b.iter(|| black_box(Solved::new(job.cache_key(), output.clone()).unwrap()))
+        b.iter_batched(
+            || engine::run(&job, &control).unwrap(),
+            |answer| black_box(Solved::new(job.cache_key(), answer).unwrap()),
+            criterion::BatchSize::SmallInput,
+        )
     });
     group.finish();
 }

@@ -2,10 +2,12 @@
 //! one coated with a viscoelastic (Kelvin) layer.
 //!
 //! Data flows one way: a job arrives as JSON ([`job`]), is validated into model inputs,
-//! dispatched by the [`engine`], solved by the [`model`] (pure numerics), and its result goes
-//! back out through the [`job`] wire types. [`http`] is the same path as a web service.
+//! dispatched by the [`engine`], solved by the [`model`] (pure numerics), and its answer
+//! leaves through the [`render`] layer (JSON, CSV). [`http`] is the same path as a web
+//! service.
 
 pub mod engine;
 pub mod http;
 pub mod job;
 pub mod model;
+pub mod render;

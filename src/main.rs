@@ -6,9 +6,10 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand, ValueEnum};
 
-use thirdbody::engine::{self, Control, Output};
+use thirdbody::engine;
 use thirdbody::http::{self, AppState, LogFormat, ServeArgs};
-use thirdbody::job::{FigureJob, Job, JobError, Limits};
+use thirdbody::job::{Control, FigureJob, Job, JobError, Limits};
+use thirdbody::render::{Answer, Format};
 
 #[derive(Parser)]
 #[command(
@@ -27,15 +28,15 @@ enum Command {
     Solve {
         /// The job file, or - for standard input.
         job: String,
-        /// Output format (csv for sweeps and figures).
-        #[arg(long, value_enum, default_value_t = Format::Json)]
-        format: Format,
+        /// Output format.
+        #[arg(long, value_enum, default_value_t = OutputFormat::Json)]
+        format: OutputFormat,
     },
     /// Print the data of Figure N (3–9) of the paper.
     Figure {
         number: i64,
-        #[arg(long, value_enum, default_value_t = Format::Json)]
-        format: Format,
+        #[arg(long, value_enum, default_value_t = OutputFormat::Json)]
+        format: OutputFormat,
     },
     /// Serve the HTTP API (see /docs once it runs); every flag has a THIRDBODY_* variable.
     Serve(Box<ServeArgs>),
@@ -43,10 +44,20 @@ enum Command {
     Openapi,
 }
 
+/// The forms of an answer on the command line (JSON is indented for people).
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
-enum Format {
+enum OutputFormat {
     Json,
     Csv,
+}
+
+impl OutputFormat {
+    fn format(self) -> Format {
+        match self {
+            OutputFormat::Json => Format::Json,
+            OutputFormat::Csv => Format::Csv,
+        }
+    }
 }
 
 /// Exit status for a job that is not valid (as distinct from one that failed to solve), and
@@ -57,13 +68,13 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let (job, format) = match cli.command {
         Command::Solve { job, format } => (read_job(&job), format),
-        Command::Figure { number, format } => (FigureJob::new(number).map(Job::Figure), format),
+        Command::Figure { number, format } => (FigureJob::new(number).map(Job::new), format),
         Command::Serve(args) => return serve(*args),
         Command::Openapi => return print(&http::openapi::spec_json()),
     };
     let result = job.and_then(|job| {
-        let output = engine::run(&job, &Control::default())?;
-        render(&output, format)
+        let answer = engine::run(&job, &Control::default())?;
+        render(&answer, format.format())
     });
     match result {
         Ok(text) => print(&text),
@@ -178,16 +189,13 @@ fn read_job(path: &str) -> Result<Job, JobError> {
     Job::from_json(&text, &Limits::default())
 }
 
-fn render(output: &Output, format: Format) -> Result<String, JobError> {
-    match (format, output) {
-        (Format::Json, _) => serde_json::to_string_pretty(output)
-            .map_err(|e| JobError::Internal(format!("cannot write the result: {e}"))),
-        (Format::Csv, Output::Sweep(s)) => Ok(s.to_csv()),
-        (Format::Csv, Output::Figure(f)) => Ok(f.to_csv()),
-        (Format::Csv, Output::Rolling(_) | Output::ThreeBody(_)) => Err(JobError::Schema {
-            field: "--format".to_string(),
-            message: "csv is available for sweeps and figures; use json for a single job"
-                .to_string(),
-        }),
-    }
+/// The answer as text in `format`; failing to render it is a fault of ours, not the job's.
+fn render(answer: &Answer, format: Format) -> Result<String, JobError> {
+    let text = match format {
+        Format::Json => answer.to_pretty_json(),
+        _ => answer
+            .render(format)
+            .map(|bytes| String::from_utf8_lossy(&bytes).into_owned()),
+    };
+    text.map_err(|e| JobError::Internal(e.to_string()))
 }

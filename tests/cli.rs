@@ -105,9 +105,22 @@ fn a_bad_job_fails_with_status_2_and_says_which_field() {
     let out = thirdbody(&["solve", "no/such/file.json"], None);
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("cannot read"));
+}
 
+#[test]
+fn every_answer_prints_as_csv_even_a_single_contact() {
     let out = thirdbody(&["solve", "examples/rolling.json", "--format", "csv"], None);
-    assert_ne!(out.status.code(), Some(0));
+    assert!(out.status.success());
+    let text = String::from_utf8_lossy(&out.stdout);
+    let lines: Vec<&str> = text.lines().collect();
+    assert_eq!(lines.len(), 2, "{text}");
+    assert!(lines[0].starts_with("radius,load,velocity,penetration,contact_area"));
+    let out = thirdbody(
+        &["solve", "examples/three_body.json", "--format", "csv"],
+        None,
+    );
+    assert!(out.status.success());
+    assert!(String::from_utf8_lossy(&out.stdout).starts_with("total_load,velocity"));
 }
 
 #[test]

@@ -2,26 +2,27 @@
 //! of rolling jobs, sweeps and figures, checked against the model and MODEL.md.
 
 use serde_json::{json, Value};
-use thirdbody::engine::{self, Control, Output};
-use thirdbody::job::sweep::{SweepPoint, SweepPoints};
-use thirdbody::job::{FieldError, Job, JobError, Limits};
+use thirdbody::engine;
+use thirdbody::job::figure::FigureOutput;
+use thirdbody::job::rolling::RollingOutput;
+use thirdbody::job::sweep::{SweepOutput, SweepPoint, SweepPoints};
+use thirdbody::job::{Control, FieldError, Job, JobError, Limits, RollingJob, Work};
 use thirdbody::model::limits::relaxed;
 use thirdbody::model::{solve, Layer, Rolling, SolveOptions};
+use thirdbody::render::Output;
 
 fn job(value: Value) -> Result<Job, JobError> {
     Job::from_value(value, &Limits::default())
 }
 
-fn run(value: Value) -> Output {
-    engine::run(&job(value).unwrap(), &Control::default()).unwrap()
+fn run<T: Output>(value: Value) -> T {
+    let answer = engine::run(&job(value).unwrap(), &Control::default()).unwrap();
+    answer.downcast().unwrap()
 }
 
 fn rolling_points(value: Value) -> Vec<SweepPoint> {
-    match run(value) {
-        Output::Sweep(out) => match out.points {
-            SweepPoints::Rolling(points) => points,
-            other => panic!("{other:?}"),
-        },
+    match run::<SweepOutput>(value).points {
+        SweepPoints::Rolling(points) => points,
         other => panic!("{other:?}"),
     }
 }
@@ -39,9 +40,10 @@ fn rel(a: f64, b: f64) -> f64 {
 
 #[test]
 fn an_empty_rolling_job_is_the_default_particle_of_model_section_5() {
-    let Job::Rolling(j) = job(json!({"kind": "rolling"})).unwrap() else {
-        panic!()
-    };
+    let j = *job(json!({"kind": "rolling"}))
+        .unwrap()
+        .downcast_ref::<RollingJob>()
+        .unwrap();
     assert_eq!(j.rolling, Rolling::default());
     assert_eq!(j.rolling.radius, 25e-9);
     assert_eq!(j.rolling.load, 1e-9);
@@ -49,7 +51,7 @@ fn an_empty_rolling_job_is_the_default_particle_of_model_section_5() {
     assert_eq!(j.rolling.layer, Layer::default());
     assert_eq!(
         job(json!({"kind": "rolling", "input": {}})).unwrap(),
-        Job::Rolling(j)
+        Job::new(j)
     );
 }
 
@@ -189,9 +191,7 @@ fn misshapen_json_names_the_field_and_malformed_json_is_a_syntax_error() {
 
 #[test]
 fn a_rolling_answer_carries_the_model_numbers_and_its_own_verification() {
-    let Output::Rolling(out) = run(json!({"kind": "rolling"})) else {
-        panic!()
-    };
+    let out: RollingOutput = run(json!({"kind": "rolling"}));
     let s = solve(&Rolling::default(), &SolveOptions::default()).unwrap();
     assert_eq!(out.contact.contact_area, s.contact_area);
     assert_eq!(out.contact.friction_coefficient, s.friction_coefficient);
@@ -230,11 +230,8 @@ fn a_rolling_answer_carries_the_model_numbers_and_its_own_verification() {
 #[test]
 fn the_pressure_grid_is_non_negative_and_carries_the_load() {
     let n = 201;
-    let Output::Rolling(out) =
-        run(json!({"kind": "rolling", "input": {"options": {"pressure_grid": n}}}))
-    else {
-        panic!()
-    };
+    let out: RollingOutput =
+        run(json!({"kind": "rolling", "input": {"options": {"pressure_grid": n}}}));
     let grid = out.pressure.unwrap();
     assert_eq!(grid.x.len(), n);
     assert_eq!(grid.values.len(), n);
@@ -283,12 +280,9 @@ fn a_sweep_is_the_product_of_its_lists_in_order_and_equals_single_solves() {
     assert_eq!(points[0].load, 1.2e-9);
 
     let csv = {
-        let Output::Sweep(out) =
-            run(json!({"kind": "sweep", "input": {"vary": {"velocity": [0, 4e-9]}}}))
-        else {
-            panic!()
-        };
-        out.to_csv()
+        let out: SweepOutput =
+            run(json!({"kind": "sweep", "input": {"vary": {"velocity": [0, 4e-9]}}}));
+        out.table().to_csv()
     };
     let lines: Vec<&str> = csv.lines().collect();
     assert_eq!(lines.len(), 3);
@@ -324,9 +318,7 @@ fn figures_3_to_9_hold_the_series_of_model_section_5() {
         (8, 10, 14),
         (9, 10, 14),
     ] {
-        let Output::Figure(f) = run(json!({"kind": "figure", "input": {"number": number}})) else {
-            panic!()
-        };
+        let f: FigureOutput = run(json!({"kind": "figure", "input": {"number": number}}));
         assert_eq!(f.figure, number);
         assert_eq!(f.series.len(), series, "figure {number}");
         assert!(
@@ -341,9 +333,7 @@ fn figures_3_to_9_hold_the_series_of_model_section_5() {
             .all(|x| x.is_finite()));
     }
     // Fig. 4: the static series are the closed form A₀, the rolling ones lie below them.
-    let Output::Figure(f) = run(json!({"kind": "figure", "input": {"number": 4}})) else {
-        panic!()
-    };
+    let f: FigureOutput = run(json!({"kind": "figure", "input": {"number": 4}}));
     for pair in f.series.chunks(2) {
         let (fixed, rolling) = (&pair[0], &pair[1]);
         assert_eq!((fixed.velocity, rolling.velocity), (0.0, 4e-9));
@@ -354,19 +344,15 @@ fn figures_3_to_9_hold_the_series_of_model_section_5() {
         }
     }
     // Fig. 6 at R = 25 nm, V = 4 nm/s, P = 1 nN: μ of the reference table.
-    let Output::Figure(f) = run(json!({"kind": "figure", "input": {"number": 6}})) else {
-        panic!()
-    };
+    let f: FigureOutput = run(json!({"kind": "figure", "input": {"number": 6}}));
     assert_eq!(f.series[1].label, "R = 25 nm, V = 4 nm/s");
     assert!((f.series[1].points[0][1] - 0.09470).abs() < 5e-6);
     // Fig. 3: each contour is closed and lies within |y| ≤ √(2Rδ).
-    let Output::Figure(f) = run(json!({"kind": "figure", "input": {"number": 3}})) else {
-        panic!()
-    };
+    let f: FigureOutput = run(json!({"kind": "figure", "input": {"number": 3}}));
     for s in &f.series {
         assert_eq!(s.points.first(), s.points.last());
     }
-    let csv = f.to_csv();
+    let csv = f.table().to_csv();
     assert_eq!(csv.lines().next(), Some("series,label,x (m),y (m)"));
     assert_eq!(csv.lines().count(), 1 + 4 * 202);
 }
@@ -388,7 +374,7 @@ fn the_engine_reports_progress_and_stops_on_cancel_or_deadline() {
     let control = Control::default();
     engine::run(&sweep, &control).unwrap();
     assert_eq!(control.done(), 4);
-    assert_eq!(sweep.size(), 4);
+    assert_eq!(sweep.work(), Work::Known(4));
 
     let cancelled = Control::default();
     cancelled.cancel();

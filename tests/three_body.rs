@@ -3,15 +3,18 @@
 
 use proptest::prelude::*;
 use serde_json::{json, Value};
-use thirdbody::engine::{self, Control, Output};
+use thirdbody::engine;
+use thirdbody::job::sweep::SweepOutput;
 use thirdbody::job::sweep::SweepPoints;
-use thirdbody::job::{Job, JobError, Limits};
+use thirdbody::job::three_body::ThreeBodyOutput;
+use thirdbody::job::{Control, Job, JobError, Limits};
 use thirdbody::model::limits::relaxed;
 use thirdbody::model::three_body::{
     self, squeeze, Asperities, Diameters, LayerContact, LayerLaw, OperatingPoint, ThreeBody,
     ThreeBodyOptions, ThreeBodySolution, UpperLaw,
 };
 use thirdbody::model::{solve, Layer, ModelError, Rolling, SolveOptions};
+use thirdbody::render::{Answer, Output};
 
 fn rel(a: f64, b: f64) -> f64 {
     (a / b - 1.0).abs()
@@ -279,18 +282,18 @@ fn asperities_carry_load_when_the_gap_is_small_and_none_in_the_gap_regime() {
     assert!(at(10e-9).loads.asperities < close.loads.asperities);
 }
 
-fn run(value: Value) -> Result<Output, JobError> {
+fn run(value: Value) -> Result<Answer, JobError> {
     let job = Job::from_value(value, &Limits::default())?;
     engine::run(&job, &Control::default())
 }
 
 #[test]
 fn a_job_naming_only_the_operating_point_is_valid_and_canonical() {
-    let Output::ThreeBody(out) =
-        run(json!({"kind": "three_body", "input": {"operating": {"total_load": "1 mN"}}})).unwrap()
-    else {
-        panic!()
-    };
+    let out: ThreeBodyOutput =
+        run(json!({"kind": "three_body", "input": {"operating": {"total_load": "1 mN"}}}))
+            .unwrap()
+            .downcast()
+            .unwrap();
     let text = serde_json::to_value(&out).unwrap();
     assert!(rel(text["loads"]["total"].as_f64().unwrap(), 1e-3) < 1e-10);
     assert!(
@@ -387,7 +390,7 @@ fn bad_three_body_input_gets_clear_errors() {
         ),
     ] {
         match run(json!({"kind": "three_body", "input": input})) {
-            Err(JobError::Solve(e)) => assert!(e.to_string().contains(needle), "{e}"),
+            Err(JobError::Unsolvable(e)) => assert!(e.contains(needle), "{e}"),
             other => panic!("{other:?}"),
         }
     }
@@ -395,10 +398,12 @@ fn bad_three_body_input_gets_clear_errors() {
 
 #[test]
 fn three_body_sweeps_vary_the_operating_point_speed_and_mean_diameter() {
-    let Output::Sweep(out) = run(json!({"kind": "sweep", "input": {
+    let out: SweepOutput = run(json!({"kind": "sweep", "input": {
         "kind": "three_body",
         "vary": {"total_load": ["0.1 mN", "1 mN"], "velocity": [0, "4 nm/s"], "mean_diameter": ["40 nm", "50 nm"]}}}))
-    .unwrap() else { panic!() };
+    .unwrap()
+    .downcast()
+    .unwrap();
     let SweepPoints::ThreeBody(points) = &out.points else {
         panic!()
     };
@@ -411,7 +416,7 @@ fn three_body_sweeps_vary_the_operating_point_speed_and_mean_diameter() {
     single.diameters = Diameters::with_default_bounds(40e-9, 5e-9);
     let direct = solve3(&single).unwrap();
     assert_eq!(first.result.state.separation, direct.rolling.separation);
-    let csv = out.to_csv();
+    let csv = out.table().to_csv();
     assert!(csv.starts_with("total_load,velocity,mean_diameter,separation"));
     assert_eq!(csv.lines().count(), 9);
     // Two operating lists at once are refused.

@@ -7,8 +7,7 @@ use std::sync::Arc;
 
 use tokio::sync::{OwnedSemaphorePermit, Semaphore};
 
-use super::Control;
-use crate::job::JobError;
+use crate::job::{Control, JobError};
 
 /// The permits of the solver threads.
 #[derive(Clone, Debug)]

@@ -1,26 +1,32 @@
-//! The compute path of the service: validated job → cache key → cache lookup that coalesces
-//! identical misses → a permit (or a refusal) → a blocking thread with a deadline and a
+//! The compute path of the service: validated job → cache key → cache lookup → one solve
+//! per key in flight → a permit (or a refusal) → a blocking thread with a deadline and a
 //! cancel flag. Synchronous solves and asynchronous jobs both go through it.
 
+use std::collections::HashMap;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
-use std::sync::Arc;
+use std::sync::{Arc, Mutex, MutexGuard};
 use std::time::{Duration, Instant};
 
+use futures_util::FutureExt;
 use metrics::{Counter, Gauge};
-use tokio::sync::OwnedSemaphorePermit;
+use tokio::sync::{watch, OwnedSemaphorePermit};
+use tokio_util::sync::CancellationToken;
 use tokio_util::task::TaskTracker;
 use tracing::Instrument;
 use uuid::Uuid;
 
-use super::cache::{ResultCache, Solved};
-use super::jobs::{JobEntry, JobState, JobStatus, JobStore};
+use super::cache::{MemoryCache, ResultCache, Solved};
+use super::coalesce::Coalescer;
 use super::metrics::{self as names, Metrics};
 use super::pool::Pool;
-use super::{run_with_meta, Control};
-use crate::job::{Job, JobError, Meta};
+use super::store::{JobRecord, JobState, JobStatus, JobStore, MemoryJobStore};
+use crate::job::{Control, Job, JobError, Meta, Work};
 
 /// Memory for the map from input text to cache key (bytes): a few thousand typical inputs.
 const INPUT_KEYS_BYTES: u64 = 16 << 20;
+/// How long a cancel waits for the job to stop (it checks between units of work, which take
+/// microseconds to milliseconds).
+const CANCEL_WAIT: Duration = Duration::from_secs(5);
 
 /// The limits of an engine.
 #[derive(Clone, Debug, PartialEq)]
@@ -39,6 +45,23 @@ pub struct EngineConfig {
     pub cache_ttl: Duration,
     /// How long a finished asynchronous job is kept.
     pub job_retention: Duration,
+}
+
+/// Where an engine keeps answers and job records.
+#[derive(Clone)]
+pub struct Storage {
+    pub cache: Arc<dyn ResultCache>,
+    pub jobs: Arc<dyn JobStore>,
+}
+
+impl Storage {
+    /// In this process's memory, within `config`'s bounds: the default.
+    pub fn in_process(config: &EngineConfig) -> Storage {
+        Storage {
+            cache: Arc::new(MemoryCache::new(config.cache_bytes, config.cache_ttl)),
+            jobs: Arc::new(MemoryJobStore::new(config.job_retention)),
+        }
+    }
 }
 
 /// Why the engine did not answer.
@@ -74,15 +97,36 @@ impl CacheStatus {
     }
 }
 
+/// The handles of an asynchronous job this process runs: what its record cannot hold.
+struct LiveJob {
+    control: Arc<Control>,
+    /// Wakes a job still waiting for a permit when it is cancelled (the solver itself
+    /// watches `control`).
+    cancel: CancellationToken,
+    /// The job's status, for those who wait for a change.
+    status: watch::Sender<JobStatus>,
+}
+
+impl LiveJob {
+    /// Asks the job to stop: at once if it is queued, at the solver's next check if it runs.
+    fn cancel(&self) {
+        self.cancel.cancel();
+        self.control.cancel();
+    }
+}
+
 /// The compute service: pool, cache and asynchronous jobs.
 pub struct Engine {
     config: EngineConfig,
     pool: Pool,
-    cache: ResultCache,
+    cache: Arc<dyn ResultCache>,
+    coalescer: Coalescer,
     /// The text of valid inputs (their kind and compact JSON with sorted keys) → their
     /// cache key, so that a repeated request is answered without being validated again.
     input_keys: moka::future::Cache<String, String>,
-    jobs: JobStore,
+    jobs: Arc<dyn JobStore>,
+    /// The jobs this process runs, by id.
+    live: Mutex<HashMap<Uuid, Arc<LiveJob>>>,
     /// The tasks of asynchronous jobs, waited for on shutdown.
     tracker: TaskTracker,
     draining: AtomicBool,
@@ -96,10 +140,18 @@ pub struct Engine {
 }
 
 impl Engine {
+    /// An engine that keeps everything in this process.
     pub fn new(config: EngineConfig, metrics: Metrics) -> Arc<Engine> {
+        let storage = Storage::in_process(&config);
+        Engine::with_storage(config, metrics, storage)
+    }
+
+    /// An engine that keeps answers and job records in `storage`.
+    pub fn with_storage(config: EngineConfig, metrics: Metrics, storage: Storage) -> Arc<Engine> {
         Arc::new(Engine {
             pool: Pool::new(config.pool_size),
-            cache: ResultCache::new(config.cache_bytes, config.cache_ttl),
+            cache: storage.cache,
+            coalescer: Coalescer::default(),
             input_keys: moka::future::Cache::builder()
                 .max_capacity(INPUT_KEYS_BYTES)
                 .weigher(|input: &String, key: &String| {
@@ -107,7 +159,8 @@ impl Engine {
                 })
                 .time_to_live(config.cache_ttl)
                 .build(),
-            jobs: JobStore::new(config.job_retention),
+            jobs: storage.jobs,
+            live: Mutex::default(),
             tracker: TaskTracker::new(),
             draining: AtomicBool::new(false),
             queued: AtomicUsize::new(0),
@@ -122,6 +175,10 @@ impl Engine {
 
     pub fn metrics(&self) -> &Metrics {
         &self.metrics
+    }
+
+    fn live(&self) -> MutexGuard<'_, HashMap<Uuid, Arc<LiveJob>>> {
+        self.live.lock().unwrap_or_else(|p| p.into_inner())
     }
 
     /// The cached answer to an input seen before (`text`: its kind and compact JSON), found
@@ -149,24 +206,31 @@ impl Engine {
     /// cache key), now, or takes its answer from the cache. Identical concurrent calls share
     /// one solve. With no solver thread free the call is refused at once.
     pub async fn solve(
-        &self,
+        self: &Arc<Self>,
         job: Job,
         meta: Meta,
     ) -> Result<(Arc<Solved>, CacheStatus), EngineError> {
         self.admit()?;
         let key = meta.input_hash.clone();
-        let solve = async {
-            let permit = self.pool.try_acquire().ok_or(EngineError::Overloaded)?;
-            let deadline = Instant::now() + self.config.solve_deadline;
-            let control = Arc::new(Control::new(Some(deadline), 1));
-            Ok(self.execute(permit, job, meta, control).await?)
+        if let Some(solved) = self.cache.get(&key).await {
+            self.cache_hits.increment(1);
+            return Ok((solved, CacheStatus::Hit));
+        }
+        let engine = self.clone();
+        let solve = move || {
+            async move {
+                let permit = engine.pool.try_acquire().ok_or(EngineError::Overloaded)?;
+                let deadline = Instant::now() + engine.config.solve_deadline;
+                let control = Arc::new(Control::new(Some(deadline), 1));
+                let solved = engine.execute(permit, job, meta, control).await?;
+                engine.cache.insert(solved.clone()).await;
+                Ok(solved)
+            }
+            .boxed()
         };
-        let (solved, fresh) = self
-            .cache
-            .get_or_solve(key.clone(), solve)
-            .await
-            .map_err(|e| self.refused(e))?;
-        if fresh {
+        let (solved, started) = self.coalescer.run(&key, solve).await;
+        let solved = solved.map_err(|e| self.refused(e))?;
+        if started {
             Ok((solved, CacheStatus::Miss))
         } else {
             self.cache_hits.increment(1);
@@ -174,9 +238,9 @@ impl Engine {
         }
     }
 
-    /// Queues `job` to run in the background; its entry tracks it. Refused when the queue
+    /// Queues `job` to run in the background; returns its record. Refused when the queue
     /// is full or the service is draining.
-    pub fn submit(self: &Arc<Self>, job: Job) -> Result<Arc<JobEntry>, EngineError> {
+    pub async fn submit(self: &Arc<Self>, job: Job) -> Result<JobRecord, EngineError> {
         self.admit()?;
         let max = self.config.max_queued_jobs;
         if self
@@ -189,41 +253,78 @@ impl Engine {
             return Err(self.refused(EngineError::Overloaded));
         }
         self.jobs_queued.increment(1.0);
+        let record = JobRecord::queued(job.kind(), job.work());
+        let id = record.id;
+        self.jobs.insert(record.clone()).await;
         let deadline = Instant::now() + self.config.job_deadline;
-        let control = Arc::new(Control::new(Some(deadline), 1));
-        let entry = self
-            .jobs
-            .insert(JobEntry::new(job.kind(), job.size(), control));
-        let span = tracing::info_span!("job", id = %entry.id, kind = job.kind().as_str());
-        let (engine, task_entry) = (self.clone(), entry.clone());
+        let live = Arc::new(LiveJob {
+            control: Arc::new(Control::new(Some(deadline), 1)),
+            cancel: CancellationToken::new(),
+            status: watch::Sender::new(JobStatus::Queued),
+        });
+        self.live().insert(id, live.clone());
+        let span = tracing::info_span!("job", id = %id, kind = job.kind());
+        let engine = self.clone();
         self.tracker.spawn(
             async move {
-                let state = engine.run_job(&task_entry, job).await;
-                tracing::info!(status = state.status().as_str(), "job finished");
-                task_entry.set_state(state);
+                let work = job.work();
+                let state = engine.run_job(&live, id, job).await;
+                let status = state.status();
+                let done = match (status, work) {
+                    (JobStatus::Succeeded, Work::Known(total)) => total,
+                    _ => live.control.done(),
+                };
+                tracing::info!(status = status.as_str(), "job finished");
+                engine.jobs.update(id, state, done).await;
+                engine.live().remove(&id);
+                live.status.send_replace(status);
             }
             .instrument(span),
         );
-        Ok(entry)
+        Ok(record)
     }
 
-    /// The asynchronous job `id`, unless unknown or expired.
-    pub fn job(&self, id: Uuid) -> Option<Arc<JobEntry>> {
-        self.jobs.get(id)
+    /// The asynchronous job `id`, unless unknown or expired; a job this process runs has
+    /// its progress counted up to now.
+    pub async fn job(&self, id: Uuid) -> Option<JobRecord> {
+        let mut record = self.jobs.get(id).await?;
+        if let Some(live) = self.live().get(&id) {
+            if !record.state.status().is_finished() {
+                record.done = live.control.done();
+            }
+        }
+        Some(record)
+    }
+
+    /// A receiver of the status changes of the job `id`, if this process runs it.
+    pub fn watch(&self, id: Uuid) -> Option<watch::Receiver<JobStatus>> {
+        self.live().get(&id).map(|live| live.status.subscribe())
+    }
+
+    /// Cancels the job `id`: a queued job at once, a running one at the solver's next check;
+    /// waits a little for it to stop and returns it then. A finished job is left as it is.
+    pub async fn cancel(&self, id: Uuid) -> Option<JobRecord> {
+        let before = self.job(id).await?;
+        let live = self.live().get(&id).cloned();
+        if let Some(live) = live {
+            live.cancel();
+            let mut status = live.status.subscribe();
+            // Still running after the wait: the answer says so, and the job stops soon after.
+            let _ = tokio::time::timeout(CANCEL_WAIT, status.wait_for(|s| s.is_finished())).await;
+        }
+        Some(self.job(id).await.unwrap_or(before))
     }
 
     /// Forgets the finished jobs past their retention.
-    pub fn purge_expired_jobs(&self) -> usize {
-        self.jobs.purge_expired()
+    pub async fn purge_expired_jobs(&self) -> usize {
+        self.jobs.purge_expired().await
     }
 
     /// Stops taking work: new solves and jobs are refused, queued jobs are cancelled.
     /// Running jobs go on; [`Engine::jobs_finished`] waits for them.
     pub fn begin_drain(&self) {
         self.draining.store(true, Ordering::SeqCst);
-        for entry in self.jobs.with_status(JobStatus::Queued) {
-            entry.cancel();
-        }
+        self.cancel_live(JobStatus::Queued);
     }
 
     pub fn is_draining(&self) -> bool {
@@ -238,8 +339,14 @@ impl Engine {
 
     /// Cancels every job still running (when the drain ran out of time).
     pub fn cancel_running_jobs(&self) {
-        for entry in self.jobs.with_status(JobStatus::Running) {
-            entry.cancel();
+        self.cancel_live(JobStatus::Running);
+    }
+
+    fn cancel_live(&self, status: JobStatus) {
+        for live in self.live().values() {
+            if *live.status.borrow() == status {
+                live.cancel();
+            }
         }
     }
 
@@ -278,7 +385,7 @@ impl Engine {
         let start = Instant::now();
         let result = Pool::run(permit, control, move |control| {
             let key = meta.input_hash.clone();
-            Solved::new(key, run_with_meta(&job, meta, control)?).map(Arc::new)
+            Solved::new(key, job.run(meta, control)?).map(Arc::new)
         })
         .await;
         let outcome = match &result {
@@ -290,14 +397,14 @@ impl Engine {
         self.metrics
             .histogram(
                 names::SOLVE_DURATION,
-                &[("kind", kind.as_str()), ("outcome", outcome)],
+                &[("kind", kind), ("outcome", outcome)],
             )
             .record(start.elapsed());
         result
     }
 
     /// The life of an asynchronous job after its submission; returns its final state.
-    async fn run_job(&self, entry: &JobEntry, job: Job) -> JobState {
+    async fn run_job(&self, live: &LiveJob, id: Uuid, job: Job) -> JobState {
         let meta = job.meta();
         let permit = match self.cache.get(&meta.input_hash).await {
             Some(hit) => {
@@ -305,7 +412,7 @@ impl Engine {
                 Err(JobState::Succeeded(hit))
             }
             None => tokio::select! {
-                () = entry.cancelled() => Err(JobState::Cancelled),
+                () = live.cancel.cancelled() => Err(JobState::Cancelled),
                 permit = self.pool.acquire() => Ok(permit),
             },
         };
@@ -315,9 +422,10 @@ impl Engine {
             Ok(permit) => permit,
             Err(state) => return state,
         };
-        entry.set_state(JobState::Running);
+        self.jobs.update(id, JobState::Running, 0).await;
+        live.status.send_replace(JobStatus::Running);
         self.jobs_running.increment(1.0);
-        let result = self.execute(permit, job, meta, entry.control()).await;
+        let result = self.execute(permit, job, meta, live.control.clone()).await;
         self.jobs_running.decrement(1.0);
         match result {
             Ok(solved) => {

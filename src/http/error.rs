@@ -14,7 +14,6 @@ use utoipa::ToSchema;
 
 use crate::engine::EngineError;
 use crate::job::{FieldError, JobError};
-use crate::model::ModelError;
 
 pub const PROBLEM_JSON: &str = "application/problem+json";
 
@@ -29,6 +28,7 @@ pub struct Problem {
     /// `malformed-json` (400), `invalid-input` (422: a field's shape or value; see `errors`),
     /// `solve-failed` (422: valid values for which the model cannot produce a number, e.g. a
     /// root finder that did not converge; change the input), `unsupported-media-type` (415),
+    /// `not-acceptable` (406: the `Accept` header names no form the resource offers),
     /// `payload-too-large` (413), `not-found` (404), `cancelled` (409), `overloaded` (429),
     /// `draining` (503), `deadline-exceeded` (504), `internal` (500); or `about:blank` for a
     /// status with no more to say than its title.
@@ -53,6 +53,7 @@ enum Kind {
     InvalidInput,
     SolveFailed,
     UnsupportedMediaType,
+    NotAcceptable,
     PayloadTooLarge,
     NotFound,
     Cancelled,
@@ -70,6 +71,7 @@ impl Kind {
             Kind::MalformedJson => StatusCode::BAD_REQUEST,
             Kind::InvalidInput | Kind::SolveFailed => StatusCode::UNPROCESSABLE_ENTITY,
             Kind::UnsupportedMediaType => StatusCode::UNSUPPORTED_MEDIA_TYPE,
+            Kind::NotAcceptable => StatusCode::NOT_ACCEPTABLE,
             Kind::PayloadTooLarge => StatusCode::PAYLOAD_TOO_LARGE,
             Kind::NotFound => StatusCode::NOT_FOUND,
             Kind::Cancelled => StatusCode::CONFLICT,
@@ -88,6 +90,7 @@ impl Kind {
             Kind::InvalidInput => ("invalid-input", "The input is not valid"),
             Kind::SolveFailed => ("solve-failed", "The model cannot solve this input"),
             Kind::UnsupportedMediaType => ("unsupported-media-type", "Send application/json"),
+            Kind::NotAcceptable => ("not-acceptable", "No acceptable form of the answer"),
             Kind::PayloadTooLarge => ("payload-too-large", "The body is too large"),
             Kind::NotFound => ("not-found", "Not found"),
             Kind::Cancelled => ("cancelled", "The job was cancelled"),
@@ -130,6 +133,10 @@ impl ApiError {
 
     pub fn not_found(detail: impl Into<String>) -> Self {
         ApiError::new(Kind::NotFound, detail)
+    }
+
+    pub fn not_acceptable(detail: impl Into<String>) -> Self {
+        ApiError::new(Kind::NotAcceptable, detail)
     }
 
     pub fn internal(detail: impl Into<String>) -> Self {
@@ -189,14 +196,9 @@ impl From<JobError> for ApiError {
                 detail,
                 errors,
             },
-            // Validation checks every range first; reaching the model with one is still
-            // the input's fault.
-            JobError::Solve(ModelError::InvalidParameter(_) | ModelError::InvalidOption(_)) => {
-                ApiError::new(Kind::InvalidInput, detail)
-            }
-            // Valid values the model cannot solve: deterministic, so retrying cannot help
-            // and the service is not at fault: the client must change the input.
-            JobError::Solve(_) => ApiError::new(Kind::SolveFailed, detail),
+            // Deterministic, so retrying cannot help and the service is not at fault: the
+            // client must change the input.
+            JobError::Unsolvable(_) => ApiError::new(Kind::SolveFailed, detail),
             JobError::Cancelled => ApiError::new(Kind::Cancelled, detail),
             JobError::DeadlineExceeded => ApiError::new(Kind::DeadlineExceeded, detail),
             JobError::Internal(_) => ApiError::new(Kind::Internal, detail),
@@ -303,7 +305,7 @@ pub fn panic_response(_panic: Box<dyn std::any::Any + Send + 'static>) -> Respon
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::ParameterError;
+    use crate::model::{ModelError, ParameterError};
 
     fn kind_of(e: JobError) -> (u16, String) {
         let problem = ApiError::from(e).problem();
@@ -325,8 +327,8 @@ mod tests {
         for (error, status, name) in [
             (JobError::Syntax("x".into()), 400, "malformed-json"),
             (JobError::Invalid(vec![]), 422, "invalid-input"),
-            (JobError::Solve(invalid), 422, "invalid-input"),
-            (JobError::Solve(no_convergence), 422, "solve-failed"),
+            (invalid.into(), 422, "invalid-input"),
+            (no_convergence.into(), 422, "solve-failed"),
             (JobError::Cancelled, 409, "cancelled"),
             (JobError::DeadlineExceeded, 504, "deadline-exceeded"),
             (JobError::Internal("x".into()), 500, "internal"),

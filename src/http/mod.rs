@@ -5,10 +5,12 @@
 //! [`app`] builds the router for a state; [`run`] serves it on a listener until a shutdown
 //! signal, then drains. Tests and the binary start the service the same way.
 
+mod accept;
 pub mod config;
 pub mod error;
 mod observe;
 pub mod openapi;
+mod responses;
 pub mod routes;
 
 use std::future::{Future, IntoFuture};
@@ -34,7 +36,7 @@ pub use config::{Config, ConfigError, CorsOrigins, LogFormat, ServeArgs};
 pub use error::ApiError;
 
 use crate::engine::metrics::Metrics;
-use crate::engine::Engine;
+use crate::engine::{Engine, Storage};
 
 const X_REQUEST_ID: HeaderName = HeaderName::from_static("x-request-id");
 /// How often metrics histograms are drained and expired jobs forgotten.
@@ -53,8 +55,15 @@ struct Inner {
 }
 
 impl AppState {
-    /// A service with its own engine and its own metrics registry.
+    /// A service with its own engine, its answers and jobs in its own memory, and its own
+    /// metrics registry.
     pub fn new(config: Config) -> Self {
+        let storage = Storage::in_process(&config.engine);
+        AppState::with_storage(config, storage)
+    }
+
+    /// A service whose engine keeps answers and jobs in `storage`.
+    pub fn with_storage(config: Config, storage: Storage) -> Self {
         let recorder = PrometheusBuilder::new()
             .set_buckets(&observe::BUCKETS)
             .expect("the buckets are not empty")
@@ -62,7 +71,7 @@ impl AppState {
         let prometheus = recorder.handle();
         let metrics = Metrics::new(Arc::new(recorder));
         observe::describe(&metrics);
-        let engine = Engine::new(config.engine.clone(), metrics);
+        let engine = Engine::with_storage(config.engine.clone(), metrics, storage);
         AppState {
             inner: Arc::new(Inner {
                 config,
@@ -209,6 +218,6 @@ async fn housekeeping(state: AppState) {
     loop {
         tick.tick().await;
         state.inner.prometheus.run_upkeep();
-        state.engine().purge_expired_jobs();
+        state.engine().purge_expired_jobs().await;
     }
 }

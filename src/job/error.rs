@@ -1,4 +1,5 @@
-//! What is wrong with a job, in terms a client can act on.
+//! What is wrong with a job, in terms a client can act on. The model's errors are sorted
+//! here, so that the layers above see only the job's.
 
 use std::fmt;
 
@@ -37,8 +38,10 @@ pub enum JobError {
     Schema { field: String, message: String },
     /// Values out of their ranges (all of them).
     Invalid(Vec<FieldError>),
-    /// The model could not produce a number (non-convergence, unrepresentable scale).
-    Solve(ModelError),
+    /// Valid values the model cannot solve (a root finder that does not converge, a scale
+    /// double precision cannot hold, a load the system cannot carry): the same input always
+    /// fails, so only a changed input can help.
+    Unsolvable(String),
     /// The job was cancelled before it finished.
     Cancelled,
     /// The job ran past its deadline.
@@ -71,7 +74,7 @@ impl fmt::Display for JobError {
                 let messages: Vec<&str> = errors.iter().map(|e| e.message.as_str()).collect();
                 f.write_str(&messages.join("; "))
             }
-            JobError::Solve(e) => e.fmt(f),
+            JobError::Unsolvable(m) => f.write_str(m),
             JobError::Cancelled => f.write_str("the job was cancelled"),
             JobError::DeadlineExceeded => f.write_str("the job ran past its deadline"),
             JobError::Internal(m) => write!(f, "internal error: {m}"),
@@ -82,7 +85,26 @@ impl fmt::Display for JobError {
 impl std::error::Error for JobError {}
 
 impl From<ModelError> for JobError {
+    /// Validation checks every range before the model runs, so a range error from the model
+    /// is still the input's; it names the parameter rather than a field path.
     fn from(e: ModelError) -> Self {
-        JobError::Solve(e)
+        let message = e.to_string();
+        match e {
+            ModelError::InvalidParameter(p) => JobError::Invalid(vec![FieldError {
+                field: String::new(),
+                value: Value::from(p.value),
+                allowed: p.allowed,
+                message,
+            }]),
+            ModelError::InvalidOption(o) => JobError::Invalid(vec![FieldError {
+                field: String::new(),
+                value: Value::from(o.value),
+                allowed: o.allowed,
+                message,
+            }]),
+            ModelError::NotRepresentable { .. }
+            | ModelError::OutOfModel(_)
+            | ModelError::NoConvergence { .. } => JobError::Unsolvable(message),
+        }
     }
 }

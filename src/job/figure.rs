@@ -4,9 +4,12 @@ use serde::{Deserialize, Serialize};
 use serde_json::{json, Value};
 use utoipa::ToSchema;
 
-use super::fields::{self, Checker};
-use super::{format_number, JobError, Meta};
-use crate::model::figures::{Figure, Plan, FIGURES};
+use super::input::{self, Checker};
+use super::meta::ROLLING_REFERENCES;
+use super::{Control, JobError, Kind, Limits, Meta, Reference, Work};
+use crate::model;
+use crate::model::figures::{Axis, Figure, Plan, FIGURES};
+use crate::render::{Column, Output, Table};
 
 /// Input of a figure job.
 #[derive(Clone, Debug, PartialEq, Deserialize, Serialize, ToSchema)]
@@ -32,30 +35,42 @@ impl FigureJob {
     /// The job for figure `number`, or the error naming the allowed numbers.
     pub fn new(number: i64) -> Result<FigureJob, JobError> {
         let Some(plan) = u8::try_from(number).ok().and_then(Plan::new) else {
-            let mut checker = Checker::new("");
-            checker.invalid(
-                "number",
-                json!(number),
-                &format!("{} to {}", FIGURES.start(), FIGURES.end()),
-            );
+            let mut checker = Checker::new();
+            let allowed = format!("{} to {}", FIGURES.start(), FIGURES.end());
+            checker.invalid("number", json!(number), &allowed);
             return Err(checker.into_error());
         };
         Ok(FigureJob { plan })
     }
+}
 
-    /// Validates a figure input given as JSON.
-    pub fn from_value(value: Value) -> Result<FigureJob, JobError> {
-        let input: FigureInput = fields::deserialize(value, "")?;
+impl Kind for FigureJob {
+    const NAME: &'static str = "figure";
+    type Output = FigureOutput;
+
+    fn validate(input: Value, _limits: &Limits) -> Result<Self, JobError> {
+        let input: FigureInput = input::deserialize(input, "")?;
         FigureJob::new(input.number)
     }
 
-    /// Rolling solves the figure takes.
-    pub fn size(&self) -> usize {
-        self.plan.contacts.len()
+    fn canonical(&self) -> Value {
+        input::canonical(&FigureInput {
+            number: i64::from(self.plan.number),
+        })
     }
 
-    pub fn canonical(&self) -> Value {
-        json!({ "number": self.plan.number })
+    fn references(&self) -> &'static [Reference] {
+        ROLLING_REFERENCES
+    }
+
+    fn work(&self) -> Work {
+        Work::Known(self.plan.contacts.len())
+    }
+
+    fn run(&self, meta: Meta, control: &Control) -> Result<FigureOutput, JobError> {
+        let plan = &self.plan;
+        let solutions = control.map(&plan.contacts, |p| model::solve(p, &plan.options))?;
+        Ok(FigureOutput::new(plan.assemble(&solutions), meta))
     }
 }
 
@@ -66,6 +81,26 @@ pub struct AxisOutput {
     pub quantity: &'static str,
     /// SI unit ("" for a plain number).
     pub unit: &'static str,
+}
+
+impl AxisOutput {
+    /// The CSV column of the axis: its quantity, with its unit if it has one.
+    fn column(&self) -> String {
+        if self.unit.is_empty() {
+            self.quantity.to_string()
+        } else {
+            format!("{} ({})", self.quantity, self.unit)
+        }
+    }
+}
+
+impl From<Axis> for AxisOutput {
+    fn from(a: Axis) -> Self {
+        AxisOutput {
+            quantity: a.quantity,
+            unit: a.unit,
+        }
+    }
 }
 
 /// One curve.
@@ -104,15 +139,11 @@ pub struct FigureOutput {
 impl FigureOutput {
     /// The answer with `meta`, the job's [`Meta`] (see [`super::Job::meta`]).
     pub fn new(figure: Figure, meta: Meta) -> Self {
-        let axis = |a: crate::model::figures::Axis| AxisOutput {
-            quantity: a.quantity,
-            unit: a.unit,
-        };
         FigureOutput {
             figure: figure.number,
             title: figure.title,
-            x: axis(figure.x),
-            y: axis(figure.y),
+            x: figure.x.into(),
+            y: figure.y.into(),
             series: figure
                 .series
                 .into_iter()
@@ -127,23 +158,41 @@ impl FigureOutput {
             meta,
         }
     }
+}
 
-    /// CSV: one line per point, `series,label,<x quantity>,<y quantity>`.
-    pub fn to_csv(&self) -> String {
-        let column = |a: &AxisOutput| {
-            if a.unit.is_empty() {
-                a.quantity.to_string()
-            } else {
-                format!("{} ({})", a.quantity, a.unit)
-            }
-        };
-        let mut csv = format!("series,label,{},{}\n", column(&self.x), column(&self.y));
-        for (i, s) in self.series.iter().enumerate() {
-            for [x, y] in &s.points {
-                let (x, y) = (format_number(*x), format_number(*y));
-                csv.push_str(&format!("{i},\"{}\",{x},{y}\n", s.label));
-            }
+/// One point of a figure, as a CSV row.
+struct FigureRow<'a> {
+    series: usize,
+    label: &'a str,
+    point: [f64; 2],
+}
+
+impl Output for FigureOutput {
+    /// One row per point: the series' index and legend, then x and y in the axes' units.
+    fn table(&self) -> Table {
+        fn columns<'a>() -> [Column<FigureRow<'a>>; 4] {
+            [
+                Column::count("series", |r| r.series),
+                Column::text("label", |r| r.label.to_string()),
+                Column::number("x", "", |r| r.point[0]),
+                Column::number("y", "", |r| r.point[1]),
+            ]
         }
-        csv
+        let rows: Vec<FigureRow> = self
+            .series
+            .iter()
+            .enumerate()
+            .flat_map(|(series, s)| {
+                s.points.iter().map(move |&point| FigureRow {
+                    series,
+                    label: &s.label,
+                    point,
+                })
+            })
+            .collect();
+        let mut table = Table::new(&columns(), &rows);
+        table.rename(2, &self.x.column(), self.x.unit);
+        table.rename(3, &self.y.column(), self.y.unit);
+        table
     }
 }

@@ -6,7 +6,6 @@ use serde_json::Value;
 use sha2::{Digest, Sha256};
 use utoipa::ToSchema;
 
-use super::JobKind;
 use crate::model::MODEL_VERSION;
 
 /// A source of the model.
@@ -21,7 +20,7 @@ pub struct Reference {
     pub doi: Option<&'static str>,
 }
 
-/// The papers behind the numbers: the first three behind every job, the last two behind
+/// The papers behind the numbers: [`ROLLING_REFERENCES`] behind every job, all of them behind
 /// three-body jobs.
 pub const REFERENCES: [Reference; 5] = [
     Reference {
@@ -58,13 +57,9 @@ pub const REFERENCES: [Reference; 5] = [
     },
 ];
 
-/// The references behind a job of `kind`.
-fn references(kind: JobKind) -> &'static [Reference] {
-    match kind {
-        JobKind::ThreeBody => &REFERENCES,
-        _ => &REFERENCES[..3],
-    }
-}
+/// The papers behind one particle rolling over the layer: the model, the strip method and
+/// the shear strength.
+pub const ROLLING_REFERENCES: &[Reference] = REFERENCES.split_at(3).0;
 
 /// The `meta` block of an answer.
 #[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
@@ -83,22 +78,23 @@ pub struct Meta {
 }
 
 impl Meta {
-    pub fn new(kind: JobKind, canonical: Value) -> Self {
+    /// The meta block of a job of `kind` whose canonical input is `canonical`.
+    pub fn new(kind: &str, canonical: Value, references: &'static [Reference]) -> Self {
         Meta {
             model_version: MODEL_VERSION,
             input_hash: input_hash(kind, &canonical),
             input: canonical,
-            references: references(kind),
+            references,
         }
     }
 }
 
 /// Hex SHA-256 of `model version \n kind \n canonical JSON` (keys sorted, shortest floats).
-pub fn input_hash(kind: JobKind, canonical: &Value) -> String {
+pub fn input_hash(kind: &str, canonical: &Value) -> String {
     let mut hasher = Sha256::new();
     hasher.update(MODEL_VERSION.as_bytes());
     hasher.update(b"\n");
-    hasher.update(kind.as_str().as_bytes());
+    hasher.update(kind.as_bytes());
     hasher.update(b"\n");
     hasher.update(canonical.to_string().as_bytes());
     hasher

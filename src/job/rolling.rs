@@ -1,15 +1,15 @@
 //! The rolling job: one particle rolling over the layer (MODEL.md §3).
 
 use serde::{Deserialize, Serialize};
-use serde_json::{json, Value};
+use serde_json::Value;
 use utoipa::ToSchema;
 
-use super::fields::{self, Checker, Quantity};
-use super::units::Dimension;
-use super::{JobError, Meta};
-use crate::model::quadrature::{DEFAULT_GAUSS_NODES, DEFAULT_MIDPOINT_STRIPS};
+use super::input::{self, field, Checker, LayerInput, QuadratureKind, Quantity};
+use super::meta::ROLLING_REFERENCES;
+use super::{Control, JobError, Kind, Limits, Meta, Reference, Work};
 use crate::model::rolling::{BoundaryPoint, PressureGrid, Verification};
-use crate::model::{Layer, Quadrature, Rolling, RollingSolution, SolveOptions};
+use crate::model::{self, Parameter, Rolling, RollingSolution, SolveOption, SolveOptions};
+use crate::render::{Column, Output, Table};
 
 /// Input of a rolling job; every field optional (MODEL.md §5 defaults).
 #[derive(Clone, Debug, Default, PartialEq, Deserialize, Serialize, ToSchema)]
@@ -27,22 +27,6 @@ pub struct RollingInput {
     pub options: Option<OptionsInput>,
 }
 
-/// The Kelvin layer.
-#[derive(Clone, Debug, Default, PartialEq, Deserialize, Serialize, ToSchema)]
-#[serde(deny_unknown_fields)]
-pub struct LayerInput {
-    /// E_L, relaxed longitudinal modulus (Pa; default 3 GPa).
-    pub elastic_modulus: Option<Quantity>,
-    /// H, layer thickness (m; default 100 nm).
-    pub thickness: Option<Quantity>,
-    /// ν, Poisson ratio (dimensionless; default 0.35).
-    pub poisson_ratio: Option<Quantity>,
-    /// T_ε, retardation time (s, ≥ T_σ; default 0.5 s).
-    pub retardation_time: Option<Quantity>,
-    /// T_σ, relaxation time (s; default 0.1 s).
-    pub relaxation_time: Option<Quantity>,
-}
-
 /// How to integrate across the contact and what to return besides the integrals.
 #[derive(Clone, Debug, Default, PartialEq, Deserialize, Serialize, ToSchema)]
 #[serde(deny_unknown_fields)]
@@ -57,98 +41,27 @@ pub struct OptionsInput {
     pub pressure_grid: Option<usize>,
 }
 
-/// The y-quadrature: exact to 1e-9 (`gauss`) or the paper's uniform strips (`midpoint`).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize, Serialize, ToSchema)]
-#[serde(rename_all = "lowercase")]
-pub enum QuadratureKind {
-    #[default]
-    Gauss,
-    Midpoint,
-}
-
-impl QuadratureKind {
-    /// The rule a job asks for: its kind (default Gauss) with `strips` nodes or strips
-    /// (default 64 Gauss nodes, or the paper's 40 midpoint strips).
-    pub fn rule(kind: Option<QuadratureKind>, strips: Option<usize>) -> Quadrature {
-        match kind.unwrap_or_default() {
-            QuadratureKind::Gauss => Quadrature::Gauss {
-                nodes: strips.unwrap_or(DEFAULT_GAUSS_NODES),
-            },
-            QuadratureKind::Midpoint => Quadrature::Midpoint {
-                strips: strips.unwrap_or(DEFAULT_MIDPOINT_STRIPS),
-            },
+impl OptionsInput {
+    fn read(&self, checker: &mut Checker) -> SolveOptions {
+        let input = self;
+        let strips = checker.count(field!(input.strips), SolveOption::Strips);
+        SolveOptions {
+            quadrature: QuadratureKind::rule(self.quadrature, strips),
+            boundary_points: checker
+                .count(field!(input.boundary_points), SolveOption::BoundaryPoints)
+                .unwrap_or(SolveOptions::default().boundary_points),
+            pressure_grid: checker.count(field!(input.pressure_grid), SolveOption::PressureGrid),
         }
     }
 
-    /// The canonical `quadrature` and `strips` of a rule.
-    pub fn canonical(rule: Quadrature) -> (&'static str, usize) {
-        match rule {
-            Quadrature::Gauss { nodes } => ("gauss", nodes),
-            Quadrature::Midpoint { strips } => ("midpoint", strips),
+    fn of(options: &SolveOptions) -> OptionsInput {
+        let (quadrature, strips) = QuadratureKind::of(options.quadrature);
+        OptionsInput {
+            quadrature: Some(quadrature),
+            strips: Some(strips),
+            boundary_points: Some(options.boundary_points),
+            pressure_grid: options.pressure_grid,
         }
-    }
-}
-
-impl LayerInput {
-    /// Reads the layer under `checker`, its fields at `prefix.*`.
-    pub fn read(input: Option<&LayerInput>, checker: &mut Checker, prefix: &str) -> Layer {
-        let d = Layer::default();
-        let layer = input.cloned().unwrap_or_default();
-        let mut q = |field: &str, value: &Option<Quantity>, dim, default| {
-            checker.quantity(&format!("{prefix}.{field}"), value.as_ref(), dim, default)
-        };
-        Layer {
-            elastic_modulus: q(
-                "elastic_modulus",
-                &layer.elastic_modulus,
-                Dimension::PRESSURE,
-                d.elastic_modulus,
-            ),
-            thickness: q(
-                "thickness",
-                &layer.thickness,
-                Dimension::LENGTH,
-                d.thickness,
-            ),
-            poisson_ratio: q(
-                "poisson_ratio",
-                &layer.poisson_ratio,
-                Dimension::NONE,
-                d.poisson_ratio,
-            ),
-            retardation_time: q(
-                "retardation_time",
-                &layer.retardation_time,
-                Dimension::TIME,
-                d.retardation_time,
-            ),
-            relaxation_time: q(
-                "relaxation_time",
-                &layer.relaxation_time,
-                Dimension::TIME,
-                d.relaxation_time,
-            ),
-        }
-    }
-
-    /// The canonical form of a layer.
-    pub fn canonical(layer: &Layer) -> Value {
-        json!({
-            "elastic_modulus": si(layer.elastic_modulus),
-            "thickness": si(layer.thickness),
-            "poisson_ratio": si(layer.poisson_ratio),
-            "retardation_time": si(layer.retardation_time),
-            "relaxation_time": si(layer.relaxation_time),
-        })
-    }
-}
-
-/// -0.0 and 0.0 are the same input: one canonical form, one cache key.
-pub(crate) fn si(x: f64) -> f64 {
-    if x == 0.0 {
-        0.0
-    } else {
-        x
     }
 }
 
@@ -160,62 +73,59 @@ pub struct RollingJob {
 }
 
 impl RollingJob {
-    /// Validates a rolling input given as JSON.
-    pub fn from_value(value: Value) -> Result<RollingJob, JobError> {
-        let input: RollingInput = fields::deserialize(value, "")?;
-        let mut checker = Checker::new("");
-        let job = RollingJob::read(&input, &mut checker);
-        checker.finish(job)
-    }
-
     /// Reads `input` under `checker`: fields that are bad are recorded there (and read as
     /// NaN here), so a caller can combine these errors with its own.
     pub fn read(input: &RollingInput, checker: &mut Checker) -> RollingJob {
         let d = Rolling::default();
         let rolling = Rolling {
-            radius: checker.quantity("radius", input.radius.as_ref(), Dimension::LENGTH, d.radius),
-            load: checker.quantity("load", input.load.as_ref(), Dimension::FORCE, d.load),
-            velocity: checker.quantity(
-                "velocity",
-                input.velocity.as_ref(),
-                Dimension::SPEED,
-                d.velocity,
-            ),
-            layer: LayerInput::read(input.layer.as_ref(), checker, "layer"),
+            radius: checker.quantity(field!(input.radius), Parameter::Radius, d.radius),
+            load: checker.quantity(field!(input.load), Parameter::Load, d.load),
+            velocity: checker.quantity(field!(input.velocity), Parameter::Velocity, d.velocity),
+            layer: checker.nested(field!(input.layer), |c, layer| layer.read(c)),
         };
-        let o = input.options.clone().unwrap_or_default();
-        let quadrature = QuadratureKind::rule(o.quadrature, o.strips);
-        let options = SolveOptions {
-            quadrature,
-            boundary_points: o
-                .boundary_points
-                .unwrap_or(SolveOptions::default().boundary_points),
-            pressure_grid: o.pressure_grid,
-        };
+        let options = checker.nested(field!(input.options), |c, o| o.read(c));
         checker.parameters(rolling.violations());
         checker.options(options.violations());
         RollingJob { rolling, options }
     }
 
-    /// The canonical input (a valid input itself).
-    pub fn canonical(&self) -> Value {
+    /// The input that gives this job: every field, in SI.
+    pub fn input(&self) -> RollingInput {
         let r = &self.rolling;
-        let (quadrature, strips) = QuadratureKind::canonical(self.options.quadrature);
-        let mut options = json!({
-            "quadrature": quadrature,
-            "strips": strips,
-            "boundary_points": self.options.boundary_points,
-        });
-        if let Some(n) = self.options.pressure_grid {
-            options["pressure_grid"] = json!(n);
+        RollingInput {
+            radius: Quantity::si(r.radius),
+            load: Quantity::si(r.load),
+            velocity: Quantity::si(r.velocity),
+            layer: Some(LayerInput::of(&r.layer)),
+            options: Some(OptionsInput::of(&self.options)),
         }
-        json!({
-            "radius": si(r.radius),
-            "load": si(r.load),
-            "velocity": si(r.velocity),
-            "layer": LayerInput::canonical(&r.layer),
-            "options": options,
-        })
+    }
+}
+
+impl Kind for RollingJob {
+    const NAME: &'static str = "rolling";
+    type Output = RollingOutput;
+
+    fn validate(input: Value, _limits: &Limits) -> Result<Self, JobError> {
+        input::validate(input, RollingJob::read)
+    }
+
+    /// A valid input itself.
+    fn canonical(&self) -> Value {
+        input::canonical(&self.input())
+    }
+
+    fn references(&self) -> &'static [Reference] {
+        ROLLING_REFERENCES
+    }
+
+    fn work(&self) -> Work {
+        Work::Known(1)
+    }
+
+    fn run(&self, meta: Meta, control: &Control) -> Result<RollingOutput, JobError> {
+        let solution = control.solve(|| model::solve(&self.rolling, &self.options))?;
+        Ok(RollingOutput::new(&self.rolling, &solution, meta))
     }
 }
 
@@ -302,6 +212,63 @@ impl From<&RollingSolution> for ContactOutput {
     }
 }
 
+/// One row of a rolling sweep.
+// Also the CSV row of a rolling answer: one declaration of the columns of rolling contacts.
+#[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
+pub struct SweepPoint {
+    /// R (m).
+    pub radius: f64,
+    /// P (N).
+    pub load: f64,
+    /// V (m/s).
+    pub velocity: f64,
+    #[serde(flatten)]
+    pub contact: ContactOutput,
+    pub verification: VerificationOutput,
+}
+
+impl SweepPoint {
+    /// The point of `rolling`, solved as `solution`.
+    pub fn new(rolling: &Rolling, solution: &RollingSolution) -> Self {
+        SweepPoint {
+            radius: rolling.radius,
+            load: rolling.load,
+            velocity: rolling.velocity,
+            contact: solution.into(),
+            verification: (&solution.verification).into(),
+        }
+    }
+
+    /// The CSV columns of rolling contacts.
+    pub const COLUMNS: [Column<SweepPoint>; 13] = [
+        Column::number("radius", "m", |p| p.radius),
+        Column::number("load", "N", |p| p.load),
+        Column::number("velocity", "m/s", |p| p.velocity),
+        Column::number("penetration", "m", |p| p.contact.penetration),
+        Column::number("contact_area", "m²", |p| p.contact.contact_area),
+        Column::number("half_width", "m", |p| p.contact.half_width),
+        Column::number("centroid_shift", "m", |p| p.contact.centroid_shift),
+        Column::number("pressure_centre_shift", "m", |p| {
+            p.contact.pressure_centre_shift
+        }),
+        Column::number("rolling_resistance_coefficient", "", |p| {
+            p.contact.rolling_resistance_coefficient
+        }),
+        Column::number("friction_coefficient", "", |p| {
+            p.contact.friction_coefficient
+        }),
+        Column::number("static_penetration", "m", |p| {
+            p.contact.static_contact.penetration
+        }),
+        Column::number("static_contact_area", "m²", |p| {
+            p.contact.static_contact.contact_area
+        }),
+        Column::number("static_friction_coefficient", "", |p| {
+            p.contact.static_contact.friction_coefficient
+        }),
+    ];
+}
+
 /// A point of the contact boundary (m).
 #[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
 pub struct BoundaryOutput {
@@ -365,11 +332,15 @@ pub struct RollingOutput {
     pub pressure: Option<PressureOutput>,
     /// Model version, cache key, the input as understood, references, verification.
     pub meta: RollingMeta,
+    /// The contact solved (its R, P, V are in `meta.input` on the wire; the CSV row needs
+    /// them).
+    #[serde(skip)]
+    rolling: Rolling,
 }
 
 impl RollingOutput {
-    /// The answer with `meta`, the job's [`Meta`] (see [`super::Job::meta`]).
-    pub fn new(solution: &RollingSolution, meta: Meta) -> Self {
+    /// The answer for `rolling`, solved as `solution`, with `meta`, the job's [`Meta`].
+    pub fn new(rolling: &Rolling, solution: &RollingSolution, meta: Meta) -> Self {
         RollingOutput {
             contact: solution.into(),
             boundary: solution.boundary.iter().map(Into::into).collect(),
@@ -378,6 +349,21 @@ impl RollingOutput {
                 meta,
                 verification: (&solution.verification).into(),
             },
+            rolling: *rolling,
         }
+    }
+}
+
+impl Output for RollingOutput {
+    /// One row: the contact's conditions and integrals, as a sweep's row.
+    fn table(&self) -> Table {
+        let point = SweepPoint {
+            radius: self.rolling.radius,
+            load: self.rolling.load,
+            velocity: self.rolling.velocity,
+            contact: self.contact.clone(),
+            verification: self.meta.verification.clone(),
+        };
+        Table::new(&SweepPoint::COLUMNS, [&point])
     }
 }

@@ -6,16 +6,17 @@ use serde::{Deserialize, Serialize};
 use serde_json::{json, Value};
 use utoipa::ToSchema;
 
-use super::fields::{self, Checker, Quantity};
-use super::rolling::{si, ContactOutput, RollingInput, RollingJob, VerificationOutput};
-use super::three_body::{
-    operating_canonical, OperatingInput, ThreeBodyInput, ThreeBodyJob, ThreeBodyResult,
-    ThreeBodyVerificationOutput,
-};
-use super::units::Dimension;
-use super::{format_number, JobError, Limits, Meta};
-use crate::model::three_body::{Diameters, OperatingPoint, ThreeBody, ThreeBodySolution};
-use crate::model::{Parameter, Rolling, RollingSolution, SolveOptions};
+use super::input::{self, field, Checker, Field, Quantity};
+use super::meta::{REFERENCES, ROLLING_REFERENCES};
+use super::rolling::{RollingInput, RollingJob};
+use super::three_body::{ThreeBodyInput, ThreeBodyJob};
+use super::{Control, JobError, Kind, Limits, Meta, Reference, Work};
+use crate::model::three_body::{self, Diameters, OperatingPoint, ThreeBody};
+use crate::model::{self, Parameter, Rolling, SolveOptions};
+use crate::render::{Output, Table};
+
+pub use super::rolling::SweepPoint;
+pub use super::three_body::ThreeBodySweepPoint;
 
 /// Input of a sweep: what is swept, a base input of that kind and the lists to vary.
 #[derive(Clone, Debug, Default, PartialEq, Deserialize, Serialize, ToSchema)]
@@ -94,117 +95,131 @@ pub struct ThreeBodySweep {
     pub operating: Vec<OperatingPoint>,
     pub velocity: Vec<f64>,
     pub mean_diameter: Vec<f64>,
+    /// Whether `vary` gave the operating points (else the base did).
+    varies_operating: bool,
     /// Whether the base fixed the diameter bounds (else they follow each mean).
     fixed_bounds: (bool, bool),
 }
 
 impl SweepJob {
-    /// Validates a sweep input given as JSON.
-    pub fn from_value(value: Value, limits: &Limits) -> Result<SweepJob, JobError> {
-        let input: SweepInput = fields::deserialize(value, "")?;
-        let base = input.base.unwrap_or_else(|| json!({}));
-        let vary = input.vary.unwrap_or_else(|| json!({}));
-        let mut checker = Checker::new("");
+    /// Number of points: the product of the list lengths; `None` past `usize`.
+    pub fn size(&self) -> Option<usize> {
+        let lengths = match self {
+            SweepJob::Rolling(s) => [s.radius.len(), s.load.len(), s.velocity.len()],
+            SweepJob::ThreeBody(s) => [s.operating.len(), s.velocity.len(), s.mean_diameter.len()],
+        };
+        lengths.into_iter().try_fold(1_usize, usize::checked_mul)
+    }
+}
+
+impl Kind for SweepJob {
+    const NAME: &'static str = "sweep";
+    type Output = SweepOutput;
+
+    fn validate(value: Value, limits: &Limits) -> Result<Self, JobError> {
+        let input: SweepInput = input::deserialize(value, "")?;
+        let mut checker = Checker::new();
+        let (base, vary) = (field!(input.base), field!(input.vary));
         let job = match input.kind.unwrap_or_default() {
             SweepOf::Rolling => SweepJob::Rolling(RollingSweep::read(base, vary, &mut checker)?),
             SweepOf::ThreeBody => {
                 SweepJob::ThreeBody(ThreeBodySweep::read(base, vary, &mut checker)?)
             }
         };
-        if job.len() > limits.max_sweep_points {
-            checker.invalid(
-                "vary",
-                json!(job.len()),
-                &format!(
-                    "at most {} points (the product of the list lengths)",
-                    limits.max_sweep_points
-                ),
-            );
+        let max = limits.max_sweep_points;
+        if job.size().map_or(true, |n| n > max) {
+            let points = job
+                .size()
+                .map_or_else(|| Value::from("more than 2^64"), Value::from);
+            let allowed = format!("at most {max} points (the product of the list lengths)");
+            checker.invalid(vary.name, points, &allowed);
         }
         checker.finish(job)
     }
 
-    /// Number of points.
-    pub fn len(&self) -> usize {
+    /// A valid sweep input itself: the base in canonical form and every list explicit.
+    fn canonical(&self) -> Value {
+        let (kind, base, vary) = match self {
+            SweepJob::Rolling(s) => (SweepOf::Rolling, s.base.canonical(), s.vary()),
+            SweepJob::ThreeBody(s) => (SweepOf::ThreeBody, s.base_input(), s.vary()),
+        };
+        input::canonical(&SweepInput {
+            kind: Some(kind),
+            base: Some(base),
+            vary: Some(vary),
+        })
+    }
+
+    fn references(&self) -> &'static [Reference] {
         match self {
-            SweepJob::Rolling(s) => s.radius.len() * s.load.len() * s.velocity.len(),
-            SweepJob::ThreeBody(s) => s.operating.len() * s.velocity.len() * s.mean_diameter.len(),
+            SweepJob::Rolling(_) => ROLLING_REFERENCES,
+            SweepJob::ThreeBody(_) => &REFERENCES,
         }
     }
 
-    /// Whether the sweep has no points (never, once validated).
-    pub fn is_empty(&self) -> bool {
-        self.len() == 0
+    fn work(&self) -> Work {
+        self.size().map_or(Work::Unknown, Work::Known)
     }
 
-    /// The canonical input: the base in canonical form and every list explicit.
-    pub fn canonical(&self) -> Value {
-        let list = |values: &[f64]| values.iter().map(|&x| si(x)).collect::<Vec<_>>();
-        match self {
-            SweepJob::Rolling(s) => json!({
-                "kind": "rolling",
-                "base": s.base.canonical(),
-                "vary": {
-                    "radius": list(&s.radius),
-                    "load": list(&s.load),
-                    "velocity": list(&s.velocity),
-                },
-            }),
-            SweepJob::ThreeBody(s) => {
-                let operating: Vec<Value> = s
-                    .operating
-                    .iter()
-                    .map(|&o| operating_canonical(o))
-                    .collect();
-                json!({
-                    "kind": "three_body",
-                    "base": s.base.canonical(),
-                    "vary": {
-                        "operating": operating,
-                        "velocity": list(&s.velocity),
-                        "mean_diameter": list(&s.mean_diameter),
-                    },
-                })
+    fn run(&self, meta: Meta, control: &Control) -> Result<SweepOutput, JobError> {
+        let points = match self {
+            SweepJob::Rolling(s) => {
+                let contacts = s.points();
+                let options = &s.base.options;
+                let solutions = control.map(&contacts, |p| model::solve(p, options))?;
+                let rows = contacts.iter().zip(&solutions);
+                SweepPoints::Rolling(rows.map(|(p, s)| SweepPoint::new(p, s)).collect())
             }
-        }
+            SweepJob::ThreeBody(s) => {
+                let systems = s.points();
+                let options = &s.base.options;
+                let solutions = control.map(&systems, |p| three_body::solve(p, options))?;
+                let rows = systems.iter().zip(&solutions);
+                SweepPoints::ThreeBody(rows.map(|(p, s)| ThreeBodySweepPoint::new(p, s)).collect())
+            }
+        };
+        Ok(SweepOutput { points, meta })
     }
 }
 
+/// A list of SI values as an input gives it.
+fn quantities(values: &[f64]) -> Option<Vec<Quantity>> {
+    Some(values.iter().filter_map(|&x| Quantity::si(x)).collect())
+}
+
 impl RollingSweep {
-    fn read(base: Value, vary: Value, checker: &mut Checker) -> Result<RollingSweep, JobError> {
-        let base: RollingInput = fields::deserialize(base, "base")?;
-        let vary: RollingVary = fields::deserialize(vary, "vary")?;
-        let mut base_checker = Checker::new("base");
-        let mut base = RollingJob::read(&base, &mut base_checker);
-        checker.absorb(base_checker);
+    fn read(
+        base: Field<Value>,
+        vary: Field<Value>,
+        checker: &mut Checker,
+    ) -> Result<RollingSweep, JobError> {
+        let base_input: RollingInput = read_object(base)?;
+        let vary_input: RollingVary = read_object(vary)?;
+        let base_field = Field {
+            name: base.name,
+            value: Some(&base_input),
+        };
+        let mut base = checker.nested(base_field, |c, b| RollingJob::read(b, c));
         base.options = SolveOptions::integrals_only(base.options.quadrature);
         let r = base.rolling;
-        Ok(RollingSweep {
-            radius: read_list(
-                checker,
-                "vary.radius",
-                vary.radius.as_deref(),
-                Parameter::Radius,
-                Dimension::LENGTH,
-                r.radius,
-            ),
-            load: read_list(
-                checker,
-                "vary.load",
-                vary.load.as_deref(),
-                Parameter::Load,
-                Dimension::FORCE,
-                r.load,
-            ),
-            velocity: read_list(
-                checker,
-                "vary.velocity",
-                vary.velocity.as_deref(),
-                Parameter::Velocity,
-                Dimension::SPEED,
-                r.velocity,
-            ),
+        let vary_field = Field {
+            name: vary.name,
+            value: Some(&vary_input),
+        };
+        Ok(checker.nested(vary_field, |c, vary| RollingSweep {
+            radius: c.list(field!(vary.radius), Parameter::Radius, r.radius),
+            load: c.list(field!(vary.load), Parameter::Load, r.load),
+            velocity: c.list(field!(vary.velocity), Parameter::Velocity, r.velocity),
             base,
+        }))
+    }
+
+    /// Every list, explicit.
+    fn vary(&self) -> Value {
+        input::canonical(&RollingVary {
+            radius: quantities(&self.radius),
+            load: quantities(&self.load),
+            velocity: quantities(&self.velocity),
         })
     }
 
@@ -227,114 +242,140 @@ impl RollingSweep {
     }
 }
 
+/// The operating-point lists of a three-body sweep: each with the parameter it gives.
+type OperatingList<'a> = (
+    Field<'a, Vec<Quantity>>,
+    Parameter,
+    fn(f64) -> OperatingPoint,
+);
+
 impl ThreeBodySweep {
-    fn read(base: Value, vary: Value, checker: &mut Checker) -> Result<ThreeBodySweep, JobError> {
-        let mut base: ThreeBodyInput = fields::deserialize(base, "base")?;
-        let vary: ThreeBodyVary = fields::deserialize(vary, "vary")?;
-        let lists = [
+    fn read(
+        base: Field<Value>,
+        vary: Field<Value>,
+        checker: &mut Checker,
+    ) -> Result<ThreeBodySweep, JobError> {
+        let mut base_input: ThreeBodyInput = read_object(base)?;
+        let vary_input: ThreeBodyVary = read_object(vary)?;
+        let v = &vary_input;
+        let lists: [OperatingList; 3] = [
             (
-                "separation",
-                &vary.separation,
+                field!(v.separation),
                 Parameter::Separation,
-                Dimension::LENGTH,
+                OperatingPoint::Separation,
             ),
             (
-                "total_load",
-                &vary.total_load,
+                field!(v.total_load),
                 Parameter::TotalLoad,
-                Dimension::FORCE,
+                OperatingPoint::TotalLoad,
             ),
             (
-                "particle_load",
-                &vary.particle_load,
+                field!(v.particle_load),
                 Parameter::ParticleLoad,
-                Dimension::FORCE,
+                OperatingPoint::ParticleLoad,
             ),
         ];
-        let varied: Vec<_> = lists.iter().filter(|l| l.1.is_some()).collect();
-        if varied.len() > 1 {
-            checker.invalid(
-                "vary",
-                json!(varied.iter().map(|l| l.0).collect::<Vec<_>>()),
-                "at most one operating-point list (separation, total_load or particle_load)",
-            );
+        let varied: Vec<&OperatingList> = lists.iter().filter(|l| l.0.value.is_some()).collect();
+        // A varied operating point replaces the base's, which then only has to be readable.
+        if !varied.is_empty() {
+            let placeholder = OperatingPoint::Separation(0.0);
+            base_input.operating = Some(super::three_body::OperatingInput::of(placeholder));
         }
-        // A varied operating point replaces the base's; the base needs one to be read.
-        if let Some((name, Some(values), ..)) = varied.first().map(|l| **l) {
-            if let Some(first) = values.first() {
-                let mut operating = OperatingInput::default();
-                match name {
-                    "separation" => operating.separation = Some(first.clone()),
-                    "total_load" => operating.total_load = Some(first.clone()),
-                    _ => operating.particle_load = Some(first.clone()),
-                }
-                base.operating = Some(operating);
-            }
-        }
-        let bounds = base.distribution.as_ref().map_or((false, false), |d| {
-            (d.min_diameter.is_some(), d.max_diameter.is_some())
-        });
-        let mut base_checker = Checker::new("base");
-        let job = ThreeBodyJob::read(&base, &mut base_checker);
-        checker.absorb(base_checker);
+        let fixed_bounds = base_input
+            .distribution
+            .as_ref()
+            .map_or((false, false), |d| {
+                (d.min_diameter.is_some(), d.max_diameter.is_some())
+            });
+        let base_field = Field {
+            name: base.name,
+            value: Some(&base_input),
+        };
+        let job = checker.nested(base_field, |c, b| ThreeBodyJob::read(b, c));
         let s = job.system;
-        let operating = match varied.first() {
-            Some(&&(name, values, parameter, dimension)) => {
-                let values = read_list(
-                    checker,
-                    &format!("vary.{name}"),
-                    values.as_deref(),
-                    parameter,
-                    dimension,
-                    f64::NAN,
+        let vary_field = Field {
+            name: vary.name,
+            value: Some(&vary_input),
+        };
+        let sweep = checker.nested(vary_field, |c, vary| {
+            if varied.len() > 1 {
+                let names: Vec<&str> = varied.iter().map(|l| l.0.name).collect();
+                c.invalid(
+                    "",
+                    json!(names),
+                    "at most one operating-point list (separation, total_load or particle_load)",
                 );
-                values
-                    .into_iter()
-                    .map(|x| match name {
-                        "separation" => OperatingPoint::Separation(x),
-                        "total_load" => OperatingPoint::TotalLoad(x),
-                        _ => OperatingPoint::ParticleLoad(x),
-                    })
-                    .collect()
             }
-            None => vec![s.operating],
-        };
-        let sweep = ThreeBodySweep {
-            velocity: read_list(
-                checker,
-                "vary.velocity",
-                vary.velocity.as_deref(),
-                Parameter::Velocity,
-                Dimension::SPEED,
-                s.velocity,
-            ),
-            mean_diameter: read_list(
-                checker,
-                "vary.mean_diameter",
-                vary.mean_diameter.as_deref(),
-                Parameter::MeanDiameter,
-                Dimension::LENGTH,
-                s.diameters.mean,
-            ),
-            operating,
-            base: job,
-            fixed_bounds: bounds,
-        };
-        // Each mean diameter must make a valid distribution with the base's bounds.
-        for (i, &mean) in sweep.mean_diameter.iter().enumerate() {
-            let system = sweep.system(mean, s.velocity, s.operating);
-            for e in system.violations() {
-                if matches!(e.parameter, Parameter::MinDiameter | Parameter::MaxDiameter) {
-                    checker.out_of_range(
-                        &format!("vary.mean_diameter[{i}]"),
-                        mean,
-                        "m",
-                        &e.allowed,
-                    );
+            let operating = match varied.first() {
+                Some(&&(list, parameter, point)) => c
+                    .list(list, parameter, f64::NAN)
+                    .into_iter()
+                    .map(point)
+                    .collect(),
+                None => vec![s.operating],
+            };
+            let sweep = ThreeBodySweep {
+                velocity: c.list(field!(vary.velocity), Parameter::Velocity, s.velocity),
+                mean_diameter: c.list(
+                    field!(vary.mean_diameter),
+                    Parameter::MeanDiameter,
+                    s.diameters.mean,
+                ),
+                operating,
+                base: job,
+                varies_operating: !varied.is_empty(),
+                fixed_bounds,
+            };
+            // Each mean diameter must make a valid distribution with the base's bounds.
+            let means = field!(vary.mean_diameter).name;
+            for (i, &mean) in sweep.mean_diameter.iter().enumerate() {
+                let system = sweep.system(mean, s.velocity, s.operating);
+                for e in system.violations() {
+                    if matches!(e.parameter, Parameter::MinDiameter | Parameter::MaxDiameter) {
+                        c.out_of_range(&format!("{means}[{i}]"), mean, "m", &e.allowed);
+                    }
                 }
             }
-        }
+            sweep
+        });
         Ok(sweep)
+    }
+
+    /// The base as an input: bounds that follow each mean and a varied operating point
+    /// are left out, so that the canonical sweep reads back as the same sweep.
+    fn base_input(&self) -> Value {
+        let mut base = self.base.input();
+        if let Some(d) = &mut base.distribution {
+            if !self.fixed_bounds.0 {
+                d.min_diameter = None;
+            }
+            if !self.fixed_bounds.1 {
+                d.max_diameter = None;
+            }
+        }
+        if self.varies_operating {
+            base.operating = None;
+        }
+        input::canonical(&base)
+    }
+
+    /// Every list, explicit; the operating points only if the sweep varies them.
+    fn vary(&self) -> Value {
+        let mut vary = ThreeBodyVary {
+            velocity: quantities(&self.velocity),
+            mean_diameter: quantities(&self.mean_diameter),
+            ..ThreeBodyVary::default()
+        };
+        if self.varies_operating {
+            let values: Vec<f64> = self.operating.iter().map(|o| o.value()).collect();
+            let list = quantities(&values);
+            match self.operating.first() {
+                Some(OperatingPoint::Separation(_)) => vary.separation = list,
+                Some(OperatingPoint::TotalLoad(_)) => vary.total_load = list,
+                Some(OperatingPoint::ParticleLoad(_)) | None => vary.particle_load = list,
+            }
+        }
+        input::canonical(&vary)
     }
 
     /// The base system at one point of the sweep.
@@ -376,63 +417,10 @@ impl ThreeBodySweep {
     }
 }
 
-/// Reads one list of the sweep; absent, it is the base value alone.
-fn read_list(
-    checker: &mut Checker,
-    name: &str,
-    values: Option<&[Quantity]>,
-    parameter: Parameter,
-    dimension: Dimension,
-    base: f64,
-) -> Vec<f64> {
-    let Some(values) = values else {
-        return vec![base];
-    };
-    if values.is_empty() {
-        checker.invalid(name, json!([]), "a list of at least one value");
-    }
-    values
-        .iter()
-        .enumerate()
-        .map(|(i, q)| {
-            let field = format!("{name}[{i}]");
-            let x = checker.quantity(&field, Some(q), dimension, base);
-            if let Err(e) = parameter.check(x) {
-                checker.out_of_range(&field, x, parameter.unit(), &e.allowed);
-            }
-            x
-        })
-        .collect()
-}
-
-/// One row of a rolling sweep.
-#[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
-pub struct SweepPoint {
-    /// R (m).
-    pub radius: f64,
-    /// P (N).
-    pub load: f64,
-    /// V (m/s).
-    pub velocity: f64,
-    #[serde(flatten)]
-    pub contact: ContactOutput,
-    pub verification: VerificationOutput,
-}
-
-/// One row of a three-body sweep.
-#[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
-pub struct ThreeBodySweepPoint {
-    /// The operating point as asked: `{"separation": d}`, `{"total_load": W}` or
-    /// `{"particle_load": P}` (SI).
-    #[schema(value_type = Object)]
-    pub operating: Value,
-    /// V (m/s).
-    pub velocity: f64,
-    /// x_a (m).
-    pub mean_diameter: f64,
-    #[serde(flatten)]
-    pub result: ThreeBodyResult,
-    pub verification: ThreeBodyVerificationOutput,
+/// Reads the object `field` (absent: `{}`) as `T`, shape errors under its name.
+fn read_object<T: serde::de::DeserializeOwned>(field: Field<Value>) -> Result<T, JobError> {
+    let value = field.value.cloned().unwrap_or_else(|| json!({}));
+    input::deserialize(value, field.name)
 }
 
 /// The rows of a sweep.
@@ -452,129 +440,12 @@ pub struct SweepOutput {
     pub meta: Meta,
 }
 
-impl SweepOutput {
-    /// A rolling sweep's answer; `solutions` are those of [`RollingSweep::points`], in order.
-    pub fn rolling(sweep: &RollingSweep, solutions: &[RollingSolution], meta: Meta) -> Self {
-        let points = sweep
-            .points()
-            .iter()
-            .zip(solutions)
-            .map(|(p, s)| SweepPoint {
-                radius: p.radius,
-                load: p.load,
-                velocity: p.velocity,
-                contact: s.into(),
-                verification: (&s.verification).into(),
-            })
-            .collect();
-        SweepOutput {
-            points: SweepPoints::Rolling(points),
-            meta,
+impl Output for SweepOutput {
+    /// One row per point.
+    fn table(&self) -> Table {
+        match &self.points {
+            SweepPoints::Rolling(points) => Table::new(&SweepPoint::COLUMNS, points),
+            SweepPoints::ThreeBody(points) => ThreeBodySweepPoint::table(points),
         }
-    }
-
-    /// A three-body sweep's answer; `solutions` follow [`ThreeBodySweep::points`].
-    pub fn three_body(sweep: &ThreeBodySweep, solutions: &[ThreeBodySolution], meta: Meta) -> Self {
-        let points = sweep
-            .points()
-            .iter()
-            .zip(solutions)
-            .map(|(p, s)| ThreeBodySweepPoint {
-                operating: operating_canonical(p.operating),
-                velocity: p.velocity,
-                mean_diameter: p.diameters.mean,
-                result: s.into(),
-                verification: s.into(),
-            })
-            .collect();
-        SweepOutput {
-            points: SweepPoints::ThreeBody(points),
-            meta,
-        }
-    }
-
-    /// One header line and one line per point, SI units, shortest round-trip numbers.
-    pub fn to_csv(&self) -> String {
-        let (header, rows): (String, Vec<Vec<f64>>) = match &self.points {
-            SweepPoints::Rolling(points) => (
-                "radius,load,velocity,penetration,contact_area,half_width,centroid_shift,\
-                 pressure_centre_shift,rolling_resistance_coefficient,friction_coefficient,\
-                 static_penetration,static_contact_area,static_friction_coefficient"
-                    .to_string(),
-                points
-                    .iter()
-                    .map(|p| {
-                        let c = &p.contact;
-                        vec![
-                            p.radius,
-                            p.load,
-                            p.velocity,
-                            c.penetration,
-                            c.contact_area,
-                            c.half_width,
-                            c.centroid_shift,
-                            c.pressure_centre_shift,
-                            c.rolling_resistance_coefficient,
-                            c.friction_coefficient,
-                            c.static_contact.penetration,
-                            c.static_contact.contact_area,
-                            c.static_contact.friction_coefficient,
-                        ]
-                    })
-                    .collect(),
-            ),
-            SweepPoints::ThreeBody(points) => (
-                format!(
-                    "{},velocity,mean_diameter,separation,particles_in_contact,\
-                     area_surface_surface,area_particle_upper,area_particle_layer,area_total,\
-                     load_asperities,load_particles,load_total,friction_static,\
-                     friction_rolling,mean_area,mean_load",
-                    // Every point of a sweep has the same kind of operating point.
-                    points
-                        .first()
-                        .and_then(|p| p.operating.as_object())
-                        .and_then(|o| o.keys().next().cloned())
-                        .unwrap_or_else(|| "operating".to_string())
-                ),
-                points
-                    .iter()
-                    .map(|p| {
-                        let r = &p.result;
-                        let s = &r.state;
-                        let operating = p
-                            .operating
-                            .as_object()
-                            .and_then(|o| o.values().next())
-                            .and_then(Value::as_f64)
-                            .unwrap_or(f64::NAN);
-                        vec![
-                            operating,
-                            p.velocity,
-                            p.mean_diameter,
-                            s.separation,
-                            s.particles_in_contact,
-                            s.areas.surface_surface,
-                            s.areas.particle_upper,
-                            s.areas.particle_layer,
-                            s.areas.total,
-                            s.loads.asperities,
-                            s.loads.particles,
-                            s.loads.total,
-                            r.friction_coefficient.static_,
-                            r.friction_coefficient.rolling,
-                            r.per_particle.mean_area,
-                            r.per_particle.mean_load,
-                        ]
-                    })
-                    .collect(),
-            ),
-        };
-        let mut csv = format!("{header}\n");
-        for row in rows {
-            let cells: Vec<String> = row.into_iter().map(format_number).collect();
-            csv.push_str(&cells.join(","));
-            csv.push('\n');
-        }
-        csv
     }
 }

@@ -2,17 +2,18 @@
 //! (MODEL.md §4).
 
 use serde::{Deserialize, Serialize};
-use serde_json::{json, Value};
+use serde_json::Value;
 use utoipa::ToSchema;
 
-use super::fields::{self, Checker, Quantity};
-use super::rolling::{si, LayerInput, QuadratureKind};
-use super::units::Dimension;
-use super::{JobError, Meta};
+use super::input::{self, field, Checker, LayerInput, QuadratureKind, Quantity};
+use super::meta::REFERENCES;
+use super::{Control, JobError, Kind, Limits, Meta, Reference, Work};
 use crate::model::three_body::{
-    Asperities, ContactState, Diameters, LayerContact, OperatingPoint, Particle, ThreeBody,
+    self, Asperities, ContactState, Diameters, LayerContact, OperatingPoint, Particle, ThreeBody,
     ThreeBodyOptions, ThreeBodySolution, UpperContact, UpperSurface, DEFAULT_DIAMETER_NODES,
 };
+use crate::model::{Parameter, SolveOption};
+use crate::render::{Column, Output, Table};
 
 /// Input of a three-body job; every field optional but the operating point.
 #[derive(Clone, Debug, Default, PartialEq, Deserialize, Serialize, ToSchema)]
@@ -128,6 +129,173 @@ pub struct ThreeBodyOptionsInput {
     pub strips: Option<usize>,
 }
 
+impl DistributionInput {
+    /// The diameters and the areal density; bounds default to x_a ∓ 3σ_a (never below 0).
+    fn read(&self, checker: &mut Checker, defaults: &ThreeBody) -> (Diameters, f64) {
+        let input = self;
+        let d0 = defaults.diameters;
+        let mean = checker.quantity(
+            field!(input.mean_diameter),
+            Parameter::MeanDiameter,
+            d0.mean,
+        );
+        let std = checker.quantity(field!(input.std_diameter), Parameter::StdDiameter, d0.std);
+        let bounds = Diameters::with_default_bounds(mean, std);
+        let diameters = Diameters {
+            mean,
+            std,
+            min: checker.quantity(
+                field!(input.min_diameter),
+                Parameter::MinDiameter,
+                bounds.min,
+            ),
+            max: checker.quantity(
+                field!(input.max_diameter),
+                Parameter::MaxDiameter,
+                bounds.max,
+            ),
+        };
+        let areal_density = checker.quantity(
+            field!(input.areal_density),
+            Parameter::ArealDensity,
+            defaults.areal_density,
+        );
+        (diameters, areal_density)
+    }
+}
+
+impl UpperSurfaceInput {
+    fn read(&self, checker: &mut Checker) -> UpperSurface {
+        let input = self;
+        let u0 = UpperSurface::default();
+        let contact = match self.contact {
+            Some(UpperContactKind::Plastic) => UpperContact::Plastic,
+            _ => UpperContact::Elastic,
+        };
+        let upper = UpperSurface {
+            elastic_modulus: checker.quantity(
+                field!(input.elastic_modulus),
+                Parameter::UpperModulus,
+                u0.elastic_modulus,
+            ),
+            poisson_ratio: checker.quantity(
+                field!(input.poisson_ratio),
+                Parameter::UpperPoissonRatio,
+                u0.poisson_ratio,
+            ),
+            contact,
+            hardness: checker.optional(field!(input.hardness), Parameter::UpperHardness),
+        };
+        if contact == UpperContact::Plastic && upper.hardness.is_none() {
+            checker.invalid(
+                field!(input.hardness).name,
+                Value::Null,
+                "a hardness (Pa): required for plastic contact",
+            );
+        }
+        upper
+    }
+
+    fn of(upper: &UpperSurface) -> UpperSurfaceInput {
+        UpperSurfaceInput {
+            elastic_modulus: Quantity::si(upper.elastic_modulus),
+            poisson_ratio: Quantity::si(upper.poisson_ratio),
+            contact: Some(match upper.contact {
+                UpperContact::Elastic => UpperContactKind::Elastic,
+                UpperContact::Plastic => UpperContactKind::Plastic,
+            }),
+            hardness: upper.hardness.and_then(Quantity::si),
+        }
+    }
+}
+
+impl ParticleInput {
+    fn read(&self, checker: &mut Checker) -> Particle {
+        let input = self;
+        Particle {
+            elastic_modulus: checker
+                .optional(field!(input.elastic_modulus), Parameter::ParticleModulus),
+            poisson_ratio: checker.quantity(
+                field!(input.poisson_ratio),
+                Parameter::ParticlePoissonRatio,
+                Particle::default().poisson_ratio,
+            ),
+        }
+    }
+
+    fn of(particle: &Particle) -> ParticleInput {
+        ParticleInput {
+            elastic_modulus: particle.elastic_modulus.and_then(Quantity::si),
+            poisson_ratio: Quantity::si(particle.poisson_ratio),
+        }
+    }
+}
+
+impl AsperitiesInput {
+    /// Every field is required once asperities are given.
+    fn read(&self, checker: &mut Checker) -> Asperities {
+        let input = self;
+        let why = "with asperities";
+        Asperities {
+            density: checker.required(field!(input.density), Parameter::AsperityDensity, why),
+            tip_radius: checker.required(field!(input.tip_radius), Parameter::TipRadius, why),
+            height_std: checker.required(field!(input.height_std), Parameter::HeightStd, why),
+            hardness: checker.required(field!(input.hardness), Parameter::AsperityHardness, why),
+        }
+    }
+
+    fn of(a: &Asperities) -> AsperitiesInput {
+        AsperitiesInput {
+            density: Quantity::si(a.density),
+            tip_radius: Quantity::si(a.tip_radius),
+            height_std: Quantity::si(a.height_std),
+            hardness: Quantity::si(a.hardness),
+        }
+    }
+}
+
+impl OperatingInput {
+    /// Every operating point given (a valid input gives exactly one).
+    fn read(&self, checker: &mut Checker) -> Vec<OperatingPoint> {
+        let input = self;
+        let mut given = Vec::new();
+        if let Some(d) = checker.optional(field!(input.separation), Parameter::Separation) {
+            given.push(OperatingPoint::Separation(d));
+        }
+        if let Some(w) = checker.optional(field!(input.total_load), Parameter::TotalLoad) {
+            given.push(OperatingPoint::TotalLoad(w));
+        }
+        if let Some(p) = checker.optional(field!(input.particle_load), Parameter::ParticleLoad) {
+            given.push(OperatingPoint::ParticleLoad(p));
+        }
+        given
+    }
+
+    /// The input of one operating point.
+    pub fn of(operating: OperatingPoint) -> OperatingInput {
+        let mut input = OperatingInput::default();
+        match operating {
+            OperatingPoint::Separation(d) => input.separation = Quantity::si(d),
+            OperatingPoint::TotalLoad(w) => input.total_load = Quantity::si(w),
+            OperatingPoint::ParticleLoad(p) => input.particle_load = Quantity::si(p),
+        }
+        input
+    }
+}
+
+impl ThreeBodyOptionsInput {
+    fn read(&self, checker: &mut Checker) -> ThreeBodyOptions {
+        let input = self;
+        let strips = checker.count(field!(input.strips), SolveOption::Strips);
+        ThreeBodyOptions {
+            diameter_nodes: checker
+                .count(field!(input.diameter_nodes), SolveOption::DiameterNodes)
+                .unwrap_or(DEFAULT_DIAMETER_NODES),
+            quadrature: QuadratureKind::rule(self.quadrature, strips),
+        }
+    }
+}
+
 /// A validated three-body job.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ThreeBodyJob {
@@ -136,144 +304,45 @@ pub struct ThreeBodyJob {
 }
 
 impl ThreeBodyJob {
-    /// Validates a three-body input given as JSON.
-    pub fn from_value(value: Value) -> Result<ThreeBodyJob, JobError> {
-        let input: ThreeBodyInput = fields::deserialize(value, "")?;
-        let mut checker = Checker::new("");
-        let job = ThreeBodyJob::read(&input, &mut checker);
-        checker.finish(job)
-    }
-
     /// Reads `input` under `checker` (bad fields are recorded there and read as NaN).
     pub fn read(input: &ThreeBodyInput, checker: &mut Checker) -> ThreeBodyJob {
-        use Dimension as D;
         let defaults = ThreeBody::with_defaults(OperatingPoint::Separation(0.0));
-        let dist = input.distribution.clone().unwrap_or_default();
-        let d0 = defaults.diameters;
-        let mean = checker.quantity(
-            "distribution.mean_diameter",
-            dist.mean_diameter.as_ref(),
-            D::LENGTH,
-            d0.mean,
-        );
-        let std = checker.quantity(
-            "distribution.std_diameter",
-            dist.std_diameter.as_ref(),
-            D::LENGTH,
-            d0.std,
-        );
-        let bounds = Diameters::with_default_bounds(mean, std);
-        let diameters = Diameters {
-            mean,
-            std,
-            min: checker.quantity(
-                "distribution.min_diameter",
-                dist.min_diameter.as_ref(),
-                D::LENGTH,
-                bounds.min,
-            ),
-            max: checker.quantity(
-                "distribution.max_diameter",
-                dist.max_diameter.as_ref(),
-                D::LENGTH,
-                bounds.max,
-            ),
-        };
-        let areal_density = checker.quantity(
-            "distribution.areal_density",
-            dist.areal_density.as_ref(),
-            D::PER_AREA,
-            defaults.areal_density,
-        );
+        let (diameters, areal_density) =
+            checker.nested(field!(input.distribution), |c, d| d.read(c, &defaults));
         let nominal_area = checker.quantity(
-            "nominal_area",
-            input.nominal_area.as_ref(),
-            D::AREA,
+            field!(input.nominal_area),
+            Parameter::NominalArea,
             defaults.nominal_area,
         );
-
-        let up = input.upper_surface.clone().unwrap_or_default();
-        let u0 = UpperSurface::default();
-        let contact = match up.contact {
-            Some(UpperContactKind::Plastic) => UpperContact::Plastic,
-            _ => UpperContact::Elastic,
-        };
-        let upper = UpperSurface {
-            elastic_modulus: checker.quantity(
-                "upper_surface.elastic_modulus",
-                up.elastic_modulus.as_ref(),
-                D::PRESSURE,
-                u0.elastic_modulus,
-            ),
-            poisson_ratio: checker.quantity(
-                "upper_surface.poisson_ratio",
-                up.poisson_ratio.as_ref(),
-                D::NONE,
-                u0.poisson_ratio,
-            ),
-            contact,
-            hardness: optional(
-                checker,
-                "upper_surface.hardness",
-                up.hardness.as_ref(),
-                D::PRESSURE,
-            ),
-        };
-        if contact == UpperContact::Plastic && upper.hardness.is_none() {
-            checker.invalid(
-                "upper_surface.hardness",
-                Value::Null,
-                "a hardness (Pa): required for plastic contact",
-            );
-        }
-        let pa = input.particle.clone().unwrap_or_default();
-        let particle = Particle {
-            elastic_modulus: optional(
-                checker,
-                "particle.elastic_modulus",
-                pa.elastic_modulus.as_ref(),
-                D::PRESSURE,
-            ),
-            poisson_ratio: checker.quantity(
-                "particle.poisson_ratio",
-                pa.poisson_ratio.as_ref(),
-                D::NONE,
-                Particle::default().poisson_ratio,
-            ),
-        };
-        let asperities = input.asperities.as_ref().map(|a| {
-            let mut required = |field: &str, value: &Option<Quantity>, dimension| {
-                let path = format!("asperities.{field}");
-                optional(checker, &path, value.as_ref(), dimension).unwrap_or_else(|| {
-                    checker.invalid(
-                        &path,
-                        Value::Null,
-                        &format!("{}: required with asperities", dimension.describe()),
-                    );
-                    f64::NAN
-                })
-            };
-            Asperities {
-                density: required("density", &a.density, D::PER_AREA),
-                tip_radius: required("tip_radius", &a.tip_radius, D::LENGTH),
-                height_std: required("height_std", &a.height_std, D::LENGTH),
-                hardness: required("hardness", &a.hardness, D::PRESSURE),
-            }
-        });
+        let upper = checker.nested(field!(input.upper_surface), |c, u| u.read(c));
+        let particle = checker.nested(field!(input.particle), |c, p| p.read(c));
+        let asperities = input
+            .asperities
+            .is_some()
+            .then(|| checker.nested(field!(input.asperities), |c, a| a.read(c)));
         let velocity = checker.quantity(
-            "velocity",
-            input.velocity.as_ref(),
-            D::SPEED,
+            field!(input.velocity),
+            Parameter::Velocity,
             defaults.velocity,
         );
-        let operating = read_operating(input.operating.as_ref(), checker);
-        let layer = LayerInput::read(input.layer.as_ref(), checker, "layer");
-        let o = input.options.clone().unwrap_or_default();
-        let quadrature = QuadratureKind::rule(o.quadrature, o.strips);
-        let options = ThreeBodyOptions {
-            diameter_nodes: o.diameter_nodes.unwrap_or(DEFAULT_DIAMETER_NODES),
-            quadrature,
+        let given = checker.nested(field!(input.operating), |c, o| o.read(c));
+        let operating = match given.as_slice() {
+            [one] => *one,
+            _ => {
+                let sent = input
+                    .operating
+                    .as_ref()
+                    .map_or(Value::Null, input::canonical);
+                checker.invalid(
+                    field!(input.operating).name,
+                    sent,
+                    "exactly one of separation (m), total_load (N), particle_load (N)",
+                );
+                OperatingPoint::Separation(f64::NAN)
+            }
         };
+        let layer = checker.nested(field!(input.layer), |c, l| l.read(c));
+        let options = checker.nested(field!(input.options), |c, o| o.read(c));
         let system = ThreeBody {
             diameters,
             areal_density,
@@ -294,121 +363,69 @@ impl ThreeBodyJob {
         ThreeBodyJob { system, options }
     }
 
-    /// The canonical input (a valid input itself).
-    pub fn canonical(&self) -> Value {
+    /// The input that gives this job: every field, in SI.
+    pub fn input(&self) -> ThreeBodyInput {
         let s = &self.system;
         let d = &s.diameters;
-        let mut upper = json!({
-            "elastic_modulus": si(s.upper.elastic_modulus),
-            "poisson_ratio": si(s.upper.poisson_ratio),
-            "contact": match s.upper.contact {
-                UpperContact::Elastic => "elastic",
-                UpperContact::Plastic => "plastic",
-            },
-        });
-        if let Some(h) = s.upper.hardness {
-            upper["hardness"] = json!(si(h));
+        let (quadrature, strips) = QuadratureKind::of(self.options.quadrature);
+        ThreeBodyInput {
+            distribution: Some(DistributionInput {
+                mean_diameter: Quantity::si(d.mean),
+                std_diameter: Quantity::si(d.std),
+                min_diameter: Quantity::si(d.min),
+                max_diameter: Quantity::si(d.max),
+                areal_density: Quantity::si(s.areal_density),
+            }),
+            nominal_area: Quantity::si(s.nominal_area),
+            upper_surface: Some(UpperSurfaceInput::of(&s.upper)),
+            particle: Some(ParticleInput::of(&s.particle)),
+            layer: Some(LayerInput::of(&s.layer)),
+            layer_contact: Some(match s.layer_contact {
+                LayerContact::KelvinLayer => LayerContactKind::KelvinLayer,
+                LayerContact::Hertz => LayerContactKind::Hertz,
+            }),
+            asperities: s.asperities.as_ref().map(AsperitiesInput::of),
+            velocity: Quantity::si(s.velocity),
+            operating: Some(OperatingInput::of(s.operating)),
+            options: Some(ThreeBodyOptionsInput {
+                diameter_nodes: Some(self.options.diameter_nodes),
+                quadrature: Some(quadrature),
+                strips: Some(strips),
+            }),
         }
-        let mut particle = json!({ "poisson_ratio": si(s.particle.poisson_ratio) });
-        if let Some(e) = s.particle.elastic_modulus {
-            particle["elastic_modulus"] = json!(si(e));
-        }
-        let (quadrature, strips) = QuadratureKind::canonical(self.options.quadrature);
-        let mut canonical = json!({
-            "distribution": {
-                "mean_diameter": si(d.mean),
-                "std_diameter": si(d.std),
-                "min_diameter": si(d.min),
-                "max_diameter": si(d.max),
-                "areal_density": si(s.areal_density),
-            },
-            "nominal_area": si(s.nominal_area),
-            "upper_surface": upper,
-            "particle": particle,
-            "layer": LayerInput::canonical(&s.layer),
-            "layer_contact": match s.layer_contact {
-                LayerContact::KelvinLayer => "kelvin_layer",
-                LayerContact::Hertz => "hertz",
-            },
-            "velocity": si(s.velocity),
-            "operating": operating_canonical(s.operating),
-            "options": {
-                "diameter_nodes": self.options.diameter_nodes,
-                "quadrature": quadrature,
-                "strips": strips,
-            },
-        });
-        if let Some(a) = &s.asperities {
-            canonical["asperities"] = json!({
-                "density": si(a.density),
-                "tip_radius": si(a.tip_radius),
-                "height_std": si(a.height_std),
-                "hardness": si(a.hardness),
-            });
-        }
-        canonical
     }
 }
 
-/// A quantity that may be absent: `None` if it is, NaN (error recorded) if unreadable.
-fn optional(
-    checker: &mut Checker,
-    field: &str,
-    value: Option<&Quantity>,
-    dimension: Dimension,
-) -> Option<f64> {
-    value.map(|v| checker.quantity(field, Some(v), dimension, f64::NAN))
-}
+impl Kind for ThreeBodyJob {
+    const NAME: &'static str = "three_body";
+    type Output = ThreeBodyOutput;
 
-/// The operating point: exactly one of its three fields.
-fn read_operating(input: Option<&OperatingInput>, checker: &mut Checker) -> OperatingPoint {
-    let op = input.cloned().unwrap_or_default();
-    let mut given = Vec::new();
-    if let Some(v) = &op.separation {
-        given.push(OperatingPoint::Separation(checker.quantity(
-            "operating.separation",
-            Some(v),
-            Dimension::LENGTH,
-            f64::NAN,
-        )));
+    fn validate(input: Value, _limits: &Limits) -> Result<Self, JobError> {
+        input::validate(input, ThreeBodyJob::read)
     }
-    if let Some(v) = &op.total_load {
-        given.push(OperatingPoint::TotalLoad(checker.quantity(
-            "operating.total_load",
-            Some(v),
-            Dimension::FORCE,
-            f64::NAN,
-        )));
+
+    /// A valid input itself.
+    fn canonical(&self) -> Value {
+        input::canonical(&self.input())
     }
-    if let Some(v) = &op.particle_load {
-        given.push(OperatingPoint::ParticleLoad(checker.quantity(
-            "operating.particle_load",
-            Some(v),
-            Dimension::FORCE,
-            f64::NAN,
-        )));
+
+    fn references(&self) -> &'static [Reference] {
+        &REFERENCES
     }
-    match given.as_slice() {
-        [one] => *one,
-        _ => {
-            let sent = serde_json::to_value(&op).unwrap_or(Value::Null);
-            checker.invalid(
-                "operating",
-                sent,
-                "exactly one of separation (m), total_load (N), particle_load (N)",
-            );
-            OperatingPoint::Separation(f64::NAN)
-        }
+
+    fn work(&self) -> Work {
+        Work::Known(1)
+    }
+
+    fn run(&self, meta: Meta, control: &Control) -> Result<ThreeBodyOutput, JobError> {
+        let solution = control.solve(|| three_body::solve(&self.system, &self.options))?;
+        Ok(ThreeBodyOutput::new(&self.system, &solution, meta))
     }
 }
 
 /// `{"separation": d}`, `{"total_load": W}` or `{"particle_load": P}`.
 pub fn operating_canonical(operating: OperatingPoint) -> Value {
-    match operating {
-        OperatingPoint::Separation(d) => json!({ "separation": si(d) }),
-        OperatingPoint::TotalLoad(w) => json!({ "total_load": si(w) }),
-        OperatingPoint::ParticleLoad(p) => json!({ "particle_load": si(p) }),
-    }
+    input::canonical(&OperatingInput::of(operating))
 }
 
 /// Real contact areas (m²).
@@ -553,17 +570,125 @@ pub struct ThreeBodyOutput {
     #[serde(flatten)]
     pub result: ThreeBodyResult,
     pub meta: ThreeBodyMeta,
+    /// The system solved (its operating point, speed and mean diameter are in `meta.input`
+    /// on the wire; the CSV row needs them).
+    #[serde(skip)]
+    system: ThreeBody,
 }
 
 impl ThreeBodyOutput {
-    /// The answer with `meta`, the job's [`Meta`] (see [`super::Job::meta`]).
-    pub fn new(solution: &ThreeBodySolution, meta: Meta) -> Self {
+    /// The answer for `system`, solved as `solution`, with `meta`, the job's [`Meta`].
+    pub fn new(system: &ThreeBody, solution: &ThreeBodySolution, meta: Meta) -> Self {
         ThreeBodyOutput {
             result: solution.into(),
             meta: ThreeBodyMeta {
                 meta,
                 verification: solution.into(),
             },
+            system: *system,
         }
     }
+}
+
+impl Output for ThreeBodyOutput {
+    /// One row: the system's operating point, speed and mean diameter and its results, as a
+    /// sweep's row.
+    fn table(&self) -> Table {
+        let point = ThreeBodySweepPoint {
+            operating: operating_canonical(self.system.operating),
+            velocity: self.system.velocity,
+            mean_diameter: self.system.diameters.mean,
+            result: self.result.clone(),
+            verification: self.meta.verification.clone(),
+            operating_point: self.system.operating,
+        };
+        ThreeBodySweepPoint::table(&[point])
+    }
+}
+
+/// One row of a three-body sweep.
+// Also the CSV row of a three-body answer: one declaration of the columns of systems.
+#[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
+pub struct ThreeBodySweepPoint {
+    /// The operating point as asked: `{"separation": d}`, `{"total_load": W}` or
+    /// `{"particle_load": P}` (SI).
+    #[schema(value_type = Object)]
+    pub operating: Value,
+    /// V (m/s).
+    pub velocity: f64,
+    /// x_a (m).
+    pub mean_diameter: f64,
+    #[serde(flatten)]
+    pub result: ThreeBodyResult,
+    pub verification: ThreeBodyVerificationOutput,
+    /// `operating`, typed (for the CSV).
+    #[serde(skip)]
+    operating_point: OperatingPoint,
+}
+
+impl ThreeBodySweepPoint {
+    /// The point of `system`, solved as `solution`.
+    pub fn new(system: &ThreeBody, solution: &ThreeBodySolution) -> Self {
+        ThreeBodySweepPoint {
+            operating: operating_canonical(system.operating),
+            velocity: system.velocity,
+            mean_diameter: system.diameters.mean,
+            result: solution.into(),
+            verification: solution.into(),
+            operating_point: system.operating,
+        }
+    }
+
+    /// The model parameter the operating point gives.
+    fn operating_parameter(&self) -> Parameter {
+        match self.operating_point {
+            OperatingPoint::Separation(_) => Parameter::Separation,
+            OperatingPoint::TotalLoad(_) => Parameter::TotalLoad,
+            OperatingPoint::ParticleLoad(_) => Parameter::ParticleLoad,
+        }
+    }
+
+    /// The table of `points`, whose operating points are all of one kind: the first column
+    /// is named after it (`separation`, `total_load` or `particle_load`) and takes its unit.
+    pub fn table(points: &[ThreeBodySweepPoint]) -> Table {
+        let mut table = Table::new(&Self::COLUMNS, points);
+        if let Some(point) = points.first() {
+            let name = point.operating.as_object().and_then(|o| o.keys().next());
+            let unit = point.operating_parameter().unit();
+            table.rename(0, name.map_or("operating", String::as_str), unit);
+        }
+        table
+    }
+
+    /// The CSV columns of three-body systems.
+    const COLUMNS: [Column<ThreeBodySweepPoint>; 16] = [
+        Column::number("operating", "", |p| p.operating_point.value()),
+        Column::number("velocity", "m/s", |p| p.velocity),
+        Column::number("mean_diameter", "m", |p| p.mean_diameter),
+        Column::number("separation", "m", |p| p.result.state.separation),
+        Column::number("particles_in_contact", "", |p| {
+            p.result.state.particles_in_contact
+        }),
+        Column::number("area_surface_surface", "m²", |p| {
+            p.result.state.areas.surface_surface
+        }),
+        Column::number("area_particle_upper", "m²", |p| {
+            p.result.state.areas.particle_upper
+        }),
+        Column::number("area_particle_layer", "m²", |p| {
+            p.result.state.areas.particle_layer
+        }),
+        Column::number("area_total", "m²", |p| p.result.state.areas.total),
+        Column::number("load_asperities", "N", |p| p.result.state.loads.asperities),
+        Column::number("load_particles", "N", |p| p.result.state.loads.particles),
+        Column::number("load_total", "N", |p| p.result.state.loads.total),
+        Column::number("friction_static", "", |p| {
+            p.result.friction_coefficient.static_
+        }),
+        Column::number("friction_rolling", "", |p| {
+            p.result.friction_coefficient.rolling
+        }),
+        Column::number("mean_area", "m²", |p| p.result.per_particle.mean_area),
+        Column::number("mean_load", "N", |p| p.result.per_particle.mean_load),
+    ];
 }

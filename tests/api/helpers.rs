@@ -6,7 +6,7 @@ use std::time::Duration;
 use clap::Parser;
 use reqwest::{Client, Method, Response, StatusCode};
 use serde_json::Value;
-use thirdbody::http::{self, AppState, ServeArgs};
+use thirdbody::http::{self, AppState, Config, ServeArgs};
 use tokio::net::TcpListener;
 use tokio::sync::oneshot;
 use tokio::task::JoinHandle;
@@ -22,25 +22,34 @@ pub struct TestApp {
     pub server: JoinHandle<std::io::Result<()>>,
 }
 
-/// The settings `thirdbody serve` would have with these flags.
-pub fn state(flags: &[&str]) -> AppState {
+/// The validated settings of `thirdbody serve` with these flags.
+pub fn config(flags: &[&str]) -> Config {
     let args = std::iter::once("serve").chain(flags.iter().copied());
-    let config = ServeArgs::try_parse_from(args)
+    ServeArgs::try_parse_from(args)
         .expect("valid flags")
         .validate()
-        .expect("valid settings");
-    AppState::new(config)
+        .expect("valid settings")
+}
+
+/// The service `thirdbody serve` would be with these flags.
+pub fn state(flags: &[&str]) -> AppState {
+    AppState::new(config(flags))
 }
 
 /// Serves on 127.0.0.1, port 0, with `flags`.
 pub async fn spawn_app(flags: &[&str]) -> TestApp {
+    serve(state(flags)).await
+}
+
+/// Serves `state` on 127.0.0.1, port 0.
+pub async fn serve(state: AppState) -> TestApp {
     let listener = TcpListener::bind("127.0.0.1:0").await.unwrap();
     let base = format!("http://{}", listener.local_addr().unwrap());
     let (tx, rx) = oneshot::channel::<()>();
     let shutdown = async {
         let _ = rx.await;
     };
-    let server = tokio::spawn(http::run(listener, state(flags), shutdown));
+    let server = tokio::spawn(http::run(listener, state, shutdown));
     TestApp {
         base,
         client: Client::new(),

@@ -2,8 +2,10 @@
 //! its own engine, cache and metrics), plus in-process router tests with `oneshot`.
 
 mod errors;
+mod forms;
 mod helpers;
 mod in_process;
 mod jobs;
 mod ops;
 mod solve;
+mod storage;

@@ -3,8 +3,8 @@
 use futures_util::future::join_all;
 use reqwest::Method;
 use serde_json::{json, Value};
-use thirdbody::engine::{self, Control};
-use thirdbody::job::{FigureJob, Job, Limits};
+use thirdbody::engine;
+use thirdbody::job::{Control, FigureJob, Job, Limits};
 
 use crate::helpers::spawn_app;
 
@@ -213,7 +213,7 @@ async fn a_figure_answers_json_or_csv() {
     assert_eq!(response.status(), 200);
     let body: Value = response.json().await.unwrap();
     assert_eq!(body["figure"], 6);
-    assert_eq!(body, engine_answer(Job::Figure(FigureJob::new(6).unwrap())));
+    assert_eq!(body, engine_answer(Job::new(FigureJob::new(6).unwrap())));
 
     let csv = app
         .send(

@@ -4,8 +4,9 @@ use axum::extract::{Path, State};
 use axum::http::HeaderMap;
 use axum::response::Response;
 
+use super::Answering;
 use crate::http::error::ApiError;
-use crate::http::openapi::{Busy, NotFound, NotModified, SolveErrors};
+use crate::http::responses::{Busy, NotAcceptable, NotFound, NotModified, SolveErrors};
 use crate::http::AppState;
 use crate::job::figure::FigureOutput;
 use crate::job::{FigureJob, Job};
@@ -23,7 +24,7 @@ use crate::job::{FigureJob, Job};
     responses(
         (status = 200, description = "The figure's axes and series", content(
             (FigureOutput = "application/json"), (String = "text/csv"))),
-        NotModified, NotFound, Busy, SolveErrors,
+        NotModified, NotFound, NotAcceptable, Busy, SolveErrors,
     )
 )]
 pub async fn figure(
@@ -31,6 +32,7 @@ pub async fn figure(
     Path(n): Path<String>,
     headers: HeaderMap,
 ) -> Result<Response, ApiError> {
+    let answering = Answering::from_headers(&headers)?;
     let job = n
         .parse()
         .ok()
@@ -38,5 +40,7 @@ pub async fn figure(
         .ok_or_else(|| {
             ApiError::not_found(format!("there is no figure {n}: figures are 3 to 9"))
         })?;
-    super::answer(&state, Job::Figure(job), &headers).await
+    let job = Job::new(job);
+    let meta = job.meta();
+    answering.solve(&state, job, meta).await
 }

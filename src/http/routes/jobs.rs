@@ -18,25 +18,24 @@ use utoipa::{IntoParams, ToSchema};
 use uuid::Uuid;
 
 use crate::engine::cache::Solved;
-use crate::engine::jobs::{JobEntry, JobState, JobStatus};
-use crate::engine::Output;
+use crate::engine::store::{JobRecord, JobState, JobStatus};
+use crate::engine::Engine;
+use crate::http::accept::{Accept, AcceptsJson};
 use crate::http::error::{ApiError, JsonBody, Problem};
-use crate::http::openapi::{BadBody, Busy, NotFound};
+use crate::http::responses::{BadBody, Busy, NotAcceptable, NotFound};
 use crate::http::AppState;
-use crate::job::{Envelope, Job, JobKind};
+use crate::job::registry::{AnyOutput, Envelope, KindName};
+use crate::job::{Job, Work};
 
 /// How often a progress stream looks at a running job's count of solves.
 const PROGRESS_INTERVAL: Duration = Duration::from_millis(100);
-/// How long `DELETE` waits for the solver to stop (it checks between solves, which take
-/// microseconds to milliseconds).
-const CANCEL_WAIT: Duration = Duration::from_secs(5);
 
 /// Solves done out of the job's total.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, ToSchema)]
 pub struct Progress {
     /// Rolling solves done (count).
     pub done: usize,
-    /// Rolling solves the job takes (count).
+    /// Rolling solves the job takes (count; 0 for a job that cannot tell in advance).
     pub total: usize,
 }
 
@@ -45,12 +44,12 @@ pub struct Progress {
 pub struct JobView {
     /// The job's id (a UUID); its URL is `/v1/jobs/{id}`.
     pub id: Uuid,
-    pub kind: JobKind,
+    pub kind: KindName,
     pub status: JobStatus,
     pub progress: Progress,
     /// The answer, once `succeeded`: the output of the job's kind.
     #[serde(skip_serializing_if = "Option::is_none", serialize_with = "rendered")]
-    #[schema(value_type = Option<Output>)]
+    #[schema(value_type = Option<AnyOutput>)]
     pub result: Option<Arc<Solved>>,
     /// Why it failed, once `failed`.
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -61,28 +60,30 @@ pub struct JobView {
 fn rendered<S: Serializer>(solved: &Option<Arc<Solved>>, s: S) -> Result<S::Ok, S::Error> {
     let raw: Option<&RawValue> = solved
         .as_ref()
-        .map(|solved| serde_json::from_slice(&solved.json))
+        .map(|solved| serde_json::from_slice(solved.json()))
         .transpose()
         .map_err(serde::ser::Error::custom)?;
     raw.serialize(s)
 }
 
 impl JobView {
-    /// The job now; with `full`, its result too once it has one.
-    fn of(entry: &JobEntry, full: bool) -> JobView {
-        let state = entry.state();
-        let (result, problem) = match &state {
+    /// The job as recorded; with `full`, its result too once it has one.
+    fn of(record: &JobRecord, full: bool) -> JobView {
+        let (result, problem) = match &record.state {
             JobState::Succeeded(solved) if full => (Some(solved.clone()), None),
             JobState::Failed(e) => (None, Some(ApiError::from(e.clone()).problem())),
             _ => (None, None),
         };
         JobView {
-            id: entry.id,
-            kind: entry.kind,
-            status: state.status(),
+            id: record.id,
+            kind: KindName::of(record.kind),
+            status: record.state.status(),
             progress: Progress {
-                done: entry.done(),
-                total: entry.total,
+                done: record.done,
+                total: match record.work {
+                    Work::Known(total) => total,
+                    Work::Unknown => 0,
+                },
             },
             result,
             problem,
@@ -99,7 +100,7 @@ pub struct JobId {
 }
 
 /// Extracts the job of the path.
-pub struct FoundJob(Arc<JobEntry>);
+pub struct FoundJob(JobRecord);
 
 impl FromRequestParts<AppState> for FoundJob {
     type Rejection = ApiError;
@@ -108,7 +109,7 @@ impl FromRequestParts<AppState> for FoundJob {
         let Path(JobId { id }) = Path::from_request_parts(parts, state)
             .await
             .map_err(|_| ApiError::not_found("no such job: its id is a UUID"))?;
-        state.engine().job(id).map(FoundJob).ok_or_else(|| {
+        state.engine().job(id).await.map(FoundJob).ok_or_else(|| {
             ApiError::not_found(format!("no job {id} (never submitted, or expired)"))
         })
     }
@@ -129,17 +130,18 @@ impl FromRequestParts<AppState> for FoundJob {
             body = JobView, headers(
                 ("location" = String, description = "The job's URL, /v1/jobs/{id}"),
                 ("retry-after" = u32, description = "Seconds to wait before polling"))),
-        BadBody, Busy,
+        BadBody, NotAcceptable, Busy,
     )
 )]
 pub async fn submit(
     State(state): State<AppState>,
+    _: AcceptsJson,
     JsonBody(envelope): JsonBody,
 ) -> Result<Response, ApiError> {
     let job = Job::from_value(envelope, &state.config().limits)?;
-    let entry = state.engine().submit(job)?;
-    let location = format!("/v1/jobs/{}", entry.id);
-    let view = JobView::of(&entry, true);
+    let record = state.engine().submit(job).await?;
+    let location = format!("/v1/jobs/{}", record.id);
+    let view = JobView::of(&record, true);
     let headers = [
         (header::LOCATION, location),
         (header::RETRY_AFTER, "1".into()),
@@ -153,10 +155,10 @@ pub async fn submit(
     path = "/v1/jobs/{id}",
     tag = "jobs",
     params(JobId),
-    responses((status = 200, description = "The job", body = JobView), NotFound)
+    responses((status = 200, description = "The job", body = JobView), NotFound, NotAcceptable)
 )]
-pub async fn status(FoundJob(entry): FoundJob) -> Json<JobView> {
-    Json(JobView::of(&entry, true))
+pub async fn status(_: AcceptsJson, FoundJob(record): FoundJob) -> Json<JobView> {
+    Json(JobView::of(&record, true))
 }
 
 /// Cancel a job.
@@ -169,14 +171,16 @@ pub async fn status(FoundJob(entry): FoundJob) -> Json<JobView> {
     path = "/v1/jobs/{id}",
     tag = "jobs",
     params(JobId),
-    responses((status = 200, description = "The job after the cancel", body = JobView), NotFound)
+    responses((status = 200, description = "The job after the cancel", body = JobView),
+        NotFound, NotAcceptable)
 )]
-pub async fn cancel(FoundJob(entry): FoundJob) -> Json<JobView> {
-    entry.cancel();
-    let mut states = entry.subscribe();
-    // Still running after the wait: the answer says so, and the job stops soon after.
-    let _ = tokio::time::timeout(CANCEL_WAIT, states.wait_for(|s| s.status().is_finished())).await;
-    Json(JobView::of(&entry, true))
+pub async fn cancel(
+    State(state): State<AppState>,
+    _: AcceptsJson,
+    FoundJob(record): FoundJob,
+) -> Json<JobView> {
+    let record = state.engine().cancel(record.id).await.unwrap_or(record);
+    Json(JobView::of(&record, true))
 }
 
 /// Follow a job as server-sent events.
@@ -193,15 +197,19 @@ pub async fn cancel(FoundJob(entry): FoundJob) -> Json<JobView> {
         (status = 200, description = "A text/event-stream of `progress` events and one \
             `completion` event, each with a JobView as data",
             content_type = "text/event-stream", body = String),
-        NotFound,
+        NotFound, NotAcceptable,
     )
 )]
 pub async fn events(
-    FoundJob(entry): FoundJob,
-) -> Sse<impl Stream<Item = Result<Event, axum::Error>>> {
+    State(state): State<AppState>,
+    accept: Accept,
+    FoundJob(record): FoundJob,
+) -> Result<Sse<impl Stream<Item = Result<Event, axum::Error>>>, ApiError> {
+    accept.require("text/event-stream")?;
     let watcher = Watcher {
-        states: entry.subscribe(),
-        entry,
+        engine: state.engine().clone(),
+        changes: state.engine().watch(record.id),
+        record,
         last: None,
         finished: false,
     };
@@ -209,13 +217,16 @@ pub async fn events(
         let event = w.next().await?;
         Some((event, w))
     });
-    Sse::new(events).keep_alive(KeepAlive::default())
+    Ok(Sse::new(events).keep_alive(KeepAlive::default()))
 }
 
 /// Turns a job's changes into events.
 struct Watcher {
-    entry: Arc<JobEntry>,
-    states: watch::Receiver<JobState>,
+    engine: Arc<Engine>,
+    /// The job as last read.
+    record: JobRecord,
+    /// Status changes, while this process runs the job (else the watcher polls).
+    changes: Option<watch::Receiver<JobStatus>>,
     /// The status and count last sent.
     last: Option<(JobStatus, usize)>,
     finished: bool,
@@ -229,8 +240,8 @@ impl Watcher {
         }
         let mut tick = tokio::time::interval(PROGRESS_INTERVAL);
         loop {
-            let status = self.entry.state().status();
-            let now = (status, self.entry.done());
+            let status = self.record.state.status();
+            let now = (status, self.record.done);
             if status.is_finished() {
                 self.finished = true;
                 return Some(self.event("completion", true));
@@ -239,9 +250,22 @@ impl Watcher {
                 self.last = Some(now);
                 return Some(self.event("progress", false));
             }
+            let changed = async {
+                let closed = match &mut self.changes {
+                    Some(changes) => changes.changed().await.is_err(),
+                    None => true,
+                };
+                if closed {
+                    std::future::pending::<()>().await;
+                }
+            };
             tokio::select! {
-                _ = self.states.changed() => {}
+                () = changed => {}
                 _ = tick.tick() => {}
+            }
+            // Gone (expired) while followed: the last record read stands.
+            if let Some(record) = self.engine.job(self.record.id).await {
+                self.record = record;
             }
         }
     }
@@ -249,6 +273,6 @@ impl Watcher {
     fn event(&self, name: &str, full: bool) -> Result<Event, axum::Error> {
         Event::default()
             .event(name)
-            .json_data(JobView::of(&self.entry, full))
+            .json_data(JobView::of(&self.record, full))
     }
 }

@@ -1,6 +1,7 @@
-//! The routes, one module per resource. A synchronous endpoint of a job kind is a thin
-//! handler over [`SolveRequest::solve`]: validate the body as that kind's input, run it
-//! through the engine, answer with the cached or fresh result.
+//! The routes, one module per resource, registered in [`router`] (which the OpenAPI
+//! description is built from). A synchronous endpoint of a job kind is a thin handler over
+//! [`SolveRequest::solve`]: validate the body as that kind's input, run it through the
+//! engine, answer with the cached or fresh result in the form the client accepts.
 
 pub mod figures;
 pub mod jobs;
@@ -13,22 +14,132 @@ use axum::extract::{FromRequest, Request};
 use axum::http::{header, HeaderMap, HeaderName, HeaderValue, StatusCode};
 use axum::response::{IntoResponse, Response};
 use serde_json::Value;
+use utoipa_axum::router::OpenApiRouter;
+use utoipa_axum::routes;
 
+use super::accept::Accept;
 use super::error::{ApiError, JsonBody};
 use super::AppState;
 use crate::engine::cache::Solved;
 use crate::engine::CacheStatus;
-use crate::job::{Job, JobKind, Meta};
+use crate::job::{Job, Meta};
+use crate::render::Format;
 
 /// `hit` when the answer came from the cache (or from an identical request solved at the
 /// same time), `miss` when this request solved it.
 pub const X_CACHE: HeaderName = HeaderName::from_static("x-cache");
 
-/// A request to a synchronous endpoint: the job's input as the JSON body, and the headers
-/// that choose the answer's form (`Accept`, `If-None-Match`).
+/// The API's routes with their OpenAPI operations. A synchronous endpoint of a new job kind
+/// is its route file and one more `.routes(routes!(...))` line here.
+pub fn router() -> OpenApiRouter<AppState> {
+    OpenApiRouter::new()
+        .routes(routes!(rolling::solve))
+        .routes(routes!(three_body::solve))
+        .routes(routes!(sweeps::solve))
+        .routes(routes!(jobs::submit))
+        .routes(routes!(jobs::status, jobs::cancel))
+        .routes(routes!(jobs::events))
+        .routes(routes!(figures::figure))
+        .routes(routes!(ops::healthz))
+        .routes(routes!(ops::readyz))
+        .routes(routes!(ops::metrics))
+}
+
+/// Declares `solve`, the synchronous endpoint of a job kind: `POST $path` with the kind's
+/// input as the body, answered with its output as JSON or CSV. The doc comment is the
+/// operation's description; `$answer` describes the 200 answer.
+macro_rules! solve_endpoint {
+    ($(#[doc = $doc:literal])* $path:literal, $kind:ident, $input:ident, $output:ident, $answer:literal) => {
+        $(#[doc = $doc])*
+        #[utoipa::path(
+            post,
+            path = $path,
+            tag = "solve",
+            request_body(content = $input, content_type = "application/json"),
+            responses(
+                (status = 200, description = $answer, content(
+                    ($output = "application/json"), (String = "text/csv"))),
+                $crate::http::responses::NotModified,
+                $crate::http::responses::BadBody,
+                $crate::http::responses::NotAcceptable,
+                $crate::http::responses::Busy,
+                $crate::http::responses::SolveErrors,
+            )
+        )]
+        pub async fn solve(
+            request: $crate::http::routes::SolveRequest,
+        ) -> Result<axum::response::Response, $crate::http::error::ApiError> {
+            request.solve(<$kind as $crate::job::Kind>::NAME).await
+        }
+    };
+}
+use solve_endpoint;
+
+/// How an answer is to be sent: the form the client accepts, and the validator it holds.
+pub struct Answering {
+    format: Format,
+    if_none_match: Vec<String>,
+}
+
+impl Answering {
+    /// Reads `Accept` (406 if no form of an answer is acceptable) and `If-None-Match`.
+    pub fn from_headers(headers: &HeaderMap) -> Result<Answering, ApiError> {
+        let format = Accept::from_headers(headers).choose(&Format::ALL)?;
+        let if_none_match = headers
+            .get_all(header::IF_NONE_MATCH)
+            .iter()
+            .filter_map(|v| v.to_str().ok())
+            .map(str::to_string)
+            .collect();
+        Ok(Answering {
+            format,
+            if_none_match,
+        })
+    }
+
+    /// The answer with its validators: the `ETag` is the cache key (per form), so an
+    /// `If-None-Match` that names it gets `304` and no body.
+    fn respond(&self, solved: &Solved, cache: CacheStatus) -> Result<Response, ApiError> {
+        let etag = match self.format {
+            Format::Json => format!("\"{}\"", solved.key),
+            Format::Csv => format!("\"{}.csv\"", solved.key),
+        };
+        let mut response = if if_none_match(&self.if_none_match, &etag) {
+            StatusCode::NOT_MODIFIED.into_response()
+        } else {
+            let body = solved
+                .body(self.format)
+                .map_err(|e| ApiError::internal(e.to_string()))?;
+            let content_type = [(header::CONTENT_TYPE, self.format.content_type())];
+            (content_type, body).into_response()
+        };
+        let h = response.headers_mut();
+        if let Ok(etag) = HeaderValue::from_str(&etag) {
+            h.insert(header::ETAG, etag);
+        }
+        h.insert(X_CACHE, HeaderValue::from_static(cache.as_str()));
+        h.insert(header::VARY, HeaderValue::from_static("accept"));
+        Ok(response)
+    }
+
+    /// Solves a validated job (whose [`Meta`], and so cache key, the caller computed) and
+    /// answers it.
+    pub async fn solve(
+        &self,
+        state: &AppState,
+        job: Job,
+        meta: Meta,
+    ) -> Result<Response, ApiError> {
+        let (solved, cache) = state.engine().solve(job, meta).await?;
+        self.respond(&solved, cache)
+    }
+}
+
+/// A request to a synchronous endpoint: the job's input as the JSON body, and how the
+/// answer is to be sent.
 pub struct SolveRequest {
     state: AppState,
-    headers: HeaderMap,
+    answering: Answering,
     input: Value,
 }
 
@@ -36,126 +147,37 @@ impl FromRequest<AppState> for SolveRequest {
     type Rejection = ApiError;
 
     async fn from_request(request: Request, state: &AppState) -> Result<Self, ApiError> {
-        // Only the headers that choose the answer's form are kept.
-        let mut headers = HeaderMap::new();
-        for name in [header::ACCEPT, header::IF_NONE_MATCH] {
-            for value in request.headers().get_all(&name) {
-                headers.append(name.clone(), value.clone());
-            }
-        }
+        let answering = Answering::from_headers(request.headers())?;
         let JsonBody(input) = JsonBody::from_request(request, state).await?;
         Ok(SolveRequest {
             state: state.clone(),
-            headers,
+            answering,
             input,
         })
     }
 }
 
 impl SolveRequest {
-    /// Validates the input as a job of `kind`, solves it and answers it. An input seen
-    /// before (the same JSON up to key order and spacing) whose answer is cached is answered
-    /// at once: validation and the cache key cost more than the lookup.
-    pub async fn solve(self, kind: JobKind) -> Result<Response, ApiError> {
+    /// Validates the input as a job of the kind named `kind`, solves it and answers it. An
+    /// input seen before (the same JSON up to key order and spacing) whose answer is cached
+    /// is answered at once: validation and the cache key cost more than the lookup.
+    pub async fn solve(self, kind: &str) -> Result<Response, ApiError> {
         let engine = self.state.engine();
-        let text = format!("{}\n{}", kind.as_str(), self.input);
+        let text = format!("{kind}\n{}", self.input);
         if let Some(solved) = engine.cached_input(&text).await? {
-            return Ok(respond(&solved, CacheStatus::Hit, &self.headers));
+            return self.answering.respond(&solved, CacheStatus::Hit);
         }
         let job = Job::from_input(kind, self.input, &self.state.config().limits)?;
         let meta = job.meta();
         engine.remember_input(text, meta.input_hash.clone()).await;
-        solve_and_answer(&self.state, job, meta, &self.headers).await
+        self.answering.solve(&self.state, job, meta).await
     }
-}
-
-/// Solves a validated job and answers it, in JSON or (if asked and offered) CSV.
-pub async fn answer(state: &AppState, job: Job, headers: &HeaderMap) -> Result<Response, ApiError> {
-    let meta = job.meta();
-    solve_and_answer(state, job, meta, headers).await
-}
-
-/// [`answer`] for a job whose [`Meta`] (and so cache key) the caller already computed.
-async fn solve_and_answer(
-    state: &AppState,
-    job: Job,
-    meta: Meta,
-    headers: &HeaderMap,
-) -> Result<Response, ApiError> {
-    let (solved, cache) = state.engine().solve(job, meta).await?;
-    Ok(respond(&solved, cache, headers))
-}
-
-/// The answer with its validators: the `ETag` is the cache key (per representation), so an
-/// `If-None-Match` that names it gets `304` and no body.
-fn respond(solved: &Solved, cache: CacheStatus, headers: &HeaderMap) -> Response {
-    let csv = if wants_csv(headers) {
-        solved.csv()
-    } else {
-        None
-    };
-    let etag = match csv {
-        Some(_) => format!("\"{}.csv\"", solved.key),
-        None => format!("\"{}\"", solved.key),
-    };
-    let mut response = if if_none_match(headers, &etag) {
-        StatusCode::NOT_MODIFIED.into_response()
-    } else if let Some(csv) = csv {
-        (
-            [(
-                header::CONTENT_TYPE,
-                "text/csv; charset=utf-8; header=present",
-            )],
-            csv,
-        )
-            .into_response()
-    } else {
-        (
-            [(header::CONTENT_TYPE, "application/json")],
-            solved.json.clone(),
-        )
-            .into_response()
-    };
-    let h = response.headers_mut();
-    if let Ok(etag) = HeaderValue::from_str(&etag) {
-        h.insert(header::ETAG, etag);
-    }
-    h.insert(X_CACHE, HeaderValue::from_static(cache.as_str()));
-    h.insert(header::VARY, HeaderValue::from_static("accept"));
-    response
-}
-
-/// Whether the client prefers CSV: `text/csv` is acceptable and `application/json` is not
-/// preferred to it (a wildcard does not count against CSV).
-fn wants_csv(headers: &HeaderMap) -> bool {
-    let (mut csv, mut json) = (0.0_f32, 0.0_f32);
-    let ranges = headers
-        .get_all(header::ACCEPT)
-        .iter()
-        .filter_map(|v| v.to_str().ok())
-        .flat_map(|v| v.split(','));
-    for range in ranges {
-        let mut params = range.split(';').map(str::trim);
-        let media = params.next().unwrap_or("").to_ascii_lowercase();
-        let q = params
-            .find_map(|p| p.strip_prefix("q="))
-            .and_then(|q| q.parse().ok())
-            .unwrap_or(1.0);
-        match media.as_str() {
-            "text/csv" => csv = csv.max(q),
-            "application/json" => json = json.max(q),
-            _ => {}
-        }
-    }
-    csv > 0.0 && csv >= json
 }
 
 /// Whether `If-None-Match` names `etag` (weak comparison, as for GET) or is `*`.
-fn if_none_match(headers: &HeaderMap, etag: &str) -> bool {
-    headers
-        .get_all(header::IF_NONE_MATCH)
+fn if_none_match(values: &[String], etag: &str) -> bool {
+    values
         .iter()
-        .filter_map(|v| v.to_str().ok())
         .flat_map(|v| v.split(','))
         .map(str::trim)
         .any(|tag| tag == "*" || tag.trim_start_matches("W/") == etag)
@@ -179,9 +201,21 @@ mod tests {
             ("*/*", false),
             ("text/csv;q=0", false),
         ] {
-            assert_eq!(wants_csv(&headers(header::ACCEPT, accept)), csv, "{accept}");
+            let format =
+                Answering::from_headers(&headers(header::ACCEPT, accept)).map(|a| a.format);
+            assert_eq!(format.is_ok_and(|f| f == Format::Csv), csv, "{accept}");
         }
-        assert!(!wants_csv(&HeaderMap::new()));
+        let none = Answering::from_headers(&HeaderMap::new()).unwrap();
+        assert_eq!(none.format, Format::Json);
+    }
+
+    #[test]
+    fn an_unacceptable_form_is_406() {
+        let refused = Answering::from_headers(&headers(header::ACCEPT, "image/png"));
+        assert_eq!(
+            refused.err().map(|e| e.status()),
+            Some(StatusCode::NOT_ACCEPTABLE)
+        );
     }
 
     #[test]
@@ -194,8 +228,11 @@ mod tests {
             ("*", true),
             ("\"abd\"", false),
         ] {
-            let h = headers(header::IF_NONE_MATCH, value);
-            assert_eq!(if_none_match(&h, etag), matches, "{value}");
+            assert_eq!(
+                if_none_match(&[value.to_string()], etag),
+                matches,
+                "{value}"
+            );
         }
     }
 }

@@ -7,8 +7,9 @@ use axum::Json;
 use serde::Serialize;
 use utoipa::ToSchema;
 
+use crate::http::accept::{Accept, AcceptsJson};
 use crate::http::error::ApiError;
-use crate::http::openapi::Draining;
+use crate::http::responses::{Draining, NotAcceptable};
 use crate::http::AppState;
 
 /// A probe's answer.
@@ -23,9 +24,9 @@ pub struct Health {
     get,
     path = "/healthz",
     tag = "operations",
-    responses((status = 200, description = "Alive", body = Health))
+    responses((status = 200, description = "Alive", body = Health), NotAcceptable)
 )]
-pub async fn healthz() -> Json<Health> {
+pub async fn healthz(_: AcceptsJson) -> Json<Health> {
     Json(Health { status: "ok" })
 }
 
@@ -34,9 +35,12 @@ pub async fn healthz() -> Json<Health> {
     get,
     path = "/readyz",
     tag = "operations",
-    responses((status = 200, description = "Ready", body = Health), Draining)
+    responses((status = 200, description = "Ready", body = Health), NotAcceptable, Draining)
 )]
-pub async fn readyz(State(state): State<AppState>) -> Result<Json<Health>, ApiError> {
+pub async fn readyz(
+    State(state): State<AppState>,
+    _: AcceptsJson,
+) -> Result<Json<Health>, ApiError> {
     if state.engine().is_draining() {
         Err(ApiError::draining())
     } else {
@@ -55,14 +59,18 @@ pub async fn readyz(State(state): State<AppState>) -> Result<Json<Health>, ApiEr
     path = "/metrics",
     tag = "operations",
     responses((status = 200, description = "Prometheus text exposition format",
-        content_type = "text/plain; version=0.0.4", body = String))
+        content_type = "text/plain; version=0.0.4", body = String), NotAcceptable)
 )]
-pub async fn metrics(State(state): State<AppState>) -> impl IntoResponse {
-    (
+pub async fn metrics(
+    State(state): State<AppState>,
+    accept: Accept,
+) -> Result<impl IntoResponse, ApiError> {
+    accept.require("text/plain")?;
+    Ok((
         [(
             header::CONTENT_TYPE,
             "text/plain; version=0.0.4; charset=utf-8",
         )],
         state.render_metrics(),
-    )
+    ))
 }

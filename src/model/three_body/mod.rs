@@ -98,6 +98,17 @@ pub enum OperatingPoint {
     ParticleLoad(f64),
 }
 
+impl OperatingPoint {
+    /// The separation, total load or mean particle load given.
+    pub fn value(self) -> f64 {
+        match self {
+            OperatingPoint::Separation(x)
+            | OperatingPoint::TotalLoad(x)
+            | OperatingPoint::ParticleLoad(x) => x,
+        }
+    }
+}
+
 /// A three-body system and its operating point (MODEL.md §4, defaults of §5).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ThreeBody {

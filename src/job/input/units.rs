@@ -59,6 +59,15 @@ impl Dimension {
         }
     }
 
+    /// The dimension of an SI unit expression such as `m/s` or `m^-2` (`""` for a plain
+    /// number).
+    pub fn of_unit(unit: &str) -> Option<Dimension> {
+        if unit.is_empty() {
+            return Some(Dimension::NONE);
+        }
+        parse_unit(unit).ok().map(|(_, dimension)| dimension)
+    }
+
     fn add(self, other: Dimension, power: i8) -> Dimension {
         let mut d = self.0;
         for (d, o) in d.iter_mut().zip(other.0) {
@@ -363,6 +372,23 @@ mod tests {
             parse_quantity(".", Dimension::LENGTH),
             Err(UnitError::NoNumber)
         );
+    }
+
+    #[test]
+    fn si_unit_expressions_have_their_dimension() {
+        for (unit, dimension) in [
+            ("", Dimension::NONE),
+            ("m", Dimension::LENGTH),
+            ("m^2", Dimension::AREA),
+            ("m^-2", Dimension::PER_AREA),
+            ("s", Dimension::TIME),
+            ("m/s", Dimension::SPEED),
+            ("N", Dimension::FORCE),
+            ("Pa", Dimension::PRESSURE),
+        ] {
+            assert_eq!(Dimension::of_unit(unit), Some(dimension), "{unit}");
+        }
+        assert_eq!(Dimension::of_unit("parsec"), None);
     }
 
     #[test]

@@ -1,0 +1,273 @@
+//! Reading the fields of an input: quantities with units, counts and lists, each checked
+//! against its range, every bad field recorded with its path and its value as sent.
+
+use serde_json::{json, Value};
+
+use super::units::{parse_quantity, Dimension, UnitError};
+use super::{Field, Quantity};
+use crate::job::FieldError;
+use crate::model::{OptionError, Parameter, ParameterError, SolveOption};
+use crate::render::format_number;
+
+/// What a field holds, so that the model's own checks land on the field that was read.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Source {
+    Parameter(Parameter),
+    Option(SolveOption),
+}
+
+/// Collects the errors of one input while its fields are read.
+#[derive(Debug, Default)]
+pub struct Checker {
+    /// Path of the object being read (`""` at the top, `layer`, `base.layer`...).
+    prefix: String,
+    errors: Vec<FieldError>,
+    /// Each quantity read: its path and the value as sent.
+    sent: Vec<(String, Value)>,
+    /// Where each model parameter and option was read (the first place).
+    paths: Vec<(Source, String)>,
+}
+
+impl Checker {
+    pub fn new() -> Self {
+        Checker::default()
+    }
+
+    /// The full path of `field` in the object being read (`""`: the object itself).
+    pub fn path(&self, field: &str) -> String {
+        if self.prefix.is_empty() {
+            field.to_string()
+        } else if field.is_empty() {
+            self.prefix.clone()
+        } else {
+            format!("{}.{field}", self.prefix)
+        }
+    }
+
+    /// Reads the object at `field` (absent: `None`) with `read`, its fields' paths under it.
+    pub fn nested<'a, T: Default + Clone + 'a, R>(
+        &mut self,
+        field: Field<'a, T>,
+        read: impl FnOnce(&mut Checker, &T) -> R,
+    ) -> R {
+        let inner = self.path(field.name);
+        let outer = std::mem::replace(&mut self.prefix, inner);
+        let object = field.value.cloned().unwrap_or_default();
+        let result = read(self, &object);
+        self.prefix = outer;
+        result
+    }
+
+    fn remember(&mut self, source: Source, path: &str) {
+        if !self.paths.iter().any(|(s, _)| *s == source) {
+            self.paths.push((source, path.to_string()));
+        }
+    }
+
+    /// The SI value of the quantity `field`, the model's `parameter` (whose unit fixes the
+    /// dimension); `default` if absent, NaN (with an error recorded) if unreadable.
+    pub fn quantity(&mut self, field: Field<Quantity>, parameter: Parameter, default: f64) -> f64 {
+        self.optional(field, parameter).unwrap_or(default)
+    }
+
+    /// [`Checker::quantity`] for a field that may be absent.
+    pub fn optional(&mut self, field: Field<Quantity>, parameter: Parameter) -> Option<f64> {
+        let path = self.path(field.name);
+        self.remember(Source::Parameter(parameter), &path);
+        Some(self.read(path, field.value?, parameter))
+    }
+
+    /// [`Checker::optional`] for a field the object needs (`why` says when).
+    pub fn required(&mut self, field: Field<Quantity>, parameter: Parameter, why: &str) -> f64 {
+        self.optional(field, parameter).unwrap_or_else(|| {
+            let dimension = dimension(parameter);
+            let allowed = format!("{}: required {why}", dimension.describe());
+            self.invalid(field.name, Value::Null, &allowed);
+            f64::NAN
+        })
+    }
+
+    /// A count such as a number of nodes, the solver `option` (its range is the model's to
+    /// check, see [`Checker::options`]).
+    pub fn count(&mut self, field: Field<usize>, option: SolveOption) -> Option<usize> {
+        let path = self.path(field.name);
+        self.remember(Source::Option(option), &path);
+        field.value.copied()
+    }
+
+    /// A list of values of `parameter`, each checked against its range; absent, the list of
+    /// `base` alone.
+    pub fn list(
+        &mut self,
+        field: Field<Vec<Quantity>>,
+        parameter: Parameter,
+        base: f64,
+    ) -> Vec<f64> {
+        let Some(values) = field.value else {
+            return vec![base];
+        };
+        if values.is_empty() {
+            self.invalid(field.name, json!([]), "a list of at least one value");
+        }
+        let path = self.path(field.name);
+        values
+            .iter()
+            .enumerate()
+            .map(|(i, q)| {
+                let item = format!("{path}[{i}]");
+                let x = self.read(item.clone(), q, parameter);
+                if let Err(e) = parameter.check(x) {
+                    self.out_of_range_at(item, x, parameter.unit(), &e.allowed);
+                }
+                x
+            })
+            .collect()
+    }
+
+    /// Reads one quantity at `path`.
+    fn read(&mut self, path: String, quantity: &Quantity, parameter: Parameter) -> f64 {
+        self.sent.push((path.clone(), quantity.sent()));
+        let dimension = dimension(parameter);
+        let parsed = match quantity {
+            Quantity::Number(x) => Ok(*x),
+            Quantity::Text(text) => parse_quantity(text, dimension),
+        };
+        parsed.unwrap_or_else(|e| {
+            self.unreadable(path, quantity.sent(), dimension, &e);
+            f64::NAN
+        })
+    }
+
+    fn unreadable(&mut self, field: String, value: Value, expected: Dimension, e: &UnitError) {
+        let allowed = expected.describe();
+        let message = format!("{field}: {value} {e}; expected {allowed}");
+        self.errors.push(FieldError {
+            field,
+            value,
+            allowed,
+            message,
+        });
+    }
+
+    /// Records a value of `field` (in the object being read) outside its range.
+    pub fn out_of_range(&mut self, field: &str, value: f64, unit: &str, allowed: &str) {
+        let path = self.path(field);
+        self.out_of_range_at(path, value, unit, allowed);
+    }
+
+    /// Records a value outside its range, unless the field (or the object holding it) was
+    /// already reported: a value read as NaN after an error says nothing new.
+    fn out_of_range_at(&mut self, path: String, value: f64, unit: &str, allowed: &str) {
+        let covered = |e: &FieldError| {
+            path == e.field
+                || path
+                    .strip_prefix(e.field.as_str())
+                    .is_some_and(|rest| rest.starts_with('.'))
+        };
+        if self.errors.iter().any(covered) {
+            return;
+        }
+        let sent = self
+            .sent
+            .iter()
+            .find(|(p, _)| *p == path)
+            .map_or_else(|| Value::from(value), |(_, v)| v.clone());
+        let number = format_number(value);
+        let si = if unit.is_empty() {
+            number
+        } else {
+            format!("{number} {unit}")
+        };
+        let message = match &sent {
+            Value::String(s) => {
+                format!("{path} = \"{s}\" ({si}) is out of range: allowed {allowed}")
+            }
+            _ => format!("{path} = {si} is out of range: allowed {allowed}"),
+        };
+        self.errors.push(FieldError {
+            field: path,
+            value: sent,
+            allowed: allowed.to_string(),
+            message,
+        });
+    }
+
+    /// The path a parameter or option was read at (its name if it was never read).
+    fn path_of(&self, source: Source, name: impl FnOnce() -> String) -> String {
+        self.paths
+            .iter()
+            .find(|(s, _)| *s == source)
+            .map_or_else(name, |(_, p)| p.clone())
+    }
+
+    /// Records the model's range violations, each at the field its parameter was read from.
+    pub fn parameters(&mut self, errors: Vec<ParameterError>) {
+        for e in errors {
+            let path = self.path_of(Source::Parameter(e.parameter), || e.parameter.to_string());
+            self.out_of_range_at(path, e.value, e.parameter.unit(), &e.allowed);
+        }
+    }
+
+    /// Records the model's option violations, each at the field its option was read from.
+    pub fn options(&mut self, errors: Vec<OptionError>) {
+        for e in errors {
+            let path = self.path_of(Source::Option(e.option), || e.option.to_string());
+            self.out_of_range_at(path, e.value as f64, "", &e.allowed);
+        }
+    }
+
+    /// Records an error of `field` that is not a range (e.g. an empty list).
+    pub fn invalid(&mut self, field: &str, value: Value, allowed: &str) {
+        let path = self.path(field);
+        let message = format!("{path}: {value} is not allowed: allowed {allowed}");
+        self.errors.push(FieldError {
+            field: path,
+            value,
+            allowed: allowed.to_string(),
+            message,
+        });
+    }
+
+    /// The recorded errors, as the job's error.
+    pub fn into_error(self) -> crate::job::JobError {
+        crate::job::JobError::Invalid(self.errors)
+    }
+
+    /// `Ok(value)` if no field was bad, else every error.
+    pub fn finish<T>(self, value: T) -> Result<T, crate::job::JobError> {
+        if self.errors.is_empty() {
+            Ok(value)
+        } else {
+            Err(self.into_error())
+        }
+    }
+}
+
+/// The dimension of a parameter's values, read off its SI unit.
+fn dimension(parameter: Parameter) -> Dimension {
+    Dimension::of_unit(parameter.unit()).expect("the model's units are SI unit expressions")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_parameter_has_the_dimension_of_its_unit() {
+        use Parameter::*;
+        for (parameter, expected) in [
+            (Radius, Dimension::LENGTH),
+            (Load, Dimension::FORCE),
+            (Velocity, Dimension::SPEED),
+            (ElasticModulus, Dimension::PRESSURE),
+            (PoissonRatio, Dimension::NONE),
+            (RelaxationTime, Dimension::TIME),
+            (ArealDensity, Dimension::PER_AREA),
+            (NominalArea, Dimension::AREA),
+            (AsperityDensity, Dimension::PER_AREA),
+            (ParticleLoad, Dimension::FORCE),
+        ] {
+            assert_eq!(dimension(parameter), expected, "{parameter}");
+        }
+    }
+}

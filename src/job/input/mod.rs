@@ -1,0 +1,130 @@
+//! The pieces every job kind's input is made of: quantities with units ([`units`]), the
+//! Kelvin layer and the quadrature options shared by several kinds, and the [`Checker`] that
+//! reads fields and reports every bad one with its path, its value as sent and the allowed
+//! range.
+//!
+//! A field's name is written once, as the field of its input struct: the [`field!`] macro
+//! takes the error path from the struct field itself, serde takes the wire name from it,
+//! and the canonical form is the input struct filled in and serialized ([`canonical`]).
+
+mod checker;
+mod layer;
+mod quadrature;
+pub mod units;
+
+use serde::de::DeserializeOwned;
+use serde::{Deserialize, Serialize};
+use serde_json::Value;
+use utoipa::ToSchema;
+
+pub use checker::Checker;
+pub use layer::LayerInput;
+pub use quadrature::QuadratureKind;
+
+use super::JobError;
+
+/// A quantity as sent: an SI number, or a string with a unit such as `"25 nm"`, `"1.2 nN"`,
+/// `"4 nm/s"`, `"3 GPa"` or `"100 ms"` (its dimension must be the field's).
+#[derive(Clone, Debug, PartialEq, Deserialize, Serialize, ToSchema)]
+#[serde(untagged)]
+pub enum Quantity {
+    Number(f64),
+    Text(String),
+}
+
+impl Quantity {
+    /// The canonical form of an SI value: a number, with -0 read as 0.
+    pub fn si(x: f64) -> Option<Quantity> {
+        Some(Quantity::Number(si(x)))
+    }
+
+    /// The value as sent, for error reports.
+    fn sent(&self) -> Value {
+        match self {
+            Quantity::Number(x) => Value::from(*x),
+            Quantity::Text(s) => Value::from(s.as_str()),
+        }
+    }
+}
+
+/// -0.0 and 0.0 are the same input: one canonical form, one cache key.
+pub fn si(x: f64) -> f64 {
+    if x == 0.0 {
+        0.0
+    } else {
+        x
+    }
+}
+
+/// A field of an input as sent: its name and its value, if any.
+#[derive(Debug)]
+pub struct Field<'a, T> {
+    pub name: &'static str,
+    pub value: Option<&'a T>,
+}
+
+impl<T> Clone for Field<'_, T> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+
+impl<T> Copy for Field<'_, T> {}
+
+/// `field!(input.radius)`: the field `radius` of `input` (an `Option`), named after the
+/// struct field itself, so that an error's path cannot drift from the input's shape.
+macro_rules! field {
+    ($input:ident . $name:ident) => {
+        $crate::job::input::Field {
+            name: stringify!($name),
+            value: $input.$name.as_ref(),
+        }
+    };
+}
+pub(crate) use field;
+
+/// Deserializes `value` as `T`; a misshapen field is reported with its path under `prefix`.
+pub fn deserialize<T: DeserializeOwned>(value: Value, prefix: &str) -> Result<T, JobError> {
+    serde_path_to_error::deserialize(value).map_err(|e| {
+        let inner = e.path().to_string();
+        let field = match (prefix, inner.as_str()) {
+            (p, ".") => p.to_string(),
+            ("", i) => i.to_string(),
+            (p, i) => format!("{p}.{i}"),
+        };
+        JobError::Schema {
+            field,
+            message: e.into_inner().to_string(),
+        }
+    })
+}
+
+/// Deserializes an input of type `I` and reads it with `read` under a fresh checker: the
+/// job, or every bad field at once.
+pub fn validate<I: DeserializeOwned, T>(
+    value: Value,
+    read: impl FnOnce(&I, &mut Checker) -> T,
+) -> Result<T, JobError> {
+    let input: I = deserialize(value, "")?;
+    let mut checker = Checker::new();
+    let job = read(&input, &mut checker);
+    checker.finish(job)
+}
+
+/// The canonical form of an input filled in: its JSON with the absent (`null`) fields left
+/// out, so that it reads back as the same input.
+pub fn canonical<T: Serialize>(input: &T) -> Value {
+    fn strip_nulls(value: Value) -> Value {
+        match value {
+            Value::Object(map) => Value::Object(
+                map.into_iter()
+                    .filter(|(_, v)| !v.is_null())
+                    .map(|(k, v)| (k, strip_nulls(v)))
+                    .collect(),
+            ),
+            Value::Array(items) => Value::Array(items.into_iter().map(strip_nulls).collect()),
+            other => other,
+        }
+    }
+    strip_nulls(serde_json::to_value(input).expect("an input serializes to JSON"))
+}

@@ -1,0 +1,145 @@
+//! A job kind is one type behind one trait ([`Kind`]): it validates its input, gives its
+//! canonical form (and so its cache key), says how much work it takes, and runs under a
+//! [`Control`] to an answer the render layer can write in every format. [`Job`] holds any
+//! validated job, whatever its kind; the registry ([`super::registry`]) finds a kind by its
+//! name on the wire and reads a job from JSON.
+
+use std::any::Any;
+use std::fmt;
+use std::sync::Arc;
+
+use serde_json::Value;
+use utoipa::ToSchema;
+
+use super::meta::{Meta, Reference};
+use super::{Control, JobError, Limits};
+use crate::render::{Answer, Output};
+
+/// How much work a job takes, in the units its [`Control`] counts (rolling solves for the
+/// kinds that solve contacts); `Unknown` for a job that cannot tell in advance (an
+/// iterative one).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Work {
+    Known(usize),
+    Unknown,
+}
+
+/// A kind of job.
+pub trait Kind: fmt::Debug + PartialEq + Send + Sync + Sized + 'static {
+    /// The kind's name on the wire: the `kind` of a job envelope and of a job's status.
+    const NAME: &'static str;
+    /// The answer.
+    type Output: Output + ToSchema;
+
+    /// Reads and validates an input of this kind; error paths are relative to the input.
+    fn validate(input: Value, limits: &Limits) -> Result<Self, JobError>;
+
+    /// The canonical input: every default filled in, every quantity an SI number. Equal
+    /// canonical inputs have equal answers.
+    fn canonical(&self) -> Value;
+
+    /// The papers behind the answer.
+    fn references(&self) -> &'static [Reference];
+
+    /// The work the job takes.
+    fn work(&self) -> Work;
+
+    /// Runs the job to its answer, whose `meta` is `meta`. A long job checks `control`
+    /// between units of work, and counts them there.
+    fn run(&self, meta: Meta, control: &Control) -> Result<Self::Output, JobError>;
+}
+
+/// What [`Job`] needs of a kind, object-safe.
+trait Dispatch: fmt::Debug + Send + Sync {
+    fn name(&self) -> &'static str;
+    fn canonical(&self) -> Value;
+    fn references(&self) -> &'static [Reference];
+    fn work(&self) -> Work;
+    fn run(&self, meta: Meta, control: &Control) -> Result<Answer, JobError>;
+    fn as_any(&self) -> &dyn Any;
+    fn same(&self, other: &dyn Any) -> bool;
+}
+
+impl<K: Kind> Dispatch for K {
+    fn name(&self) -> &'static str {
+        K::NAME
+    }
+
+    fn canonical(&self) -> Value {
+        Kind::canonical(self)
+    }
+
+    fn references(&self) -> &'static [Reference] {
+        Kind::references(self)
+    }
+
+    fn work(&self) -> Work {
+        Kind::work(self)
+    }
+
+    fn run(&self, meta: Meta, control: &Control) -> Result<Answer, JobError> {
+        Kind::run(self, meta, control).map(Answer::new)
+    }
+
+    fn as_any(&self) -> &dyn Any {
+        self
+    }
+
+    fn same(&self, other: &dyn Any) -> bool {
+        other.downcast_ref::<K>() == Some(self)
+    }
+}
+
+/// A validated job of any kind, ready for the engine (cheap to clone).
+#[derive(Clone, Debug)]
+pub struct Job(Arc<dyn Dispatch>);
+
+impl Job {
+    /// A job of kind `K`.
+    pub fn new<K: Kind>(job: K) -> Job {
+        Job(Arc::new(job))
+    }
+
+    /// The kind's name on the wire.
+    pub fn kind(&self) -> &'static str {
+        self.0.name()
+    }
+
+    /// The canonical input: every default filled in, every quantity an SI number.
+    pub fn canonical(&self) -> Value {
+        self.0.canonical()
+    }
+
+    /// The `meta` block of the job's answer: model version, canonical input and its hash,
+    /// references. Computing it costs a few µs, so a caller that needs both the key and the
+    /// answer computes it once and passes it on.
+    pub fn meta(&self) -> Meta {
+        Meta::new(self.kind(), self.canonical(), self.0.references())
+    }
+
+    /// Hash of the canonical input and the model version: equal keys, equal results.
+    pub fn cache_key(&self) -> String {
+        self.meta().input_hash
+    }
+
+    /// The work the job takes.
+    pub fn work(&self) -> Work {
+        self.0.work()
+    }
+
+    /// Runs the job to its answer, whose `meta` is `meta` (see [`Job::meta`]).
+    pub fn run(&self, meta: Meta, control: &Control) -> Result<Answer, JobError> {
+        self.0.run(meta, control)
+    }
+
+    /// The job, if it is of kind `K`.
+    pub fn downcast_ref<K: Kind>(&self) -> Option<&K> {
+        self.0.as_any().downcast_ref()
+    }
+}
+
+impl PartialEq for Job {
+    fn eq(&self, other: &Job) -> bool {
+        self.0.same(other.0.as_any())
+    }
+}

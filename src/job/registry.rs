@@ -1,0 +1,206 @@
+//! The job kinds the service knows, found by their name on the wire. Adding a kind is its
+//! module and one line in [`LIST`]: the envelope, the job store, the OpenAPI schemas of
+//! `JobKind` and `Output` follow from here.
+
+use std::borrow::Cow;
+
+use serde::{Deserialize, Deserializer, Serialize, Serializer};
+use serde_json::Value;
+use utoipa::openapi::schema::{ObjectBuilder, OneOfBuilder, Schema, Type};
+use utoipa::openapi::{Ref, RefOr};
+use utoipa::{PartialSchema, ToSchema};
+
+use super::figure::FigureJob;
+use super::kind::{Job, Kind};
+use super::rolling::RollingJob;
+use super::sweep::SweepJob;
+use super::three_body::ThreeBodyJob;
+use super::{JobError, Limits};
+
+/// Schemas as utoipa collects them: (name, schema).
+type Schemas = Vec<(String, RefOr<Schema>)>;
+
+/// A registered kind: its name and what the rest of the crate needs of it without knowing
+/// its type.
+pub struct Registered {
+    name: &'static str,
+    validate: fn(Value, &Limits) -> Result<Job, JobError>,
+    output_schema: fn(&mut Schemas) -> RefOr<Schema>,
+}
+
+impl Registered {
+    const fn of<K: Kind>() -> Registered {
+        Registered {
+            name: K::NAME,
+            validate: validate::<K>,
+            output_schema: output_schema::<K>,
+        }
+    }
+
+    /// Reads and validates an input of this kind.
+    pub fn validate(&self, input: Value, limits: &Limits) -> Result<Job, JobError> {
+        (self.validate)(input, limits)
+    }
+}
+
+fn validate<K: Kind>(input: Value, limits: &Limits) -> Result<Job, JobError> {
+    K::validate(input, limits).map(Job::new)
+}
+
+/// Adds the schema of `K`'s output (and those it refers to) to `schemas`; returns a
+/// reference to it.
+fn output_schema<K: Kind>(schemas: &mut Schemas) -> RefOr<Schema> {
+    let name = K::Output::name();
+    schemas.push((name.to_string(), K::Output::schema()));
+    K::Output::schemas(schemas);
+    Ref::from_schema_name(name).into()
+}
+
+/// Every job kind, one line each.
+const LIST: [Registered; 4] = [
+    Registered::of::<RollingJob>(),
+    Registered::of::<ThreeBodyJob>(),
+    Registered::of::<SweepJob>(),
+    Registered::of::<FigureJob>(),
+];
+
+static KINDS: [Registered; LIST.len()] = LIST;
+
+/// The kinds' names, in the order of [`LIST`].
+const NAMES: [&str; LIST.len()] = {
+    let mut names = [""; LIST.len()];
+    let mut i = 0;
+    while i < names.len() {
+        names[i] = LIST[i].name;
+        i += 1;
+    }
+    names
+};
+
+/// The kind named `name`, or the error naming the known ones.
+pub fn find(name: &str) -> Result<&'static Registered, JobError> {
+    KINDS
+        .iter()
+        .find(|k| k.name == name)
+        .ok_or_else(|| JobError::Schema {
+            field: "kind".to_string(),
+            message: unknown_kind(name),
+        })
+}
+
+fn unknown_kind(name: &str) -> String {
+    let known: Vec<String> = NAMES.iter().map(|n| format!("\"{n}\"")).collect();
+    format!(
+        "unknown kind \"{name}\": expected one of {}",
+        known.join(", ")
+    )
+}
+
+impl Job {
+    /// Parses and validates an enveloped job from JSON text.
+    pub fn from_json(text: &[u8], limits: &Limits) -> Result<Job, JobError> {
+        let value: Value = serde_json::from_slice(text).map_err(JobError::from_json)?;
+        Job::from_value(value, limits)
+    }
+
+    /// Validates an enveloped job `{"kind": ..., "input": {...}}` already parsed as JSON.
+    pub fn from_value(value: Value, limits: &Limits) -> Result<Job, JobError> {
+        let envelope: Envelope = super::input::deserialize(value, "")?;
+        let input = envelope
+            .input
+            .unwrap_or_else(|| Value::Object(Default::default()));
+        Job::from_input(envelope.kind.name(), input, limits)
+    }
+
+    /// Validates the input of a job of the kind named `kind` (the envelope's `input`, or the
+    /// body of the HTTP endpoint of that kind): error paths are relative to the input.
+    pub fn from_input(kind: &str, input: Value, limits: &Limits) -> Result<Job, JobError> {
+        find(kind)?.validate(input, limits)
+    }
+}
+
+/// The name of a registered kind, as the wire has it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct KindName(&'static str);
+
+impl KindName {
+    pub fn of(kind: &'static str) -> KindName {
+        KindName(kind)
+    }
+
+    pub fn name(self) -> &'static str {
+        self.0
+    }
+}
+
+impl Serialize for KindName {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(self.0)
+    }
+}
+
+impl<'de> Deserialize<'de> for KindName {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let name = Cow::<str>::deserialize(d)?;
+        find(&name)
+            .map(|k| KindName(k.name))
+            .map_err(|_| serde::de::Error::custom(unknown_kind(&name)))
+    }
+}
+
+impl PartialSchema for KindName {
+    fn schema() -> RefOr<Schema> {
+        ObjectBuilder::new()
+            .schema_type(Type::String)
+            .description(Some("What a job computes."))
+            .enum_values(Some(NAMES))
+            .into()
+    }
+}
+
+impl ToSchema for KindName {
+    fn name() -> Cow<'static, str> {
+        Cow::Borrowed("JobKind")
+    }
+}
+
+/// The envelope `{"kind": ..., "input": {...}}`; a missing input means all defaults.
+#[derive(Deserialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct Envelope {
+    pub kind: KindName,
+    /// The input of the job's kind: a `RollingInput`, `ThreeBodyInput`, `SweepInput` or
+    /// `FigureInput`.
+    /// Absent, every field takes its default.
+    #[serde(default)]
+    #[schema(value_type = Option<Object>)]
+    pub input: Option<Value>,
+}
+
+/// The answer to any job, for the OpenAPI description: one of the kinds' outputs.
+pub struct AnyOutput;
+
+impl PartialSchema for AnyOutput {
+    fn schema() -> RefOr<Schema> {
+        let mut ignored = Schemas::new();
+        KINDS
+            .iter()
+            .fold(OneOfBuilder::new(), |one_of, k| {
+                one_of.item((k.output_schema)(&mut ignored))
+            })
+            .description(Some("The answer to any job."))
+            .into()
+    }
+}
+
+impl ToSchema for AnyOutput {
+    fn name() -> Cow<'static, str> {
+        Cow::Borrowed("Output")
+    }
+
+    fn schemas(schemas: &mut Schemas) {
+        for kind in &KINDS {
+            (kind.output_schema)(schemas);
+        }
+    }
+}

@@ -1,0 +1,264 @@
+//! Every answer leaves through here: as JSON, or as a CSV table built from the columns its
+//! output declares once. The job layer defines the answers ([`Output`]); the HTTP service
+//! and the command line choose a [`Format`] ([`negotiate`] for HTTP) and render an
+//! [`Answer`] into bytes.
+
+mod negotiate;
+mod number;
+mod table;
+
+use std::any::Any;
+use std::fmt;
+
+use serde::{Serialize, Serializer};
+use serde_json::value::RawValue;
+
+pub use negotiate::negotiate;
+pub use number::format_number;
+pub use table::{Cell, Column, Heading, Table};
+
+/// The forms an answer can take.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Format {
+    Json,
+    Csv,
+}
+
+impl Format {
+    /// Every format, in the service's order of preference (the first when the client
+    /// accepts any).
+    pub const ALL: [Format; 2] = [Format::Json, Format::Csv];
+
+    /// The media type a client names in `Accept`.
+    pub fn media_type(self) -> &'static str {
+        match self {
+            Format::Json => "application/json",
+            Format::Csv => "text/csv",
+        }
+    }
+
+    /// The `Content-Type` of an answer in this format.
+    pub fn content_type(self) -> &'static str {
+        match self {
+            Format::Json => "application/json",
+            Format::Csv => "text/csv; charset=utf-8; header=present",
+        }
+    }
+
+    /// The format a client prefers among `offered`, from the values of its `Accept`
+    /// headers; `None` when it accepts none of them.
+    pub fn negotiate<'a>(
+        accept: impl IntoIterator<Item = &'a str>,
+        offered: &[Format],
+    ) -> Option<Format> {
+        let types: Vec<&str> = offered.iter().map(|f| f.media_type()).collect();
+        negotiate(accept, &types).map(|i| offered[i])
+    }
+}
+
+/// Why an answer could not be rendered: a fault of the service, never of the job.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RenderError(String);
+
+impl fmt::Display for RenderError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl std::error::Error for RenderError {}
+
+/// The answer of a job kind: JSON through serde, and one table for CSV.
+pub trait Output: Serialize + fmt::Debug + PartialEq + Send + Sync + 'static {
+    /// The answer as one table, its columns declared once by the output.
+    fn table(&self) -> Table;
+}
+
+/// What [`Answer`] needs of an output, object-safe.
+trait Render: fmt::Debug + Send + Sync {
+    fn json(&self, pretty: bool) -> serde_json::Result<Vec<u8>>;
+    fn table(&self) -> Table;
+    fn as_any(&self) -> &dyn Any;
+    fn into_any(self: Box<Self>) -> Box<dyn Any>;
+    fn same(&self, other: &dyn Any) -> bool;
+}
+
+impl<T: Output> Render for T {
+    fn json(&self, pretty: bool) -> serde_json::Result<Vec<u8>> {
+        if pretty {
+            serde_json::to_vec_pretty(self)
+        } else {
+            serde_json::to_vec(self)
+        }
+    }
+
+    fn table(&self) -> Table {
+        Output::table(self)
+    }
+
+    fn as_any(&self) -> &dyn Any {
+        self
+    }
+
+    fn into_any(self: Box<Self>) -> Box<dyn Any> {
+        self
+    }
+
+    fn same(&self, other: &dyn Any) -> bool {
+        other.downcast_ref::<T>() == Some(self)
+    }
+}
+
+/// The answer to any job, whatever its kind.
+#[derive(Debug)]
+pub struct Answer(Box<dyn Render>);
+
+impl Answer {
+    pub fn new<T: Output>(output: T) -> Answer {
+        Answer(Box::new(output))
+    }
+
+    /// The answer in `format`: compact JSON, or CSV.
+    pub fn render(&self, format: Format) -> Result<Vec<u8>, RenderError> {
+        match format {
+            Format::Json => self.json(false),
+            Format::Csv => {
+                let table = self.0.table();
+                let finite = table.rows.iter().flatten().all(|cell| match cell {
+                    Cell::Number(x) => x.is_finite(),
+                    Cell::Count(_) | Cell::Text(_) => true,
+                });
+                if !finite {
+                    return Err(non_finite());
+                }
+                Ok(table.to_csv().into_bytes())
+            }
+        }
+    }
+
+    /// Indented JSON, for people reading a terminal.
+    pub fn to_pretty_json(&self) -> Result<String, RenderError> {
+        let json = self.json(true)?;
+        String::from_utf8(json).map_err(|e| RenderError(e.to_string()))
+    }
+
+    /// serde_json writes a non-finite float as `null`, and the answers never hold `null`
+    /// (absent options are skipped): a `null` can only be such a float, which the model
+    /// promises never to return. It is an error here rather than a silent `null`.
+    fn json(&self, pretty: bool) -> Result<Vec<u8>, RenderError> {
+        let json = self
+            .0
+            .json(pretty)
+            .map_err(|e| RenderError(format!("cannot write the result: {e}")))?;
+        if has_null(&json) {
+            return Err(non_finite());
+        }
+        Ok(json)
+    }
+
+    /// The answer's table (the rows of its CSV).
+    pub fn table(&self) -> Table {
+        self.0.table()
+    }
+
+    /// The output, if it is a `T`.
+    pub fn downcast_ref<T: Output>(&self) -> Option<&T> {
+        self.0.as_any().downcast_ref()
+    }
+
+    /// The output, if it is a `T`; else the answer back.
+    pub fn downcast<T: Output>(self) -> Result<T, Answer> {
+        if self.downcast_ref::<T>().is_none() {
+            return Err(self);
+        }
+        Ok(*self
+            .0
+            .into_any()
+            .downcast()
+            .expect("the type was checked above"))
+    }
+}
+
+impl PartialEq for Answer {
+    fn eq(&self, other: &Answer) -> bool {
+        self.0.same(other.0.as_any())
+    }
+}
+
+/// Writes the answer's JSON (for serde_json serializers: it goes in as raw JSON).
+impl Serialize for Answer {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        let json = self.json(false).map_err(serde::ser::Error::custom)?;
+        let text = String::from_utf8(json).map_err(serde::ser::Error::custom)?;
+        let raw = RawValue::from_string(text).map_err(serde::ser::Error::custom)?;
+        raw.serialize(s)
+    }
+}
+
+fn non_finite() -> RenderError {
+    RenderError("the result holds a non-finite number".to_string())
+}
+
+/// Whether JSON text holds a `null` value. Outside strings the letter `n` can only start
+/// `null` (`true`, `false` and numbers have none), so one pass that skips strings finds it.
+fn has_null(json: &[u8]) -> bool {
+    let (mut in_string, mut escaped) = (false, false);
+    for &b in json {
+        if in_string {
+            match b {
+                _ if escaped => escaped = false,
+                b'\\' => escaped = true,
+                b'"' => in_string = false,
+                _ => {}
+            }
+        } else if b == b'"' {
+            in_string = true;
+        } else if b == b'n' {
+            return true;
+        }
+    }
+    false
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_null_value_is_found_and_a_null_inside_a_string_is_not() {
+        assert!(has_null(br#"{"a":null}"#));
+        assert!(has_null(br#"{"a":[1,null]}"#));
+        assert!(has_null(b"[null]"));
+        assert!(has_null(b"{\n  \"a\": null\n}"));
+        assert!(!has_null(br#"{"a":"nullable","b":1}"#));
+        assert!(!has_null(br#"{"a":"x: null"}"#));
+        assert!(!has_null(br#"{"a":"quote \" null","b":true}"#));
+        assert!(!has_null(br#"{"a":"back\\","b":false}"#));
+    }
+
+    #[derive(Debug, PartialEq, Serialize)]
+    struct Point {
+        x: f64,
+    }
+
+    impl Output for Point {
+        fn table(&self) -> Table {
+            const COLUMNS: [Column<Point>; 1] = [Column::number("x", "m", |p| p.x)];
+            Table::new(&COLUMNS, [self])
+        }
+    }
+
+    #[test]
+    fn an_answer_renders_in_every_format_and_refuses_a_non_finite_number() {
+        let answer = Answer::new(Point { x: 0.5 });
+        assert_eq!(answer.render(Format::Json).unwrap(), br#"{"x":0.5}"#);
+        assert_eq!(answer.render(Format::Csv).unwrap(), b"x\n0.5\n");
+        assert_eq!(answer, Answer::new(Point { x: 0.5 }));
+        assert_eq!(serde_json::to_string(&answer).unwrap(), r#"{"x":0.5}"#);
+        assert_eq!(answer.downcast::<Point>().unwrap(), Point { x: 0.5 });
+        let bad = Answer::new(Point { x: f64::NAN });
+        assert!(bad.render(Format::Json).is_err());
+        assert!(bad.render(Format::Csv).is_err());
+        assert!(bad.to_pretty_json().is_err());
+    }
+}

@@ -1,0 +1,172 @@
+//! Answers as tables: each output declares its columns once (name, unit, how a row gives its
+//! cell), and the header and every row are written from that one declaration, so a CSV
+//! header cannot drift from its rows.
+
+use super::number::format_number;
+
+/// One cell of a table.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Cell {
+    /// A quantity in the column's SI unit.
+    Number(f64),
+    /// A count or an index.
+    Count(usize),
+    /// Free text, such as a legend (quoted in CSV).
+    Text(String),
+}
+
+/// How a column reads its cell off a row.
+enum Read<R> {
+    Number(fn(&R) -> f64),
+    Count(fn(&R) -> usize),
+    Text(fn(&R) -> String),
+}
+
+/// A column of a table whose rows are `R`s.
+pub struct Column<R> {
+    pub name: &'static str,
+    /// SI unit of the column ("" for plain numbers, counts and text).
+    pub unit: &'static str,
+    read: Read<R>,
+}
+
+impl<R> Column<R> {
+    /// A column of quantities in `unit` (SI; "" for a plain number).
+    pub const fn number(name: &'static str, unit: &'static str, read: fn(&R) -> f64) -> Self {
+        Column {
+            name,
+            unit,
+            read: Read::Number(read),
+        }
+    }
+
+    /// A column of counts or indices.
+    pub const fn count(name: &'static str, read: fn(&R) -> usize) -> Self {
+        Column {
+            name,
+            unit: "",
+            read: Read::Count(read),
+        }
+    }
+
+    /// A column of text.
+    pub const fn text(name: &'static str, read: fn(&R) -> String) -> Self {
+        Column {
+            name,
+            unit: "",
+            read: Read::Text(read),
+        }
+    }
+
+    /// The cell of `row`.
+    pub fn cell(&self, row: &R) -> Cell {
+        match self.read {
+            Read::Number(read) => Cell::Number(read(row)),
+            Read::Count(read) => Cell::Count(read(row)),
+            Read::Text(read) => Cell::Text(read(row)),
+        }
+    }
+}
+
+/// The heading of a column of a built table.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Heading {
+    pub name: String,
+    pub unit: &'static str,
+}
+
+/// A table of cells under headings, one row per record.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Table {
+    pub headings: Vec<Heading>,
+    pub rows: Vec<Vec<Cell>>,
+}
+
+impl Table {
+    /// The table of `rows` under `columns`.
+    pub fn new<'a, R: 'a>(columns: &[Column<R>], rows: impl IntoIterator<Item = &'a R>) -> Table {
+        Table {
+            headings: columns
+                .iter()
+                .map(|c| Heading {
+                    name: c.name.to_string(),
+                    unit: c.unit,
+                })
+                .collect(),
+            rows: rows
+                .into_iter()
+                .map(|row| columns.iter().map(|c| c.cell(row)).collect())
+                .collect(),
+        }
+    }
+
+    /// Renames column `index` and gives it `unit` (a column whose quantity depends on the
+    /// rows, such as the operating point a sweep varies).
+    pub fn rename(&mut self, index: usize, name: &str, unit: &'static str) {
+        if let Some(heading) = self.headings.get_mut(index) {
+            heading.name = name.to_string();
+            heading.unit = unit;
+        }
+    }
+
+    /// CSV (RFC 4180): one header line, one line per row; numbers in their shortest
+    /// round-trip form, text quoted.
+    pub fn to_csv(&self) -> String {
+        let mut csv = String::new();
+        let names: Vec<&str> = self.headings.iter().map(|h| h.name.as_str()).collect();
+        csv.push_str(&names.join(","));
+        csv.push('\n');
+        for row in &self.rows {
+            let cells: Vec<String> = row.iter().map(csv_cell).collect();
+            csv.push_str(&cells.join(","));
+            csv.push('\n');
+        }
+        csv
+    }
+}
+
+fn csv_cell(cell: &Cell) -> String {
+    match cell {
+        Cell::Number(x) => format_number(*x),
+        Cell::Count(n) => n.to_string(),
+        Cell::Text(text) => format!("\"{}\"", text.replace('"', "\"\"")),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    struct Row {
+        x: f64,
+        label: &'static str,
+    }
+
+    const COLUMNS: [Column<Row>; 3] = [
+        Column::count("index", |_| 7),
+        Column::number("x", "m", |r| r.x),
+        Column::text("label", |r| r.label.to_string()),
+    ];
+
+    #[test]
+    fn the_header_and_the_rows_come_from_one_declaration() {
+        let rows = [
+            Row {
+                x: 2.5e-8,
+                label: "a",
+            },
+            Row {
+                x: 0.5,
+                label: "say \"b\"",
+            },
+        ];
+        let mut table = Table::new(&COLUMNS, &rows);
+        assert_eq!(
+            table.to_csv(),
+            "index,x,label\n7,2.5e-8,\"a\"\n7,0.5,\"say \"\"b\"\"\"\n"
+        );
+        table.rename(1, "load", "N");
+        assert!(table.to_csv().starts_with("index,load,label\n"));
+        assert_eq!(table.headings[1].unit, "N");
+    }
+}

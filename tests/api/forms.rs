@@ -1,0 +1,98 @@
+//! Every answer in the form the client accepts: JSON or CSV for every job's answer, one
+//! form for the other resources, and 406 with a problem when none is acceptable.
+
+use reqwest::Method;
+use serde_json::{json, Value};
+
+use crate::helpers::{problem, problem_type, spawn_app};
+
+#[tokio::test]
+async fn every_job_answer_comes_as_csv_when_asked() {
+    let app = spawn_app(&[]).await;
+    let csv = [("accept", "text/csv")];
+    for (path, body, first) in [
+        ("/v1/rolling", json!({}), "radius,load,velocity,penetration"),
+        (
+            "/v1/three-body",
+            json!({"operating": {"total_load": "1 mN"}}),
+            "total_load,velocity,mean_diameter,separation",
+        ),
+    ] {
+        let response = app.send(Method::POST, path, &csv, Some(&body)).await;
+        assert_eq!(response.status(), 200, "{path}");
+        assert!(response.headers()["etag"]
+            .to_str()
+            .unwrap()
+            .ends_with(".csv\""));
+        let text = response.text().await.unwrap();
+        assert!(text.starts_with(first), "{text}");
+        assert_eq!(text.lines().count(), 2, "{text}");
+    }
+    // The CSV row holds the same numbers as the JSON answer.
+    let json: Value = app
+        .post("/v1/rolling", &json!({}))
+        .await
+        .json()
+        .await
+        .unwrap();
+    let text = app
+        .send(Method::POST, "/v1/rolling", &csv, Some(&json!({})))
+        .await
+        .text()
+        .await
+        .unwrap();
+    let row: Vec<f64> = text
+        .lines()
+        .nth(1)
+        .unwrap()
+        .split(',')
+        .map(|c| c.parse().unwrap())
+        .collect();
+    assert_eq!(row[4], json["contact_area"].as_f64().unwrap());
+    assert_eq!(row[9], json["friction_coefficient"].as_f64().unwrap());
+}
+
+#[tokio::test]
+async fn a_form_no_resource_offers_is_406_before_any_work() {
+    let app = spawn_app(&[]).await;
+    let png = [("accept", "image/png")];
+    let refused = app.send(Method::GET, "/v1/figures/6", &png, None).await;
+    let refusal = problem(refused, 406).await;
+    assert_eq!(refusal["type"], problem_type("not-acceptable"));
+    assert!(refusal["detail"].as_str().unwrap().contains("text/csv"));
+    assert_eq!(app.solves(&[]).await, 0.0, "nothing was solved");
+
+    let csv = [("accept", "text/csv")];
+    let body = json!({"kind": "rolling"});
+    for (method, path, body, accept) in [
+        (Method::POST, "/v1/rolling", Some(&body), &png),
+        (Method::POST, "/v1/jobs", Some(&body), &csv),
+        (Method::GET, "/healthz", None, &csv),
+        (Method::GET, "/readyz", None, &png),
+        (
+            Method::GET,
+            "/metrics",
+            None,
+            &[("accept", "application/json")],
+        ),
+    ] {
+        let response = app.send(method.clone(), path, accept, body).await;
+        problem(response, 406).await;
+    }
+    let location = app.submit(&body).await;
+    problem(app.send(Method::GET, &location, &csv, None).await, 406).await;
+    let events = format!("{location}/events");
+    problem(app.send(Method::GET, &events, &csv, None).await, 406).await;
+
+    // Wildcards and browsers' lists are served.
+    for accept in [
+        "*/*",
+        "application/*",
+        "text/html,application/xhtml+xml,*/*;q=0.8",
+    ] {
+        let response = app
+            .send(Method::GET, "/healthz", &[("accept", accept)], None)
+            .await;
+        assert_eq!(response.status(), 200, "{accept}");
+    }
+}

@@ -1,0 +1,218 @@
+//! The job-kind seam: a kind is one type behind `Kind`; the engine runs any kind, known or
+//! not to the registry; every kind's canonical input reads back as the same job; every
+//! answer renders as JSON and as CSV from one declaration of its columns.
+
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+use serde::Serialize;
+use serde_json::{json, Value};
+use thirdbody::engine::metrics::Metrics;
+use thirdbody::engine::store::JobStatus;
+use thirdbody::engine::{self, Engine, EngineConfig};
+use thirdbody::job::{
+    Control, Job, JobError, Kind, Limits, Meta, Reference, Work, ROLLING_REFERENCES,
+};
+use thirdbody::render::{Column, Format, Output, Table};
+use utoipa::ToSchema;
+
+/// A scratch kind that cannot tell its work in advance (as an iterative fit): it counts
+/// `steps` units of work, a millisecond each, checking its control between them.
+#[derive(Debug, PartialEq)]
+struct Countdown {
+    steps: usize,
+}
+
+#[derive(Debug, PartialEq, Serialize, ToSchema)]
+struct CountdownOutput {
+    steps: usize,
+    meta: Meta,
+}
+
+impl Output for CountdownOutput {
+    fn table(&self) -> Table {
+        Table::new(
+            &[Column::count("steps", |o: &CountdownOutput| o.steps)],
+            [self],
+        )
+    }
+}
+
+impl Kind for Countdown {
+    const NAME: &'static str = "countdown";
+    type Output = CountdownOutput;
+
+    fn validate(input: Value, _limits: &Limits) -> Result<Self, JobError> {
+        let steps = input["steps"].as_u64().unwrap_or(1);
+        Ok(Countdown {
+            steps: usize::try_from(steps).unwrap_or(usize::MAX),
+        })
+    }
+
+    fn canonical(&self) -> Value {
+        json!({ "steps": self.steps })
+    }
+
+    fn references(&self) -> &'static [Reference] {
+        ROLLING_REFERENCES
+    }
+
+    fn work(&self) -> Work {
+        Work::Unknown
+    }
+
+    fn run(&self, meta: Meta, control: &Control) -> Result<CountdownOutput, JobError> {
+        for _ in 0..self.steps {
+            control.check()?;
+            std::thread::sleep(Duration::from_millis(1));
+            control.advance(1);
+        }
+        Ok(CountdownOutput {
+            steps: self.steps,
+            meta,
+        })
+    }
+}
+
+fn engine() -> Arc<Engine> {
+    let config = EngineConfig {
+        pool_size: 1,
+        solve_deadline: Duration::from_secs(30),
+        job_deadline: Duration::from_secs(60),
+        max_queued_jobs: 4,
+        cache_bytes: 1 << 20,
+        cache_ttl: Duration::from_secs(60),
+        job_retention: Duration::from_secs(60),
+    };
+    Engine::new(config, Metrics::noop())
+}
+
+#[test]
+fn a_kind_of_unknown_size_runs_and_stops_on_cancel_and_deadline() {
+    let job = Job::new(Countdown { steps: 5 });
+    assert_eq!(job.kind(), "countdown");
+    assert_eq!(job.work(), Work::Unknown);
+    let answer = engine::run(&job, &Control::new(None, 1)).unwrap();
+    let out: CountdownOutput = answer.downcast().unwrap();
+    assert_eq!(out.steps, 5);
+    assert_eq!(out.meta.input, json!({"steps": 5}));
+
+    let long = Job::new(Countdown { steps: 1_000_000 });
+    let late = Control::new(Some(Instant::now() + Duration::from_millis(20)), 1);
+    assert_eq!(engine::run(&long, &late), Err(JobError::DeadlineExceeded));
+    assert!(late.done() > 0 && late.done() < 1_000);
+    let cancelled = Control::new(None, 1);
+    cancelled.cancel();
+    assert_eq!(engine::run(&long, &cancelled), Err(JobError::Cancelled));
+    assert_eq!(cancelled.done(), 0);
+}
+
+#[tokio::test]
+async fn the_engine_runs_an_unregistered_kind_reports_its_progress_and_cancels_it() {
+    let engine = engine();
+    let record = engine
+        .submit(Job::new(Countdown { steps: 1_000_000 }))
+        .await
+        .unwrap();
+    assert_eq!((record.kind, record.work), ("countdown", Work::Unknown));
+    let started = Instant::now();
+    loop {
+        let now = engine.job(record.id).await.unwrap();
+        if now.done >= 20 {
+            assert_eq!(now.state.status(), JobStatus::Running);
+            break;
+        }
+        assert!(started.elapsed() < Duration::from_secs(60), "no progress");
+        tokio::time::sleep(Duration::from_millis(5)).await;
+    }
+    let cancel = Instant::now();
+    let stopped = engine.cancel(record.id).await.unwrap();
+    assert_eq!(stopped.state.status(), JobStatus::Cancelled);
+    // The job checks its control every millisecond; the whole run would take 17 minutes.
+    assert!(
+        cancel.elapsed() < Duration::from_secs(1),
+        "{:?}",
+        cancel.elapsed()
+    );
+
+    let short = engine
+        .submit(Job::new(Countdown { steps: 30 }))
+        .await
+        .unwrap();
+    let mut status = engine.watch(short.id).unwrap();
+    status.wait_for(|s| s.is_finished()).await.unwrap();
+    let done = engine.job(short.id).await.unwrap();
+    assert_eq!((done.state.status(), done.done), (JobStatus::Succeeded, 30));
+}
+
+fn job(value: Value) -> Job {
+    Job::from_value(value, &Limits::default()).unwrap()
+}
+
+/// One job of every registered kind, with its defaults and without.
+fn jobs() -> Vec<Job> {
+    [
+        json!({"kind": "rolling"}),
+        json!({"kind": "rolling", "input": {"radius": "50 nm", "layer": {"thickness": "80 nm"},
+            "options": {"quadrature": "midpoint", "pressure_grid": 5}}}),
+        json!({"kind": "three_body", "input": {"operating": {"total_load": "1 mN"}}}),
+        json!({"kind": "three_body", "input": {"operating": {"separation": "55 nm"},
+            "particle": {"elastic_modulus": "100 GPa"}, "layer_contact": "hertz",
+            "asperities": {"density": "1e14 m^-2", "tip_radius": "1 um",
+                           "height_std": "2 nm", "hardness": "2 GPa"}}}),
+        json!({"kind": "sweep", "input": {"vary": {"load": ["1 nN", "1.2 nN"]}}}),
+        json!({"kind": "sweep", "input": {"kind": "three_body",
+            "vary": {"particle_load": ["1 nN", "2 nN"], "mean_diameter": ["40 nm", "50 nm"]}}}),
+        json!({"kind": "sweep", "input": {"kind": "three_body",
+            "base": {"operating": {"separation": "50 nm"},
+                     "distribution": {"min_diameter": "30 nm"}},
+            "vary": {"velocity": [0, "4 nm/s"]}}}),
+        json!({"kind": "figure", "input": {"number": 3}}),
+    ]
+    .into_iter()
+    .map(job)
+    .collect()
+}
+
+#[test]
+fn every_canonical_input_reads_back_as_the_same_job() {
+    for job in jobs() {
+        let again = Job::from_input(job.kind(), job.canonical(), &Limits::default())
+            .unwrap_or_else(|e| panic!("{}: {e}: {}", job.kind(), job.canonical()));
+        assert_eq!(again, job, "{}", job.canonical());
+        assert_eq!(again.canonical(), job.canonical());
+        assert_eq!(again.cache_key(), job.cache_key());
+    }
+}
+
+#[test]
+fn a_three_body_sweep_whose_bounds_follow_the_mean_has_another_key_than_fixed_bounds() {
+    let vary = json!({"mean_diameter": ["50 nm", "80 nm"]});
+    let following = job(json!({"kind": "sweep", "input": {"kind": "three_body",
+        "base": {"operating": {"separation": "60 nm"}}, "vary": vary}}));
+    // The bounds the base would have at its default mean, given explicitly: fixed.
+    let fixed = job(json!({"kind": "sweep", "input": {"kind": "three_body",
+        "base": {"operating": {"separation": "60 nm"},
+                 "distribution": {"min_diameter": "35 nm", "max_diameter": "65 nm"}},
+        "vary": vary}}));
+    assert_ne!(following.cache_key(), fixed.cache_key());
+}
+
+#[test]
+fn every_answer_renders_as_json_and_as_a_rectangular_csv() {
+    for job in jobs() {
+        let answer = engine::run(&job, &Control::default()).unwrap();
+        let json: Value = serde_json::from_slice(&answer.render(Format::Json).unwrap()).unwrap();
+        assert_eq!(json["meta"]["input_hash"], json!(job.cache_key()));
+        let csv = String::from_utf8(answer.render(Format::Csv).unwrap()).unwrap();
+        let table = answer.table();
+        assert!(!table.rows.is_empty(), "{}", job.kind());
+        let lines: Vec<&str> = csv.lines().collect();
+        assert_eq!(lines.len(), 1 + table.rows.len(), "{csv}");
+        let header = lines[0].split(',').count();
+        assert_eq!(header, table.headings.len());
+        for row in &table.rows {
+            assert_eq!(row.len(), header, "{}", job.kind());
+        }
+    }
+}
