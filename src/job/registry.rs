@@ -57,14 +57,14 @@ fn output_schema<K: Kind>(schemas: &mut Schemas) -> RefOr<Schema> {
 }
 
 /// Every job kind, one line each.
-const LIST: [Registered; 4] = [
+const LIST: &[Registered] = &[
     Registered::of::<RollingJob>(),
     Registered::of::<ThreeBodyJob>(),
     Registered::of::<SweepJob>(),
     Registered::of::<FigureJob>(),
 ];
 
-static KINDS: [Registered; LIST.len()] = LIST;
+static KINDS: &[Registered] = LIST;
 
 /// The kinds' names, in the order of [`LIST`].
 const NAMES: [&str; LIST.len()] = {
@@ -199,7 +199,7 @@ impl ToSchema for AnyOutput {
     }
 
     fn schemas(schemas: &mut Schemas) {
-        for kind in &KINDS {
+        for kind in KINDS {
             (kind.output_schema)(schemas);
         }
     }
