@@ -81,9 +81,10 @@ fn main() -> ExitCode {
         Err(e) => {
             eprintln!("thirdbody: {e}");
             match e {
-                JobError::Syntax(_) | JobError::Schema { .. } | JobError::Invalid(_) => {
-                    ExitCode::from(INVALID_JOB)
-                }
+                JobError::Syntax(_)
+                | JobError::Schema { .. }
+                | JobError::Invalid(_)
+                | JobError::OutOfDomain(_) => ExitCode::from(INVALID_JOB),
                 _ => ExitCode::FAILURE,
             }
         }

@@ -79,7 +79,7 @@ fn figures_print_as_json_or_csv() {
     let text = String::from_utf8_lossy(&csv.stdout);
     assert_eq!(
         text.lines().next(),
-        Some("series,label,radius (m),friction_coefficient")
+        Some("series,label,radius [m],friction_coefficient")
     );
     assert_eq!(text.lines().count(), 1 + 10 * 14);
 }
@@ -114,13 +114,14 @@ fn every_answer_prints_as_csv_even_a_single_contact() {
     let text = String::from_utf8_lossy(&out.stdout);
     let lines: Vec<&str> = text.lines().collect();
     assert_eq!(lines.len(), 2, "{text}");
-    assert!(lines[0].starts_with("radius,load,velocity,penetration,contact_area"));
+    assert!(lines[0]
+        .starts_with("radius [m],load [N],velocity [m/s],penetration [m],contact_area [m²]"));
     let out = thirdbody(
         &["solve", "examples/three_body.json", "--format", "csv"],
         None,
     );
     assert!(out.status.success());
-    assert!(String::from_utf8_lossy(&out.stdout).starts_with("total_load,velocity"));
+    assert!(String::from_utf8_lossy(&out.stdout).starts_with("total_load [N],velocity [m/s]"));
 }
 
 #[test]

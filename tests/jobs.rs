@@ -286,7 +286,8 @@ fn a_sweep_is_the_product_of_its_lists_in_order_and_equals_single_solves() {
     };
     let lines: Vec<&str> = csv.lines().collect();
     assert_eq!(lines.len(), 3);
-    assert!(lines[0].starts_with("radius,load,velocity,penetration,contact_area"));
+    assert!(lines[0]
+        .starts_with("radius [m],load [N],velocity [m/s],penetration [m],contact_area [m²]"));
     let area: f64 = lines[2].split(',').nth(4).unwrap().parse().unwrap();
     assert!((area * 1e18 - 85.234).abs() < 5e-4, "{area}");
 }
@@ -353,7 +354,7 @@ fn figures_3_to_9_hold_the_series_of_model_section_5() {
         assert_eq!(s.points.first(), s.points.last());
     }
     let csv = f.table().to_csv();
-    assert_eq!(csv.lines().next(), Some("series,label,x (m),y (m)"));
+    assert_eq!(csv.lines().next(), Some("series,label,x [m],y [m]"));
     assert_eq!(csv.lines().count(), 1 + 4 * 202);
 }
 

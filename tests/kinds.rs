@@ -11,9 +11,9 @@ use thirdbody::engine::metrics::Metrics;
 use thirdbody::engine::store::JobStatus;
 use thirdbody::engine::{self, Engine, EngineConfig};
 use thirdbody::job::{
-    Control, Job, JobError, Kind, Limits, Meta, Reference, Work, ROLLING_REFERENCES,
+    Control, Job, JobError, Kind, Limits, Meta, Reference, Validated, Work, ROLLING_REFERENCES,
 };
-use thirdbody::render::{Column, Format, Output, Table};
+use thirdbody::render::{Column, Format, Output, Table, Units};
 use utoipa::ToSchema;
 
 /// A scratch kind that cannot tell its work in advance (as an iterative fit): it counts
@@ -30,6 +30,8 @@ struct CountdownOutput {
 }
 
 impl Output for CountdownOutput {
+    const UNITS: Units = &[&[("steps", "")]];
+
     fn table(&self) -> Table {
         Table::new(
             &[Column::count("steps", |o: &CountdownOutput| o.steps)],
@@ -42,11 +44,10 @@ impl Kind for Countdown {
     const NAME: &'static str = "countdown";
     type Output = CountdownOutput;
 
-    fn validate(input: Value, _limits: &Limits) -> Result<Self, JobError> {
+    fn validate(input: Value, _limits: &Limits) -> Result<Validated<Self>, JobError> {
         let steps = input["steps"].as_u64().unwrap_or(1);
-        Ok(Countdown {
-            steps: usize::try_from(steps).unwrap_or(usize::MAX),
-        })
+        let steps = usize::try_from(steps).unwrap_or(usize::MAX);
+        Ok(Countdown { steps }.into())
     }
 
     fn canonical(&self) -> Value {

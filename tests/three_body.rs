@@ -417,7 +417,7 @@ fn three_body_sweeps_vary_the_operating_point_speed_and_mean_diameter() {
     let direct = solve3(&single).unwrap();
     assert_eq!(first.result.state.separation, direct.rolling.separation);
     let csv = out.table().to_csv();
-    assert!(csv.starts_with("total_load,velocity,mean_diameter,separation"));
+    assert!(csv.starts_with("total_load [N],velocity [m/s],mean_diameter [m],separation [m]"));
     assert_eq!(csv.lines().count(), 9);
     // Two operating lists at once are refused.
     assert!(matches!(

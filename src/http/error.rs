@@ -3,17 +3,17 @@
 //! could not read, or a layer (method not allowed, timeout, panic).
 
 use axum::body::Body;
-use axum::extract::rejection::JsonRejection;
+use axum::extract::rejection::BytesRejection;
 use axum::extract::{FromRequest, Request};
-use axum::http::{header, HeaderValue, StatusCode};
+use axum::http::{header, HeaderMap, HeaderValue, StatusCode};
 use axum::response::{IntoResponse, Response};
-use axum::Json;
+use bytes::Bytes;
 use serde::Serialize;
 use serde_json::Value;
 use utoipa::ToSchema;
 
 use crate::engine::EngineError;
-use crate::job::{FieldError, JobError};
+use crate::job::{input, FieldError, JobError};
 
 pub const PROBLEM_JSON: &str = "application/problem+json";
 
@@ -27,7 +27,9 @@ pub struct Problem {
     /// The kind of problem: `tag:thirdbody,2026:problems/` followed by one of
     /// `malformed-json` (400), `invalid-input` (422: a field's shape or value; see `errors`),
     /// `solve-failed` (422: valid values for which the model cannot produce a number, e.g. a
-    /// root finder that did not converge; change the input), `unsupported-media-type` (415),
+    /// root finder that did not converge; change the input), `out-of-domain` (422: an
+    /// assumption of the model fails for these values, see `meta.validity`),
+    /// `unsupported-media-type` (415),
     /// `not-acceptable` (406: the `Accept` header names no form the resource offers),
     /// `payload-too-large` (413), `not-found` (404), `cancelled` (409), `overloaded` (429),
     /// `draining` (503), `deadline-exceeded` (504), `internal` (500); or `about:blank` for a
@@ -52,6 +54,7 @@ enum Kind {
     MalformedJson,
     InvalidInput,
     SolveFailed,
+    OutOfDomain,
     UnsupportedMediaType,
     NotAcceptable,
     PayloadTooLarge,
@@ -69,7 +72,9 @@ impl Kind {
     fn status(self) -> StatusCode {
         match self {
             Kind::MalformedJson => StatusCode::BAD_REQUEST,
-            Kind::InvalidInput | Kind::SolveFailed => StatusCode::UNPROCESSABLE_ENTITY,
+            Kind::InvalidInput | Kind::SolveFailed | Kind::OutOfDomain => {
+                StatusCode::UNPROCESSABLE_ENTITY
+            }
             Kind::UnsupportedMediaType => StatusCode::UNSUPPORTED_MEDIA_TYPE,
             Kind::NotAcceptable => StatusCode::NOT_ACCEPTABLE,
             Kind::PayloadTooLarge => StatusCode::PAYLOAD_TOO_LARGE,
@@ -89,6 +94,7 @@ impl Kind {
             Kind::MalformedJson => ("malformed-json", "The body is not valid JSON"),
             Kind::InvalidInput => ("invalid-input", "The input is not valid"),
             Kind::SolveFailed => ("solve-failed", "The model cannot solve this input"),
+            Kind::OutOfDomain => ("out-of-domain", "Outside the model's domain of validity"),
             Kind::UnsupportedMediaType => ("unsupported-media-type", "Send application/json"),
             Kind::NotAcceptable => ("not-acceptable", "No acceptable form of the answer"),
             Kind::PayloadTooLarge => ("payload-too-large", "The body is too large"),
@@ -199,6 +205,7 @@ impl From<JobError> for ApiError {
             // Deterministic, so retrying cannot help and the service is not at fault: the
             // client must change the input.
             JobError::Unsolvable(_) => ApiError::new(Kind::SolveFailed, detail),
+            JobError::OutOfDomain(_) => ApiError::new(Kind::OutOfDomain, detail),
             JobError::Cancelled => ApiError::new(Kind::Cancelled, detail),
             JobError::DeadlineExceeded => ApiError::new(Kind::DeadlineExceeded, detail),
             JobError::Internal(_) => ApiError::new(Kind::Internal, detail),
@@ -223,19 +230,12 @@ impl From<EngineError> for ApiError {
     }
 }
 
-impl From<JsonRejection> for ApiError {
-    fn from(rejection: JsonRejection) -> Self {
+impl From<BytesRejection> for ApiError {
+    fn from(rejection: BytesRejection) -> Self {
         let detail = rejection.body_text();
-        match rejection {
-            JsonRejection::JsonSyntaxError(_) => ApiError::new(Kind::MalformedJson, detail),
-            JsonRejection::MissingJsonContentType(_) => ApiError::new(
-                Kind::UnsupportedMediaType,
-                "send the body with Content-Type: application/json",
-            ),
-            r if r.status() == StatusCode::PAYLOAD_TOO_LARGE => {
-                ApiError::new(Kind::PayloadTooLarge, detail)
-            }
-            r => ApiError::from_status(r.status(), detail),
+        match rejection.status() {
+            StatusCode::PAYLOAD_TOO_LARGE => ApiError::new(Kind::PayloadTooLarge, detail),
+            status => ApiError::from_status(status, detail),
         }
     }
 }
@@ -257,16 +257,39 @@ impl IntoResponse for ApiError {
     }
 }
 
-/// A JSON body, any shape (the job layer reads it); what axum cannot read is a problem.
+/// A JSON body, any shape (the job layer reads it), parsed by the job layer so that a key
+/// sent twice is refused; a body that is not JSON is a problem.
 pub struct JsonBody(pub Value);
 
 impl<S: Send + Sync> FromRequest<S> for JsonBody {
     type Rejection = ApiError;
 
     async fn from_request(request: Request, state: &S) -> Result<Self, ApiError> {
-        let Json(value) = Json::<Value>::from_request(request, state).await?;
-        Ok(JsonBody(value))
+        if !is_json(request.headers()) {
+            return Err(ApiError::new(
+                Kind::UnsupportedMediaType,
+                "send the body with Content-Type: application/json",
+            ));
+        }
+        let body = Bytes::from_request(request, state).await?;
+        Ok(JsonBody(input::parse(&body)?))
     }
+}
+
+/// Whether the body is declared JSON: `application/json` or `application/*+json`.
+fn is_json(headers: &HeaderMap) -> bool {
+    let Some(media_type) = headers
+        .get(header::CONTENT_TYPE)
+        .and_then(|v| v.to_str().ok())
+        .and_then(|v| v.split(';').next())
+        .map(|v| v.trim().to_ascii_lowercase())
+    else {
+        return false;
+    };
+    media_type == "application/json"
+        || media_type
+            .strip_prefix("application/")
+            .is_some_and(|subtype| subtype.ends_with("+json"))
 }
 
 /// Turns an error response that is not yet a problem (axum's 405, a timeout, a rejection

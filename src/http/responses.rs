@@ -53,8 +53,9 @@ problems!(
         (413, "payload-too-large: the body is larger than the body limit", false),
         (415, "unsupported-media-type: the body is not application/json", false),
         (422, "invalid-input: fields of the wrong shape or out of range, each named in \
-            `errors` with its value and the allowed range; or solve-failed: valid values \
-            the model cannot solve", false),
+            `errors` with its value and the allowed range; solve-failed: valid values \
+            the model cannot solve; or out-of-domain: values for which an assumption of the \
+            model fails (the detail names it, with its numbers)", false),
     }
 );
 

@@ -42,26 +42,15 @@ pub enum JobError {
     /// double precision cannot hold, a load the system cannot carry): the same input always
     /// fails, so only a changed input can help.
     Unsolvable(String),
+    /// Valid values for which an assumption of the model fails (MODEL.md §7): the answer
+    /// would be a number the model cannot vouch for.
+    OutOfDomain(String),
     /// The job was cancelled before it finished.
     Cancelled,
     /// The job ran past its deadline.
     DeadlineExceeded,
     /// A fault of the service, not of the job.
     Internal(String),
-}
-
-impl JobError {
-    /// Classifies a serde_json error: syntax (not JSON) or schema (JSON of the wrong shape).
-    pub fn from_json(e: serde_json::Error) -> JobError {
-        if e.is_data() {
-            JobError::Schema {
-                field: String::new(),
-                message: e.to_string(),
-            }
-        } else {
-            JobError::Syntax(e.to_string())
-        }
-    }
 }
 
 impl fmt::Display for JobError {
@@ -74,7 +63,7 @@ impl fmt::Display for JobError {
                 let messages: Vec<&str> = errors.iter().map(|e| e.message.as_str()).collect();
                 f.write_str(&messages.join("; "))
             }
-            JobError::Unsolvable(m) => f.write_str(m),
+            JobError::Unsolvable(m) | JobError::OutOfDomain(m) => f.write_str(m),
             JobError::Cancelled => f.write_str("the job was cancelled"),
             JobError::DeadlineExceeded => f.write_str("the job ran past its deadline"),
             JobError::Internal(m) => write!(f, "internal error: {m}"),

@@ -6,10 +6,10 @@ use utoipa::ToSchema;
 
 use super::input::{self, Checker};
 use super::meta::ROLLING_REFERENCES;
-use super::{Control, JobError, Kind, Limits, Meta, Reference, Work};
+use super::{Control, JobError, Kind, Limits, Meta, Reference, Validated, Work};
 use crate::model;
 use crate::model::figures::{Axis, Figure, Plan, FIGURES};
-use crate::render::{Column, Output, Table};
+use crate::render::{Column, Output, Table, Units};
 
 /// Input of a figure job.
 #[derive(Clone, Debug, PartialEq, Deserialize, Serialize, ToSchema)]
@@ -48,9 +48,9 @@ impl Kind for FigureJob {
     const NAME: &'static str = "figure";
     type Output = FigureOutput;
 
-    fn validate(input: Value, _limits: &Limits) -> Result<Self, JobError> {
+    fn validate(input: Value, _limits: &Limits) -> Result<Validated<Self>, JobError> {
         let input: FigureInput = input::deserialize(input, "")?;
-        FigureJob::new(input.number)
+        FigureJob::new(input.number).map(Validated::from)
     }
 
     fn canonical(&self) -> Value {
@@ -81,17 +81,6 @@ pub struct AxisOutput {
     pub quantity: &'static str,
     /// SI unit ("" for a plain number).
     pub unit: &'static str,
-}
-
-impl AxisOutput {
-    /// The CSV column of the axis: its quantity, with its unit if it has one.
-    fn column(&self) -> String {
-        if self.unit.is_empty() {
-            self.quantity.to_string()
-        } else {
-            format!("{} ({})", self.quantity, self.unit)
-        }
-    }
 }
 
 impl From<Axis> for AxisOutput {
@@ -168,6 +157,15 @@ struct FigureRow<'a> {
 }
 
 impl Output for FigureOutput {
+    /// The points are in the units of the axes, which the answer names.
+    const UNITS: Units = &[&[
+        ("figure", ""),
+        ("series[].radius", "m"),
+        ("series[].load", "N"),
+        ("series[].velocity", "m/s"),
+        ("series[].points[][]", "x.unit, y.unit"),
+    ]];
+
     /// One row per point: the series' index and legend, then x and y in the axes' units.
     fn table(&self) -> Table {
         fn columns<'a>() -> [Column<FigureRow<'a>>; 4] {
@@ -191,8 +189,8 @@ impl Output for FigureOutput {
             })
             .collect();
         let mut table = Table::new(&columns(), &rows);
-        table.rename(2, &self.x.column(), self.x.unit);
-        table.rename(3, &self.y.column(), self.y.unit);
+        table.rename(2, self.x.quantity, self.x.unit);
+        table.rename(3, self.y.quantity, self.y.unit);
         table
     }
 }

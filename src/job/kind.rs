@@ -11,7 +11,7 @@ use std::sync::Arc;
 use serde_json::Value;
 use utoipa::ToSchema;
 
-use super::meta::{Meta, Reference};
+use super::meta::{InputWarning, Meta, Reference};
 use super::{Control, JobError, Limits};
 use crate::render::{Answer, Output};
 
@@ -24,6 +24,23 @@ pub enum Work {
     Unknown,
 }
 
+/// A job of kind `K` as validated, and what was implausible in its input.
+#[derive(Debug)]
+pub struct Validated<K> {
+    pub job: K,
+    pub warnings: Vec<InputWarning>,
+}
+
+impl<K> From<K> for Validated<K> {
+    /// A job whose input raised no warning.
+    fn from(job: K) -> Self {
+        Validated {
+            job,
+            warnings: Vec::new(),
+        }
+    }
+}
+
 /// A kind of job.
 pub trait Kind: fmt::Debug + PartialEq + Send + Sync + Sized + 'static {
     /// The kind's name on the wire: the `kind` of a job envelope and of a job's status.
@@ -32,7 +49,7 @@ pub trait Kind: fmt::Debug + PartialEq + Send + Sync + Sized + 'static {
     type Output: Output + ToSchema;
 
     /// Reads and validates an input of this kind; error paths are relative to the input.
-    fn validate(input: Value, limits: &Limits) -> Result<Self, JobError>;
+    fn validate(input: Value, limits: &Limits) -> Result<Validated<Self>, JobError>;
 
     /// The canonical input: every default filled in, every quantity an SI number. Equal
     /// canonical inputs have equal answers.
@@ -56,6 +73,7 @@ trait Dispatch: fmt::Debug + Send + Sync {
     fn references(&self) -> &'static [Reference];
     fn work(&self) -> Work;
     fn run(&self, meta: Meta, control: &Control) -> Result<Answer, JobError>;
+    fn units(&self) -> crate::render::Units;
     fn as_any(&self) -> &dyn Any;
     fn same(&self, other: &dyn Any) -> bool;
 }
@@ -81,6 +99,10 @@ impl<K: Kind> Dispatch for K {
         Kind::run(self, meta, control).map(Answer::new)
     }
 
+    fn units(&self) -> crate::render::Units {
+        K::Output::UNITS
+    }
+
     fn as_any(&self) -> &dyn Any {
         self
     }
@@ -92,29 +114,52 @@ impl<K: Kind> Dispatch for K {
 
 /// A validated job of any kind, ready for the engine (cheap to clone).
 #[derive(Clone, Debug)]
-pub struct Job(Arc<dyn Dispatch>);
+pub struct Job {
+    kind: Arc<dyn Dispatch>,
+    warnings: Vec<InputWarning>,
+}
 
 impl Job {
     /// A job of kind `K`.
     pub fn new<K: Kind>(job: K) -> Job {
-        Job(Arc::new(job))
+        Job::validated(job.into())
+    }
+
+    /// A validated job of kind `K`, with its input's warnings.
+    pub fn validated<K: Kind>(validated: Validated<K>) -> Job {
+        Job {
+            kind: Arc::new(validated.job),
+            warnings: validated.warnings,
+        }
+    }
+
+    /// What was implausible in the job's input.
+    pub fn warnings(&self) -> &[InputWarning] {
+        &self.warnings
     }
 
     /// The kind's name on the wire.
     pub fn kind(&self) -> &'static str {
-        self.0.name()
+        self.kind.name()
     }
 
     /// The canonical input: every default filled in, every quantity an SI number.
     pub fn canonical(&self) -> Value {
-        self.0.canonical()
+        self.kind.canonical()
     }
 
     /// The `meta` block of the job's answer: model version, canonical input and its hash,
     /// references. Computing it costs a few µs, so a caller that needs both the key and the
     /// answer computes it once and passes it on.
     pub fn meta(&self) -> Meta {
-        Meta::new(self.kind(), self.canonical(), self.0.references())
+        let kind = &self.kind;
+        Meta::new(
+            kind.name(),
+            kind.canonical(),
+            kind.references(),
+            self.warnings.clone(),
+            kind.units(),
+        )
     }
 
     /// Hash of the canonical input and the model version: equal keys, equal results.
@@ -124,22 +169,22 @@ impl Job {
 
     /// The work the job takes.
     pub fn work(&self) -> Work {
-        self.0.work()
+        self.kind.work()
     }
 
     /// Runs the job to its answer, whose `meta` is `meta` (see [`Job::meta`]).
     pub fn run(&self, meta: Meta, control: &Control) -> Result<Answer, JobError> {
-        self.0.run(meta, control)
+        self.kind.run(meta, control)
     }
 
     /// The job, if it is of kind `K`.
     pub fn downcast_ref<K: Kind>(&self) -> Option<&K> {
-        self.0.as_any().downcast_ref()
+        self.kind.as_any().downcast_ref()
     }
 }
 
 impl PartialEq for Job {
     fn eq(&self, other: &Job) -> bool {
-        self.0.same(other.0.as_any())
+        self.kind.same(other.kind.as_any()) && self.warnings == other.warnings
     }
 }

@@ -1,12 +1,13 @@
 //! What every answer says about itself: the model version, the canonical input and its hash,
 //! and the papers behind the numbers.
 
-use serde::Serialize;
+use serde::{Serialize, Serializer};
 use serde_json::Value;
 use sha2::{Digest, Sha256};
 use utoipa::ToSchema;
 
 use crate::model::MODEL_VERSION;
+use crate::render::Units;
 
 /// A source of the model.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, ToSchema)]
@@ -61,11 +62,45 @@ pub const REFERENCES: [Reference; 5] = [
 /// the shear strength.
 pub const ROLLING_REFERENCES: &[Reference] = REFERENCES.split_at(3).0;
 
+/// The version of this software (the crate's).
+pub const SOFTWARE_VERSION: &str = env!("CARGO_PKG_VERSION");
+/// The git commit this binary was built from (`build.rs`), or `unknown`.
+pub const GIT_COMMIT: &str = env!("THIRDBODY_GIT_COMMIT");
+
+/// The software that computed an answer.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, ToSchema)]
+pub struct Software {
+    /// The crate's version (semver).
+    pub version: &'static str,
+    /// The git commit it was built from (`unknown` when built without one).
+    pub commit: &'static str,
+}
+
+/// This software.
+pub const SOFTWARE: Software = Software {
+    version: SOFTWARE_VERSION,
+    commit: GIT_COMMIT,
+};
+
+/// A valid value that is implausible as sent: a bare number far from its field's scale.
+#[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
+pub struct InputWarning {
+    /// Path of the field in the input.
+    pub field: String,
+    /// The value as sent.
+    #[schema(value_type = Object)]
+    pub value: Value,
+    /// What the value means, and the form the sender may have meant.
+    pub message: String,
+}
+
 /// The `meta` block of an answer.
 #[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
 pub struct Meta {
     /// Version of the model's numbers (semver): a new version may change results.
     pub model_version: &'static str,
+    /// The software that computed the answer.
+    pub software: Software,
     /// SHA-256 of the model version, the job kind and the canonical input (hex): the cache
     /// key, and the HTTP `ETag`.
     pub input_hash: String,
@@ -75,28 +110,76 @@ pub struct Meta {
     /// The papers behind the numbers.
     #[schema(value_type = Vec<Reference>)]
     pub references: &'static [Reference],
+    /// Values of the input that are valid but implausible as sent.
+    pub warnings: Vec<InputWarning>,
+    /// The unit of every numeric field of the answer, by its path (`boundary[].exit`);
+    /// those of `meta.input` are the SI units of the input's fields.
+    #[serde(serialize_with = "units_map")]
+    #[schema(value_type = std::collections::BTreeMap<String, String>)]
+    pub units: Units,
+}
+
+/// The groups of units as one object (groups may share entries, as the two kinds of sweep
+/// points do).
+fn units_map<S: Serializer>(units: &Units, s: S) -> Result<S::Ok, S::Error> {
+    let map: std::collections::BTreeMap<_, _> = units
+        .iter()
+        .flat_map(|group| group.iter().copied())
+        .collect();
+    s.collect_map(map)
 }
 
 impl Meta {
-    /// The meta block of a job of `kind` whose canonical input is `canonical`.
-    pub fn new(kind: &str, canonical: Value, references: &'static [Reference]) -> Self {
+    /// The meta block of a job of `kind` whose canonical input is `canonical`, with the
+    /// `warnings` its input raised and the `units` of its answer.
+    pub fn new(
+        kind: &str,
+        canonical: Value,
+        references: &'static [Reference],
+        warnings: Vec<InputWarning>,
+        units: Units,
+    ) -> Self {
         Meta {
             model_version: MODEL_VERSION,
-            input_hash: input_hash(kind, &canonical),
+            software: SOFTWARE,
+            input_hash: input_hash(kind, &canonical, &warnings),
             input: canonical,
             references,
+            warnings,
+            units,
         }
+    }
+
+    /// One line saying where the answer comes from, for files that travel without their
+    /// `meta` (CSV): `# thirdbody 0.1.0 (commit …), model 1.0.0, input sha256 …`.
+    pub fn provenance(&self) -> String {
+        provenance(&self.input_hash)
     }
 }
 
-/// Hex SHA-256 of `model version \n kind \n canonical JSON` (keys sorted, shortest floats).
-pub fn input_hash(kind: &str, canonical: &Value) -> String {
+/// The provenance line of the answer whose cache key is `input_hash` (see
+/// [`Meta::provenance`]).
+pub fn provenance(input_hash: &str) -> String {
+    format!(
+        "# thirdbody {SOFTWARE_VERSION} (commit {GIT_COMMIT}), model {MODEL_VERSION}, \
+         input sha256 {input_hash}"
+    )
+}
+
+/// Hex SHA-256 of `model version \n kind \n canonical JSON` (keys sorted, shortest floats),
+/// followed by the input's warnings if it raised any: an answer that carries warnings is
+/// another answer than the same input's without them.
+pub fn input_hash(kind: &str, canonical: &Value, warnings: &[InputWarning]) -> String {
     let mut hasher = Sha256::new();
     hasher.update(MODEL_VERSION.as_bytes());
     hasher.update(b"\n");
     hasher.update(kind.as_bytes());
     hasher.update(b"\n");
     hasher.update(canonical.to_string().as_bytes());
+    for warning in warnings {
+        hasher.update(b"\n");
+        hasher.update(warning.message.as_bytes());
+    }
     hasher
         .finalize()
         .iter()

@@ -18,13 +18,14 @@ pub mod registry;
 pub mod rolling;
 pub mod sweep;
 pub mod three_body;
+pub mod validity;
 
 pub use control::Control;
 pub use error::{FieldError, JobError};
 pub use figure::FigureJob;
 pub use input::Quantity;
-pub use kind::{Job, Kind, Work};
-pub use meta::{Meta, Reference, REFERENCES, ROLLING_REFERENCES};
+pub use kind::{Job, Kind, Validated, Work};
+pub use meta::{InputWarning, Meta, Reference, Software, REFERENCES, ROLLING_REFERENCES, SOFTWARE};
 pub use rolling::RollingJob;
 pub use sweep::SweepJob;
 pub use three_body::ThreeBodyJob;

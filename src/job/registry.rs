@@ -44,7 +44,7 @@ impl Registered {
 }
 
 fn validate<K: Kind>(input: Value, limits: &Limits) -> Result<Job, JobError> {
-    K::validate(input, limits).map(Job::new)
+    K::validate(input, limits).map(Job::validated)
 }
 
 /// Adds the schema of `K`'s output (and those it refers to) to `schemas`; returns a
@@ -99,8 +99,7 @@ fn unknown_kind(name: &str) -> String {
 impl Job {
     /// Parses and validates an enveloped job from JSON text.
     pub fn from_json(text: &[u8], limits: &Limits) -> Result<Job, JobError> {
-        let value: Value = serde_json::from_slice(text).map_err(JobError::from_json)?;
-        Job::from_value(value, limits)
+        Job::from_value(super::input::parse(text)?, limits)
     }
 
     /// Validates an enveloped job `{"kind": ..., "input": {...}}` already parsed as JSON.

@@ -6,10 +6,11 @@ use utoipa::ToSchema;
 
 use super::input::{self, field, Checker, LayerInput, QuadratureKind, Quantity};
 use super::meta::ROLLING_REFERENCES;
-use super::{Control, JobError, Kind, Limits, Meta, Reference, Work};
+use super::validity::{self, validity_units, Subject, ValidityOutput};
+use super::{Control, JobError, Kind, Limits, Meta, Reference, Validated, Work};
 use crate::model::rolling::{BoundaryPoint, PressureGrid, Verification};
 use crate::model::{self, Parameter, Rolling, RollingSolution, SolveOption, SolveOptions};
-use crate::render::{Column, Output, Table};
+use crate::render::{Column, Output, Table, Units};
 
 /// Input of a rolling job; every field optional (MODEL.md §5 defaults).
 #[derive(Clone, Debug, Default, PartialEq, Deserialize, Serialize, ToSchema)]
@@ -106,7 +107,7 @@ impl Kind for RollingJob {
     const NAME: &'static str = "rolling";
     type Output = RollingOutput;
 
-    fn validate(input: Value, _limits: &Limits) -> Result<Self, JobError> {
+    fn validate(input: Value, _limits: &Limits) -> Result<Validated<Self>, JobError> {
         input::validate(input, RollingJob::read)
     }
 
@@ -125,9 +126,42 @@ impl Kind for RollingJob {
 
     fn run(&self, meta: Meta, control: &Control) -> Result<RollingOutput, JobError> {
         let solution = control.solve(|| model::solve(&self.rolling, &self.options))?;
-        Ok(RollingOutput::new(&self.rolling, &solution, meta))
+        RollingOutput::new(&self.rolling, &solution, meta)
     }
 }
+
+/// The units of a rolling contact's integral quantities (`ContactOutput`), under `$prefix`.
+macro_rules! contact_units {
+    ($prefix:literal) => {
+        &[
+            (concat!($prefix, "penetration"), "m"),
+            (concat!($prefix, "contact_area"), "m²"),
+            (concat!($prefix, "half_width"), "m"),
+            (concat!($prefix, "centroid_shift"), "m"),
+            (concat!($prefix, "pressure_centre_shift"), "m"),
+            (concat!($prefix, "rolling_resistance_coefficient"), ""),
+            (concat!($prefix, "friction_coefficient"), ""),
+            (concat!($prefix, "static.penetration"), "m"),
+            (concat!($prefix, "static.contact_area"), "m²"),
+            (concat!($prefix, "static.friction_coefficient"), ""),
+        ]
+    };
+}
+pub(crate) use contact_units;
+
+/// The units of a rolling contact's verification block, under `$prefix`.
+macro_rules! verification_units {
+    ($prefix:literal) => {
+        &[
+            (concat!($prefix, "relative_load_residual"), ""),
+            (concat!($prefix, "quadrature_error_estimate"), ""),
+            (concat!($prefix, "quadrature_nodes"), ""),
+            (concat!($prefix, "iterations"), ""),
+            (concat!($prefix, "exit_root_iterations"), ""),
+        ]
+    };
+}
+pub(crate) use verification_units;
 
 /// The integral quantities of a rolling contact, shared by rolling answers and sweep points.
 #[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
@@ -225,22 +259,33 @@ pub struct SweepPoint {
     #[serde(flatten)]
     pub contact: ContactOutput,
     pub verification: VerificationOutput,
+    /// The model's assumptions at this point (MODEL.md §7).
+    pub validity: ValidityOutput,
+}
+
+/// The validity of a rolling contact; a violated assumption is the job's error.
+fn validity(rolling: &Rolling, solution: &RollingSolution) -> Result<ValidityOutput, JobError> {
+    validity::assess(
+        &model::validity::rolling(rolling, solution),
+        Subject::Particle,
+    )
 }
 
 impl SweepPoint {
-    /// The point of `rolling`, solved as `solution`.
-    pub fn new(rolling: &Rolling, solution: &RollingSolution) -> Self {
-        SweepPoint {
+    /// The point of `rolling`, solved as `solution`, unless the model's domain excludes it.
+    pub fn new(rolling: &Rolling, solution: &RollingSolution) -> Result<Self, JobError> {
+        Ok(SweepPoint {
             radius: rolling.radius,
             load: rolling.load,
             velocity: rolling.velocity,
             contact: solution.into(),
             verification: (&solution.verification).into(),
-        }
+            validity: validity(rolling, solution)?,
+        })
     }
 
     /// The CSV columns of rolling contacts.
-    pub const COLUMNS: [Column<SweepPoint>; 13] = [
+    pub const COLUMNS: [Column<SweepPoint>; 14] = [
         Column::number("radius", "m", |p| p.radius),
         Column::number("load", "N", |p| p.load),
         Column::number("velocity", "m/s", |p| p.velocity),
@@ -266,6 +311,7 @@ impl SweepPoint {
         Column::number("static_friction_coefficient", "", |p| {
             p.contact.static_contact.friction_coefficient
         }),
+        Column::text("validity", |p| validity::summary(&p.validity)),
     ];
 }
 
@@ -318,6 +364,8 @@ pub struct RollingMeta {
     pub meta: Meta,
     /// How far the numbers can be trusted.
     pub verification: VerificationOutput,
+    /// How far the model can be trusted here (MODEL.md §7).
+    pub validity: ValidityOutput,
 }
 
 /// The answer to a rolling job.
@@ -339,22 +387,42 @@ pub struct RollingOutput {
 }
 
 impl RollingOutput {
-    /// The answer for `rolling`, solved as `solution`, with `meta`, the job's [`Meta`].
-    pub fn new(rolling: &Rolling, solution: &RollingSolution, meta: Meta) -> Self {
-        RollingOutput {
+    /// The answer for `rolling`, solved as `solution`, with `meta`, the job's [`Meta`];
+    /// refused where the model's domain excludes it.
+    pub fn new(
+        rolling: &Rolling,
+        solution: &RollingSolution,
+        meta: Meta,
+    ) -> Result<Self, JobError> {
+        Ok(RollingOutput {
             contact: solution.into(),
             boundary: solution.boundary.iter().map(Into::into).collect(),
             pressure: solution.pressure.as_ref().map(Into::into),
             meta: RollingMeta {
                 meta,
                 verification: (&solution.verification).into(),
+                validity: validity(rolling, solution)?,
             },
             rolling: *rolling,
-        }
+        })
     }
 }
 
 impl Output for RollingOutput {
+    const UNITS: Units = &[
+        contact_units!(""),
+        &[
+            ("boundary[].y", "m"),
+            ("boundary[].exit", "m"),
+            ("boundary[].entry", "m"),
+            ("pressure.x[]", "m"),
+            ("pressure.y[]", "m"),
+            ("pressure.values[][]", "Pa"),
+        ],
+        verification_units!("meta.verification."),
+        validity_units!("meta.validity."),
+    ];
+
     /// One row: the contact's conditions and integrals, as a sweep's row.
     fn table(&self) -> Table {
         let point = SweepPoint {
@@ -363,6 +431,7 @@ impl Output for RollingOutput {
             velocity: self.rolling.velocity,
             contact: self.contact.clone(),
             verification: self.meta.verification.clone(),
+            validity: self.meta.validity.clone(),
         };
         Table::new(&SweepPoint::COLUMNS, [&point])
     }

@@ -8,12 +8,15 @@ use utoipa::ToSchema;
 
 use super::input::{self, field, Checker, Field, Quantity};
 use super::meta::{REFERENCES, ROLLING_REFERENCES};
-use super::rolling::{RollingInput, RollingJob};
-use super::three_body::{ThreeBodyInput, ThreeBodyJob};
-use super::{Control, JobError, Kind, Limits, Meta, Reference, Work};
+use super::rolling::{contact_units, verification_units, RollingInput, RollingJob};
+use super::three_body::{
+    result_units, three_body_verification_units, ThreeBodyInput, ThreeBodyJob,
+};
+use super::validity::validity_units;
+use super::{Control, JobError, Kind, Limits, Meta, Reference, Validated, Work};
 use crate::model::three_body::{self, Diameters, OperatingPoint, ThreeBody};
 use crate::model::{self, Parameter, Rolling, SolveOptions};
-use crate::render::{Output, Table};
+use crate::render::{Output, Table, Units};
 
 pub use super::rolling::SweepPoint;
 pub use super::three_body::ThreeBodySweepPoint;
@@ -116,7 +119,7 @@ impl Kind for SweepJob {
     const NAME: &'static str = "sweep";
     type Output = SweepOutput;
 
-    fn validate(value: Value, limits: &Limits) -> Result<Self, JobError> {
+    fn validate(value: Value, limits: &Limits) -> Result<Validated<Self>, JobError> {
         let input: SweepInput = input::deserialize(value, "")?;
         let mut checker = Checker::new();
         let (base, vary) = (field!(input.base), field!(input.vary));
@@ -167,18 +170,34 @@ impl Kind for SweepJob {
                 let contacts = s.points();
                 let options = &s.base.options;
                 let solutions = control.map(&contacts, |p| model::solve(p, options))?;
-                let rows = contacts.iter().zip(&solutions);
-                SweepPoints::Rolling(rows.map(|(p, s)| SweepPoint::new(p, s)).collect())
+                let rows = contacts.iter().zip(&solutions).enumerate();
+                SweepPoints::Rolling(
+                    rows.map(|(i, (p, s))| SweepPoint::new(p, s).map_err(|e| at_point(i, e)))
+                        .collect::<Result<_, _>>()?,
+                )
             }
             SweepJob::ThreeBody(s) => {
                 let systems = s.points();
                 let options = &s.base.options;
                 let solutions = control.map(&systems, |p| three_body::solve(p, options))?;
-                let rows = systems.iter().zip(&solutions);
-                SweepPoints::ThreeBody(rows.map(|(p, s)| ThreeBodySweepPoint::new(p, s)).collect())
+                let rows = systems.iter().zip(&solutions).enumerate();
+                SweepPoints::ThreeBody(
+                    rows.map(|(i, (p, s))| {
+                        ThreeBodySweepPoint::new(p, s).map_err(|e| at_point(i, e))
+                    })
+                    .collect::<Result<_, _>>()?,
+                )
             }
         };
         Ok(SweepOutput { points, meta })
+    }
+}
+
+/// The error of point `index` of a sweep, said so.
+fn at_point(index: usize, e: JobError) -> JobError {
+    match e {
+        JobError::OutOfDomain(m) => JobError::OutOfDomain(format!("points[{index}]: {m}")),
+        other => other,
     }
 }
 
@@ -441,6 +460,24 @@ pub struct SweepOutput {
 }
 
 impl Output for SweepOutput {
+    /// The points of a rolling sweep or of a three-body sweep.
+    const UNITS: Units = &[
+        &[
+            ("points[].radius", "m"),
+            ("points[].load", "N"),
+            ("points[].velocity", "m/s"),
+            ("points[].mean_diameter", "m"),
+            ("points[].operating.separation", "m"),
+            ("points[].operating.total_load", "N"),
+            ("points[].operating.particle_load", "N"),
+        ],
+        contact_units!("points[]."),
+        verification_units!("points[].verification."),
+        result_units!("points[]."),
+        three_body_verification_units!("points[].verification."),
+        validity_units!("points[].validity."),
+    ];
+
     /// One row per point.
     fn table(&self) -> Table {
         match &self.points {

@@ -7,13 +7,14 @@ use utoipa::ToSchema;
 
 use super::input::{self, field, Checker, LayerInput, QuadratureKind, Quantity};
 use super::meta::REFERENCES;
-use super::{Control, JobError, Kind, Limits, Meta, Reference, Work};
+use super::validity::{self, validity_units, Subject, ValidityOutput};
+use super::{Control, JobError, Kind, Limits, Meta, Reference, Validated, Work};
 use crate::model::three_body::{
     self, Asperities, ContactState, Diameters, LayerContact, OperatingPoint, Particle, ThreeBody,
     ThreeBodyOptions, ThreeBodySolution, UpperContact, UpperSurface, DEFAULT_DIAMETER_NODES,
 };
 use crate::model::{Parameter, SolveOption};
-use crate::render::{Column, Output, Table};
+use crate::render::{Column, Output, Table, Units};
 
 /// Input of a three-body job; every field optional but the operating point.
 #[derive(Clone, Debug, Default, PartialEq, Deserialize, Serialize, ToSchema)]
@@ -400,7 +401,7 @@ impl Kind for ThreeBodyJob {
     const NAME: &'static str = "three_body";
     type Output = ThreeBodyOutput;
 
-    fn validate(input: Value, _limits: &Limits) -> Result<Self, JobError> {
+    fn validate(input: Value, _limits: &Limits) -> Result<Validated<Self>, JobError> {
         input::validate(input, ThreeBodyJob::read)
     }
 
@@ -419,7 +420,7 @@ impl Kind for ThreeBodyJob {
 
     fn run(&self, meta: Meta, control: &Control) -> Result<ThreeBodyOutput, JobError> {
         let solution = control.solve(|| three_body::solve(&self.system, &self.options))?;
-        Ok(ThreeBodyOutput::new(&self.system, &solution, meta))
+        ThreeBodyOutput::new(&self.system, &solution, meta)
     }
 }
 
@@ -427,6 +428,69 @@ impl Kind for ThreeBodyJob {
 pub fn operating_canonical(operating: OperatingPoint) -> Value {
     input::canonical(&OperatingInput::of(operating))
 }
+
+/// The units of a three-body result's fields (`ThreeBodyResult`), under `$prefix`.
+macro_rules! result_units {
+    ($prefix:literal) => {
+        &[
+            (concat!($prefix, "separation"), "m"),
+            (concat!($prefix, "particles_in_contact"), ""),
+            (concat!($prefix, "areas.surface_surface"), "m²"),
+            (concat!($prefix, "areas.particle_upper"), "m²"),
+            (concat!($prefix, "areas.particle_layer"), "m²"),
+            (concat!($prefix, "areas.total"), "m²"),
+            (concat!($prefix, "loads.asperities"), "N"),
+            (concat!($prefix, "loads.particles"), "N"),
+            (concat!($prefix, "loads.total"), "N"),
+            (concat!($prefix, "friction_coefficient.static"), ""),
+            (concat!($prefix, "friction_coefficient.rolling"), ""),
+            (concat!($prefix, "per_particle.mean_area"), "m²"),
+            (concat!($prefix, "per_particle.mean_load"), "N"),
+            (concat!($prefix, "static_operating_point.separation"), "m"),
+            (
+                concat!($prefix, "static_operating_point.particles_in_contact"),
+                "",
+            ),
+            (
+                concat!($prefix, "static_operating_point.areas.surface_surface"),
+                "m²",
+            ),
+            (
+                concat!($prefix, "static_operating_point.areas.particle_upper"),
+                "m²",
+            ),
+            (
+                concat!($prefix, "static_operating_point.areas.particle_layer"),
+                "m²",
+            ),
+            (concat!($prefix, "static_operating_point.areas.total"), "m²"),
+            (
+                concat!($prefix, "static_operating_point.loads.asperities"),
+                "N",
+            ),
+            (
+                concat!($prefix, "static_operating_point.loads.particles"),
+                "N",
+            ),
+            (concat!($prefix, "static_operating_point.loads.total"), "N"),
+        ]
+    };
+}
+pub(crate) use result_units;
+
+/// The units of a three-body verification block, under `$prefix`.
+macro_rules! three_body_verification_units {
+    ($prefix:literal) => {
+        &[
+            (concat!($prefix, "diameter_nodes"), ""),
+            (concat!($prefix, "separation_iterations"), ""),
+            (concat!($prefix, "relative_load_residual"), ""),
+            (concat!($prefix, "quadrature_error_estimate"), ""),
+            (concat!($prefix, "layer_table_error"), ""),
+        ]
+    };
+}
+pub(crate) use three_body_verification_units;
 
 /// Real contact areas (m²).
 #[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
@@ -562,6 +626,14 @@ pub struct ThreeBodyMeta {
     #[serde(flatten)]
     pub meta: Meta,
     pub verification: ThreeBodyVerificationOutput,
+    /// How far the model can be trusted here (MODEL.md §7).
+    pub validity: ValidityOutput,
+}
+
+/// The validity of a three-body system; a violated assumption is the job's error.
+fn validity(system: &ThreeBody, solution: &ThreeBodySolution) -> Result<ValidityOutput, JobError> {
+    let checks = crate::model::validity::three_body(system, solution);
+    validity::assess(&checks, Subject::System)
 }
 
 /// The answer to a three-body job.
@@ -577,20 +649,32 @@ pub struct ThreeBodyOutput {
 }
 
 impl ThreeBodyOutput {
-    /// The answer for `system`, solved as `solution`, with `meta`, the job's [`Meta`].
-    pub fn new(system: &ThreeBody, solution: &ThreeBodySolution, meta: Meta) -> Self {
-        ThreeBodyOutput {
+    /// The answer for `system`, solved as `solution`, with `meta`, the job's [`Meta`];
+    /// refused where the model's domain excludes it.
+    pub fn new(
+        system: &ThreeBody,
+        solution: &ThreeBodySolution,
+        meta: Meta,
+    ) -> Result<Self, JobError> {
+        Ok(ThreeBodyOutput {
             result: solution.into(),
             meta: ThreeBodyMeta {
                 meta,
                 verification: solution.into(),
+                validity: validity(system, solution)?,
             },
             system: *system,
-        }
+        })
     }
 }
 
 impl Output for ThreeBodyOutput {
+    const UNITS: Units = &[
+        result_units!(""),
+        three_body_verification_units!("meta.verification."),
+        validity_units!("meta.validity."),
+    ];
+
     /// One row: the system's operating point, speed and mean diameter and its results, as a
     /// sweep's row.
     fn table(&self) -> Table {
@@ -600,6 +684,7 @@ impl Output for ThreeBodyOutput {
             mean_diameter: self.system.diameters.mean,
             result: self.result.clone(),
             verification: self.meta.verification.clone(),
+            validity: self.meta.validity.clone(),
             operating_point: self.system.operating,
         };
         ThreeBodySweepPoint::table(&[point])
@@ -621,22 +706,25 @@ pub struct ThreeBodySweepPoint {
     #[serde(flatten)]
     pub result: ThreeBodyResult,
     pub verification: ThreeBodyVerificationOutput,
+    /// The model's assumptions at this point (MODEL.md §7).
+    pub validity: ValidityOutput,
     /// `operating`, typed (for the CSV).
     #[serde(skip)]
     operating_point: OperatingPoint,
 }
 
 impl ThreeBodySweepPoint {
-    /// The point of `system`, solved as `solution`.
-    pub fn new(system: &ThreeBody, solution: &ThreeBodySolution) -> Self {
-        ThreeBodySweepPoint {
+    /// The point of `system`, solved as `solution`, unless the model's domain excludes it.
+    pub fn new(system: &ThreeBody, solution: &ThreeBodySolution) -> Result<Self, JobError> {
+        Ok(ThreeBodySweepPoint {
             operating: operating_canonical(system.operating),
             velocity: system.velocity,
             mean_diameter: system.diameters.mean,
             result: solution.into(),
             verification: solution.into(),
+            validity: validity(system, solution)?,
             operating_point: system.operating,
-        }
+        })
     }
 
     /// The model parameter the operating point gives.
@@ -661,7 +749,7 @@ impl ThreeBodySweepPoint {
     }
 
     /// The CSV columns of three-body systems.
-    const COLUMNS: [Column<ThreeBodySweepPoint>; 16] = [
+    const COLUMNS: [Column<ThreeBodySweepPoint>; 17] = [
         Column::number("operating", "", |p| p.operating_point.value()),
         Column::number("velocity", "m/s", |p| p.velocity),
         Column::number("mean_diameter", "m", |p| p.mean_diameter),
@@ -690,5 +778,6 @@ impl ThreeBodySweepPoint {
         }),
         Column::number("mean_area", "m²", |p| p.result.per_particle.mean_area),
         Column::number("mean_load", "N", |p| p.result.per_particle.mean_load),
+        Column::text("validity", |p| validity::summary(&p.validity)),
     ];
 }

@@ -13,6 +13,7 @@ mod roots;
 mod special;
 pub mod strip;
 pub mod three_body;
+pub mod validity;
 
 pub use error::{ModelError, OptionError, SolveOption};
 pub use layer::{Layer, Parameter, ParameterError};

@@ -68,8 +68,15 @@ impl fmt::Display for RenderError {
 
 impl std::error::Error for RenderError {}
 
+/// The unit of each numeric field of an answer, by path (`a.b`, `list[].c`): SI, `""` for
+/// plain numbers and counts; in groups, so that the parts answers share are declared once.
+pub type Units = &'static [&'static [(&'static str, &'static str)]];
+
 /// The answer of a job kind: JSON through serde, and one table for CSV.
 pub trait Output: Serialize + fmt::Debug + PartialEq + Send + Sync + 'static {
+    /// The unit of every numeric field of the JSON answer (outside `meta.input`).
+    const UNITS: Units;
+
     /// The answer as one table, its columns declared once by the output.
     fn table(&self) -> Table;
 }
@@ -242,6 +249,8 @@ mod tests {
     }
 
     impl Output for Point {
+        const UNITS: Units = &[&[("x", "m")]];
+
         fn table(&self) -> Table {
             const COLUMNS: [Column<Point>; 1] = [Column::number("x", "m", |p| p.x)];
             Table::new(&COLUMNS, [self])
@@ -252,7 +261,7 @@ mod tests {
     fn an_answer_renders_in_every_format_and_refuses_a_non_finite_number() {
         let answer = Answer::new(Point { x: 0.5 });
         assert_eq!(answer.render(Format::Json).unwrap(), br#"{"x":0.5}"#);
-        assert_eq!(answer.render(Format::Csv).unwrap(), b"x\n0.5\n");
+        assert_eq!(answer.render(Format::Csv).unwrap(), b"x [m]\n0.5\n");
         assert_eq!(answer, Answer::new(Point { x: 0.5 }));
         assert_eq!(serde_json::to_string(&answer).unwrap(), r#"{"x":0.5}"#);
         assert_eq!(answer.downcast::<Point>().unwrap(), Point { x: 0.5 });

@@ -75,6 +75,17 @@ pub struct Heading {
     pub unit: &'static str,
 }
 
+impl Heading {
+    /// The column's name with its unit: `radius [m]`, or `friction_coefficient`.
+    pub fn label(&self) -> String {
+        if self.unit.is_empty() {
+            self.name.clone()
+        } else {
+            format!("{} [{}]", self.name, self.unit)
+        }
+    }
+}
+
 /// A table of cells under headings, one row per record.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Table {
@@ -109,11 +120,11 @@ impl Table {
         }
     }
 
-    /// CSV (RFC 4180): one header line, one line per row; numbers in their shortest
-    /// round-trip form, text quoted.
+    /// CSV (RFC 4180): one header line, each column named with its unit (`radius [m]`),
+    /// then one line per row; numbers in their shortest round-trip form, text quoted.
     pub fn to_csv(&self) -> String {
         let mut csv = String::new();
-        let names: Vec<&str> = self.headings.iter().map(|h| h.name.as_str()).collect();
+        let names: Vec<String> = self.headings.iter().map(Heading::label).collect();
         csv.push_str(&names.join(","));
         csv.push('\n');
         for row in &self.rows {
@@ -163,10 +174,10 @@ mod tests {
         let mut table = Table::new(&COLUMNS, &rows);
         assert_eq!(
             table.to_csv(),
-            "index,x,label\n7,2.5e-8,\"a\"\n7,0.5,\"say \"\"b\"\"\"\n"
+            "index,x [m],label\n7,2.5e-8,\"a\"\n7,0.5,\"say \"\"b\"\"\"\n"
         );
         table.rename(1, "load", "N");
-        assert!(table.to_csv().starts_with("index,load,label\n"));
+        assert!(table.to_csv().starts_with("index,load [N],label\n"));
         assert_eq!(table.headings[1].unit, "N");
     }
 }

@@ -203,7 +203,7 @@ async fn a_sweep_answers_json_or_csv_with_one_row_per_point() {
     assert_ne!(csv.headers()["etag"], json_etag);
     let text = csv.text().await.unwrap();
     assert_eq!(text.lines().count(), 16);
-    assert!(text.starts_with("radius,load,velocity,"));
+    assert!(text.starts_with("radius [m],load [N],velocity [m/s],"));
 }
 
 #[tokio::test]

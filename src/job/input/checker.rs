@@ -5,7 +5,7 @@ use serde_json::{json, Value};
 
 use super::units::{parse_quantity, Dimension, UnitError};
 use super::{Field, Quantity};
-use crate::job::FieldError;
+use crate::job::{FieldError, InputWarning, JobError, Validated};
 use crate::model::{OptionError, Parameter, ParameterError, SolveOption};
 use crate::render::format_number;
 
@@ -26,6 +26,7 @@ pub struct Checker {
     sent: Vec<(String, Value)>,
     /// Where each model parameter and option was read (the first place).
     paths: Vec<(Source, String)>,
+    warnings: Vec<InputWarning>,
 }
 
 impl Checker {
@@ -129,10 +130,21 @@ impl Checker {
         self.sent.push((path.clone(), quantity.sent()));
         let dimension = dimension(parameter);
         let parsed = match quantity {
-            Quantity::Number(x) => Ok(*x),
+            Quantity::Number(x) => {
+                if let Some(message) = implausible(parameter, *x) {
+                    let message = format!("{path}: {message}");
+                    self.warnings.push(InputWarning {
+                        field: path.clone(),
+                        value: quantity.sent(),
+                        message,
+                    });
+                }
+                Ok(*x)
+            }
             Quantity::Text(text) => parse_quantity(text, dimension),
         };
-        parsed.unwrap_or_else(|e| {
+        // -0 is 0: one value, one canonical form, one cache key.
+        parsed.map(super::si).unwrap_or_else(|e| {
             self.unreadable(path, quantity.sent(), dimension, &e);
             f64::NAN
         })
@@ -229,18 +241,56 @@ impl Checker {
     }
 
     /// The recorded errors, as the job's error.
-    pub fn into_error(self) -> crate::job::JobError {
-        crate::job::JobError::Invalid(self.errors)
+    pub fn into_error(self) -> JobError {
+        JobError::Invalid(self.errors)
     }
 
-    /// `Ok(value)` if no field was bad, else every error.
-    pub fn finish<T>(self, value: T) -> Result<T, crate::job::JobError> {
+    /// The job read, with the input's warnings, if no field was bad; else every error.
+    pub fn finish<T>(self, job: T) -> Result<Validated<T>, JobError> {
         if self.errors.is_empty() {
-            Ok(value)
+            Ok(Validated {
+                job,
+                warnings: self.warnings,
+            })
         } else {
             Err(self.into_error())
         }
     }
+}
+
+/// What is implausible about a bare (unit-less, so SI) number for `parameter`, and the
+/// form the sender may have meant (MODEL.md §7): a length above 1 mm, a load above 1 N, a
+/// speed above 1 m/s, a modulus below 1 kPa or above 1 TPa, a time above 1e6 s.
+fn implausible(parameter: Parameter, x: f64) -> Option<String> {
+    use Parameter::*;
+    let (limit_low, limit_high, meant) = match parameter {
+        Radius | Thickness | MeanDiameter | StdDiameter | MinDiameter | MaxDiameter | TipRadius
+        | HeightStd | Separation => (0.0, 1e-3, Some("nm")),
+        Load | ParticleLoad => (0.0, 1.0, Some("nN")),
+        Velocity => (0.0, 1.0, Some("nm/s")),
+        ElasticModulus | UpperModulus | ParticleModulus | UpperHardness | AsperityHardness => {
+            (1e3, 1e12, None)
+        }
+        RetardationTime | RelaxationTime => (0.0, 1e6, Some("ms")),
+        PoissonRatio | UpperPoissonRatio | ParticlePoissonRatio | ArealDensity | NominalArea
+        | AsperityDensity | TotalLoad => return None,
+    };
+    if !(x.is_finite() && x > 0.0) || (limit_low..=limit_high).contains(&x) {
+        return None;
+    }
+    let number = format_number(x);
+    let si = format!("{number} {}", parameter.unit());
+    let suggestion = match meant {
+        Some(unit) => Some(format!("\"{number} {unit}\"")),
+        // A modulus too small for a solid was most likely meant in GPa; one above 1 TPa
+        // (stiffer than diamond) has no likely reading.
+        None if x < limit_low => Some(format!("\"{number} GPa\"")),
+        None => None,
+    };
+    Some(match suggestion {
+        Some(meant) => format!("{number} is {si}; did you mean {meant}?"),
+        None => format!("{number} is {si}, above 1 TPa: stiffer than any solid"),
+    })
 }
 
 /// The dimension of a parameter's values, read off its SI unit.
@@ -251,6 +301,37 @@ fn dimension(parameter: Parameter) -> Dimension {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_bare_number_far_from_its_field_s_scale_is_named_with_what_was_meant() {
+        assert_eq!(
+            implausible(Parameter::Radius, 25.0).unwrap(),
+            "25 is 25 m; did you mean \"25 nm\"?"
+        );
+        assert_eq!(
+            implausible(Parameter::ElasticModulus, 3.0).unwrap(),
+            "3 is 3 Pa; did you mean \"3 GPa\"?"
+        );
+        assert!(implausible(Parameter::ElasticModulus, 1e300)
+            .unwrap()
+            .contains("above 1 TPa"));
+        assert!(implausible(Parameter::Load, 2.0)
+            .unwrap()
+            .contains("\"2 nN\""));
+        assert!(implausible(Parameter::RelaxationTime, 2e6)
+            .unwrap()
+            .contains("ms"));
+        for (parameter, x) in [
+            (Parameter::Radius, 25e-9),
+            (Parameter::Radius, -1.0),
+            (Parameter::Velocity, 0.0),
+            (Parameter::ElasticModulus, 3e9),
+            (Parameter::PoissonRatio, 30.0),
+            (Parameter::TotalLoad, 5.0),
+        ] {
+            assert_eq!(implausible(parameter, x), None, "{parameter} {x}");
+        }
+    }
 
     #[test]
     fn every_parameter_has_the_dimension_of_its_unit() {

@@ -8,16 +8,20 @@
 //! and the canonical form is the input struct filled in and serialized ([`canonical`]).
 
 mod checker;
+mod json;
 mod layer;
 mod quadrature;
 pub mod units;
 
-use serde::de::DeserializeOwned;
-use serde::{Deserialize, Serialize};
+use std::fmt;
+
+use serde::de::{self, DeserializeOwned, Visitor};
+use serde::{Deserialize, Deserializer, Serialize};
 use serde_json::Value;
 use utoipa::ToSchema;
 
 pub use checker::Checker;
+pub use json::parse;
 pub use layer::LayerInput;
 pub use quadrature::QuadratureKind;
 
@@ -25,11 +29,44 @@ use super::JobError;
 
 /// A quantity as sent: an SI number, or a string with a unit such as `"25 nm"`, `"1.2 nN"`,
 /// `"4 nm/s"`, `"3 GPa"` or `"100 ms"` (its dimension must be the field's).
-#[derive(Clone, Debug, PartialEq, Deserialize, Serialize, ToSchema)]
+#[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
 #[serde(untagged)]
 pub enum Quantity {
     Number(f64),
     Text(String),
+}
+
+impl<'de> Deserialize<'de> for Quantity {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        d.deserialize_any(QuantityVisitor)
+    }
+}
+
+/// Reads a number or a string, and says what it expects in the user's terms.
+struct QuantityVisitor;
+
+impl Visitor<'_> for QuantityVisitor {
+    type Value = Quantity;
+
+    fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+        f.write_str("a number (in SI units) or a string with a unit such as \"25 nm\"")
+    }
+
+    fn visit_f64<E: de::Error>(self, x: f64) -> Result<Quantity, E> {
+        Ok(Quantity::Number(x))
+    }
+
+    fn visit_i64<E: de::Error>(self, n: i64) -> Result<Quantity, E> {
+        Ok(Quantity::Number(n as f64))
+    }
+
+    fn visit_u64<E: de::Error>(self, n: u64) -> Result<Quantity, E> {
+        Ok(Quantity::Number(n as f64))
+    }
+
+    fn visit_str<E: de::Error>(self, s: &str) -> Result<Quantity, E> {
+        Ok(Quantity::Text(s.to_string()))
+    }
 }
 
 impl Quantity {
@@ -83,9 +120,10 @@ macro_rules! field {
 }
 pub(crate) use field;
 
-/// Deserializes `value` as `T`; a misshapen field is reported with its path under `prefix`.
+/// Reads `value` strictly as `T` (objects only where `T` has one; see [`json::Strict`]); a
+/// misshapen field is reported with its path under `prefix`.
 pub fn deserialize<T: DeserializeOwned>(value: Value, prefix: &str) -> Result<T, JobError> {
-    serde_path_to_error::deserialize(value).map_err(|e| {
+    serde_path_to_error::deserialize(json::Strict(value)).map_err(|e| {
         let inner = e.path().to_string();
         let field = match (prefix, inner.as_str()) {
             (p, ".") => p.to_string(),
@@ -100,11 +138,11 @@ pub fn deserialize<T: DeserializeOwned>(value: Value, prefix: &str) -> Result<T,
 }
 
 /// Deserializes an input of type `I` and reads it with `read` under a fresh checker: the
-/// job, or every bad field at once.
+/// job (with its input's warnings), or every bad field at once.
 pub fn validate<I: DeserializeOwned, T>(
     value: Value,
     read: impl FnOnce(&I, &mut Checker) -> T,
-) -> Result<T, JobError> {
+) -> Result<super::Validated<T>, JobError> {
     let input: I = deserialize(value, "")?;
     let mut checker = Checker::new();
     let job = read(&input, &mut checker);

@@ -68,12 +68,16 @@ impl Dimension {
         parse_unit(unit).ok().map(|(_, dimension)| dimension)
     }
 
-    fn add(self, other: Dimension, power: i8) -> Dimension {
+    /// `self · other^power`, if every base power stays within ±[`MAX_DIMENSION`].
+    fn add(self, other: Dimension, power: i8) -> Option<Dimension> {
         let mut d = self.0;
         for (d, o) in d.iter_mut().zip(other.0) {
-            *d += o * power;
+            *d = o
+                .checked_mul(power)
+                .and_then(|p| d.checked_add(p))
+                .filter(|p| p.abs() <= MAX_DIMENSION)?;
         }
-        Dimension(d)
+        Some(Dimension(d))
     }
 }
 
@@ -105,6 +109,8 @@ pub enum UnitError {
     NoNumber,
     /// A unit symbol that is not an SI symbol with an SI prefix.
     UnknownUnit(String),
+    /// A unit power out of range (`m^127`).
+    Power(String),
     /// A valid unit of another dimension than the field's.
     WrongDimension {
         found: Dimension,
@@ -120,10 +126,20 @@ impl fmt::Display for UnitError {
                 f,
                 "has an unknown unit \"{u}\" (SI symbols m, g, s, N, Pa with SI prefixes)"
             ),
+            UnitError::Power(u) => write!(
+                f,
+                "has a unit power out of range in \"{u}\" (allowed: −{MAX_POWER} to {MAX_POWER} \
+                 per symbol, at most {MAX_DIMENSION} in all)"
+            ),
             UnitError::WrongDimension { found, .. } => write!(f, "is {found}"),
         }
     }
 }
+
+/// Largest power of one symbol in a unit (`m^4`): beyond it a unit is a typo, not a unit.
+const MAX_POWER: i8 = 4;
+/// Largest power of a base unit (m, kg, s) in a whole unit expression.
+const MAX_DIMENSION: i8 = 8;
 
 /// SI prefixes as powers of ten; both micro signs and `u` are accepted.
 const PREFIXES: [(&str, i32); 22] = [
@@ -254,15 +270,20 @@ fn parse_unit(unit: &str) -> Result<(i32, Dimension), UnitError> {
         }
         let (symbol, power) = split_power(term).ok_or_else(unknown)?;
         let (scale, dim) = parse_symbol(symbol).ok_or_else(unknown)?;
-        let power = power * sign;
+        let out_of_range = || UnitError::Power(unit.to_string());
+        let power = i8::try_from(power)
+            .ok()
+            .filter(|p| p.abs() <= MAX_POWER)
+            .ok_or_else(out_of_range)?
+            * sign;
         ten_power += scale * i32::from(power);
-        dimension = dimension.add(dim, power);
+        dimension = dimension.add(dim, power).ok_or_else(out_of_range)?;
     }
     Ok((ten_power, dimension))
 }
 
 /// Splits "mm^2", "m²", "m^-2", "m⁻²" into the symbol and its power.
-fn split_power(term: &str) -> Option<(&str, i8)> {
+fn split_power(term: &str) -> Option<(&str, i64)> {
     if let Some((symbol, power)) = term.split_once('^') {
         return Some((symbol, power.parse().ok()?));
     }
@@ -389,6 +410,24 @@ mod tests {
             assert_eq!(Dimension::of_unit(unit), Some(dimension), "{unit}");
         }
         assert_eq!(Dimension::of_unit("parsec"), None);
+    }
+
+    #[test]
+    fn unit_powers_are_bounded_and_never_overflow() {
+        for text in [
+            "25 m^127 m^127 m^3",
+            "25 m^5",
+            "25 m^99999999999999999",
+            "25 m^4 m^4 m^4",
+            "25 m m m m m m m m m",
+        ] {
+            let err = parse_quantity(text, Dimension::LENGTH).unwrap_err();
+            assert!(matches!(err, UnitError::Power(_)), "{text}: {err:?}");
+            assert!(err.to_string().contains("out of range"), "{err}");
+        }
+        let many = format!("1 {}", "m/".repeat(100_000));
+        assert!(parse_quantity(&many, Dimension::LENGTH).is_err());
+        assert_eq!(parse_quantity("1 m^4/m^3", Dimension::LENGTH), Ok(1.0));
     }
 
     #[test]

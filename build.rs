@@ -1,0 +1,34 @@
+//! Captures the git commit the binary is built from, for the provenance every answer carries
+//! (`meta.software.commit`, the `X-Software-Commit` header, `thirdbody solve --provenance`).
+//! `THIRDBODY_GIT_COMMIT` overrides it (a container build has no `.git`); without either it
+//! is `unknown`.
+
+use std::process::Command;
+
+fn git(args: &[&str]) -> Option<String> {
+    let output = Command::new("git").args(args).output().ok()?;
+    let text = String::from_utf8(output.stdout).ok()?;
+    let text = text.trim();
+    (output.status.success() && !text.is_empty()).then(|| text.to_string())
+}
+
+fn main() {
+    println!("cargo:rerun-if-env-changed=THIRDBODY_GIT_COMMIT");
+    let commit = std::env::var("THIRDBODY_GIT_COMMIT")
+        .ok()
+        .filter(|c| !c.trim().is_empty())
+        .or_else(|| git(&["rev-parse", "--short=12", "HEAD"]))
+        .unwrap_or_else(|| "unknown".to_string());
+    println!("cargo:rustc-env=THIRDBODY_GIT_COMMIT={commit}");
+    // Build again when HEAD moves: a checkout changes HEAD, a commit changes its branch.
+    if let Some(dir) = git(&["rev-parse", "--git-dir"]) {
+        println!("cargo:rerun-if-changed={dir}/HEAD");
+    }
+    if let (Some(common), Some(branch)) = (
+        git(&["rev-parse", "--git-common-dir"]),
+        git(&["symbolic-ref", "-q", "HEAD"]),
+    ) {
+        println!("cargo:rerun-if-changed={common}/{branch}");
+        println!("cargo:rerun-if-changed={common}/packed-refs");
+    }
+}

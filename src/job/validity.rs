@@ -1,0 +1,313 @@
+//! The domain of validity in an answer (MODEL.md §7): each assumption of the model with its
+//! ratio and status, in `meta.validity` (and per sweep point); a violated assumption refuses
+//! the answer with a message naming the cause and the numbers.
+
+use serde::Serialize;
+use utoipa::ToSchema;
+
+use super::JobError;
+use crate::model::validity::{Assumption, Check, Status};
+
+/// The units of a validity block's fields, under `$prefix` (a string literal).
+macro_rules! validity_units {
+    ($prefix:literal) => {
+        &[
+            (concat!($prefix, "assumptions[].value"), ""),
+            (concat!($prefix, "assumptions[].at_rest"), ""),
+        ]
+    };
+}
+pub(crate) use validity_units;
+
+/// `ok`, or `warn`: the answer is given, and a note says why it may be off.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Serialize, ToSchema)]
+#[serde(rename_all = "lowercase")]
+pub enum ValidityStatus {
+    Ok,
+    Warn,
+}
+
+/// One assumption of the model, measured on this answer.
+#[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
+pub struct AssumptionOutput {
+    /// `inside_layer`, `parabolic_sphere`, `local_layer`, `adhesive_friction`,
+    /// `surfaces_apart`, `asperity_gap` or `particles_in_contact`.
+    pub name: &'static str,
+    /// The assumption in words.
+    pub assumption: &'static str,
+    /// What the ratio measures, e.g. `penetration / thickness`.
+    pub ratio: &'static str,
+    /// The ratio at the job's speed (dimensionless).
+    pub value: f64,
+    /// The ratio of the V = 0 companion the answer also gives (dimensionless).
+    pub at_rest: f64,
+    /// The worse of the two.
+    pub status: ValidityStatus,
+    /// When the ratio warns and when it refuses the answer.
+    pub rule: &'static str,
+    /// Why it warns, in words (with `warn` only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub note: Option<String>,
+}
+
+/// The model's own error on this answer (the `verification` block gives the numerical
+/// error).
+#[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
+pub struct ValidityOutput {
+    /// The worst status of the assumptions.
+    pub status: ValidityStatus,
+    pub assumptions: Vec<AssumptionOutput>,
+}
+
+/// What the checks are measured on, for their words.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Subject {
+    /// One particle rolling over the layer.
+    Particle,
+    /// A three-body system, measured on its largest particle in contact.
+    System,
+}
+
+/// The validity block of `checks`, or the error of the first violated one.
+pub fn assess(checks: &[Check], subject: Subject) -> Result<ValidityOutput, JobError> {
+    if let Some(check) = checks.iter().find(|c| c.status() == Status::Violated) {
+        return Err(JobError::OutOfDomain(violation(check, subject)));
+    }
+    let assumptions: Vec<AssumptionOutput> = checks.iter().map(|c| output(c, subject)).collect();
+    let status = assumptions
+        .iter()
+        .map(|a| a.status)
+        .max()
+        .unwrap_or(ValidityStatus::Ok);
+    Ok(ValidityOutput {
+        status,
+        assumptions,
+    })
+}
+
+/// The names of the assumptions that warn, for a CSV cell: `ok`, or `warn: local_layer`.
+pub fn summary(validity: &ValidityOutput) -> String {
+    let warned: Vec<&str> = validity
+        .assumptions
+        .iter()
+        .filter(|a| a.status == ValidityStatus::Warn)
+        .map(|a| a.name)
+        .collect();
+    if warned.is_empty() {
+        "ok".to_string()
+    } else {
+        format!("warn: {}", warned.join(" "))
+    }
+}
+
+/// A length as people read it: 651 nm, 5.58 nm, 2.1 µm; far below a picometre, 3.2e-80 m.
+fn length(x: f64) -> String {
+    if x != 0.0 && x.abs() < 1e-13 {
+        return format!("{x:.2e} m");
+    }
+    let (scale, unit) = [(1.0, "m"), (1e-3, "mm"), (1e-6, "µm"), (1e-9, "nm")]
+        .into_iter()
+        .find(|(scale, _)| x.abs() >= *scale)
+        .unwrap_or((1e-12, "pm"));
+    format!("{} {unit}", significant(x / scale))
+}
+
+/// Three significant digits, without trailing zeros.
+fn significant(x: f64) -> String {
+    if x == 0.0 || !x.is_finite() {
+        return format!("{x}");
+    }
+    let digits = (2 - x.abs().log10().floor() as i32).clamp(0, 12) as usize;
+    let text = format!("{x:.digits$}");
+    if text.contains('.') {
+        text.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        text
+    }
+}
+
+fn names(assumption: Assumption) -> (&'static str, &'static str, &'static str, &'static str) {
+    use Assumption::*;
+    match assumption {
+        InsideLayer => (
+            "inside_layer",
+            "the sphere stays inside the layer: the rigid base is never reached",
+            "penetration / thickness",
+            "warn above 0.1 (the linear layer law assumes small strain); refused at 1",
+        ),
+        Parabolic => (
+            "parabolic_sphere",
+            "the sphere is a paraboloid near the contact (contact an order smaller than R)",
+            "contact extent / radius",
+            "warn when (ratio)²/4, the profile's error, passes 0.05; refused at 1",
+        ),
+        LocalLayer => (
+            "local_layer",
+            "the layer is local (Winkler): the contact is wide compared with the layer",
+            "contact half-width / thickness",
+            "warn below 1",
+        ),
+        AdhesiveFriction => (
+            "adhesive_friction",
+            "adhesive friction τ_a A / P (eq. 12) is meaningful",
+            "friction coefficient",
+            "warn above 1",
+        ),
+        SurfacesApart => (
+            "surfaces_apart",
+            "the surfaces stay apart (the paper's always-a-gap regime)",
+            "separation / largest diameter",
+            "refused at or below 0",
+        ),
+        AsperityGap => (
+            "asperity_gap",
+            "the asperities of the surfaces stay apart",
+            "separation / asperity height standard deviation",
+            "warn below 3",
+        ),
+        ParticlesInContact => (
+            "particles_in_contact",
+            "at least one particle is in contact",
+            "particles in contact",
+            "warn below 1",
+        ),
+    }
+}
+
+fn output(check: &Check, subject: Subject) -> AssumptionOutput {
+    let (name, assumption, ratio, rule) = names(check.assumption);
+    let status = match check.status() {
+        Status::Ok => ValidityStatus::Ok,
+        _ => ValidityStatus::Warn,
+    };
+    AssumptionOutput {
+        name,
+        assumption,
+        ratio,
+        value: check.ratio(),
+        at_rest: check.ratio_at_rest(),
+        status,
+        rule,
+        note: (status == ValidityStatus::Warn).then(|| note(check, subject)),
+    }
+}
+
+/// The state that decides a check's status, in words, and its numbers.
+fn state(check: &Check) -> (&'static str, (f64, f64)) {
+    if check.caused_at_rest() {
+        (
+            "at rest (V = 0, the `static` companion the answer also gives), ",
+            check.at_rest,
+        )
+    } else {
+        ("", check.rolling)
+    }
+}
+
+fn whose(subject: Subject) -> &'static str {
+    match subject {
+        Subject::Particle => "the",
+        Subject::System => "the largest particle's",
+    }
+}
+
+/// Why a check warns, in a user's words.
+fn note(check: &Check, subject: Subject) -> String {
+    use Assumption::*;
+    let (when, (value, reference)) = state(check);
+    let ratio = value / reference;
+    match check.assumption {
+        InsideLayer => format!(
+            "{when}{} penetration {} is {}% of the layer's thickness {}: the linear layer law \
+             assumes small strain",
+            whose(subject),
+            length(value),
+            significant(100.0 * ratio),
+            length(reference)
+        ),
+        Parabolic => format!(
+            "{when}the contact extends to {} of the radius {}: the parabolic profile errs by \
+             about {}%",
+            length(value),
+            length(reference),
+            significant(25.0 * ratio * ratio)
+        ),
+        LocalLayer => format!(
+            "{when}{} contact half-width {} is smaller than the layer's thickness {}: a real \
+             layer spreads the load over about its thickness, which the local (Winkler) law \
+             ignores, so the area's response to load and speed is overestimated. The paper's \
+             own parameters are in this regime",
+            whose(subject),
+            length(value),
+            length(reference)
+        ),
+        AdhesiveFriction => format!(
+            "{when}μ = {} is above 1: the load is too small for τ_a A / P to be a friction \
+             coefficient",
+            significant(value)
+        ),
+        SurfacesApart => String::new(),
+        AsperityGap => format!(
+            "{when}the separation {} is {} times the asperities' height spread {}: the \
+             asperities touch and their contact (Zhao–Maietta–Chang) is in the answer, outside \
+             the paper's always-a-gap regime",
+            length(value),
+            significant(ratio),
+            length(reference)
+        ),
+        ParticlesInContact => format!(
+            "{when}only {} particles are in contact, fewer than one: the means per particle \
+             describe a fraction of a particle",
+            significant(value)
+        ),
+    }
+}
+
+/// Why a violated check refuses the answer, with its numbers.
+fn violation(check: &Check, subject: Subject) -> String {
+    use Assumption::*;
+    let (when, (value, reference)) = state(check);
+    let rest = if check.caused_at_rest() {
+        " (the rolling contact stays inside the model's domain, but the answer carries both)"
+    } else {
+        ""
+    };
+    let cause = match check.assumption {
+        InsideLayer => format!(
+            "{} penetration {} reaches the layer's thickness {}: the sphere would touch the \
+             rigid base",
+            whose(subject),
+            length(value),
+            length(reference)
+        ),
+        Parabolic => format!(
+            "the contact's extent {} reaches the sphere's radius {}: the contact is not small \
+             compared with the sphere",
+            length(value),
+            length(reference)
+        ),
+        SurfacesApart => format!(
+            "the separation {} is not positive: the surfaces touch, outside the three-body model",
+            length(value)
+        ),
+        LocalLayer | AdhesiveFriction | AsperityGap | ParticlesInContact => note(check, subject),
+    };
+    format!("{when}{cause}{rest}")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn lengths_read_as_people_write_them() {
+        assert_eq!(length(651.47e-9), "651 nm");
+        assert_eq!(length(5.5842e-9), "5.58 nm");
+        assert_eq!(length(1e-7), "100 nm");
+        assert_eq!(length(2.1e-6), "2.1 µm");
+        assert_eq!(length(25.0), "25 m");
+        assert_eq!(length(3e-13), "0.3 pm");
+        assert_eq!(length(6.79e-82), "6.79e-82 m");
+        assert_eq!(length(0.0), "0 pm");
+    }
+}

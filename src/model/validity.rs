@@ -1,0 +1,231 @@
+//! The model's domain of validity (MODEL.md §7): each assumption the model rests on, measured
+//! on a solved contact as a ratio, with its status. The verification block of an answer says
+//! how exact the numbers are; this says how far the model itself can be trusted there.
+
+use super::three_body::{LayerContact, ThreeBody, ThreeBodySolution};
+use super::{Rolling, RollingSolution};
+
+/// Where a ratio stands.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub enum Status {
+    Ok,
+    /// The answer is given; the assumption is strained there.
+    Warn,
+    /// The assumption fails: no answer.
+    Violated,
+}
+
+/// An assumption of the model and how it is measured.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Assumption {
+    /// The sphere stays inside the layer (the rigid base is never reached): δ/H (three-body:
+    /// the largest ω₂/H). Warn above 0.1 (the linear layer law assumes small strain);
+    /// violated at 1.
+    InsideLayer,
+    /// The sphere is a paraboloid: a_max/R with a_max the largest extent of the contact;
+    /// the profile's error is about (a_max/R)²/4. Warn when that passes 0.05; violated at 1.
+    Parabolic,
+    /// The layer is local (Winkler): half-width/H. Warn below 1 (a thick layer spreads the
+    /// load, which the local law ignores).
+    LocalLayer,
+    /// Adhesive friction is meaningful: μ of eq. 12. Warn above 1.
+    AdhesiveFriction,
+    /// Three-body: the surfaces stay apart: d/x_max. Violated at or below 0.
+    SurfacesApart,
+    /// Three-body with asperities: d/σ_s. Warn below 3 (the asperities touch: outside the
+    /// paper's always-a-gap regime, their contact is in the answer).
+    AsperityGap,
+    /// Three-body: particles in contact, n_a. Warn below 1 (a fraction of a particle).
+    ParticlesInContact,
+}
+
+impl Assumption {
+    /// The status of `ratio`.
+    pub fn status(self, ratio: f64) -> Status {
+        use Assumption::*;
+        let (warn, violated) = match self {
+            InsideLayer => (ratio > 0.1, ratio >= 1.0),
+            Parabolic => (ratio * ratio / 4.0 > 0.05, ratio >= 1.0),
+            LocalLayer => (ratio < 1.0, false),
+            AdhesiveFriction => (ratio > 1.0, false),
+            SurfacesApart => (false, ratio <= 0.0),
+            AsperityGap => (ratio < 3.0, false),
+            ParticlesInContact => (ratio < 1.0, false),
+        };
+        if violated {
+            Status::Violated
+        } else if warn {
+            Status::Warn
+        } else {
+            Status::Ok
+        }
+    }
+}
+
+/// One assumption measured on an answer: the ratio (its numerator and denominator, for
+/// messages) in the moving contact and in its V = 0 companion, which the answer also gives.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Check {
+    pub assumption: Assumption,
+    /// (numerator, denominator) at the job's speed.
+    pub rolling: (f64, f64),
+    /// The same for the V = 0 companion.
+    pub at_rest: (f64, f64),
+}
+
+impl Check {
+    fn new(assumption: Assumption, rolling: (f64, f64), at_rest: (f64, f64)) -> Check {
+        Check {
+            assumption,
+            rolling,
+            at_rest,
+        }
+    }
+
+    /// The ratio at the job's speed.
+    pub fn ratio(&self) -> f64 {
+        self.rolling.0 / self.rolling.1
+    }
+
+    /// The ratio at rest.
+    pub fn ratio_at_rest(&self) -> f64 {
+        self.at_rest.0 / self.at_rest.1
+    }
+
+    /// The worse of the two states.
+    pub fn status(&self) -> Status {
+        let status = |r: f64| self.assumption.status(r);
+        status(self.ratio()).max(status(self.ratio_at_rest()))
+    }
+
+    /// Whether only the V = 0 companion makes the status what it is.
+    pub fn caused_at_rest(&self) -> bool {
+        self.assumption.status(self.ratio_at_rest()) > self.assumption.status(self.ratio())
+    }
+}
+
+/// The assumptions of MODEL.md §7 on one rolling contact.
+pub fn rolling(rolling: &Rolling, s: &RollingSolution) -> Vec<Check> {
+    let h = rolling.layer.thickness;
+    let r = rolling.radius;
+    let rest = &s.static_contact;
+    // b(0) is the half-width and |a(0)| < b(0) (MODEL.md §3): the half-width is a_max.
+    vec![
+        Check::new(
+            Assumption::InsideLayer,
+            (s.penetration, h),
+            (rest.penetration, h),
+        ),
+        Check::new(
+            Assumption::Parabolic,
+            (s.half_width, r),
+            (rest.half_width, r),
+        ),
+        Check::new(
+            Assumption::LocalLayer,
+            (s.half_width, h),
+            (rest.half_width, h),
+        ),
+        Check::new(
+            Assumption::AdhesiveFriction,
+            (s.friction_coefficient, 1.0),
+            (rest.friction_coefficient, 1.0),
+        ),
+    ]
+}
+
+/// The assumptions of MODEL.md §7 on a three-body system, measured on its largest particle
+/// in contact (the deepest and widest contact) and on the whole system.
+pub fn three_body(system: &ThreeBody, s: &ThreeBodySolution) -> Vec<Check> {
+    let h = system.layer.thickness;
+    let x_max = system.diameters.max;
+    let radius = 0.5 * x_max;
+    // Contact half-width of the largest particle on the layer: √(2Rω₂) in the Kelvin layer
+    // (MODEL.md §3), √(Rω₂) for Hertz.
+    let half_width = |omega: f64| match system.layer_contact {
+        LayerContact::KelvinLayer => (2.0 * radius * omega).sqrt(),
+        LayerContact::Hertz => (radius * omega).sqrt(),
+    };
+    let (moving, rest) = (&s.rolling, &s.static_state);
+    let (w_moving, w_rest) = (moving.max_layer_penetration, rest.max_layer_penetration);
+    let mut checks = vec![
+        Check::new(Assumption::InsideLayer, (w_moving, h), (w_rest, h)),
+        Check::new(
+            Assumption::Parabolic,
+            (half_width(w_moving), radius),
+            (half_width(w_rest), radius),
+        ),
+        Check::new(
+            Assumption::LocalLayer,
+            (half_width(w_moving), h),
+            (half_width(w_rest), h),
+        ),
+        Check::new(
+            Assumption::AdhesiveFriction,
+            (moving.friction_coefficient, 1.0),
+            (rest.friction_coefficient, 1.0),
+        ),
+        Check::new(
+            Assumption::SurfacesApart,
+            (moving.separation, x_max),
+            (rest.separation, x_max),
+        ),
+        Check::new(
+            Assumption::ParticlesInContact,
+            (moving.particles_in_contact, 1.0),
+            (rest.particles_in_contact, 1.0),
+        ),
+    ];
+    if let Some(a) = &system.asperities {
+        checks.push(Check::new(
+            Assumption::AsperityGap,
+            (moving.separation, a.height_std),
+            (rest.separation, a.height_std),
+        ));
+    }
+    checks
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::{solve, SolveOptions};
+
+    #[test]
+    fn the_thresholds_are_those_of_model_section_7() {
+        use Assumption::*;
+        for (assumption, ratio, status) in [
+            (InsideLayer, 0.1, Status::Ok),
+            (InsideLayer, 0.11, Status::Warn),
+            (InsideLayer, 1.0, Status::Violated),
+            (Parabolic, 0.2_f64.sqrt() * 0.999, Status::Ok),
+            (Parabolic, 0.2_f64.sqrt() * 1.001, Status::Warn),
+            (Parabolic, 1.0, Status::Violated),
+            (LocalLayer, 0.99, Status::Warn),
+            (LocalLayer, 1.0, Status::Ok),
+            (AdhesiveFriction, 1.01, Status::Warn),
+            (SurfacesApart, 0.0, Status::Violated),
+            (SurfacesApart, 1e-9, Status::Ok),
+            (AsperityGap, 2.9, Status::Warn),
+            (ParticlesInContact, 0.5, Status::Warn),
+        ] {
+            assert_eq!(assumption.status(ratio), status, "{assumption:?} {ratio}");
+        }
+    }
+
+    #[test]
+    fn the_default_particle_warns_only_on_the_local_layer() {
+        let r = Rolling::default();
+        let s = solve(&r, &SolveOptions::default()).unwrap();
+        let checks = rolling(&r, &s);
+        let warned: Vec<Assumption> = checks
+            .iter()
+            .filter(|c| c.status() != Status::Ok)
+            .map(|c| c.assumption)
+            .collect();
+        assert_eq!(warned, [Assumption::LocalLayer]);
+        // δ/H and a_max/R of the reference row (MODEL.md §3: δ = 0.6237 nm, b(0) = 5.5842 nm).
+        assert!((checks[0].ratio() - 0.6237e-2).abs() < 1e-6);
+        assert!((checks[1].ratio() * 25.0 - 5.5842).abs() < 1e-4);
+    }
+}
