@@ -6,6 +6,7 @@
 //! leaves through the [`render`] layer (JSON, CSV). [`http`] is the same path as a web
 //! service.
 
+pub mod check;
 pub mod engine;
 pub mod http;
 pub mod job;

@@ -2,11 +2,12 @@
 //! HTTP API.
 
 use std::io::{IsTerminal, Read, Write};
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-use clap::{Parser, Subcommand, ValueEnum};
+use clap::{Args, Parser, Subcommand, ValueEnum};
 
-use thirdbody::engine;
+use thirdbody::check;
 use thirdbody::http::{self, AppState, LogFormat, ServeArgs};
 use thirdbody::job::{Control, FigureJob, Job, JobError, Limits};
 use thirdbody::render::{Answer, Format};
@@ -28,20 +29,43 @@ enum Command {
     Solve {
         /// The job file, or - for standard input.
         job: String,
-        /// Output format.
-        #[arg(long, value_enum, default_value_t = OutputFormat::Json)]
-        format: OutputFormat,
+        #[command(flatten)]
+        output: OutputArgs,
     },
     /// Print the data of Figure N (3–9) of the paper.
     Figure {
         number: i64,
-        #[arg(long, value_enum, default_value_t = OutputFormat::Json)]
-        format: OutputFormat,
+        #[command(flatten)]
+        output: OutputArgs,
+    },
+    /// Run the checks of a file, for CI: prints a report; exits 0 when every check holds, 1
+    /// when one fails, 2 when the file is not valid.
+    Check {
+        /// The checks file: {"checks": [{"name", "job", "expect": {...}, "golden": {...}}]}.
+        checks: PathBuf,
+        /// Also write the report as JUnit XML to this file.
+        #[arg(long)]
+        junit: Option<PathBuf>,
+        /// Rewrite every golden answer file with today's answer.
+        #[arg(long)]
+        update: bool,
     },
     /// Serve the HTTP API (see /docs once it runs); every flag has a THIRDBODY_* variable.
     Serve(Box<ServeArgs>),
     /// Print the OpenAPI description of the HTTP API.
     Openapi,
+}
+
+/// How an answer is printed.
+#[derive(Args)]
+struct OutputArgs {
+    /// Output format.
+    #[arg(long, value_enum, default_value_t = OutputFormat::Json)]
+    format: OutputFormat,
+    /// Print first a line saying where the answer comes from: software version and git
+    /// commit, model version, SHA-256 of the input.
+    #[arg(long)]
+    provenance: bool,
 }
 
 /// The forms of an answer on the command line (JSON is indented for people).
@@ -66,15 +90,29 @@ const INVALID_JOB: u8 = 2;
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
-    let (job, format) = match cli.command {
-        Command::Solve { job, format } => (read_job(&job), format),
-        Command::Figure { number, format } => (FigureJob::new(number).map(Job::new), format),
+    let (job, output) = match cli.command {
+        Command::Solve { job, output } => (read_job(&job), output),
+        Command::Figure { number, output } => (FigureJob::new(number).map(Job::new), output),
+        Command::Check {
+            checks,
+            junit,
+            update,
+        } => return check(&checks, junit.as_deref(), update),
         Command::Serve(args) => return serve(*args),
         Command::Openapi => return print(&http::openapi::spec_json()),
     };
     let result = job.and_then(|job| {
-        let answer = engine::run(&job, &Control::default())?;
-        render(&answer, format.format())
+        for warning in job.warnings() {
+            eprintln!("thirdbody: warning: {}", warning.message);
+        }
+        let meta = job.meta();
+        let provenance = output.provenance.then(|| meta.provenance());
+        let answer = job.run(meta, &Control::default())?;
+        let text = render(&answer, output.format.format())?;
+        Ok(match provenance {
+            Some(line) => format!("{line}\n{text}"),
+            None => text,
+        })
     });
     match result {
         Ok(text) => print(&text),
@@ -88,6 +126,29 @@ fn main() -> ExitCode {
                 _ => ExitCode::FAILURE,
             }
         }
+    }
+}
+
+/// `thirdbody check`: the report on standard output (and in JUnit XML if asked).
+fn check(path: &Path, junit: Option<&Path>, update: bool) -> ExitCode {
+    let report = match check::run_file(path, update) {
+        Ok(report) => report,
+        Err(e) => {
+            eprintln!("thirdbody check: {e}");
+            return ExitCode::from(INVALID_JOB);
+        }
+    };
+    if let Some(junit) = junit {
+        if let Err(e) = std::fs::write(junit, report.to_junit()) {
+            eprintln!("thirdbody check: cannot write {}: {e}", junit.display());
+            return ExitCode::from(INVALID_JOB);
+        }
+    }
+    let printed = print(&report.to_text());
+    if report.passed {
+        printed
+    } else {
+        ExitCode::FAILURE
     }
 }
 

@@ -224,3 +224,110 @@ fn the_container_configuration_starts_a_service_that_drains_on_sigterm() {
         "{logs}"
     );
 }
+
+#[test]
+fn a_csv_can_say_where_it_comes_from_and_warnings_reach_standard_error() {
+    let out = thirdbody(
+        &["solve", "-", "--format", "csv", "--provenance"],
+        Some(r#"{"kind": "rolling", "input": {"radius": 25}}"#),
+    );
+    assert!(out.status.success());
+    let text = String::from_utf8_lossy(&out.stdout);
+    let first = text.lines().next().unwrap();
+    assert!(
+        first.starts_with(&format!("# thirdbody {}", env!("CARGO_PKG_VERSION"))),
+        "{first}"
+    );
+    assert!(
+        first.contains(&format!("model {}", thirdbody::model::MODEL_VERSION)),
+        "{first}"
+    );
+    assert!(first.contains("input sha256 "), "{first}");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("warning: radius: 25 is 25 m; did you mean \"25 nm\"?"),
+        "{stderr}"
+    );
+}
+
+/// A fresh directory for files a test writes.
+fn scratch(name: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("thirdbody-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+#[test]
+fn check_exits_0_when_every_check_holds_1_when_one_fails_2_on_bad_input() {
+    let out = thirdbody(&["check", "examples/checks.json"], None);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stdout)
+    );
+    assert!(String::from_utf8_lossy(&out.stdout).ends_with("5 checks: 5 passed, 0 failed\n"));
+
+    let dir = scratch("check");
+    let checks = dir.join("checks.json");
+    std::fs::write(
+        &checks,
+        r#"{"checks": [
+            {"name": "low", "job": {"kind": "rolling"}, "expect": {"friction_coefficient": {"max": 0.01}}},
+            {"name": "same as before", "job": {"kind": "rolling", "input": {"load": "1.1 nN"}},
+             "golden": {"file": "golden/a.json"}}]}"#,
+    )
+    .unwrap();
+    // No golden answer yet: bad input, and the message says how to write it.
+    let out = thirdbody(&["check", checks.to_str().unwrap()], None);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--update"));
+    // --update writes it; the other check still fails, and the JUnit report says which.
+    let junit = dir.join("junit.xml");
+    let out = thirdbody(
+        &[
+            "check",
+            checks.to_str().unwrap(),
+            "--update",
+            "--junit",
+            junit.to_str().unwrap(),
+        ],
+        None,
+    );
+    assert_eq!(out.status.code(), Some(1));
+    let report = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        report.contains("FAIL  low\n      friction_coefficient = 0.0947"),
+        "{report}"
+    );
+    assert!(report.contains("PASS  same as before"), "{report}");
+    let xml = std::fs::read_to_string(&junit).unwrap();
+    assert!(
+        xml.contains("<testcase name=\"low\" classname=\"thirdbody.rolling\">"),
+        "{xml}"
+    );
+    assert!(
+        xml.contains("<failure message=\"friction_coefficient = 0.0947"),
+        "{xml}"
+    );
+    let golden: Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("golden/a.json")).unwrap()).unwrap();
+    assert!(golden["contact_area"].as_f64().unwrap() > 0.0);
+    // A golden answer that moved fails its check.
+    let mut moved = golden.clone();
+    moved["contact_area"] = serde_json::json!(golden["contact_area"].as_f64().unwrap() * 1.001);
+    std::fs::write(dir.join("golden/a.json"), moved.to_string()).unwrap();
+    let out = thirdbody(&["check", checks.to_str().unwrap()], None);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stdout).contains("contact_area = "));
+
+    std::fs::write(
+        &checks,
+        r#"{"checks": [{"name": "x", "job": {"kind": "nope"}, "expect": {}}]}"#,
+    )
+    .unwrap();
+    let out = thirdbody(&["check", checks.to_str().unwrap()], None);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("unknown kind \"nope\""));
+}

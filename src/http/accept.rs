@@ -36,12 +36,17 @@ impl Accept {
         })
     }
 
+    /// The media type the client prefers among `offered`, or 406.
+    pub fn choose_media<'a>(&self, offered: &[&'a str]) -> Result<&'a str, ApiError> {
+        match negotiate(self.values(), offered) {
+            Some(i) => Ok(offered[i]),
+            None => Err(self.refusal(offered)),
+        }
+    }
+
     /// Checks that the client accepts `media_type`, the one form of a route's answer.
     pub fn require(&self, media_type: &str) -> Result<(), ApiError> {
-        match negotiate(self.values(), &[media_type]) {
-            Some(_) => Ok(()),
-            None => Err(self.refusal(&[media_type])),
-        }
+        self.choose_media(&[media_type]).map(|_| ())
     }
 
     fn refusal(&self, offered: &[&str]) -> ApiError {

@@ -31,7 +31,8 @@ pub struct Problem {
     /// assumption of the model fails for these values, see `meta.validity`),
     /// `unsupported-media-type` (415),
     /// `not-acceptable` (406: the `Accept` header names no form the resource offers),
-    /// `payload-too-large` (413), `not-found` (404), `cancelled` (409), `overloaded` (429),
+    /// `payload-too-large` (413), `not-found` (404), `not-ready` (409: the job has no result
+    /// yet), `cancelled` (409), `overloaded` (429),
     /// `draining` (503), `deadline-exceeded` (504), `internal` (500); or `about:blank` for a
     /// status with no more to say than its title.
     #[serde(rename = "type")]
@@ -59,6 +60,7 @@ enum Kind {
     NotAcceptable,
     PayloadTooLarge,
     NotFound,
+    NotReady,
     Cancelled,
     Overloaded,
     Draining,
@@ -79,7 +81,7 @@ impl Kind {
             Kind::NotAcceptable => StatusCode::NOT_ACCEPTABLE,
             Kind::PayloadTooLarge => StatusCode::PAYLOAD_TOO_LARGE,
             Kind::NotFound => StatusCode::NOT_FOUND,
-            Kind::Cancelled => StatusCode::CONFLICT,
+            Kind::Cancelled | Kind::NotReady => StatusCode::CONFLICT,
             Kind::Overloaded => StatusCode::TOO_MANY_REQUESTS,
             Kind::Draining => StatusCode::SERVICE_UNAVAILABLE,
             Kind::DeadlineExceeded => StatusCode::GATEWAY_TIMEOUT,
@@ -99,6 +101,7 @@ impl Kind {
             Kind::NotAcceptable => ("not-acceptable", "No acceptable form of the answer"),
             Kind::PayloadTooLarge => ("payload-too-large", "The body is too large"),
             Kind::NotFound => ("not-found", "Not found"),
+            Kind::NotReady => ("not-ready", "The job has no result yet"),
             Kind::Cancelled => ("cancelled", "The job was cancelled"),
             Kind::Overloaded => ("overloaded", "Every solver thread is busy"),
             Kind::Draining => ("draining", "The service is shutting down"),
@@ -112,7 +115,7 @@ impl Kind {
     fn retry_after(self) -> Option<u32> {
         match self {
             // Solves take microseconds to seconds: a permit is soon free.
-            Kind::Overloaded => Some(1),
+            Kind::Overloaded | Kind::NotReady => Some(1),
             // Another instance should have taken over by then.
             Kind::Draining => Some(5),
             _ => None,
@@ -143,6 +146,10 @@ impl ApiError {
 
     pub fn not_acceptable(detail: impl Into<String>) -> Self {
         ApiError::new(Kind::NotAcceptable, detail)
+    }
+
+    pub fn not_ready(detail: impl Into<String>) -> Self {
+        ApiError::new(Kind::NotReady, detail)
     }
 
     pub fn internal(detail: impl Into<String>) -> Self {

@@ -154,13 +154,18 @@ fn cors(origins: &CorsOrigins) -> Option<CorsLayer> {
                 header::IF_NONE_MATCH,
                 X_REQUEST_ID,
             ])
-            .expose_headers([
-                header::LOCATION,
-                header::ETAG,
-                header::RETRY_AFTER,
-                routes::X_CACHE,
-                X_REQUEST_ID,
-            ])
+            .expose_headers(
+                [
+                    header::LOCATION,
+                    header::ETAG,
+                    header::RETRY_AFTER,
+                    routes::X_CACHE,
+                    X_REQUEST_ID,
+                ]
+                .into_iter()
+                .chain(routes::PROVENANCE)
+                .collect::<Vec<_>>(),
+            )
             .max_age(Duration::from_secs(3600)),
     )
 }

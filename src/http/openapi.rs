@@ -62,8 +62,19 @@ fn document_validators(spec: &mut Spec) {
             if let Some(RefOr::T(ok)) = responses.get_mut("200") {
                 let etag = "The cache key of the answer, quoted; suffixed `.csv` for CSV";
                 ok.headers.insert("etag".to_string(), header(etag));
-                let cache = "`hit` (from the cache) or `miss` (solved for this request)";
-                ok.headers.insert("x-cache".to_string(), header(cache));
+                if operation.operation_id.as_deref() != Some("result") {
+                    let cache = "`hit` (from the cache) or `miss` (solved for this request)";
+                    ok.headers.insert("x-cache".to_string(), header(cache));
+                }
+                for (name, description) in routes::PROVENANCE.iter().zip([
+                    "The version of the model's numbers",
+                    "The version of the software",
+                    "The git commit the software was built from",
+                    "SHA-256 of the canonical input (the cache key)",
+                ]) {
+                    ok.headers
+                        .insert(name.as_str().to_string(), header(description));
+                }
             }
         }
     }

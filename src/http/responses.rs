@@ -105,3 +105,21 @@ impl IntoResponses for NotModified {
         BTreeMap::from([("304".to_string(), response.into())])
     }
 }
+
+problems!(
+    /// A job's result that is not there.
+    Unfinished {
+        (409, "not-ready: the job is queued or running (retry after the seconds given); or \
+            cancelled: it was cancelled and has no result", true),
+    }
+);
+
+problems!(
+    /// The problem a failed job ended with.
+    JobFailure {
+        (422, "invalid-input, solve-failed or out-of-domain: the job's values could not be \
+            answered", false),
+        (500, "internal: a fault of the service", false),
+        (504, "deadline-exceeded: the job ran past the job deadline", false),
+    }
+);

@@ -13,7 +13,7 @@ mod error;
 pub mod figure;
 pub mod input;
 mod kind;
-mod meta;
+pub mod meta;
 pub mod registry;
 pub mod rolling;
 pub mod sweep;

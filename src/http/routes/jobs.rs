@@ -6,7 +6,7 @@ use std::time::Duration;
 
 use axum::extract::{FromRequestParts, Path, State};
 use axum::http::request::Parts;
-use axum::http::{header, StatusCode};
+use axum::http::{header, HeaderMap, StatusCode};
 use axum::response::sse::{Event, KeepAlive, Sse};
 use axum::response::{IntoResponse, Response};
 use axum::Json;
@@ -17,15 +17,18 @@ use tokio::sync::watch;
 use utoipa::{IntoParams, ToSchema};
 use uuid::Uuid;
 
+use super::Answering;
 use crate::engine::cache::Solved;
 use crate::engine::store::{JobRecord, JobState, JobStatus};
 use crate::engine::Engine;
 use crate::http::accept::{Accept, AcceptsJson};
 use crate::http::error::{ApiError, JsonBody, Problem};
-use crate::http::responses::{BadBody, Busy, NotAcceptable, NotFound};
+use crate::http::responses::{
+    BadBody, Busy, JobFailure, NotAcceptable, NotFound, NotModified, Unfinished,
+};
 use crate::http::AppState;
 use crate::job::registry::{AnyOutput, Envelope, KindName};
-use crate::job::{Job, Work};
+use crate::job::{Job, JobError, Work};
 
 /// How often a progress stream looks at a running job's count of solves.
 const PROGRESS_INTERVAL: Duration = Duration::from_millis(100);
@@ -181,6 +184,37 @@ pub async fn cancel(
 ) -> Json<JobView> {
     let record = state.engine().cancel(record.id).await.unwrap_or(record);
     Json(JobView::of(&record, true))
+}
+
+/// A finished job's answer.
+///
+/// The answer alone, in the form the client accepts: JSON (as the job's `result`) or, with
+/// `Accept: text/csv`, CSV, with its `ETag` and provenance headers, as the synchronous
+/// endpoints give it. A job still queued or running answers 409 `not-ready` (with
+/// `Retry-After`); a cancelled one 409 `cancelled`; a failed one the problem it failed with.
+#[utoipa::path(
+    get,
+    path = "/v1/jobs/{id}/result",
+    tag = "jobs",
+    params(JobId),
+    responses(
+        (status = 200, description = "The job's answer", content(
+            (AnyOutput = "application/json"), (String = "text/csv"))),
+        NotModified, NotFound, NotAcceptable, Unfinished, JobFailure,
+    )
+)]
+pub async fn result(headers: HeaderMap, FoundJob(record): FoundJob) -> Result<Response, ApiError> {
+    let answering = Answering::from_headers(&headers)?;
+    match record.state {
+        JobState::Succeeded(solved) => answering.respond(&solved, None),
+        JobState::Failed(e) => Err(e.into()),
+        JobState::Cancelled => Err(JobError::Cancelled.into()),
+        JobState::Queued | JobState::Running => Err(ApiError::not_ready(format!(
+            "job {} is {}: poll /v1/jobs/{0}, or follow /v1/jobs/{0}/events",
+            record.id,
+            record.state.status().as_str()
+        ))),
+    }
 }
 
 /// Follow a job as server-sent events.

@@ -3,6 +3,7 @@
 //! [`SolveRequest::solve`]: validate the body as that kind's input, run it through the
 //! engine, answer with the cached or fresh result in the form the client accepts.
 
+pub mod checks;
 pub mod figures;
 pub mod jobs;
 pub mod ops;
@@ -22,12 +23,28 @@ use super::error::{ApiError, JsonBody};
 use super::AppState;
 use crate::engine::cache::Solved;
 use crate::engine::CacheStatus;
+use crate::job::meta::{GIT_COMMIT, SOFTWARE_VERSION};
 use crate::job::{Job, Meta};
+use crate::model::MODEL_VERSION;
 use crate::render::Format;
 
 /// `hit` when the answer came from the cache (or from an identical request solved at the
 /// same time), `miss` when this request solved it.
 pub const X_CACHE: HeaderName = HeaderName::from_static("x-cache");
+
+/// The provenance of every answer, for forms that carry no `meta` (CSV): the model's
+/// version, the software's version and commit, and the SHA-256 of the input (the cache key).
+pub const PROVENANCE: [HeaderName; 4] = [
+    HeaderName::from_static("x-model-version"),
+    HeaderName::from_static("x-software-version"),
+    HeaderName::from_static("x-software-commit"),
+    HeaderName::from_static("x-input-hash"),
+];
+
+/// The values of [`PROVENANCE`] for the answer whose cache key is `key`.
+fn provenance(key: &str) -> [&str; 4] {
+    [MODEL_VERSION, SOFTWARE_VERSION, GIT_COMMIT, key]
+}
 
 /// The API's routes with their OpenAPI operations. A synchronous endpoint of a new job kind
 /// is its route file and one more `.routes(routes!(...))` line here.
@@ -36,9 +53,11 @@ pub fn router() -> OpenApiRouter<AppState> {
         .routes(routes!(rolling::solve))
         .routes(routes!(three_body::solve))
         .routes(routes!(sweeps::solve))
+        .routes(routes!(checks::run))
         .routes(routes!(jobs::submit))
         .routes(routes!(jobs::status, jobs::cancel))
         .routes(routes!(jobs::events))
+        .routes(routes!(jobs::result))
         .routes(routes!(figures::figure))
         .routes(routes!(ops::healthz))
         .routes(routes!(ops::readyz))
@@ -97,9 +116,14 @@ impl Answering {
         })
     }
 
-    /// The answer with its validators: the `ETag` is the cache key (per form), so an
-    /// `If-None-Match` that names it gets `304` and no body.
-    fn respond(&self, solved: &Solved, cache: CacheStatus) -> Result<Response, ApiError> {
+    /// The answer with its validators and provenance: the `ETag` is the cache key (per
+    /// form), so an `If-None-Match` that names it gets `304` and no body. `cache` says
+    /// whether it was solved for this request, when it may have been.
+    pub fn respond(
+        &self,
+        solved: &Solved,
+        cache: Option<CacheStatus>,
+    ) -> Result<Response, ApiError> {
         let etag = match self.format {
             Format::Json => format!("\"{}\"", solved.key),
             Format::Csv => format!("\"{}.csv\"", solved.key),
@@ -117,8 +141,15 @@ impl Answering {
         if let Ok(etag) = HeaderValue::from_str(&etag) {
             h.insert(header::ETAG, etag);
         }
-        h.insert(X_CACHE, HeaderValue::from_static(cache.as_str()));
+        if let Some(cache) = cache {
+            h.insert(X_CACHE, HeaderValue::from_static(cache.as_str()));
+        }
         h.insert(header::VARY, HeaderValue::from_static("accept"));
+        for (name, value) in PROVENANCE.into_iter().zip(provenance(&solved.key)) {
+            if let Ok(value) = HeaderValue::from_str(value) {
+                h.insert(name, value);
+            }
+        }
         Ok(response)
     }
 
@@ -131,7 +162,7 @@ impl Answering {
         meta: Meta,
     ) -> Result<Response, ApiError> {
         let (solved, cache) = state.engine().solve(job, meta).await?;
-        self.respond(&solved, cache)
+        self.respond(&solved, Some(cache))
     }
 }
 
@@ -165,7 +196,7 @@ impl SolveRequest {
         let engine = self.state.engine();
         let text = format!("{kind}\n{}", self.input);
         if let Some(solved) = engine.cached_input(&text).await? {
-            return self.answering.respond(&solved, CacheStatus::Hit);
+            return self.answering.respond(&solved, Some(CacheStatus::Hit));
         }
         let job = Job::from_input(kind, self.input, &self.state.config().limits)?;
         let meta = job.meta();

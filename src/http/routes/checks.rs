@@ -1,0 +1,77 @@
+//! `POST /v1/checks`: the checks `thirdbody check` runs, for a pipeline without the binary.
+
+use axum::extract::State;
+use axum::http::{header, HeaderMap};
+use axum::response::{IntoResponse, Response};
+use serde_json::Value;
+
+use crate::check::{ChecksInput, Report, Suite};
+use crate::engine::EngineError;
+use crate::http::accept::Accept;
+use crate::http::error::{ApiError, JsonBody};
+use crate::http::responses::{BadBody, Busy, NotAcceptable};
+use crate::http::AppState;
+use crate::job::JobError;
+
+/// The forms of a report: JSON, or JUnit XML for CI systems.
+const FORMS: [&str; 2] = ["application/json", "application/xml"];
+
+/// Run checks.
+///
+/// The body is a checks document, as `thirdbody check` takes (golden answers inline, as
+/// `golden.answer`): each check a job and expectations on its answer. Every job is solved
+/// through the cache like a synchronous request. The answer is the report (200 whether the
+/// checks passed or not: see `passed`), as JSON or, with `Accept: application/xml`, as
+/// JUnit XML.
+#[utoipa::path(
+    post,
+    path = "/v1/checks",
+    tag = "solve",
+    request_body(content = ChecksInput, content_type = "application/json"),
+    responses(
+        (status = 200, description = "The report", content(
+            (Report = "application/json"), (String = "application/xml"))),
+        BadBody, NotAcceptable, Busy,
+    )
+)]
+pub async fn run(
+    State(state): State<AppState>,
+    headers: HeaderMap,
+    JsonBody(checks): JsonBody,
+) -> Result<Response, ApiError> {
+    let accept = Accept::from_headers(&headers);
+    let xml = accept.choose_media(&FORMS)? == FORMS[1];
+    let suite = Suite::from_value(checks, &state.config().limits)?;
+    if let Some(spec) = suite
+        .checks
+        .iter()
+        .find(|c| c.golden.as_ref().is_some_and(|g| g.answer.is_none()))
+    {
+        return Err(JobError::Schema {
+            field: "golden".to_string(),
+            message: format!(
+                "check \"{}\": a golden file is for `thirdbody check`; send the answer inline \
+                 as golden.answer",
+                spec.name
+            ),
+        }
+        .into());
+    }
+    let mut reports = Vec::new();
+    for spec in &suite.checks {
+        let meta = spec.job.meta();
+        let answer = match state.engine().solve(spec.job.clone(), meta).await {
+            Ok((solved, _)) => serde_json::from_slice::<Value>(solved.json())
+                .map_err(|e| JobError::Internal(e.to_string())),
+            Err(EngineError::Job(e)) => Err(e),
+            Err(refusal) => return Err(refusal.into()),
+        };
+        reports.push(spec.judge(answer));
+    }
+    let report = Report::new(reports);
+    Ok(if xml {
+        ([(header::CONTENT_TYPE, FORMS[1])], report.to_junit()).into_response()
+    } else {
+        axum::Json(report).into_response()
+    })
+}

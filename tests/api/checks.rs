@@ -1,0 +1,107 @@
+//! `POST /v1/checks` and the provenance of answers: what a CI pipeline without the binary
+//! uses.
+
+use reqwest::Method;
+use serde_json::{json, Value};
+
+use crate::helpers::{problem, problem_type, spawn_app};
+
+#[tokio::test]
+async fn checks_run_over_http_and_report_as_json_or_junit() {
+    let app = spawn_app(&[]).await;
+    let checks = json!({"checks": [
+        {"name": "mu stays low", "job": {"kind": "rolling", "input": {"load": "1.2 nN"}},
+         "expect": {"friction_coefficient": {"max": 0.1},
+                    "contact_area": {"equals": 9.411134777002667e-17, "rtol": 1e-9}}},
+        {"name": "too strict", "job": {"kind": "sweep", "input": {"vary": {"load": ["1 nN", "1.4 nN"]}}},
+         "expect": {"points[].friction_coefficient": {"max": 0.09}}},
+        {"name": "pierced", "job": {"kind": "rolling", "input": {"load": "1 mN"}},
+         "expect": {"friction_coefficient": {"max": 1}}}
+    ]});
+    let response = app.post("/v1/checks", &checks).await;
+    assert_eq!(response.status(), 200);
+    let report: Value = response.json().await.unwrap();
+    assert_eq!(report["passed"], false);
+    assert_eq!(
+        report["summary"],
+        json!({"checks": 3, "passed": 1, "failed": 2})
+    );
+    assert_eq!(report["checks"][0]["passed"], true);
+    let strict = &report["checks"][1]["outcomes"];
+    assert_eq!(strict[0]["path"], "points[0].friction_coefficient");
+    assert_eq!(strict[0]["passed"], false);
+    assert!(report["checks"][2]["error"]
+        .as_str()
+        .unwrap()
+        .contains("651 nm"));
+
+    let xml = app
+        .send(
+            Method::POST,
+            "/v1/checks",
+            &[("accept", "application/xml")],
+            Some(&checks),
+        )
+        .await;
+    assert_eq!(xml.headers()["content-type"], "application/xml");
+    let xml = xml.text().await.unwrap();
+    assert!(xml.contains("tests=\"3\" failures=\"2\""), "{xml}");
+
+    let bad = json!({"checks": [{"name": "x", "job": {"kind": "rolling"}, "expect": {"a..b": {"max": 1}}}]});
+    let refused = problem(app.post("/v1/checks", &bad).await, 422).await;
+    assert_eq!(refused["type"], problem_type("invalid-input"));
+    assert!(refused["detail"]
+        .as_str()
+        .unwrap()
+        .contains("not a field path"));
+}
+
+#[tokio::test]
+async fn every_answer_says_where_it_comes_from_and_a_job_result_comes_as_csv() {
+    let app = spawn_app(&[]).await;
+    let response = app
+        .send(
+            Method::POST,
+            "/v1/sweeps",
+            &[("accept", "text/csv")],
+            Some(&json!({"vary": {"load": ["1 nN", "1.1 nN"]}})),
+        )
+        .await;
+    let headers = response.headers().clone();
+    assert_eq!(headers["x-model-version"], thirdbody::model::MODEL_VERSION);
+    assert_eq!(headers["x-software-version"], env!("CARGO_PKG_VERSION"));
+    assert!(!headers["x-software-commit"].is_empty());
+    let hash = headers["x-input-hash"].to_str().unwrap().to_string();
+    assert_eq!(headers["etag"], format!("\"{hash}.csv\"").as_str());
+    let text = response.text().await.unwrap();
+    assert!(
+        text.starts_with("radius [m],load [N],velocity [m/s],"),
+        "{text}"
+    );
+
+    let location = app
+        .submit(&json!({"kind": "sweep", "input": {"vary": {"load": ["1 nN", "1.1 nN"]}}}))
+        .await;
+    let result = format!("{location}/result");
+    app.wait_for_job(&location, |j| j["status"] == "succeeded")
+        .await;
+    let csv = app
+        .send(Method::GET, &result, &[("accept", "text/csv")], None)
+        .await;
+    assert_eq!(csv.status(), 200);
+    assert_eq!(csv.headers()["x-input-hash"], hash.as_str());
+    assert_eq!(
+        csv.text().await.unwrap(),
+        text,
+        "the job's CSV is the synchronous one"
+    );
+    let json: Value = app.get(&result).await.json().await.unwrap();
+    assert_eq!(json["meta"]["input_hash"], hash);
+
+    let running = app.submit(&crate::helpers::long_sweep(21)).await;
+    let not_ready = problem(app.get(&format!("{running}/result")).await, 409).await;
+    assert_eq!(not_ready["type"], problem_type("not-ready"));
+    app.delete(&running).await;
+    let cancelled = problem(app.get(&format!("{running}/result")).await, 409).await;
+    assert_eq!(cancelled["type"], problem_type("cancelled"));
+}

@@ -1,0 +1,309 @@
+//! Honest answers (MODEL.md §7): the domain of validity in every answer, inputs that mean one
+//! thing, units and provenance in every output; each example of the issue as a case, and a
+//! property over the whole input space: an answer is finite numbers with a validity block,
+//! or a problem.
+
+use proptest::prelude::*;
+use serde_json::{json, Value};
+use thirdbody::engine;
+use thirdbody::job::{Control, Job, JobError, Limits};
+use thirdbody::render::Format;
+
+fn job(value: Value) -> Result<Job, JobError> {
+    Job::from_value(value, &Limits::default())
+}
+
+/// The answer as clients read it, or the job's error.
+fn answer(value: Value) -> Result<Value, JobError> {
+    let answer = engine::run(&job(value)?, &Control::new(None, 1))?;
+    let json = answer.render(Format::Json).expect("an answer renders");
+    Ok(serde_json::from_slice(&json).unwrap())
+}
+
+fn rolling(input: Value) -> Result<Value, JobError> {
+    answer(json!({"kind": "rolling", "input": input}))
+}
+
+fn validity<'a>(answer: &'a Value, name: &str) -> &'a Value {
+    answer["meta"]["validity"]["assumptions"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|a| a["name"] == name)
+        .unwrap_or_else(|| panic!("no {name} in {}", answer["meta"]["validity"]))
+}
+
+#[test]
+fn a_sphere_pressed_through_the_layer_is_refused_with_the_numbers() {
+    match rolling(json!({"load": "1 mN"})) {
+        Err(JobError::OutOfDomain(m)) => assert_eq!(
+            m,
+            "the penetration 651 nm reaches the layer's thickness 100 nm: the sphere would \
+             touch the rigid base"
+        ),
+        other => panic!("{other:?}"),
+    }
+    // Rolling penetrates less than resting: when only the V = 0 companion reaches the base,
+    // the refusal says so.
+    // R = 10 µm, δ₀ = √(P/(πkR)) = 150 nm at rest; rolling fast (ξ ≈ 600) it sinks only
+    // δ₀ √(T_σ/T_ε) ≈ 47 nm.
+    let at_rest = rolling(
+        json!({"radius": "10 um", "load": "21.2 mN", "velocity": "1 mm/s",
+        "layer": {"relaxation_time": "1 s", "retardation_time": "10 s"}}),
+    );
+    match at_rest {
+        Err(JobError::OutOfDomain(m)) => {
+            assert!(m.starts_with("at rest (V = 0"), "{m}");
+            assert!(m.contains("the rolling contact stays inside"), "{m}");
+        }
+        other => panic!("{other:?}"),
+    }
+}
+
+#[test]
+fn a_bare_number_far_from_its_scale_is_answered_with_a_warning_naming_what_was_meant() {
+    let answer = rolling(json!({"radius": 25})).unwrap();
+    let warnings = answer["meta"]["warnings"].as_array().unwrap();
+    assert_eq!(warnings.len(), 1);
+    assert_eq!(warnings[0]["field"], "radius");
+    assert_eq!(
+        warnings[0]["message"],
+        "radius: 25 is 25 m; did you mean \"25 nm\"?"
+    );
+    // μ = 3592 for a 25 m sphere: the friction row warns too.
+    assert!(answer["friction_coefficient"].as_f64().unwrap() > 1000.0);
+    assert_eq!(validity(&answer, "adhesive_friction")["status"], "warn");
+    // The same value with its unit is what was meant: no warning, and another cache key.
+    let meant = rolling(json!({"radius": "25 m"})).unwrap();
+    assert!(meant["meta"]["warnings"].as_array().unwrap().is_empty());
+    assert_ne!(meant["meta"]["input_hash"], answer["meta"]["input_hash"]);
+
+    let stiff = rolling(json!({"layer": {"elastic_modulus": 1e300}})).unwrap();
+    let message = stiff["meta"]["warnings"][0]["message"].as_str().unwrap();
+    assert!(message.contains("above 1 TPa"), "{message}");
+    assert_eq!(validity(&stiff, "adhesive_friction")["status"], "warn");
+}
+
+#[test]
+fn a_vanishing_load_is_answered_but_its_friction_warns() {
+    let answer = rolling(json!({"load": "1e-300 N"})).unwrap();
+    let mu = answer["friction_coefficient"].as_f64().unwrap();
+    assert!(mu > 1e140, "{mu}");
+    let friction = validity(&answer, "adhesive_friction");
+    assert_eq!(friction["status"], "warn");
+    assert!(friction["note"].as_str().unwrap().contains("above 1"));
+    assert_eq!(answer["meta"]["validity"]["status"], "warn");
+}
+
+#[test]
+fn the_paper_s_particle_warns_on_the_local_layer_only_and_says_why() {
+    let answer = rolling(json!({})).unwrap();
+    assert_eq!(answer["meta"]["validity"]["status"], "warn");
+    for assumption in answer["meta"]["validity"]["assumptions"]
+        .as_array()
+        .unwrap()
+    {
+        let expected = if assumption["name"] == "local_layer" {
+            "warn"
+        } else {
+            "ok"
+        };
+        assert_eq!(assumption["status"], expected, "{assumption}");
+    }
+    let local = validity(&answer, "local_layer");
+    let value = local["value"].as_f64().unwrap();
+    // Half-width √(2Rδ) = b(0) of MODEL.md §3 (5.5842 nm) over H = 100 nm.
+    assert!((value - 0.055842).abs() < 1e-6, "{value}");
+    assert!(local["note"]
+        .as_str()
+        .unwrap()
+        .contains("paper's own parameters"));
+    // The inside-layer ratio is δ/H (0.6237 nm / 100 nm), and the V = 0 one δ₀/H.
+    // (to the table's four digits).
+    let inside = validity(&answer, "inside_layer");
+    assert!((inside["value"].as_f64().unwrap() * 100.0 - 0.6237).abs() < 5e-5);
+    assert!((inside["at_rest"].as_f64().unwrap() * 100.0 - 0.6515).abs() < 5e-5);
+}
+
+#[test]
+fn inputs_mean_one_thing_and_errors_speak_the_users_terms() {
+    // -0 is 0: one answer, one key.
+    let minus_zero = rolling(json!({"velocity": -0.0})).unwrap();
+    let zero = rolling(json!({"velocity": 0})).unwrap();
+    assert_eq!(minus_zero["meta"]["input_hash"], zero["meta"]["input_hash"]);
+    assert_eq!(minus_zero["centroid_shift"], 0.0);
+
+    let refused = |input: Value| match rolling(input.clone()) {
+        Err(e @ (JobError::Schema { .. } | JobError::Invalid(_))) => e.to_string(),
+        other => panic!("{input}: {other:?}"),
+    };
+    let messages = [
+        refused(json!(["50 nm", "2 nN", null, null, null])),
+        refused(json!({"radius": "25 m^127 m^127 m^3"})),
+        refused(json!({"radius": true})),
+        refused(json!({"options": {"strips": 1.5}})),
+        refused(json!({"options": {"strips": -3}})),
+        refused(json!({"options": {"quadrature": 3}})),
+        refused(json!({"layer": "thin"})),
+        refused(json!({"layer": [1, 2]})),
+    ];
+    assert!(
+        messages[0].contains("expected an object, got a list"),
+        "{}",
+        messages[0]
+    );
+    assert!(
+        messages[1].contains("unit power out of range"),
+        "{}",
+        messages[1]
+    );
+    assert!(
+        messages[3].contains("a whole number ≥ 0, got 1.5"),
+        "{}",
+        messages[3]
+    );
+    for message in messages {
+        for rust in [
+            "untagged", "usize", "i64", "u8", "struct", "enum", "variant", "Quantity",
+        ] {
+            assert!(!message.contains(rust), "{message}");
+        }
+    }
+    match Job::from_json(
+        br#"{"kind": "rolling", "input": {"load": 1, "load": 2}}"#,
+        &Limits::default(),
+    ) {
+        Err(JobError::Schema { field, message }) => {
+            assert_eq!(field, "input");
+            assert!(message.contains("\"load\" is sent twice"), "{message}");
+        }
+        other => panic!("{other:?}"),
+    }
+}
+
+#[test]
+fn every_numeric_field_of_every_answer_has_a_unit() {
+    fn leaves(value: &Value, at: String, out: &mut Vec<String>) {
+        match value {
+            Value::Object(map) => {
+                for (k, v) in map {
+                    if at == "meta" && k == "input" {
+                        continue;
+                    }
+                    let path = if at.is_empty() {
+                        k.clone()
+                    } else {
+                        format!("{at}.{k}")
+                    };
+                    leaves(v, path, out);
+                }
+            }
+            Value::Array(items) => items.iter().for_each(|v| leaves(v, format!("{at}[]"), out)),
+            Value::Number(_) => out.push(at),
+            _ => {}
+        }
+    }
+    for job in [
+        json!({"kind": "rolling", "input": {"options": {"pressure_grid": 3}}}),
+        json!({"kind": "three_body", "input": {"operating": {"total_load": "1 mN"},
+            "asperities": {"density": "1e14 m^-2", "tip_radius": "1 um",
+                           "height_std": "2 nm", "hardness": "2 GPa"}}}),
+        json!({"kind": "sweep", "input": {"vary": {"load": ["1 nN", "2 nN"]}}}),
+        json!({"kind": "sweep", "input": {"kind": "three_body",
+            "vary": {"separation": ["50 nm"]}}}),
+        json!({"kind": "figure", "input": {"number": 3}}),
+    ] {
+        let answer = answer(job.clone()).unwrap();
+        let units = answer["meta"]["units"].as_object().unwrap();
+        let mut paths = Vec::new();
+        leaves(&answer, String::new(), &mut paths);
+        for path in paths {
+            assert!(
+                units.contains_key(&path),
+                "{}: no unit for {path}",
+                job["kind"]
+            );
+        }
+        assert_eq!(
+            answer["meta"]["software"]["version"],
+            env!("CARGO_PKG_VERSION")
+        );
+        assert!(!answer["meta"]["software"]["commit"]
+            .as_str()
+            .unwrap()
+            .is_empty());
+    }
+}
+
+/// A value drawn log-uniformly between 10^lo and 10^hi, as a bare SI number.
+fn log_uniform(lo: f64, hi: f64) -> impl Strategy<Value = f64> {
+    (lo..hi).prop_map(|e: f64| 10f64.powf(e))
+}
+
+/// Checks an answer: finite numbers only (serde_json writes a non-finite one as null), a
+/// validity block, and no violated geometry.
+fn honest(answer: &Value) -> Result<(), TestCaseError> {
+    let text = answer.to_string();
+    prop_assert!(!text.contains("null"), "{}", text);
+    let validity = &answer["meta"]["validity"];
+    let assumptions = validity["assumptions"].as_array();
+    prop_assert!(assumptions.is_some_and(|a| !a.is_empty()), "{}", validity);
+    for a in assumptions.into_iter().flatten() {
+        let geometry = a["name"] == "inside_layer" || a["name"] == "parabolic_sphere";
+        let worst = a["value"]
+            .as_f64()
+            .unwrap()
+            .max(a["at_rest"].as_f64().unwrap());
+        prop_assert!(!geometry || worst < 1.0, "{}", a);
+    }
+    Ok(())
+}
+
+fn judge(result: Result<Value, JobError>) -> Result<(), TestCaseError> {
+    match result {
+        Ok(answer) => honest(&answer),
+        Err(JobError::Invalid(_) | JobError::Unsolvable(_) | JobError::OutOfDomain(_)) => Ok(()),
+        Err(e) => Err(TestCaseError::fail(format!(
+            "not a problem of the input: {e:?}"
+        ))),
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(200))]
+
+    #[test]
+    fn every_rolling_answer_is_finite_and_valid_or_a_problem(
+        radius in log_uniform(-12.0, 3.0),
+        load in log_uniform(-18.0, 3.0),
+        velocity in prop_oneof![Just(0.0), log_uniform(-15.0, 2.0)],
+        modulus in log_uniform(2.0, 13.0),
+        thickness in log_uniform(-10.0, -1.0),
+        poisson in 0.0..0.5f64,
+        relaxation in log_uniform(-6.0, 6.0),
+        kappa in prop_oneof![Just(0.0), log_uniform(-12.0, 4.0)],
+    ) {
+        judge(rolling(json!({
+            "radius": radius, "load": load, "velocity": velocity,
+            "layer": {"elastic_modulus": modulus, "thickness": thickness,
+                      "poisson_ratio": poisson, "relaxation_time": relaxation,
+                      "retardation_time": relaxation * (1.0 + kappa)}})))?;
+    }
+
+    #[test]
+    fn every_three_body_answer_is_finite_and_valid_or_a_problem(
+        mean in log_uniform(-8.5, -6.5),
+        spread in 0.0..0.3f64,
+        load in log_uniform(-8.0, 1.0),
+        velocity in prop_oneof![Just(0.0), log_uniform(-12.0, -3.0)],
+        thickness in log_uniform(-8.0, -5.0),
+        hertz in any::<bool>(),
+    ) {
+        judge(answer(json!({"kind": "three_body", "input": {
+            "distribution": {"mean_diameter": mean, "std_diameter": mean * spread},
+            "layer": {"thickness": thickness},
+            "layer_contact": if hertz { "hertz" } else { "kelvin_layer" },
+            "velocity": velocity,
+            "operating": {"total_load": load}}})))?;
+    }
+}
