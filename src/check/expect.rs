@@ -11,6 +11,11 @@ const DEFAULT_RTOL: f64 = 1e-9;
 /// Mismatches of a golden answer listed in a report, at most.
 const GOLDEN_MISMATCHES: usize = 10;
 
+/// Whether `x` is `value` within `rtol`·|value| + `atol` (never for a NaN).
+fn within(x: f64, value: f64, rtol: f64, atol: f64) -> bool {
+    (x - value).abs() <= atol + rtol * value.abs()
+}
+
 /// A step of a field path.
 #[derive(Clone, Debug, PartialEq)]
 enum Step {
@@ -162,7 +167,7 @@ impl Expectation {
             Bound::Range { min, max } => {
                 min.map_or(true, |lo| lo <= x) && max.map_or(true, |hi| x <= hi)
             }
-            Bound::Equals { value, rtol, atol } => (x - value).abs() <= atol + rtol * value.abs(),
+            Bound::Equals { value, rtol, atol } => within(x, value, rtol, atol),
         }
     }
 
@@ -248,39 +253,32 @@ impl Golden {
         }
     }
 
+    /// Lists in `out` where `answer` differs from `golden` below the path `at` (the top's
+    /// `meta` is left out: it names the software and the hash, not results).
     fn compare(&self, golden: &Value, answer: &Value, at: String, out: &mut Vec<String>) {
-        let here = |at: &str| {
+        let child = |key: &str| {
             if at.is_empty() {
-                "the answer".to_string()
+                key.to_string()
             } else {
-                at.to_string()
+                format!("{at}.{key}")
             }
+        };
+        let judged = |key: &&String| !(at.is_empty() && *key == "meta");
+        let here = if at.is_empty() {
+            "the answer"
+        } else {
+            at.as_str()
         };
         match (golden, answer) {
             (Value::Object(g), Value::Object(a)) => {
-                for (key, g) in g.iter().filter(|(k, _)| !(at.is_empty() && *k == "meta")) {
-                    let path = if at.is_empty() {
-                        key.clone()
-                    } else {
-                        format!("{at}.{key}")
-                    };
+                for key in g.keys().filter(judged) {
                     match a.get(key) {
-                        Some(a) => self.compare(g, a, path, out),
-                        None => out.push(format!("{path} is missing")),
+                        Some(value) => self.compare(&g[key], value, child(key), out),
+                        None => out.push(format!("{} is missing", child(key))),
                     }
                 }
-                for key in a
-                    .keys()
-                    .filter(|k| !g.contains_key(*k) && !(at.is_empty() && *k == "meta"))
-                {
-                    out.push(format!(
-                        "{} is new",
-                        if at.is_empty() {
-                            key.clone()
-                        } else {
-                            format!("{at}.{key}")
-                        }
-                    ));
+                for key in a.keys().filter(judged).filter(|k| !g.contains_key(*k)) {
+                    out.push(format!("{} is new", child(key)));
                 }
             }
             (Value::Array(g), Value::Array(a)) if g.len() == a.len() => {
@@ -288,28 +286,19 @@ impl Golden {
                     self.compare(g, a, format!("{at}[{i}]"), out);
                 }
             }
-            (Value::Array(g), Value::Array(a)) => out.push(format!(
-                "{} has {} items, golden {}",
-                here(&at),
-                a.len(),
-                g.len()
-            )),
+            (Value::Array(g), Value::Array(a)) => {
+                out.push(format!("{here} has {} items, golden {}", a.len(), g.len()))
+            }
             (Value::Number(g), Value::Number(a)) => {
-                let (g, a) = (
-                    g.as_f64().unwrap_or(f64::NAN),
-                    a.as_f64().unwrap_or(f64::NAN),
-                );
-                if !((a - g).abs() <= self.atol + self.rtol * g.abs()) {
-                    out.push(format!(
-                        "{} = {}, golden {}",
-                        here(&at),
-                        format_number(a),
-                        format_number(g)
-                    ));
+                let g = g.as_f64().unwrap_or(f64::NAN);
+                let a = a.as_f64().unwrap_or(f64::NAN);
+                if !within(a, g, self.rtol, self.atol) {
+                    let (a, g) = (format_number(a), format_number(g));
+                    out.push(format!("{here} = {a}, golden {g}"));
                 }
             }
             (g, a) if g == a => {}
-            (g, a) => out.push(format!("{} = {a}, golden {g}", here(&at))),
+            (g, a) => out.push(format!("{here} = {a}, golden {g}")),
         }
     }
 }
