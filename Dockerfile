@@ -1,13 +1,16 @@
 # thirdbody: the HTTP service in a container.
 #
-#   docker build -t thirdbody .
+#   docker build -t thirdbody --build-arg THIRDBODY_GIT_COMMIT=$(git rev-parse --short=12 HEAD) .
 #   docker run --rm -p 8080:8080 thirdbody
 #
 # Build stage: the same toolchain as CI, dependencies fetched by cargo (crates.io only; the
 # API docs assets are vendored in a crate, nothing is downloaded at run time).
 FROM rust:1.95-slim-bookworm AS build
+# The commit every answer names (meta.software.commit): .git is not in the build context.
+ARG THIRDBODY_GIT_COMMIT=unknown
+ENV THIRDBODY_GIT_COMMIT=${THIRDBODY_GIT_COMMIT}
 WORKDIR /src
-COPY Cargo.toml Cargo.lock ./
+COPY Cargo.toml Cargo.lock build.rs ./
 COPY src src
 COPY benches benches
 COPY openapi openapi

@@ -148,7 +148,8 @@ fn serve_refuses_a_bad_setting_at_start_up_with_status_2() {
 /// `ENV` settings of the Dockerfile's run stage, as (name, value) pairs.
 fn dockerfile_env() -> Vec<(String, String)> {
     let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/Dockerfile")).unwrap();
-    let joined = text.replace("\\\n", " ");
+    let run_stage = &text[text.rfind("\nFROM ").unwrap()..];
+    let joined = run_stage.replace("\\\n", " ");
     joined
         .lines()
         .filter_map(|l| l.trim().strip_prefix("ENV "))

@@ -307,3 +307,34 @@ proptest! {
             "operating": {"total_load": load}}})))?;
     }
 }
+
+#[test]
+fn a_number_and_the_same_value_as_a_unit_string_are_one_input() {
+    // Decimal texts whose nearest double the default serde_json parser misses by an ulp in
+    // a fair share of cases; with float_roundtrip both readings are the correctly rounded one.
+    let mut texts = Vec::new();
+    for mantissa in [
+        "1.2345678901234567",
+        "2.5",
+        "3.333333333333333",
+        "7.0710678118654755",
+    ] {
+        for exponent in -12..=-3 {
+            for digit in 1..=4 {
+                texts.push(format!("{mantissa}{digit}e{exponent}"));
+            }
+        }
+    }
+    assert!(texts.len() >= 150);
+    for text in texts {
+        let number: Value = serde_json::from_str(&format!(r#"{{"radius": {text}}}"#)).unwrap();
+        let bare = job(json!({"kind": "rolling", "input": number})).unwrap();
+        let with_unit =
+            job(json!({"kind": "rolling", "input": {"radius": format!("{text} m")}})).unwrap();
+        assert_eq!(bare.canonical(), with_unit.canonical(), "{text}");
+        assert_eq!(
+            bare.canonical()["radius"].as_f64().unwrap(),
+            text.parse::<f64>().unwrap()
+        );
+    }
+}

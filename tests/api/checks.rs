@@ -105,3 +105,13 @@ async fn every_answer_says_where_it_comes_from_and_a_job_result_comes_as_csv() {
     let cancelled = problem(app.get(&format!("{running}/result")).await, 409).await;
     assert_eq!(cancelled["type"], problem_type("cancelled"));
 }
+
+#[tokio::test]
+async fn the_readme_s_checks_pass_against_the_service() {
+    let app = spawn_app(&[]).await;
+    let checks: Value =
+        serde_json::from_str(include_str!("../../examples/checks-inline.json")).unwrap();
+    let report: Value = app.post("/v1/checks", &checks).await.json().await.unwrap();
+    assert_eq!(report["passed"], true, "{report}");
+    assert_eq!(report["summary"]["checks"], 4);
+}
