@@ -62,7 +62,7 @@ fn document_validators(spec: &mut Spec) {
             if let Some(RefOr::T(ok)) = responses.get_mut("200") {
                 let etag = "The cache key of the answer, quoted; suffixed `.csv` for CSV";
                 ok.headers.insert("etag".to_string(), header(etag));
-                if operation.operation_id.as_deref() != Some("result") {
+                if operation.operation_id.as_deref() != Some("get_job_result") {
                     let cache = "`hit` (from the cache) or `miss` (solved for this request)";
                     ok.headers.insert("x-cache".to_string(), header(cache));
                 }

@@ -15,7 +15,7 @@ pub struct FieldError {
     /// Path of the field in the input, e.g. `layer.thickness` or `vary.radius[2]`.
     pub field: String,
     /// The value as sent (any JSON value; `null` when the field's shape was wrong).
-    #[schema(value_type = Object)]
+    #[schema(value_type = serde_json::Value)]
     pub value: Value,
     /// The allowed values.
     pub allowed: String,
@@ -60,8 +60,18 @@ impl fmt::Display for JobError {
             JobError::Schema { field, message } if field.is_empty() => f.write_str(message),
             JobError::Schema { field, message } => write!(f, "{field}: {message}"),
             JobError::Invalid(errors) => {
-                let messages: Vec<&str> = errors.iter().map(|e| e.message.as_str()).collect();
-                f.write_str(&messages.join("; "))
+                // A sentence, not a listing: `errors` of the problem has every field.
+                const SHOWN: usize = 10;
+                let messages: Vec<&str> = errors
+                    .iter()
+                    .take(SHOWN)
+                    .map(|e| e.message.as_str())
+                    .collect();
+                f.write_str(&messages.join("; "))?;
+                match errors.len().saturating_sub(SHOWN) {
+                    0 => Ok(()),
+                    more => write!(f, "; and {more} more (see `errors`)"),
+                }
             }
             JobError::Unsolvable(m) | JobError::OutOfDomain(m) => f.write_str(m),
             JobError::Cancelled => f.write_str("the job was cancelled"),

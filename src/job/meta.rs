@@ -88,7 +88,7 @@ pub struct InputWarning {
     /// Path of the field in the input.
     pub field: String,
     /// The value as sent.
-    #[schema(value_type = Object)]
+    #[schema(value_type = serde_json::Value)]
     pub value: Value,
     /// What the value means, and the form the sender may have meant.
     pub message: String,

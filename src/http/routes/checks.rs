@@ -26,6 +26,7 @@ const FORMS: [&str; 2] = ["application/json", "application/xml"];
 #[utoipa::path(
     post,
     path = "/v1/checks",
+    operation_id = "run_checks",
     tag = "solve",
     request_body(content = ChecksInput, content_type = "application/json"),
     responses(

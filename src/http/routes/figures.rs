@@ -19,6 +19,7 @@ use crate::job::{FigureJob, Job};
 #[utoipa::path(
     get,
     path = "/v1/figures/{n}",
+    operation_id = "get_figure",
     tag = "figures",
     params(("n" = u8, Path, description = "The figure's number in the paper, 3 to 9")),
     responses(

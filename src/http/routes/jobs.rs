@@ -126,6 +126,7 @@ impl FromRequestParts<AppState> for FoundJob {
 #[utoipa::path(
     post,
     path = "/v1/jobs",
+    operation_id = "submit_job",
     tag = "jobs",
     request_body(content = Envelope, content_type = "application/json"),
     responses(
@@ -156,6 +157,7 @@ pub async fn submit(
 #[utoipa::path(
     get,
     path = "/v1/jobs/{id}",
+    operation_id = "get_job",
     tag = "jobs",
     params(JobId),
     responses((status = 200, description = "The job", body = JobView), NotFound, NotAcceptable)
@@ -172,6 +174,7 @@ pub async fn status(_: AcceptsJson, FoundJob(record): FoundJob) -> Json<JobView>
 #[utoipa::path(
     delete,
     path = "/v1/jobs/{id}",
+    operation_id = "cancel_job",
     tag = "jobs",
     params(JobId),
     responses((status = 200, description = "The job after the cancel", body = JobView),
@@ -195,6 +198,7 @@ pub async fn cancel(
 #[utoipa::path(
     get,
     path = "/v1/jobs/{id}/result",
+    operation_id = "get_job_result",
     tag = "jobs",
     params(JobId),
     responses(
@@ -225,6 +229,7 @@ pub async fn result(headers: HeaderMap, FoundJob(record): FoundJob) -> Result<Re
 #[utoipa::path(
     get,
     path = "/v1/jobs/{id}/events",
+    operation_id = "follow_job",
     tag = "jobs",
     params(JobId),
     responses(

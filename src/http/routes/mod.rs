@@ -64,15 +64,16 @@ pub fn router() -> OpenApiRouter<AppState> {
         .routes(routes!(ops::metrics))
 }
 
-/// Declares `solve`, the synchronous endpoint of a job kind: `POST $path` with the kind's
-/// input as the body, answered with its output as JSON or CSV. The doc comment is the
-/// operation's description; `$answer` describes the 200 answer.
+/// Declares `solve`, the synchronous endpoint of a job kind: `POST $path` (OpenAPI operation
+/// `$operation`) with the kind's input as the body, answered with its output as JSON or
+/// CSV. The doc comment is the operation's description; `$answer` describes the 200 answer.
 macro_rules! solve_endpoint {
-    ($(#[doc = $doc:literal])* $path:literal, $kind:ident, $input:ident, $output:ident, $answer:literal) => {
+    ($(#[doc = $doc:literal])* $path:literal, $operation:literal, $kind:ident, $input:ident, $output:ident, $answer:literal) => {
         $(#[doc = $doc])*
         #[utoipa::path(
             post,
             path = $path,
+            operation_id = $operation,
             tag = "solve",
             request_body(content = $input, content_type = "application/json"),
             responses(

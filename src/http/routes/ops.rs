@@ -23,6 +23,7 @@ pub struct Health {
 #[utoipa::path(
     get,
     path = "/healthz",
+    operation_id = "healthz",
     tag = "operations",
     responses((status = 200, description = "Alive", body = Health), NotAcceptable)
 )]
@@ -34,6 +35,7 @@ pub async fn healthz(_: AcceptsJson) -> Json<Health> {
 #[utoipa::path(
     get,
     path = "/readyz",
+    operation_id = "readyz",
     tag = "operations",
     responses((status = 200, description = "Ready", body = Health), NotAcceptable, Draining)
 )]
@@ -57,6 +59,7 @@ pub async fn readyz(
 #[utoipa::path(
     get,
     path = "/metrics",
+    operation_id = "metrics",
     tag = "operations",
     responses((status = 200, description = "Prometheus text exposition format",
         content_type = "text/plain; version=0.0.4", body = String), NotAcceptable)

@@ -11,6 +11,7 @@ solve_endpoint!(
     /// valid job. Quantities are SI numbers or strings with units (`"25 nm"`). With
     /// `Accept: text/csv` the answer is one CSV row of the contact's integrals.
     "/v1/rolling",
+    "solve_rolling",
     RollingJob,
     RollingInput,
     RollingOutput,

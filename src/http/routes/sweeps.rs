@@ -10,6 +10,7 @@ solve_endpoint!(
     /// `Accept: text/csv` the answer is CSV (SI units, one header line). Big sweeps belong in
     /// `POST /v1/jobs`, which reports progress and can be cancelled.
     "/v1/sweeps",
+    "solve_sweep",
     SweepJob,
     SweepInput,
     SweepOutput,

@@ -13,6 +13,7 @@ solve_endpoint!(
     /// `particle_load`. Quantities are SI numbers or strings with units (`"1 mN"`). With
     /// `Accept: text/csv` the answer is one CSV row, as a sweep's.
     "/v1/three-body",
+    "solve_three_body",
     ThreeBodyJob,
     ThreeBodyInput,
     ThreeBodyOutput,

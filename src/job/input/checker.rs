@@ -1,6 +1,8 @@
 //! Reading the fields of an input: quantities with units, counts and lists, each checked
 //! against its range, every bad field recorded with its path and its value as sent.
 
+use std::collections::{HashMap, HashSet};
+
 use serde_json::{json, Value};
 
 use super::units::{parse_quantity, Dimension, UnitError};
@@ -22,12 +24,19 @@ pub struct Checker {
     /// Path of the object being read (`""` at the top, `layer`, `base.layer`...).
     prefix: String,
     errors: Vec<FieldError>,
-    /// Each quantity read: its path and the value as sent.
-    sent: Vec<(String, Value)>,
+    /// Each quantity read, by path: the value as sent.
+    sent: HashMap<String, Value>,
+    /// The paths of the fields reported (a field reported once is not reported again).
+    reported: HashSet<String>,
     /// Where each model parameter and option was read (the first place).
     paths: Vec<(Source, String)>,
     warnings: Vec<InputWarning>,
+    /// Errors found past [`MAX_ERRORS`].
+    omitted: usize,
 }
+
+/// Errors listed at most; the rest are counted.
+const MAX_ERRORS: usize = 100;
 
 impl Checker {
     pub fn new() -> Self {
@@ -127,7 +136,7 @@ impl Checker {
 
     /// Reads one quantity at `path`.
     fn read(&mut self, path: String, quantity: &Quantity, parameter: Parameter) -> f64 {
-        self.sent.push((path.clone(), quantity.sent()));
+        self.sent.insert(path.clone(), quantity.sent());
         let dimension = dimension(parameter);
         let parsed = match quantity {
             Quantity::Number(x) => {
@@ -153,12 +162,23 @@ impl Checker {
     fn unreadable(&mut self, field: String, value: Value, expected: Dimension, e: &UnitError) {
         let allowed = expected.describe();
         let message = format!("{field}: {value} {e}; expected {allowed}");
-        self.errors.push(FieldError {
+        self.report(FieldError {
             field,
             value,
             allowed,
             message,
         });
+    }
+
+    /// Records an error; past [`MAX_ERRORS`] only counts it, so that the answer to a huge
+    /// bad input stays small.
+    fn report(&mut self, error: FieldError) {
+        self.reported.insert(error.field.clone());
+        if self.errors.len() < MAX_ERRORS {
+            self.errors.push(error);
+        } else {
+            self.omitted += 1;
+        }
     }
 
     /// Records a value of `field` (in the object being read) outside its range.
@@ -168,22 +188,18 @@ impl Checker {
     }
 
     /// Records a value outside its range, unless the field (or the object holding it) was
-    /// already reported: a value read as NaN after an error says nothing new.
+    /// already reported: a value read as NaN after an error says nothing new. Linear in the
+    /// depth of the path, whatever the number of errors.
     fn out_of_range_at(&mut self, path: String, value: f64, unit: &str, allowed: &str) {
-        let covered = |e: &FieldError| {
-            path == e.field
-                || path
-                    .strip_prefix(e.field.as_str())
-                    .is_some_and(|rest| rest.starts_with('.'))
-        };
-        if self.errors.iter().any(covered) {
+        let mut ancestors = path.match_indices('.').map(|(i, _)| &path[..i]);
+        if self.reported.contains(&path) || ancestors.any(|a| self.reported.contains(a)) {
             return;
         }
         let sent = self
             .sent
-            .iter()
-            .find(|(p, _)| *p == path)
-            .map_or_else(|| Value::from(value), |(_, v)| v.clone());
+            .get(&path)
+            .cloned()
+            .unwrap_or_else(|| Value::from(value));
         let number = format_number(value);
         let si = if unit.is_empty() {
             number
@@ -196,7 +212,7 @@ impl Checker {
             }
             _ => format!("{path} = {si} is out of range: allowed {allowed}"),
         };
-        self.errors.push(FieldError {
+        self.report(FieldError {
             field: path,
             value: sent,
             allowed: allowed.to_string(),
@@ -232,7 +248,7 @@ impl Checker {
     pub fn invalid(&mut self, field: &str, value: Value, allowed: &str) {
         let path = self.path(field);
         let message = format!("{path}: {value} is not allowed: allowed {allowed}");
-        self.errors.push(FieldError {
+        self.report(FieldError {
             field: path,
             value,
             allowed: allowed.to_string(),
@@ -240,8 +256,17 @@ impl Checker {
         });
     }
 
-    /// The recorded errors, as the job's error.
-    pub fn into_error(self) -> JobError {
+    /// The recorded errors, as the job's error (the last one counting those not listed).
+    pub fn into_error(mut self) -> JobError {
+        if self.omitted > 0 {
+            let n = self.omitted;
+            self.errors.push(FieldError {
+                field: String::new(),
+                value: Value::from(n),
+                allowed: String::new(),
+                message: format!("and {n} more errors like these, not listed"),
+            });
+        }
         JobError::Invalid(self.errors)
     }
 
