@@ -865,7 +865,7 @@ fn graded_integrals(half_width: f64, xi: f64, kappa: f64) -> [f64; 4] {
             sum[0] += weight * q;
             sum[1] += weight * b * (2.0 - rho);
             sum[2] += weight * b * b * rho * (2.0 - rho);
-            sum[3] += weight * strip.moment(rho, q);
+            sum[3] += weight * strip.moment(rho);
         }
     }
     // ∫₀^r f dy = r ∫ f sin φ dφ; P = 2∫q dy, A = 2∫(b − a) dy, ∬x dA = ∫(b² − a²) dy,

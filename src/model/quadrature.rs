@@ -75,16 +75,19 @@ impl Quadrature {
         }
     }
 
-    /// A rule of the same kind with about half the strips: the companion used to estimate
-    /// the quadrature error of this one.
-    pub fn halved(self) -> Quadrature {
+    /// The rule the quadrature error of this one is estimated against (see
+    /// `rolling::Verification::quadrature_error_estimate`): the same kind with half the
+    /// strips, whose error (at least twice this rule's once the rule converges) bounds this
+    /// one's; below 8 strips, where that ratio is not yet reached, twice the strips instead.
+    pub fn companion(self) -> Quadrature {
+        const FEW: usize = 8;
         match self {
-            Quadrature::Gauss { nodes } => Quadrature::Gauss {
-                nodes: (nodes / 2).max(2),
-            },
-            Quadrature::Midpoint { strips } => Quadrature::Midpoint {
-                strips: (strips / 2).max(1),
-            },
+            Quadrature::Gauss { nodes } if nodes < FEW => Quadrature::Gauss { nodes: 2 * nodes },
+            Quadrature::Gauss { nodes } => Quadrature::Gauss { nodes: nodes / 2 },
+            Quadrature::Midpoint { strips } if strips < FEW => {
+                Quadrature::Midpoint { strips: 2 * strips }
+            }
+            Quadrature::Midpoint { strips } => Quadrature::Midpoint { strips: strips / 2 },
         }
     }
 }

@@ -124,15 +124,18 @@ impl Strip {
             + self.retardation_length() * b2 * rho * (2.0 - rho) / 2.0
     }
 
-    /// Strip moment m·R/k, with m = ∫ₐᵇ x p dx. `load` is [`Strip::load`] at the same ρ.
+    /// Strip moment m·R/k, with m = ∫ₐᵇ x p dx, at the exit root ρ.
     ///
     /// Slow strips use the exact m = (k/2R)[(b² − a²)²/4 + (2/3) V T_ε (b³ − a³)] − V T_σ q
-    /// (from p(a) = p(b) = 0). For fast strips its terms grow like λ_σ while m stays finite,
+    /// (from p(a) = p(b) = 0), written so that its two large terms, which cancel as κ → 0
+    /// (the strip turns symmetric and m → 0), never meet: with a + b = ρb and Δλ = κλ_σ,
+    /// m = (k/2R)(b − a)[(b − a)(a + b)²/4 + (a + b)λ_σ(a − λ_ε) + (2/3)Δλ(a² + ab + b²)],
+    /// every term of which carries a factor ρ or κ. For fast strips its terms grow like λ_σ while m stays finite,
     /// so there m is split into the instantaneous part (1 + κ)(b² − a²)²/4 (exact) and the
     /// small viscous correction of [`Strip::viscous_pressure`], integrated by 16-point
     /// Gauss–Legendre (exact to rounding: the integrand is entire and varies on the scale
     /// λ_σ > b).
-    pub fn moment(&self, rho: f64, load: f64) -> f64 {
+    pub fn moment(&self, rho: f64) -> f64 {
         let b = self.entry;
         let chord_squares = b * b * rho * (2.0 - rho); // b² − a²
         if self.beta() < FAST_STRIP {
@@ -150,10 +153,12 @@ impl Strip {
                 * half;
             return 0.5 * ((1.0 + self.kappa) * chord_squares * chord_squares / 4.0 - correction);
         }
-        let chord_cubes = b * b * b * (2.0 - rho) * (rho * rho - rho + 1.0); // b³ − a³
-        0.5 * (chord_squares * chord_squares / 4.0
-            + 2.0 / 3.0 * self.retardation_length() * chord_cubes)
-            - self.relaxation_length * load
+        let (lambda, chord, sum) = (self.relaxation_length, b * (2.0 - rho), rho * b); // b − a, a + b
+        let a = (rho - 1.0) * b;
+        0.5 * chord
+            * (chord * sum * sum / 4.0
+                + sum * lambda * (a - self.retardation_length())
+                + 2.0 / 3.0 * self.kappa * lambda * b * b * (rho * rho - rho + 1.0))
     }
 
     /// β = b/λ_σ (infinite at rest).
@@ -310,7 +315,7 @@ mod tests {
                 }
             }
             let exact_load = s.load(rho);
-            let exact_moment = s.moment(rho, exact_load);
+            let exact_moment = s.moment(rho);
             assert!(
                 (load / exact_load - 1.0).abs() < 1e-11,
                 "β = {beta}: load {load} vs {exact_load}"

@@ -176,7 +176,8 @@ pub fn long_sweep(n: usize) -> Value {
 /// Reads a `text/event-stream` body event by event.
 pub struct Events {
     response: Response,
-    buffer: String,
+    /// Bytes read and not yet parsed (a chunk may end inside a character).
+    buffer: Vec<u8>,
 }
 
 impl Events {
@@ -185,7 +186,7 @@ impl Events {
         assert_eq!(response.headers()["content-type"], "text/event-stream");
         Events {
             response,
-            buffer: String::new(),
+            buffer: Vec::new(),
         }
     }
 
@@ -205,8 +206,9 @@ impl Events {
     pub async fn next(&mut self) -> Option<(String, Value)> {
         within(async {
             loop {
-                if let Some(end) = self.buffer.find("\n\n") {
-                    let block: String = self.buffer.drain(..end + 2).collect();
+                if let Some(end) = self.buffer.windows(2).position(|w| w == b"\n\n") {
+                    let bytes: Vec<u8> = self.buffer.drain(..end + 2).collect();
+                    let block = String::from_utf8(bytes).unwrap();
                     let field = |name: &str| {
                         block
                             .lines()
@@ -219,7 +221,7 @@ impl Events {
                     continue;
                 }
                 match self.response.chunk().await {
-                    Ok(Some(bytes)) => self.buffer.push_str(std::str::from_utf8(&bytes).unwrap()),
+                    Ok(Some(bytes)) => self.buffer.extend_from_slice(&bytes),
                     _ => return None,
                 }
             }

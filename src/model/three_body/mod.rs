@@ -444,8 +444,10 @@ impl<'a> Model<'a> {
             .map_or(0.0, |e| compliance(e, system.particle.poisson_ratio));
         let upper_modulus =
             1.0 / (compliance(upper.elastic_modulus, upper.poisson_ratio) + particle);
-        // Rigid particles in the layer contact (MODEL.md §4).
-        let layer_modulus = 1.0 / compliance(layer.elastic_modulus, layer.poisson_ratio);
+        // E_s2a of the layer and the particle (MODEL.md §4): a finite particle modulus enters
+        // the Hertz layer contact; the Kelvin layer contact (§3) takes the particle rigid.
+        let layer_modulus =
+            1.0 / (compliance(layer.elastic_modulus, layer.poisson_ratio) + particle);
         let pair_modulus = 1.0
             / (compliance(upper.elastic_modulus, upper.poisson_ratio)
                 + compliance(layer.elastic_modulus, layer.poisson_ratio));
