@@ -84,7 +84,7 @@ fn figures(c: &mut Criterion) {
 fn three_body(c: &mut Criterion) {
     let mut group = c.benchmark_group("three_body");
     let options = ThreeBodyOptions::default();
-    // The default system of MODEL.md §5 carrying W = 1 mN (target: < 20 ms median).
+    // The default system of docs/model.md §5 carrying W = 1 mN (target: < 20 ms median).
     let kelvin = ThreeBody::with_defaults(OperatingPoint::TotalLoad(1e-3));
     group.bench_function("kelvin_layer_total_load", |b| {
         b.iter(|| three_body::solve(black_box(&kelvin), &options).unwrap())

@@ -1,4 +1,4 @@
-//! Honest answers (MODEL.md §7): the domain of validity in every answer, inputs that mean one
+//! Honest answers (docs/model.md §7): the domain of validity in every answer, inputs that mean one
 //! thing, units and provenance in every output; each example of the issue as a case, and a
 //! property over the whole input space: an answer is finite numbers with a validity block,
 //! or a problem.
@@ -112,7 +112,7 @@ fn the_paper_s_particle_warns_on_the_local_layer_only_and_says_why() {
     }
     let local = validity(&answer, "local_layer");
     let value = local["value"].as_f64().unwrap();
-    // Half-width √(2Rδ) = b(0) of MODEL.md §3 (5.5842 nm) over H = 100 nm.
+    // Half-width √(2Rδ) = b(0) of docs/model.md §3 (5.5842 nm) over H = 100 nm.
     assert!((value - 0.055842).abs() < 1e-6, "{value}");
     assert!(local["note"]
         .as_str()

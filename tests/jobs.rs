@@ -1,5 +1,5 @@
 //! The job layer and the engine: validation, canonical form and cache key, and the answers
-//! of rolling jobs, sweeps and figures, checked against the model and MODEL.md.
+//! of rolling jobs, sweeps and figures, checked against the model and docs/model.md.
 
 use serde_json::{json, Value};
 use thirdbody::engine;
@@ -223,7 +223,7 @@ fn a_rolling_answer_carries_the_model_numbers_and_its_own_verification() {
         .collect();
     assert!(dois.contains(&&json!("10.1177/1687814019872303")));
     assert!(!text.to_string().contains("null"), "no silent nulls");
-    // MODEL.md §3 reference row R = 25 nm, P = 1 nN, V = 4 nm/s.
+    // docs/model.md §3 reference row R = 25 nm, P = 1 nN, V = 4 nm/s.
     assert!((text["friction_coefficient"].as_f64().unwrap() - 0.09470).abs() < 5e-6);
 }
 

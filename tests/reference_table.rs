@@ -1,4 +1,4 @@
-//! MODEL.md §3 reference table, to every printed digit.
+//! docs/model.md §3 reference table, to every printed digit.
 
 use thirdbody::model::{solve, Layer, Rolling, SolveOptions};
 

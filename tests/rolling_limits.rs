@@ -1,8 +1,8 @@
-//! The rolling solver (MODEL.md §3) against its closed-form limits, the similarity law, the
+//! The rolling solver (docs/model.md §3) against its closed-form limits, the similarity law, the
 //! accuracy of its quadrature and its input checks. Every comparison is relative: lengths
-//! are ~1e-9 m (MODEL.md: "never absolute tolerances").
+//! are ~1e-9 m (docs/model.md: "never absolute tolerances").
 //!
-//! Notation (MODEL.md §1, §3): R radius, P load, V speed, δ penetration, A contact area,
+//! Notation (docs/model.md §1, §3): R radius, P load, V speed, δ penetration, A contact area,
 //! r = √(2Rδ) half-width, x_c area centroid, x_p centre of pressure, μ_r = x_p/R, μ = τ_a A/P,
 //! k = E_L/H, κ = T_ε/T_σ − 1, ξ = V T_σ / r₀, r₀ = √(2Rδ₀) the static half-width.
 
@@ -35,7 +35,7 @@ fn layer(
     }
 }
 
-/// (R, P, layer) combinations spanning the ranges of MODEL.md §5 and beyond (a macroscopic
+/// (R, P, layer) combinations spanning the ranges of docs/model.md §5 and beyond (a macroscopic
 /// rubber-like contact), with κ from 0.5 to 199.
 fn cases() -> Vec<(f64, f64, Layer)> {
     vec![
@@ -205,7 +205,7 @@ fn slow_rolling_errors(xi: f64, radius: f64, load: f64, layer: &Layer) -> [f64; 
     );
     let asymptotic = slow_rolling(radius, load, v, layer);
     let c = relaxed(radius, load, layer);
-    // The oracle is what MODEL.md §3 writes: A₀ − 2V(T_ε − T_σ)r₀, V(T_ε − T_σ)/2, V(T_ε − T_σ)/R.
+    // The oracle is what docs/model.md §3 writes: A₀ − 2V(T_ε − T_σ)r₀, V(T_ε − T_σ)/2, V(T_ε − T_σ)/R.
     let lag = v * (layer.retardation_time - layer.relaxation_time);
     assert!(
         rel(
@@ -319,7 +319,7 @@ fn equal_retardation_and_relaxation_times_give_static_contact_at_any_v() {
 }
 
 // ---------------------------------------------------------------------------------------
-// Similarity (MODEL.md §3): the contact shape depends on R and P only through R·P; A/A₀,
+// Similarity (docs/model.md §3): the contact shape depends on R and P only through R·P; A/A₀,
 // δ/δ₀, x_c/r₀ depend only on ξ = V T_σ/r₀ and κ.
 
 #[test]
@@ -435,7 +435,7 @@ fn ratios_to_static_contact_depend_only_on_xi_and_kappa() {
 }
 
 // ---------------------------------------------------------------------------------------
-// Quadrature in y (the only discretisation error, MODEL.md §3).
+// Quadrature in y (the only discretisation error, docs/model.md §3).
 
 /// δ, A, x_c, x_p of a solution.
 fn integrals(s: &RollingSolution) -> [f64; 4] {
@@ -540,7 +540,7 @@ fn midpoint_strips_converge_like_n_to_the_minus_1_5() {
             errors[1] / errors[2],
             errors[2] / errors[3],
         );
-        // MODEL.md: N = 40 errs by 0.04 % in A.
+        // docs/model.md: N = 40 errs by 0.04 % in A.
         assert!(
             errors[1] < 5e-4,
             "V = {velocity}: N = 40 errs by {}",
@@ -832,7 +832,7 @@ fn extreme_scales_give_finite_results_or_errors_not_panics() {
 
 // ---------------------------------------------------------------------------------------
 // An independent solution of the same contact: the strip closed forms of `strip::Strip`
-// (checked there against MODEL.md's literal G(s)), but integrated across y by composite
+// (checked there against docs/model.md's literal G(s)), but integrated across y by composite
 // 16-point Gauss–Legendre on panels graded geometrically towards the contact edge
 // y → r (where the strips turn fast, b ≲ V T_σ), and with its own load solve.
 

@@ -1,4 +1,4 @@
-//! The three-body system (MODEL.md §4) against independent computations, closed forms and
+//! The three-body system (docs/model.md §4) against independent computations, closed forms and
 //! the single-particle model, and its stated trends as properties.
 
 use proptest::prelude::*;

@@ -1,4 +1,4 @@
-//! Every trend that MODEL.md §6 states the paper makes, as a property over random valid
+//! Every trend that docs/model.md §6 states the paper makes, as a property over random valid
 //! parameters:
 //!
 //! A decreases with V; the contact shifts in the rolling direction (x_c > 0, a(0) > −b(0));
@@ -7,7 +7,7 @@
 //! Δμ = μ₀ − μ(V) is larger at smaller P and at larger R.
 //!
 //! Parameters are drawn two ways (half each): over physically sensible ranges around the
-//! defaults of MODEL.md §5 (R 5–500 nm, P 0.1–10 nN, V 0.5–20 nm/s, E_L 0.3–30 GPa,
+//! defaults of docs/model.md §5 (R 5–500 nm, P 0.1–10 nN, V 0.5–20 nm/s, E_L 0.3–30 GPa,
 //! H 20–500 nm, ν 0–0.49, T_σ 0.01–1 s, T_ε/T_σ 1.5–20), which reach ξ = V T_σ/r₀ from
 //! ~1e-4 to ~25; and with the same sphere and layer ranges but V chosen for a log-uniform
 //! ξ in [1e-5, 1e3], so the whole similarity range (A/A₀ depends only on ξ and κ) is covered
@@ -56,7 +56,7 @@ prop_compose! {
 }
 
 prop_compose! {
-    /// MODEL.md §5 ranges for every parameter, V included.
+    /// docs/model.md §5 ranges for every parameter, V included.
     fn physical()(
         radius in log_uniform(5e-9, 500e-9),
         load in log_uniform(0.1e-9, 10e-9),

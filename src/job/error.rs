@@ -42,7 +42,7 @@ pub enum JobError {
     /// double precision cannot hold, a load the system cannot carry): the same input always
     /// fails, so only a changed input can help.
     Unsolvable(String),
-    /// Valid values for which an assumption of the model fails (MODEL.md §7): the answer
+    /// Valid values for which an assumption of the model fails (docs/model.md §7): the answer
     /// would be a number the model cannot vouch for.
     OutOfDomain(String),
     /// The job was cancelled before it finished.

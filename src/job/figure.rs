@@ -1,4 +1,4 @@
-//! The figure job: the data of one of the paper's Figures 3–9 (MODEL.md §5).
+//! The figure job: the data of one of the paper's Figures 3–9 (docs/model.md §5).
 
 use serde::{Deserialize, Serialize};
 use serde_json::{json, Value};

@@ -5,7 +5,7 @@
 //! [`sweep`], [`figure`], registered by name in [`registry`]. The pieces their inputs share
 //! (quantities with units, the layer, the quadrature, the field checker) are in [`input`].
 //! The same types serve `thirdbody solve` and the HTTP API. Every input field is optional
-//! and defaults to MODEL.md §5; validation reports every bad field at once, each with its
+//! and defaults to docs/model.md §5; validation reports every bad field at once, each with its
 //! value and the allowed range.
 
 mod control;

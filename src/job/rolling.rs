@@ -1,4 +1,4 @@
-//! The rolling job: one particle rolling over the layer (MODEL.md §3).
+//! The rolling job: one particle rolling over the layer (docs/model.md §3).
 
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
@@ -12,7 +12,7 @@ use crate::model::rolling::{BoundaryPoint, PressureGrid, Verification};
 use crate::model::{self, Parameter, Rolling, RollingSolution, SolveOption, SolveOptions};
 use crate::render::{Column, Output, Table, Units};
 
-/// Input of a rolling job; every field optional (MODEL.md §5 defaults).
+/// Input of a rolling job; every field optional (docs/model.md §5 defaults).
 #[derive(Clone, Debug, Default, PartialEq, Deserialize, Serialize, ToSchema)]
 #[serde(deny_unknown_fields)]
 pub struct RollingInput {
@@ -22,7 +22,7 @@ pub struct RollingInput {
     pub load: Option<Quantity>,
     /// V, rolling speed (m/s, ≥ 0; default 4 nm/s).
     pub velocity: Option<Quantity>,
-    /// The viscoelastic layer (default: MODEL.md §5).
+    /// The viscoelastic layer (default: docs/model.md §5).
     pub layer: Option<LayerInput>,
     /// Quadrature and extra outputs.
     pub options: Option<OptionsInput>,
@@ -259,7 +259,7 @@ pub struct SweepPoint {
     #[serde(flatten)]
     pub contact: ContactOutput,
     pub verification: VerificationOutput,
-    /// The model's assumptions at this point (MODEL.md §7).
+    /// The model's assumptions at this point (docs/model.md §7).
     pub validity: ValidityOutput,
 }
 
@@ -364,7 +364,7 @@ pub struct RollingMeta {
     pub meta: Meta,
     /// How far the numbers can be trusted.
     pub verification: VerificationOutput,
-    /// How far the model can be trusted here (MODEL.md §7).
+    /// How far the model can be trusted here (docs/model.md §7).
     pub validity: ValidityOutput,
 }
 

@@ -1,5 +1,5 @@
 //! The three-body job: a population of particles between the upper surface and the layer
-//! (MODEL.md §4).
+//! (docs/model.md §4).
 
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
@@ -87,7 +87,7 @@ pub struct ParticleInput {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, Serialize, ToSchema)]
 #[serde(rename_all = "snake_case")]
 pub enum LayerContactKind {
-    /// The rolling contact of MODEL.md §3 at the job's speed (default).
+    /// The rolling contact of docs/model.md §3 at the job's speed (default).
     KelvinLayer,
     /// Hertz (the paper's eq. 6 reading).
     Hertz,
@@ -626,7 +626,7 @@ pub struct ThreeBodyMeta {
     #[serde(flatten)]
     pub meta: Meta,
     pub verification: ThreeBodyVerificationOutput,
-    /// How far the model can be trusted here (MODEL.md §7).
+    /// How far the model can be trusted here (docs/model.md §7).
     pub validity: ValidityOutput,
 }
 
@@ -706,7 +706,7 @@ pub struct ThreeBodySweepPoint {
     #[serde(flatten)]
     pub result: ThreeBodyResult,
     pub verification: ThreeBodyVerificationOutput,
-    /// The model's assumptions at this point (MODEL.md §7).
+    /// The model's assumptions at this point (docs/model.md §7).
     pub validity: ValidityOutput,
     /// `operating`, typed (for the CSV).
     #[serde(skip)]

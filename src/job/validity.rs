@@ -1,4 +1,4 @@
-//! The domain of validity in an answer (MODEL.md §7): each assumption of the model with its
+//! The domain of validity in an answer (docs/model.md §7): each assumption of the model with its
 //! ratio and status, in `meta.validity` (and per sweep point); a violated assumption refuses
 //! the answer with a message naming the cause and the numbers.
 

@@ -1,4 +1,4 @@
-//! The data behind the paper's Figures 3–9 (MODEL.md §5): which contacts to solve and
+//! The data behind the paper's Figures 3–9 (docs/model.md §5): which contacts to solve and
 //! which of their quantities each figure plots. Solving is left to the caller (the engine
 //! runs the points in parallel), so this module stays pure.
 

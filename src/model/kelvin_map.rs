@@ -1,8 +1,8 @@
 //! The rolling contact at a given penetration, tabulated once per layer: the forward map
 //! penetration → (load, area) that the three-body model evaluates for every diameter at
-//! every trial separation (MODEL.md §4, `kelvin_layer`).
+//! every trial separation (docs/model.md §4, `kelvin_layer`).
 //!
-//! By the similarity law (MODEL.md §3) the ratios Φ_P = P/(πkRδ²) and Φ_A = A/(2πRδ) depend
+//! By the similarity law (docs/model.md §3) the ratios Φ_P = P/(πkRδ²) and Φ_A = A/(2πRδ) depend
 //! only on ξ = V T_σ/√(2Rδ) and κ, so one table in ξ serves every diameter and every load.
 //! It is a Chebyshev interpolant in v = (u − 1)/(u + 1), u = √((1 + κ)ξ), which maps
 //! ξ ∈ [0, ∞] onto [−1, 1], centres the viscous transition (it starts where V T_ε ≈ r) and

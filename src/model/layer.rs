@@ -1,9 +1,9 @@
 //! The viscoelastic (Kelvin / standard linear solid) layer and the physical ranges of every
-//! parameter of a rolling contact (MODEL.md §1).
+//! parameter of a rolling contact (docs/model.md §1).
 
 use std::fmt;
 
-/// A thin Kelvin layer bonded to a rigid base (MODEL.md eq. 4): locally
+/// A thin Kelvin layer bonded to a rigid base (docs/model.md eq. 4): locally
 /// v + T_ε ∂v/∂t = (H/E_L)(p + T_σ ∂p/∂t).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Layer {
@@ -20,7 +20,7 @@ pub struct Layer {
 }
 
 impl Default for Layer {
-    /// MODEL.md §5: E_L = 3 GPa, H = 100 nm, ν = 0.35, T_ε = 0.5 s, T_σ = 0.1 s.
+    /// docs/model.md §5: E_L = 3 GPa, H = 100 nm, ν = 0.35, T_ε = 0.5 s, T_σ = 0.1 s.
     fn default() -> Self {
         Layer {
             elastic_modulus: 3e9,
@@ -96,7 +96,7 @@ pub enum Parameter {
     PoissonRatio,
     RetardationTime,
     RelaxationTime,
-    /// x_a of the three-body model (MODEL.md §4).
+    /// x_a of the three-body model (docs/model.md §4).
     MeanDiameter,
     /// σ_a.
     StdDiameter,

@@ -1,4 +1,4 @@
-//! Closed-form limits of the rolling contact (MODEL.md §3): the exact answers at V = 0 and
+//! Closed-form limits of the rolling contact (docs/model.md §3): the exact answers at V = 0 and
 //! V → ∞, and the first-order small-V asymptotics. They are the oracles the solver is tested
 //! against, and the V = 0 one is the "static" (the paper's "without rolling") result.
 

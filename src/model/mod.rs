@@ -1,5 +1,5 @@
 //! The physics core: a rigid sphere rolling over a Kelvin layer bonded to a rigid base
-//! (MODEL.md §1–3, §5, §6). Pure numerics over plain structs in SI units: no I/O, no async,
+//! (docs/model.md §1–3, §5, §6). Pure numerics over plain structs in SI units: no I/O, no async,
 //! no serde. Everything else in the crate calls into this module.
 
 mod error;

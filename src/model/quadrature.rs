@@ -1,6 +1,6 @@
 //! Quadrature across the contact: which strips y = const are evaluated and with what weight.
 //!
-//! Strips do not interact (MODEL.md §3), so with the exact strip load and moment the only
+//! Strips do not interact (docs/model.md §3), so with the exact strip load and moment the only
 //! discretisation error of the whole solution is the quadrature in y. Two rules are offered:
 //! Gauss–Legendre in θ with y = r sin θ, which makes the integrand smooth and reaches 1e-9
 //! relative accuracy with about a hundred nodes, and the paper's uniform midpoint strips

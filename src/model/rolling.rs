@@ -1,5 +1,5 @@
 //! A rigid sphere rolling at constant speed over the Kelvin layer: penetration, contact
-//! region, area, centroid and centre of pressure, friction (MODEL.md §3, eqs. 2–5, 9–12).
+//! region, area, centroid and centre of pressure, friction (docs/model.md §3, eqs. 2–5, 9–12).
 //!
 //! The solution is computed in units of the static half-width r₀ = √(2Rδ₀): there the
 //! contact shape depends only on ξ = V T_σ / r₀ and κ (the similarity law), the load to
@@ -25,7 +25,7 @@ pub const MAX_BOUNDARY_POINTS: usize = 10_001;
 /// Largest pressure grid (points per side).
 pub const MAX_PRESSURE_GRID: usize = 501;
 
-/// One particle rolling over the layer: the inputs of MODEL.md §3.
+/// One particle rolling over the layer: the inputs of docs/model.md §3.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Rolling {
     /// R (m).
@@ -38,7 +38,7 @@ pub struct Rolling {
 }
 
 impl Default for Rolling {
-    /// MODEL.md §5: R = 25 nm, P = 1 nN, V = 4 nm/s on the default layer.
+    /// docs/model.md §5: R = 25 nm, P = 1 nN, V = 4 nm/s on the default layer.
     fn default() -> Self {
         Rolling {
             radius: 25e-9,
@@ -157,7 +157,7 @@ pub struct Verification {
     pub converged: bool,
 }
 
-/// The rolling contact (MODEL.md §3), in SI units.
+/// The rolling contact (docs/model.md §3), in SI units.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RollingSolution {
     /// δ (m).
@@ -181,7 +181,7 @@ pub struct RollingSolution {
     pub verification: Verification,
 }
 
-/// Solves the rolling contact of `rolling` (MODEL.md §3).
+/// Solves the rolling contact of `rolling` (docs/model.md §3).
 ///
 /// Fails, never panics nor returns a non-finite number, on parameters outside their ranges,
 /// scales beyond double precision, or a root that does not converge.
@@ -254,7 +254,7 @@ pub fn solve(rolling: &Rolling, options: &SolveOptions) -> Result<RollingSolutio
 }
 
 /// The contact at a given penetration δ rather than a given load (the forward map of the
-/// three-body model, MODEL.md §4), as ratios to the static contact at the same δ:
+/// three-body model, docs/model.md §4), as ratios to the static contact at the same δ:
 /// P = π k R δ² Φ_P and A = 2π R δ Φ_A, where Φ_P and Φ_A depend only on
 /// ξ = V T_σ/√(2Rδ) and κ (the similarity law). Φ_P runs from 1 (ξ = 0) to 1 + κ (ξ → ∞);
 /// Φ_A is 1 at both ends and dips in between.
@@ -348,7 +348,7 @@ struct Shape {
 
 impl Shape {
     /// Solves ln P̂(e^u) = ln(π/4) for u = ln r̂ by the secant method, guarded by the bracket
-    /// δ ∈ [0.9 δ_∞, 1.05 δ₀] of MODEL.md §3. ln P̂ is nearly linear in u (slope 4 at both
+    /// δ ∈ [0.9 δ_∞, 1.05 δ₀] of docs/model.md §3. ln P̂ is nearly linear in u (slope 4 at both
     /// limits), so the secant converges in a handful of steps; the exit roots of every strip
     /// are warm-started from the previous step.
     fn solve(xi: f64, kappa: f64, rule: &StripRule) -> Result<Shape, ModelError> {

@@ -1,4 +1,4 @@
-//! Cancellation-free exponential kernels of the strip solution (MODEL.md §3).
+//! Cancellation-free exponential kernels of the strip solution (docs/model.md §3).
 //!
 //! The exit-edge equation and the pressure of a strip contain differences such as
 //! `(sβ + 1) − (β + 1)e^{β(s−1)}` that cancel catastrophically for fast strips (β → 0),

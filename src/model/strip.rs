@@ -1,5 +1,5 @@
 //! One strip y = const of a sphere rolling over a Kelvin layer: the exact solution of
-//! MODEL.md §3 (eq. 5 integrated along x with p = 0 at the entry edge).
+//! docs/model.md §3 (eq. 5 integrated along x with p = 0 at the entry edge).
 //!
 //! Every function here works in any consistent length unit and returns its quantity divided
 //! by the stiffness factor it carries (k/R for loads, k/2R for pressures): the caller scales.
@@ -49,7 +49,7 @@ impl Strip {
         (1.0 + self.kappa) * self.relaxation_length
     }
 
-    /// The exit edge: the root ρ ∈ (0, 2) of g(ρ) = −G(s)/(s − 1), s = ρ − 1 (MODEL.md §3),
+    /// The exit edge: the root ρ ∈ (0, 2) of g(ρ) = −G(s)/(s − 1), s = ρ − 1 (docs/model.md §3),
     ///
     /// g(ρ) = ρ + 2κ [E₁(z) + σ E₂(z)],  σ = ρ − 2,  z = βσ,  β = b/λ_σ,
     ///
@@ -217,7 +217,7 @@ mod tests {
         }
     }
 
-    /// G(s) of MODEL.md §3 written literally, for checking the root where it does not cancel.
+    /// G(s) of docs/model.md §3 written literally, for checking the root where it does not cancel.
     fn g_literal(s: f64, beta: f64, kappa: f64) -> f64 {
         1.0 - s * s
             + 2.0 * kappa / (beta * beta)

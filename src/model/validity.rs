@@ -1,4 +1,4 @@
-//! The model's domain of validity (MODEL.md §7): each assumption the model rests on, measured
+//! The model's domain of validity (docs/model.md §7): each assumption the model rests on, measured
 //! on a solved contact as a ratio, with its status. The verification block of an answer says
 //! how exact the numbers are; this says how far the model itself can be trusted there.
 
@@ -104,12 +104,12 @@ impl Check {
     }
 }
 
-/// The assumptions of MODEL.md §7 on one rolling contact.
+/// The assumptions of docs/model.md §7 on one rolling contact.
 pub fn rolling(rolling: &Rolling, s: &RollingSolution) -> Vec<Check> {
     let h = rolling.layer.thickness;
     let r = rolling.radius;
     let rest = &s.static_contact;
-    // b(0) is the half-width and |a(0)| < b(0) (MODEL.md §3): the half-width is a_max.
+    // b(0) is the half-width and |a(0)| < b(0) (docs/model.md §3): the half-width is a_max.
     vec![
         Check::new(
             Assumption::InsideLayer,
@@ -134,14 +134,14 @@ pub fn rolling(rolling: &Rolling, s: &RollingSolution) -> Vec<Check> {
     ]
 }
 
-/// The assumptions of MODEL.md §7 on a three-body system, measured on its largest particle
+/// The assumptions of docs/model.md §7 on a three-body system, measured on its largest particle
 /// in contact (the deepest and widest contact) and on the whole system.
 pub fn three_body(system: &ThreeBody, s: &ThreeBodySolution) -> Vec<Check> {
     let h = system.layer.thickness;
     let x_max = system.diameters.max;
     let radius = 0.5 * x_max;
     // Contact half-width of the largest particle on the layer: √(2Rω₂) in the Kelvin layer
-    // (MODEL.md §3), √(Rω₂) for Hertz.
+    // (docs/model.md §3), √(Rω₂) for Hertz.
     let half_width = |omega: f64| match system.layer_contact {
         LayerContact::KelvinLayer => (2.0 * radius * omega).sqrt(),
         LayerContact::Hertz => (radius * omega).sqrt(),
@@ -224,7 +224,7 @@ mod tests {
             .map(|c| c.assumption)
             .collect();
         assert_eq!(warned, [Assumption::LocalLayer]);
-        // δ/H and a_max/R of the reference row (MODEL.md §3: δ = 0.6237 nm, b(0) = 5.5842 nm).
+        // δ/H and a_max/R of the reference row (docs/model.md §3: δ = 0.6237 nm, b(0) = 5.5842 nm).
         assert!((checks[0].ratio() - 0.6237e-2).abs() < 1e-6);
         assert!((checks[1].ratio() * 25.0 - 5.5842).abs() < 1e-4);
     }

@@ -28,7 +28,7 @@ async fn a_rolling_job_is_solved_in_process() {
     assert_eq!(status, StatusCode::OK);
     assert_eq!(headers["x-cache"], "miss");
     let body: Value = serde_json::from_slice(&body).unwrap();
-    // MODEL.md §3, V = 0: A₀ = 102.333 nm².
+    // docs/model.md §3, V = 0: A₀ = 102.333 nm².
     let area = body["contact_area"].as_f64().unwrap() * 1e18;
     assert!((area - 102.333).abs() < 5e-4, "{area}");
 }

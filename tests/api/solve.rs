@@ -24,7 +24,7 @@ async fn rolling_answers_the_model_section_3_reference_row() {
     assert_eq!(response.headers()["x-cache"], "miss");
     let etag = response.headers()["etag"].to_str().unwrap().to_string();
     let body: Value = response.json().await.unwrap();
-    // MODEL.md §3, R = 25 nm, P = 1 nN, V = 4 nm/s: A = 85.234 nm², μ = 0.09470.
+    // docs/model.md §3, R = 25 nm, P = 1 nN, V = 4 nm/s: A = 85.234 nm², μ = 0.09470.
     let area = body["contact_area"].as_f64().unwrap() * 1e18;
     assert!((area - 85.234).abs() < 5e-4, "{area}");
     let mu = body["friction_coefficient"].as_f64().unwrap();

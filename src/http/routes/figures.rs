@@ -13,7 +13,7 @@ use crate::job::{FigureJob, Job};
 
 /// The data of Figure n of the paper.
 ///
-/// Figures 3 to 9 (MODEL.md §5): the contact region, and contact area and friction
+/// Figures 3 to 9 (docs/model.md §5): the contact region, and contact area and friction
 /// against load and radius, with and without rolling. With `Accept: text/csv` the answer is
 /// CSV, one line per point.
 #[utoipa::path(

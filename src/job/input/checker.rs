@@ -284,7 +284,7 @@ impl Checker {
 }
 
 /// What is implausible about a bare (unit-less, so SI) number for `parameter`, and the
-/// form the sender may have meant (MODEL.md §7): a length above 1 mm, a load above 1 N, a
+/// form the sender may have meant (docs/model.md §7): a length above 1 mm, a load above 1 N, a
 /// speed above 1 m/s, a modulus below 1 kPa or above 1 TPa, a time above 1e6 s.
 fn implausible(parameter: Parameter, x: f64) -> Option<String> {
     use Parameter::*;

@@ -1,4 +1,4 @@
-//! Surface-to-surface contact of the asperities: the Zhao–Maietta–Chang model (MODEL.md §4),
+//! Surface-to-surface contact of the asperities: the Zhao–Maietta–Chang model (docs/model.md §4),
 //! elastic, then elastic-plastic, then fully plastic as the interference grows, summed over
 //! Gaussian asperity heights.
 

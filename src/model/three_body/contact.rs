@@ -1,4 +1,4 @@
-//! One particle squeezed between the upper surface and the layer (MODEL.md §4): the two
+//! One particle squeezed between the upper surface and the layer (docs/model.md §4): the two
 //! contact laws and the split of the interference ω = x − d into ω₁ (upper) and ω₂ (layer)
 //! at which both contacts carry the same force.
 
@@ -50,7 +50,7 @@ impl UpperLaw {
 /// How the layer takes a particle of radius R = x/2 (the particle is rigid there).
 #[derive(Clone, Debug)]
 pub enum LayerLaw {
-    /// The rolling contact of MODEL.md §3 at a given penetration δ = ω₂:
+    /// The rolling contact of docs/model.md §3 at a given penetration δ = ω₂:
     /// F = πkRδ²Φ_P(ξ), A₂ = 2πRδΦ_A(ξ), ξ = V T_σ/√(2Rδ). At rest Φ_P = Φ_A = 1.
     Kelvin {
         /// k = E_L/H.

@@ -1,5 +1,5 @@
 //! Particle diameters: a Gaussian truncated to [x_min, x_max] and renormalised there
-//! (MODEL.md eq. 1), and the count of particles in contact (eq. 7) in closed form.
+//! (docs/model.md eq. 1), and the count of particles in contact (eq. 7) in closed form.
 
 use std::f64::consts::{FRAC_1_SQRT_2, PI};
 
@@ -18,7 +18,7 @@ pub struct Diameters {
 }
 
 impl Diameters {
-    /// Bounds x_a ∓ 3σ_a, never below 0 (MODEL.md §4).
+    /// Bounds x_a ∓ 3σ_a, never below 0 (docs/model.md §4).
     pub fn with_default_bounds(mean: f64, std: f64) -> Self {
         Diameters {
             mean,

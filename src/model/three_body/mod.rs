@@ -1,4 +1,4 @@
-//! The three-body system (MODEL.md §4): a population of hard particles, Gaussian in diameter,
+//! The three-body system (docs/model.md §4): a population of hard particles, Gaussian in diameter,
 //! squeezed between a rigid-backed upper surface and the viscoelastic layer, with optional
 //! asperity contact; its real contact area, load and friction coefficient with and without
 //! rolling, at a given separation, total load or mean particle load.
@@ -28,7 +28,7 @@ const EDGE_POWER: i32 = 4;
 /// How the upper surface deforms where a particle presses into it.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum UpperContact {
-    /// Hertz (MODEL.md §4, default).
+    /// Hertz (docs/model.md §4, default).
     #[default]
     Elastic,
     /// Fully plastic at the surface's hardness (Horng's option).
@@ -48,7 +48,7 @@ pub struct UpperSurface {
 }
 
 impl Default for UpperSurface {
-    /// Steel: 210 GPa, ν = 0.3 (MODEL.md §5).
+    /// Steel: 210 GPa, ν = 0.3 (docs/model.md §5).
     fn default() -> Self {
         UpperSurface {
             elastic_modulus: 210e9,
@@ -80,7 +80,7 @@ impl Default for Particle {
 /// How the layer takes a particle.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum LayerContact {
-    /// The rolling contact of MODEL.md §3 at the job's speed (default).
+    /// The rolling contact of docs/model.md §3 at the job's speed (default).
     #[default]
     KelvinLayer,
     /// Hertz with E_s2a (the paper's eq. 6 reading); independent of speed.
@@ -109,7 +109,7 @@ impl OperatingPoint {
     }
 }
 
-/// A three-body system and its operating point (MODEL.md §4, defaults of §5).
+/// A three-body system and its operating point (docs/model.md §4, defaults of §5).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ThreeBody {
     pub diameters: Diameters,
@@ -128,7 +128,7 @@ pub struct ThreeBody {
 }
 
 impl ThreeBody {
-    /// MODEL.md §5: A_n = 1 mm², η_a = 1e12 m⁻², x_a = 50 nm, σ_a = 5 nm, steel upper surface,
+    /// docs/model.md §5: A_n = 1 mm², η_a = 1e12 m⁻², x_a = 50 nm, σ_a = 5 nm, steel upper surface,
     /// rigid particles, the default layer, V = 4 nm/s, no asperities; at `operating`.
     pub fn with_defaults(operating: OperatingPoint) -> Self {
         ThreeBody {
@@ -340,7 +340,7 @@ pub struct ThreeBodySolution {
     pub verification: ThreeBodyVerification,
 }
 
-/// Solves the three-body system (MODEL.md §4).
+/// Solves the three-body system (docs/model.md §4).
 pub fn solve(
     system: &ThreeBody,
     options: &ThreeBodyOptions,
@@ -444,7 +444,7 @@ impl<'a> Model<'a> {
             .map_or(0.0, |e| compliance(e, system.particle.poisson_ratio));
         let upper_modulus =
             1.0 / (compliance(upper.elastic_modulus, upper.poisson_ratio) + particle);
-        // E_s2a of the layer and the particle (MODEL.md §4): a finite particle modulus enters
+        // E_s2a of the layer and the particle (docs/model.md §4): a finite particle modulus enters
         // the Hertz layer contact; the Kelvin layer contact (§3) takes the particle rigid.
         let layer_modulus =
             1.0 / (compliance(layer.elastic_modulus, layer.poisson_ratio) + particle);
