@@ -103,6 +103,8 @@ struct LiveJob {
     /// Wakes a job still waiting for a permit when it is cancelled (the solver itself
     /// watches `control`).
     cancel: CancellationToken,
+    /// Whether the job is being stopped by the shutdown rather than by its client.
+    interrupted: AtomicBool,
     /// The job's status, for those who wait for a change.
     status: watch::Sender<JobStatus>,
 }
@@ -112,6 +114,43 @@ impl LiveJob {
     fn cancel(&self) {
         self.cancel.cancel();
         self.control.cancel();
+    }
+
+    /// The state of a job that stopped on a cancel: interrupted if the shutdown asked.
+    fn stopped(&self) -> JobState {
+        if self.interrupted.load(Ordering::SeqCst) {
+            JobState::Interrupted
+        } else {
+            JobState::Cancelled
+        }
+    }
+}
+
+/// Ids of asynchronous jobs: a tag of the process that accepted the job, then random bits.
+/// A process that does not know an id can tell whether it is its own (expired, or never
+/// given) or another run's (whose unfinished jobs a shutdown interrupted).
+#[derive(Clone, Copy, Debug)]
+struct JobIds {
+    instance: [u8; 4],
+}
+
+impl JobIds {
+    fn new() -> Self {
+        let tag = Uuid::new_v4();
+        let mut instance = [0; 4];
+        instance.copy_from_slice(&tag.as_bytes()[..4]);
+        JobIds { instance }
+    }
+
+    fn next(&self) -> Uuid {
+        let mut bytes = *Uuid::new_v4().as_bytes();
+        bytes[..4].copy_from_slice(&self.instance);
+        // Keep the version (4) and variant bits of the random UUID.
+        Uuid::from_bytes(bytes)
+    }
+
+    fn issued(&self, id: Uuid) -> bool {
+        id.as_bytes()[..4] == self.instance
     }
 }
 
@@ -127,6 +166,10 @@ pub struct Engine {
     jobs: Arc<dyn JobStore>,
     /// The jobs this process runs, by id.
     live: Mutex<HashMap<Uuid, Arc<LiveJob>>>,
+    ids: JobIds,
+    /// Solver threads asynchronous jobs may hold at once: all but one, so that synchronous
+    /// requests always find one that no job holds.
+    job_slots: Arc<tokio::sync::Semaphore>,
     /// The tasks of asynchronous jobs, waited for on shutdown.
     tracker: TaskTracker,
     draining: AtomicBool,
@@ -161,6 +204,10 @@ impl Engine {
                 .build(),
             jobs: storage.jobs,
             live: Mutex::default(),
+            ids: JobIds::new(),
+            job_slots: Arc::new(tokio::sync::Semaphore::new(
+                config.pool_size.saturating_sub(1).max(1),
+            )),
             tracker: TaskTracker::new(),
             draining: AtomicBool::new(false),
             queued: AtomicUsize::new(0),
@@ -253,13 +300,14 @@ impl Engine {
             return Err(self.refused(EngineError::Overloaded));
         }
         self.jobs_queued.increment(1.0);
-        let record = JobRecord::queued(job.kind(), job.work());
+        let record = JobRecord::queued(self.ids.next(), job.kind(), job.work());
         let id = record.id;
         self.jobs.insert(record.clone()).await;
         let deadline = Instant::now() + self.config.job_deadline;
         let live = Arc::new(LiveJob {
             control: Arc::new(Control::new(Some(deadline), 1)),
             cancel: CancellationToken::new(),
+            interrupted: AtomicBool::new(false),
             status: watch::Sender::new(JobStatus::Queued),
         });
         self.live().insert(id, live.clone());
@@ -296,6 +344,11 @@ impl Engine {
         Some(record)
     }
 
+    /// Whether `id` is the id of a job this process accepted (known or forgotten since).
+    pub fn issued(&self, id: Uuid) -> bool {
+        self.ids.issued(id)
+    }
+
     /// A receiver of the status changes of the job `id`, if this process runs it.
     pub fn watch(&self, id: Uuid) -> Option<watch::Receiver<JobStatus>> {
         self.live().get(&id).map(|live| live.status.subscribe())
@@ -320,11 +373,10 @@ impl Engine {
         self.jobs.purge_expired().await
     }
 
-    /// Stops taking work: new solves and jobs are refused, queued jobs are cancelled.
-    /// Running jobs go on; [`Engine::jobs_finished`] waits for them.
+    /// Stops taking work: new solves and jobs are refused. The jobs accepted, queued or
+    /// running, go on; [`Engine::jobs_finished`] waits for them.
     pub fn begin_drain(&self) {
         self.draining.store(true, Ordering::SeqCst);
-        self.cancel_live(JobStatus::Queued);
     }
 
     pub fn is_draining(&self) -> bool {
@@ -337,16 +389,12 @@ impl Engine {
         self.tracker.wait().await;
     }
 
-    /// Cancels every job still running (when the drain ran out of time).
-    pub fn cancel_running_jobs(&self) {
-        self.cancel_live(JobStatus::Running);
-    }
-
-    fn cancel_live(&self, status: JobStatus) {
+    /// Stops every job not finished yet (the drain ran out of time): they end
+    /// `interrupted`.
+    pub fn interrupt_unfinished_jobs(&self) {
         for live in self.live().values() {
-            if *live.status.borrow() == status {
-                live.cancel();
-            }
+            live.interrupted.store(true, Ordering::SeqCst);
+            live.cancel();
         }
     }
 
@@ -412,14 +460,17 @@ impl Engine {
                 Err(JobState::Succeeded(hit))
             }
             None => tokio::select! {
-                () = live.cancel.cancelled() => Err(JobState::Cancelled),
-                permit = self.pool.acquire() => Ok(permit),
+                () = live.cancel.cancelled() => Err(live.stopped()),
+                permits = async {
+                    let slot = self.job_slots.clone().acquire_owned().await;
+                    (slot, self.pool.acquire().await)
+                } => Ok(permits),
             },
         };
         self.queued.fetch_sub(1, Ordering::SeqCst);
         self.jobs_queued.decrement(1.0);
-        let permit = match permit {
-            Ok(permit) => permit,
+        let (_slot, permit) = match permit {
+            Ok(permits) => permits,
             Err(state) => return state,
         };
         self.jobs.update(id, JobState::Running, 0).await;
@@ -432,7 +483,7 @@ impl Engine {
                 self.cache.insert(solved.clone()).await;
                 JobState::Succeeded(solved)
             }
-            Err(JobError::Cancelled) => JobState::Cancelled,
+            Err(JobError::Cancelled) => live.stopped(),
             Err(e) => JobState::Failed(e),
         }
     }

@@ -25,6 +25,8 @@ pub enum JobStatus {
     Succeeded,
     Failed,
     Cancelled,
+    /// Stopped unfinished because the service shut down (it ran out of its drain time).
+    Interrupted,
 }
 
 impl JobStatus {
@@ -35,13 +37,17 @@ impl JobStatus {
             JobStatus::Succeeded => "succeeded",
             JobStatus::Failed => "failed",
             JobStatus::Cancelled => "cancelled",
+            JobStatus::Interrupted => "interrupted",
         }
     }
 
     pub fn is_finished(self) -> bool {
         matches!(
             self,
-            JobStatus::Succeeded | JobStatus::Failed | JobStatus::Cancelled
+            JobStatus::Succeeded
+                | JobStatus::Failed
+                | JobStatus::Cancelled
+                | JobStatus::Interrupted
         )
     }
 }
@@ -54,6 +60,7 @@ pub enum JobState {
     Succeeded(Arc<Solved>),
     Failed(JobError),
     Cancelled,
+    Interrupted,
 }
 
 impl JobState {
@@ -64,6 +71,7 @@ impl JobState {
             JobState::Succeeded(_) => JobStatus::Succeeded,
             JobState::Failed(_) => JobStatus::Failed,
             JobState::Cancelled => JobStatus::Cancelled,
+            JobState::Interrupted => JobStatus::Interrupted,
         }
     }
 }
@@ -85,10 +93,10 @@ pub struct JobRecord {
 }
 
 impl JobRecord {
-    /// A job just accepted.
-    pub fn queued(kind: &'static str, work: Work) -> JobRecord {
+    /// A job just accepted, whose id is `id`.
+    pub fn queued(id: Uuid, kind: &'static str, work: Work) -> JobRecord {
         JobRecord {
-            id: Uuid::new_v4(),
+            id,
             kind,
             work,
             state: JobState::Queued,

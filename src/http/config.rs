@@ -9,6 +9,7 @@ use std::time::Duration;
 use axum::http::HeaderValue;
 use clap::{Parser, ValueEnum};
 
+use super::server::ConnectionLimits;
 use crate::engine::EngineConfig;
 use crate::job::Limits;
 
@@ -59,6 +60,16 @@ pub struct ServeArgs {
     #[arg(long, env = "THIRDBODY_JOB_RETENTION", default_value = "15m", value_parser = duration)]
     pub job_retention: Duration,
 
+    /// Connections open at once; more wait in the kernel's backlog (keep it below the
+    /// process's limit on open files).
+    #[arg(long, env = "THIRDBODY_MAX_CONNECTIONS", default_value_t = 512)]
+    pub max_connections: usize,
+
+    /// Longest a client may take to send a request's headers; also how long an idle
+    /// keep-alive connection stays open.
+    #[arg(long, env = "THIRDBODY_HEADER_TIMEOUT", default_value = "10s", value_parser = duration)]
+    pub header_timeout: Duration,
+
     /// Origins allowed to call the API from a browser, comma-separated (`*` for any);
     /// none by default.
     #[arg(
@@ -77,8 +88,8 @@ pub struct ServeArgs {
     #[arg(long, env = "THIRDBODY_DRAIN_DELAY", default_value = "0s", value_parser = duration)]
     pub drain_delay: Duration,
 
-    /// On shutdown, how long in-flight requests and running jobs have to finish before
-    /// they are cancelled.
+    /// On shutdown, how long the jobs accepted (queued and running) and the requests in
+    /// flight have to finish; what is left then is interrupted.
     #[arg(long, env = "THIRDBODY_SHUTDOWN_TIMEOUT", default_value = "30s", value_parser = duration)]
     pub shutdown_timeout: Duration,
 }
@@ -105,6 +116,7 @@ pub enum CorsOrigins {
 #[derive(Clone, Debug)]
 pub struct Config {
     pub bind: SocketAddr,
+    pub connections: ConnectionLimits,
     pub engine: EngineConfig,
     pub limits: Limits,
     pub body_limit: usize,
@@ -156,7 +168,11 @@ impl ServeArgs {
         if self.max_sweep_points == 0 {
             return fail("--max-sweep-points 0: allowed at least 1".to_string());
         }
+        if self.max_connections == 0 {
+            return fail("--max-connections 0: allowed at least 1".to_string());
+        }
         for (flag, value) in [
+            ("--header-timeout", self.header_timeout),
             ("--request-timeout", self.request_timeout),
             ("--solve-deadline", self.solve_deadline),
             ("--job-deadline", self.job_deadline),
@@ -178,6 +194,10 @@ impl ServeArgs {
         }
         Ok(Config {
             bind: self.bind,
+            connections: ConnectionLimits {
+                max_connections: self.max_connections,
+                header_timeout: self.header_timeout,
+            },
             engine: EngineConfig {
                 pool_size,
                 solve_deadline: self.solve_deadline,

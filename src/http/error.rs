@@ -31,8 +31,9 @@ pub struct Problem {
     /// assumption of the model fails for these values, see `meta.validity`),
     /// `unsupported-media-type` (415),
     /// `not-acceptable` (406: the `Accept` header names no form the resource offers),
-    /// `payload-too-large` (413), `not-found` (404), `not-ready` (409: the job has no result
-    /// yet), `cancelled` (409), `overloaded` (429),
+    /// `payload-too-large` (413), `not-found` (404), `interrupted` (410: the service stopped
+    /// before the job finished), `not-ready` (409: the job has no result yet), `cancelled`
+    /// (409), `overloaded` (429),
     /// `draining` (503), `deadline-exceeded` (504), `internal` (500); or `about:blank` for a
     /// status with no more to say than its title.
     #[serde(rename = "type")]
@@ -60,6 +61,7 @@ enum Kind {
     NotAcceptable,
     PayloadTooLarge,
     NotFound,
+    Interrupted,
     NotReady,
     Cancelled,
     Overloaded,
@@ -81,6 +83,7 @@ impl Kind {
             Kind::NotAcceptable => StatusCode::NOT_ACCEPTABLE,
             Kind::PayloadTooLarge => StatusCode::PAYLOAD_TOO_LARGE,
             Kind::NotFound => StatusCode::NOT_FOUND,
+            Kind::Interrupted => StatusCode::GONE,
             Kind::Cancelled | Kind::NotReady => StatusCode::CONFLICT,
             Kind::Overloaded => StatusCode::TOO_MANY_REQUESTS,
             Kind::Draining => StatusCode::SERVICE_UNAVAILABLE,
@@ -101,6 +104,7 @@ impl Kind {
             Kind::NotAcceptable => ("not-acceptable", "No acceptable form of the answer"),
             Kind::PayloadTooLarge => ("payload-too-large", "The body is too large"),
             Kind::NotFound => ("not-found", "Not found"),
+            Kind::Interrupted => ("interrupted", "The service stopped before the job finished"),
             Kind::NotReady => ("not-ready", "The job has no result yet"),
             Kind::Cancelled => ("cancelled", "The job was cancelled"),
             Kind::Overloaded => ("overloaded", "Every solver thread is busy"),
@@ -146,6 +150,14 @@ impl ApiError {
 
     pub fn not_acceptable(detail: impl Into<String>) -> Self {
         ApiError::new(Kind::NotAcceptable, detail)
+    }
+
+    pub fn payload_too_large(detail: impl Into<String>) -> Self {
+        ApiError::new(Kind::PayloadTooLarge, detail)
+    }
+
+    pub fn interrupted(detail: impl Into<String>) -> Self {
+        ApiError::new(Kind::Interrupted, detail)
     }
 
     pub fn not_ready(detail: impl Into<String>) -> Self {

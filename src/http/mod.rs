@@ -12,8 +12,9 @@ mod observe;
 pub mod openapi;
 mod responses;
 pub mod routes;
+mod server;
 
-use std::future::{Future, IntoFuture};
+use std::future::Future;
 use std::sync::Arc;
 use std::time::Duration;
 
@@ -34,6 +35,7 @@ use utoipa_swagger_ui::SwaggerUi;
 
 pub use config::{Config, ConfigError, CorsOrigins, LogFormat, ServeArgs};
 pub use error::ApiError;
+pub use server::ConnectionLimits;
 
 use crate::engine::metrics::Metrics;
 use crate::engine::{Engine, Storage};
@@ -107,6 +109,10 @@ pub fn app(state: AppState) -> Router {
         .route_layer(middleware::from_fn(observe::tag_route))
         .fallback(not_found)
         .layer(DefaultBodyLimit::max(config.body_limit))
+        .layer(middleware::from_fn_with_state(
+            state.clone(),
+            observe::refuse_declared_overflow,
+        ))
         .layer(TimeoutLayer::with_status_code(
             StatusCode::REQUEST_TIMEOUT,
             config.request_timeout,
@@ -129,6 +135,7 @@ pub fn app(state: AppState) -> Router {
                 ),
         )
         .layer(SetRequestIdLayer::new(X_REQUEST_ID, MakeRequestUuid))
+        .layer(middleware::from_fn(observe::sanitize_request_id))
         .with_state(state)
 }
 
@@ -170,21 +177,36 @@ fn cors(origins: &CorsOrigins) -> Option<CorsLayer> {
     )
 }
 
-/// Serves `state` on `listener` until `shutdown` resolves, then drains: `/readyz` and new
-/// work answer 503 and queued jobs are cancelled; after the drain delay the listener
-/// closes; in-flight requests and running jobs then have the shutdown timeout to finish,
-/// after which what is left is cancelled.
+/// Serves `state` on `listener` until `shutdown` resolves, then drains: new work is refused
+/// (503, `/readyz` fails) while the jobs already accepted, queued or running, go on and their
+/// clients can still poll and follow them; after the drain delay and once those jobs are done,
+/// or the shutdown timeout is spent (what is left then ends `interrupted`), the listener
+/// closes and the requests in flight finish within what remains of the timeout.
 pub async fn run(
     listener: TcpListener,
     state: AppState,
     shutdown: impl Future<Output = ()> + Send + 'static,
 ) -> std::io::Result<()> {
+    let config = state.config().clone();
     let stop_accepting = CancellationToken::new();
     let housekeeping = tokio::spawn(housekeeping(state.clone()));
-    let server = axum::serve(listener, app(state.clone()))
-        .with_graceful_shutdown(stop_accepting.clone().cancelled_owned())
-        .into_future();
-    let mut server = tokio::spawn(server);
+    let deadline = Arc::new(std::sync::Mutex::new(None::<tokio::time::Instant>));
+    let remaining = {
+        let deadline = deadline.clone();
+        move || {
+            let at = *deadline.lock().unwrap_or_else(|p| p.into_inner());
+            at.map_or(config.shutdown_timeout, |at| {
+                at.saturating_duration_since(tokio::time::Instant::now())
+            })
+        }
+    };
+    let mut server = tokio::spawn(server::serve(
+        listener,
+        app(state.clone()),
+        config.connections,
+        stop_accepting.clone(),
+        remaining,
+    ));
     tokio::select! {
         result = &mut server => {
             housekeeping.abort();
@@ -192,28 +214,25 @@ pub async fn run(
         }
         () = shutdown => {}
     }
-    let config = state.config();
     let engine = state.engine();
+    let end = tokio::time::Instant::now() + config.shutdown_timeout;
+    *deadline.lock().unwrap_or_else(|p| p.into_inner()) = Some(end);
     tracing::info!("shutting down: draining");
     engine.begin_drain();
     tokio::time::sleep(config.drain_delay).await;
-    stop_accepting.cancel();
-    let drained = tokio::time::timeout(config.shutdown_timeout, async {
-        let served = (&mut server).await;
-        engine.jobs_finished().await;
-        served
-    })
-    .await;
-    housekeeping.abort();
-    match drained {
-        Ok(served) => served?,
-        Err(_) => {
-            tracing::warn!("the drain ran out of time: cancelling what is left");
-            engine.cancel_running_jobs();
-            server.abort();
-            Ok(())
-        }
+    if tokio::time::timeout_at(end, engine.jobs_finished())
+        .await
+        .is_err()
+    {
+        tracing::warn!("the drain ran out of time: interrupting the jobs left");
+        engine.interrupt_unfinished_jobs();
+        // They stop at their next check, microseconds to milliseconds away.
+        let _ = tokio::time::timeout(Duration::from_secs(1), engine.jobs_finished()).await;
     }
+    stop_accepting.cancel();
+    let served = server.await;
+    housekeeping.abort();
+    served?
 }
 
 /// Periodic chores: drain the metrics histograms (they buffer samples until rendered) and

@@ -4,11 +4,16 @@
 use std::time::Instant;
 
 use axum::extract::{MatchedPath, Request, State};
+use axum::http::{header, HeaderValue, Method};
 use axum::middleware::Next;
-use axum::response::Response;
+use axum::response::{IntoResponse, Response};
 use tracing::Span;
 
+use super::error::ApiError;
 use super::AppState;
+
+/// The request id header, set by the client or by the service.
+const REQUEST_ID: &str = "x-request-id";
 use crate::engine::metrics::Metrics;
 
 /// Requests answered, by method, route and status.
@@ -38,7 +43,7 @@ pub fn describe(metrics: &Metrics) {
 pub fn request_span(request: &Request) -> Span {
     let id = request
         .headers()
-        .get("x-request-id")
+        .get(REQUEST_ID)
         .and_then(|v| v.to_str().ok())
         .unwrap_or("");
     tracing::info_span!(
@@ -68,7 +73,7 @@ pub async fn record_request(
     next: Next,
 ) -> Response {
     let start = Instant::now();
-    let method = request.method().clone();
+    let method = method_label(request.method());
     let response = next.run(request).await;
     let route = response
         .extensions()
@@ -79,18 +84,71 @@ pub async fn record_request(
     metrics
         .counter(
             HTTP_REQUESTS,
-            &[
-                ("method", method.as_str()),
-                ("route", route),
-                ("status", &status),
-            ],
+            &[("method", method), ("route", route), ("status", &status)],
         )
         .increment(1);
     metrics
-        .histogram(
-            HTTP_DURATION,
-            &[("method", method.as_str()), ("route", route)],
-        )
+        .histogram(HTTP_DURATION, &[("method", method), ("route", route)])
         .record(start.elapsed());
     response
+}
+
+/// The method as a metric label: one of the standard methods, or `other`, so that a client
+/// cannot make up series.
+fn method_label(method: &Method) -> &'static str {
+    const STANDARD: [Method; 9] = [
+        Method::GET,
+        Method::POST,
+        Method::PUT,
+        Method::DELETE,
+        Method::HEAD,
+        Method::OPTIONS,
+        Method::PATCH,
+        Method::TRACE,
+        Method::CONNECT,
+    ];
+    STANDARD
+        .iter()
+        .find(|m| *m == method)
+        .map_or("other", Method::as_str)
+}
+
+/// A request id a client may choose: up to 128 letters, digits and `-_.:`; anything else
+/// (which could forge fields in a text log line) is replaced by one of ours.
+pub async fn sanitize_request_id(mut request: Request, next: Next) -> Response {
+    let valid = |v: &HeaderValue| {
+        let bytes = v.as_bytes();
+        !bytes.is_empty()
+            && bytes.len() <= 128
+            && bytes
+                .iter()
+                .all(|b| b.is_ascii_alphanumeric() || b"-_.:".contains(b))
+    };
+    let headers = request.headers_mut();
+    if headers.get(REQUEST_ID).is_some_and(|v| !valid(v)) {
+        headers.remove(REQUEST_ID);
+    }
+    next.run(request).await
+}
+
+/// Refuses at once (413) a body whose declared length is over the limit, rather than
+/// reading it up to the limit first.
+pub async fn refuse_declared_overflow(
+    State(state): State<AppState>,
+    request: Request,
+    next: Next,
+) -> Response {
+    let limit = state.config().body_limit;
+    let declared = request
+        .headers()
+        .get(header::CONTENT_LENGTH)
+        .and_then(|v| v.to_str().ok())
+        .and_then(|v| v.parse::<u64>().ok());
+    match declared {
+        Some(length) if length > limit as u64 => ApiError::payload_too_large(format!(
+            "the body declares {length} bytes; the limit is {limit}"
+        ))
+        .into_response(),
+        _ => next.run(request).await,
+    }
 }

@@ -123,3 +123,11 @@ problems!(
         (504, "deadline-exceeded: the job ran past the job deadline", false),
     }
 );
+
+problems!(
+    /// A job the service accepted but could not finish.
+    Gone {
+        (410, "interrupted: the service stopped before the job finished (its id names an \
+            earlier run of the service); submit it again", false),
+    }
+);

@@ -71,14 +71,21 @@ async fn unknown_routes_jobs_and_figures_are_404_and_wrong_methods_405() {
     let app = spawn_app(&[]).await;
     for path in [
         "/v2/rolling",
-        "/v1/jobs/00000000-0000-4000-8000-000000000000",
         "/v1/jobs/not-a-uuid",
-        "/v1/jobs/00000000-0000-4000-8000-000000000000/events",
         "/v1/figures/10",
         "/v1/figures/six",
     ] {
         let not_found = problem(app.get(path).await, 404).await;
         assert_eq!(not_found["type"], problem_type("not-found"), "{path}");
+    }
+    // A job id this run of the service did not give out: an earlier run's, whose
+    // unfinished jobs its shutdown interrupted (not "never submitted").
+    for path in [
+        "/v1/jobs/00000000-0000-4000-8000-000000000000",
+        "/v1/jobs/00000000-0000-4000-8000-000000000000/events",
+    ] {
+        let gone = problem(app.get(path).await, 410).await;
+        assert_eq!(gone["type"], problem_type("interrupted"), "{path}");
     }
     let response = app.get("/v1/rolling").await;
     assert_eq!(response.headers()["allow"], "POST");

@@ -7,6 +7,7 @@ mod forms;
 mod helpers;
 mod in_process;
 mod jobs;
+mod limits;
 mod ops;
 mod solve;
 mod storage;

@@ -24,7 +24,7 @@ use crate::engine::Engine;
 use crate::http::accept::{Accept, AcceptsJson};
 use crate::http::error::{ApiError, JsonBody, Problem};
 use crate::http::responses::{
-    BadBody, Busy, JobFailure, NotAcceptable, NotFound, NotModified, Unfinished,
+    BadBody, Busy, Gone, JobFailure, NotAcceptable, NotFound, NotModified, Unfinished,
 };
 use crate::http::AppState;
 use crate::job::registry::{AnyOutput, Envelope, KindName};
@@ -112,9 +112,18 @@ impl FromRequestParts<AppState> for FoundJob {
         let Path(JobId { id }) = Path::from_request_parts(parts, state)
             .await
             .map_err(|_| ApiError::not_found("no such job: its id is a UUID"))?;
-        state.engine().job(id).await.map(FoundJob).ok_or_else(|| {
-            ApiError::not_found(format!("no job {id} (never submitted, or expired)"))
-        })
+        let engine = state.engine();
+        match engine.job(id).await {
+            Some(record) => Ok(FoundJob(record)),
+            None if engine.issued(id) => Err(ApiError::not_found(format!(
+                "no job {id}: it expired (it finished more than the retention time ago)"
+            ))),
+            None => Err(ApiError::interrupted(format!(
+                "job {id} was accepted by an earlier run of the service, which stopped before \
+                 this one started: unless it had finished and been collected, it was \
+                 interrupted. Submit it again"
+            ))),
+        }
     }
 }
 
@@ -160,7 +169,7 @@ pub async fn submit(
     operation_id = "get_job",
     tag = "jobs",
     params(JobId),
-    responses((status = 200, description = "The job", body = JobView), NotFound, NotAcceptable)
+    responses((status = 200, description = "The job", body = JobView), NotFound, Gone, NotAcceptable)
 )]
 pub async fn status(_: AcceptsJson, FoundJob(record): FoundJob) -> Json<JobView> {
     Json(JobView::of(&record, true))
@@ -178,7 +187,7 @@ pub async fn status(_: AcceptsJson, FoundJob(record): FoundJob) -> Json<JobView>
     tag = "jobs",
     params(JobId),
     responses((status = 200, description = "The job after the cancel", body = JobView),
-        NotFound, NotAcceptable)
+        NotFound, Gone, NotAcceptable)
 )]
 pub async fn cancel(
     State(state): State<AppState>,
@@ -204,7 +213,7 @@ pub async fn cancel(
     responses(
         (status = 200, description = "The job's answer", content(
             (AnyOutput = "application/json"), (String = "text/csv"))),
-        NotModified, NotFound, NotAcceptable, Unfinished, JobFailure,
+        NotModified, NotFound, Gone, NotAcceptable, Unfinished, JobFailure,
     )
 )]
 pub async fn result(headers: HeaderMap, FoundJob(record): FoundJob) -> Result<Response, ApiError> {
@@ -213,6 +222,10 @@ pub async fn result(headers: HeaderMap, FoundJob(record): FoundJob) -> Result<Re
         JobState::Succeeded(solved) => answering.respond(&solved, None),
         JobState::Failed(e) => Err(e.into()),
         JobState::Cancelled => Err(JobError::Cancelled.into()),
+        JobState::Interrupted => Err(ApiError::interrupted(format!(
+            "job {} was interrupted: the service stopped before it finished. Submit it again",
+            record.id
+        ))),
         JobState::Queued | JobState::Running => Err(ApiError::not_ready(format!(
             "job {} is {}: poll /v1/jobs/{0}, or follow /v1/jobs/{0}/events",
             record.id,
@@ -236,7 +249,7 @@ pub async fn result(headers: HeaderMap, FoundJob(record): FoundJob) -> Result<Re
         (status = 200, description = "A text/event-stream of `progress` events and one \
             `completion` event, each with a JobView as data",
             content_type = "text/event-stream", body = String),
-        NotFound, NotAcceptable,
+        NotFound, Gone, NotAcceptable,
     )
 )]
 pub async fn events(

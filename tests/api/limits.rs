@@ -1,0 +1,191 @@
+//! Hardening: the limits that keep one client from stalling, exhausting or crashing the
+//! service, and a shutdown that loses no accepted job.
+
+use std::io::{Read, Write};
+use std::net::TcpStream;
+use std::time::{Duration, Instant};
+
+use reqwest::Method;
+use serde_json::json;
+
+use crate::helpers::{long_sweep, problem, problem_type, spawn_app, within, Events};
+
+/// A raw connection to the test server.
+fn connect(base: &str) -> TcpStream {
+    TcpStream::connect(base.trim_start_matches("http://")).unwrap()
+}
+
+/// Reads until the server closes the connection (or `patience` passes); returns whether it
+/// closed and what it sent.
+fn read_until_closed(mut stream: TcpStream, patience: Duration) -> (bool, String) {
+    stream.set_read_timeout(Some(patience)).unwrap();
+    let mut text = Vec::new();
+    let closed = stream.read_to_end(&mut text).is_ok();
+    (closed, String::from_utf8_lossy(&text).into_owned())
+}
+
+#[tokio::test]
+async fn a_client_that_sends_its_headers_slowly_or_idles_is_disconnected() {
+    let app = spawn_app(&["--header-timeout", "1s"]).await;
+    let base = app.base.clone();
+    let (slow, idle) = tokio::task::spawn_blocking(move || {
+        let mut slow = connect(&base);
+        slow.write_all(b"GET /healthz HTTP/1.1\r\nHost: x\r\n")
+            .unwrap();
+        let start = Instant::now();
+        let (closed, _) = read_until_closed(slow, Duration::from_secs(20));
+        let slow = (closed, start.elapsed());
+        // A keep-alive connection that sent one request and then idles.
+        let mut idle = connect(&base);
+        idle.write_all(b"GET /healthz HTTP/1.1\r\nHost: x\r\n\r\n")
+            .unwrap();
+        let start = Instant::now();
+        let (closed, text) = read_until_closed(idle, Duration::from_secs(20));
+        assert!(text.starts_with("HTTP/1.1 200"), "{text}");
+        (slow, (closed, start.elapsed()))
+    })
+    .await
+    .unwrap();
+    for (closed, after) in [slow, idle] {
+        assert!(
+            closed && after < Duration::from_secs(10),
+            "{closed} after {after:?}"
+        );
+    }
+}
+
+#[tokio::test]
+async fn connections_are_capped_and_freed_by_the_header_timeout() {
+    let app = spawn_app(&["--max-connections", "2", "--header-timeout", "1s"]).await;
+    let base = app.base.clone();
+    // Two connections that never send anything hold both places...
+    let held: Vec<TcpStream> = (0..2).map(|_| connect(&base)).collect();
+    // ...until the header timeout frees them, and a real client is served.
+    let start = Instant::now();
+    let health = within(app.get("/healthz")).await;
+    assert_eq!(health.status(), 200);
+    assert!(start.elapsed() < Duration::from_secs(10));
+    drop(held);
+}
+
+#[tokio::test]
+async fn a_body_declared_too_large_is_refused_before_it_is_read() {
+    let app = spawn_app(&[]).await;
+    let base = app.base.clone();
+    let (text, after) = tokio::task::spawn_blocking(move || {
+        let mut stream = connect(&base);
+        let head = "POST /v1/rolling HTTP/1.1\r\nHost: x\r\nContent-Type: application/json\r\n\
+                    Content-Length: 67108864\r\n\r\n";
+        stream.write_all(head.as_bytes()).unwrap();
+        stream.write_all(&[b' '; 1 << 20]).ok();
+        let start = Instant::now();
+        let (_, text) = read_until_closed(stream, Duration::from_secs(30));
+        (text, start.elapsed())
+    })
+    .await
+    .unwrap();
+    assert!(text.starts_with("HTTP/1.1 413"), "{text}");
+    assert!(text.contains("payload-too-large"), "{text}");
+    assert!(after < Duration::from_secs(5), "{after:?}");
+}
+
+#[tokio::test]
+async fn made_up_methods_do_not_make_up_metric_series_and_request_ids_are_clean() {
+    let app = spawn_app(&[]).await;
+    for i in 0..20 {
+        let method = Method::from_bytes(format!("INVENTED{i}").as_bytes()).unwrap();
+        app.send(method, "/healthz", &[], None).await;
+    }
+    let metrics = app.get("/metrics").await.text().await.unwrap();
+    assert!(!metrics.contains("INVENTED"), "{metrics}");
+    assert!(
+        app.metric("http_requests_total", &[("method", "other")])
+            .await
+            >= 20.0
+    );
+
+    let forged = "abc\" level=ERROR msg=\"forged";
+    let response = app
+        .send(Method::GET, "/healthz", &[("x-request-id", forged)], None)
+        .await;
+    let id = response.headers()["x-request-id"].to_str().unwrap();
+    assert_ne!(id, forged);
+    assert!(
+        id.chars().all(|c| c.is_ascii_alphanumeric() || c == '-'),
+        "{id}"
+    );
+    let kept = app
+        .send(
+            Method::GET,
+            "/healthz",
+            &[("x-request-id", "trace-42.a:b_c")],
+            None,
+        )
+        .await;
+    assert_eq!(kept.headers()["x-request-id"], "trace-42.a:b_c");
+}
+
+#[tokio::test]
+async fn asynchronous_jobs_leave_a_solver_thread_to_synchronous_requests() {
+    let app = spawn_app(&["--pool-size", "2", "--max-sweep-points", "1000000"]).await;
+    let first = app.submit(&long_sweep(60)).await;
+    let second = app.submit(&long_sweep(60)).await;
+    app.wait_for_job(&first, |j| j["status"] == "running").await;
+    // The second job waits for a solver thread the first does not hold...
+    let queued: serde_json::Value = app.get(&second).await.json().await.unwrap();
+    assert_eq!(queued["status"], "queued");
+    // ...which synchronous requests get.
+    let response = app.post("/v1/rolling", &json!({"load": "1.05 nN"})).await;
+    assert_eq!(response.status(), 200);
+    app.delete(&first).await;
+    app.delete(&second).await;
+}
+
+#[tokio::test]
+async fn a_shutdown_finishes_the_accepted_jobs_and_keeps_answering_their_clients() {
+    let mut app = spawn_app(&[
+        "--pool-size",
+        "1",
+        "--max-sweep-points",
+        "1000000",
+        "--shutdown-timeout",
+        "1m",
+    ])
+    .await;
+    // A job running and one queued behind it when the shutdown starts: both finish.
+    let running = app.submit(&long_sweep(20)).await;
+    app.wait_for_job(&running, |j| j["status"] == "running")
+        .await;
+    let queued = app
+        .submit(&json!({"kind": "rolling", "input": {"load": "1.01 nN"}}))
+        .await;
+    let mut running_events = Events::new(app.get(&format!("{running}/events")).await);
+    let mut queued_events = Events::new(app.get(&format!("{queued}/events")).await);
+    app.shut_down();
+    // New work is refused while the accepted jobs are still answered.
+    tokio::time::sleep(Duration::from_millis(50)).await;
+    let refused = app.post("/v1/rolling", &json!({})).await;
+    assert_eq!(
+        problem(refused, 503).await["type"],
+        problem_type("draining")
+    );
+    let polled: serde_json::Value = app.get(&queued).await.json().await.unwrap();
+    assert!(polled["status"].is_string());
+    for events in [&mut running_events, &mut queued_events] {
+        let (_, completion) = events.until_completion().await;
+        assert_eq!(completion["status"], "succeeded");
+    }
+    within(&mut app.server).await.unwrap().unwrap();
+}
+
+#[tokio::test]
+async fn a_job_the_shutdown_bound_cannot_fit_ends_interrupted() {
+    let mut app = spawn_app(&["--max-sweep-points", "1000000", "--shutdown-timeout", "2s"]).await;
+    let long = app.submit(&long_sweep(100)).await;
+    app.wait_for_job(&long, |j| j["status"] == "running").await;
+    let mut events = Events::new(app.get(&format!("{long}/events")).await);
+    app.shut_down();
+    let (_, completion) = events.until_completion().await;
+    assert_eq!(completion["status"], "interrupted");
+    within(&mut app.server).await.unwrap().unwrap();
+}
