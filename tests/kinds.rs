@@ -81,7 +81,8 @@ fn engine() -> Arc<Engine> {
         solve_deadline: Duration::from_secs(30),
         job_deadline: Duration::from_secs(60),
         max_queued_jobs: 4,
-        cache_bytes: 1 << 20,
+        memory_budget: 1 << 20,
+        max_jobs: 100,
         cache_ttl: Duration::from_secs(60),
         job_retention: Duration::from_secs(60),
     };
@@ -216,4 +217,45 @@ fn every_answer_renders_as_json_and_as_a_rectangular_csv() {
             assert_eq!(row.len(), header, "{}", job.kind());
         }
     }
+}
+
+/// A memo that counts what it is asked.
+#[derive(Debug, Default)]
+struct CountingMemo {
+    kept: std::sync::Mutex<std::collections::HashMap<String, thirdbody::job::Kept>>,
+    recalled: std::sync::atomic::AtomicUsize,
+}
+
+impl thirdbody::job::Memo for CountingMemo {
+    fn recall(&self, key: &str) -> Option<thirdbody::job::Kept> {
+        let found = self.kept.lock().unwrap().get(key).cloned();
+        if found.is_some() {
+            self.recalled
+                .fetch_add(1, std::sync::atomic::Ordering::SeqCst);
+        }
+        found
+    }
+
+    fn keep(&self, key: String, value: thirdbody::job::Kept, _bytes: usize) {
+        self.kept.lock().unwrap().insert(key, value);
+    }
+}
+
+#[test]
+fn a_sweep_cut_by_its_deadline_leaves_its_solved_points_to_its_retry() {
+    let sweep = job(json!({"kind": "sweep", "input": {"vary": {
+        "radius": (1..=20).map(|i| format!("{} nm", 20 + i)).collect::<Vec<_>>(),
+        "load": (0..10).map(|i| format!("{} pN", 1000 + 40 * i)).collect::<Vec<_>>(),
+        "velocity": (1..=10).map(|i| format!("{i} nm/s")).collect::<Vec<_>>()}}}));
+    let memo = Arc::new(CountingMemo::default());
+    let cut =
+        Control::new(Some(Instant::now() + Duration::from_millis(20)), 1).with_memo(memo.clone());
+    assert_eq!(engine::run(&sweep, &cut), Err(JobError::DeadlineExceeded));
+    let solved_before = memo.kept.lock().unwrap().len();
+    assert!(solved_before > 0 && solved_before < 2000, "{solved_before}");
+    let retry = Control::new(None, 1).with_memo(memo.clone());
+    let answer = engine::run(&sweep, &retry).unwrap();
+    let recalled = memo.recalled.load(std::sync::atomic::Ordering::SeqCst);
+    assert_eq!(recalled, solved_before);
+    assert_eq!(answer, engine::run(&sweep, &Control::new(None, 1)).unwrap());
 }

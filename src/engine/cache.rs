@@ -9,6 +9,7 @@ use async_trait::async_trait;
 use bytes::Bytes;
 use moka::future::Cache;
 
+use super::budget;
 use crate::job::JobError;
 use crate::render::{Answer, Format, RenderError};
 
@@ -56,10 +57,11 @@ impl Solved {
         }
     }
 
-    /// Bytes held in memory, roughly: the JSON text and the decoded answer, which is of the
-    /// same size.
-    fn weight(&self) -> u32 {
-        u32::try_from(2 * self.json.len() + self.key.len()).unwrap_or(u32::MAX)
+    /// Bytes held in memory, roughly: the JSON text and the decoded answer (of about the
+    /// same size), the key, and the CSV once rendered (counted ahead: it is smaller than
+    /// the JSON).
+    pub fn weight(&self) -> u64 {
+        (3 * self.json.len() + self.key.len()) as u64
     }
 }
 
@@ -88,7 +90,7 @@ impl MemoryCache {
         MemoryCache {
             cache: Cache::builder()
                 .max_capacity(max_bytes)
-                .weigher(|_, solved: &Arc<Solved>| solved.weight())
+                .weigher(|_, solved: &Arc<Solved>| budget::weight(solved.weight()))
                 .time_to_live(ttl)
                 .build(),
         }

@@ -5,8 +5,10 @@
 //! jobs ([`store`]). The cache and the store are traits, so that a shared backend can take
 //! the place of the in-process ones.
 
+mod budget;
 pub mod cache;
 mod coalesce;
+mod memo;
 pub mod metrics;
 pub mod pool;
 mod service;

@@ -15,15 +15,15 @@ use tokio_util::task::TaskTracker;
 use tracing::Instrument;
 use uuid::Uuid;
 
+use super::budget::{self, Budget};
 use super::cache::{MemoryCache, ResultCache, Solved};
 use super::coalesce::Coalescer;
+use super::memo::PointMemo;
 use super::metrics::{self as names, Metrics};
 use super::pool::Pool;
 use super::store::{JobRecord, JobState, JobStatus, JobStore, MemoryJobStore};
 use crate::job::{Control, Job, JobError, Meta, Work};
 
-/// Memory for the map from input text to cache key (bytes): a few thousand typical inputs.
-const INPUT_KEYS_BYTES: u64 = 16 << 20;
 /// How long a cancel waits for the job to stop (it checks between units of work, which take
 /// microseconds to milliseconds).
 const CANCEL_WAIT: Duration = Duration::from_secs(5);
@@ -39,8 +39,11 @@ pub struct EngineConfig {
     pub job_deadline: Duration,
     /// Asynchronous jobs that may wait for a solver thread.
     pub max_queued_jobs: usize,
-    /// Memory for cached answers (bytes, roughly).
-    pub cache_bytes: u64,
+    /// Memory for everything kept between requests (bytes, estimated): cached answers, the
+    /// results of finished jobs, the input memo, solved points ([`Budget`]).
+    pub memory_budget: u64,
+    /// Records of asynchronous jobs kept at most (the oldest finished are forgotten first).
+    pub max_jobs: usize,
     /// How long an answer stays cached.
     pub cache_ttl: Duration,
     /// How long a finished asynchronous job is kept.
@@ -57,9 +60,14 @@ pub struct Storage {
 impl Storage {
     /// In this process's memory, within `config`'s bounds: the default.
     pub fn in_process(config: &EngineConfig) -> Storage {
+        let budget = Budget::split(config.memory_budget);
         Storage {
-            cache: Arc::new(MemoryCache::new(config.cache_bytes, config.cache_ttl)),
-            jobs: Arc::new(MemoryJobStore::new(config.job_retention)),
+            cache: Arc::new(MemoryCache::new(budget.answers, config.cache_ttl)),
+            jobs: Arc::new(MemoryJobStore::new(
+                config.job_retention,
+                config.max_jobs,
+                budget.job_results,
+            )),
         }
     }
 }
@@ -163,6 +171,8 @@ pub struct Engine {
     /// The text of valid inputs (their kind and compact JSON with sorted keys) → their
     /// cache key, so that a repeated request is answered without being validated again.
     input_keys: moka::future::Cache<String, String>,
+    /// Solved points of sweeps, for a retry after a deadline.
+    points: Arc<PointMemo>,
     jobs: Arc<dyn JobStore>,
     /// The jobs this process runs, by id.
     live: Mutex<HashMap<Uuid, Arc<LiveJob>>>,
@@ -196,12 +206,16 @@ impl Engine {
             cache: storage.cache,
             coalescer: Coalescer::default(),
             input_keys: moka::future::Cache::builder()
-                .max_capacity(INPUT_KEYS_BYTES)
+                .max_capacity(Budget::split(config.memory_budget).inputs)
                 .weigher(|input: &String, key: &String| {
-                    u32::try_from(input.len() + key.len()).unwrap_or(u32::MAX)
+                    budget::weight((input.len() + key.len()) as u64)
                 })
                 .time_to_live(config.cache_ttl)
                 .build(),
+            points: Arc::new(PointMemo::new(
+                Budget::split(config.memory_budget).points,
+                config.cache_ttl,
+            )),
             jobs: storage.jobs,
             live: Mutex::default(),
             ids: JobIds::new(),
@@ -268,7 +282,7 @@ impl Engine {
             async move {
                 let permit = engine.pool.try_acquire().ok_or(EngineError::Overloaded)?;
                 let deadline = Instant::now() + engine.config.solve_deadline;
-                let control = Arc::new(Control::new(Some(deadline), 1));
+                let control = Arc::new(engine.control(deadline));
                 let solved = engine.execute(permit, job, meta, control).await?;
                 engine.cache.insert(solved.clone()).await;
                 Ok(solved)
@@ -305,7 +319,7 @@ impl Engine {
         self.jobs.insert(record.clone()).await;
         let deadline = Instant::now() + self.config.job_deadline;
         let live = Arc::new(LiveJob {
-            control: Arc::new(Control::new(Some(deadline), 1)),
+            control: Arc::new(self.control(deadline)),
             cancel: CancellationToken::new(),
             interrupted: AtomicBool::new(false),
             status: watch::Sender::new(JobStatus::Queued),
@@ -336,6 +350,12 @@ impl Engine {
     /// its progress counted up to now.
     pub async fn job(&self, id: Uuid) -> Option<JobRecord> {
         let mut record = self.jobs.get(id).await?;
+        if let JobState::Dropped { key } = &record.state {
+            // The store let the result go; the cache may still hold the answer.
+            if let Some(solved) = self.cache.get(key).await {
+                record.state = JobState::Succeeded(solved);
+            }
+        }
         if let Some(live) = self.live().get(&id) {
             if !record.state.status().is_finished() {
                 record.done = live.control.done();
@@ -396,6 +416,11 @@ impl Engine {
             live.interrupted.store(true, Ordering::SeqCst);
             live.cancel();
         }
+    }
+
+    /// The control of a job run by this engine: one thread, `deadline`, and the point memo.
+    fn control(&self, deadline: Instant) -> Control {
+        Control::new(Some(deadline), 1).with_memo(self.points.clone())
     }
 
     fn admit(&self) -> Result<(), EngineError> {

@@ -48,9 +48,14 @@ pub struct ServeArgs {
     #[arg(long, env = "THIRDBODY_MAX_QUEUED_JOBS", default_value_t = 64)]
     pub max_queued_jobs: usize,
 
-    /// Memory for cached answers, in bytes (0: no caching).
-    #[arg(long, env = "THIRDBODY_CACHE_BYTES", default_value_t = 256 << 20)]
-    pub cache_bytes: u64,
+    /// Memory for everything kept between requests, in bytes: cached answers (3/4), results
+    /// of finished jobs (3/16), the input memo and the solved points of sweeps (1/32 each).
+    #[arg(long, env = "THIRDBODY_MEMORY_BUDGET", default_value_t = 256 << 20)]
+    pub memory_budget: u64,
+
+    /// Records of asynchronous jobs kept at most; the oldest finished are forgotten first.
+    #[arg(long, env = "THIRDBODY_MAX_JOBS", default_value_t = 10_000)]
+    pub max_jobs: usize,
 
     /// How long an answer stays cached.
     #[arg(long, env = "THIRDBODY_CACHE_TTL", default_value = "1h", value_parser = duration)]
@@ -168,6 +173,9 @@ impl ServeArgs {
         if self.max_sweep_points == 0 {
             return fail("--max-sweep-points 0: allowed at least 1".to_string());
         }
+        if self.max_jobs == 0 {
+            return fail("--max-jobs 0: allowed at least 1".to_string());
+        }
         if self.max_connections == 0 {
             return fail("--max-connections 0: allowed at least 1".to_string());
         }
@@ -203,7 +211,8 @@ impl ServeArgs {
                 solve_deadline: self.solve_deadline,
                 job_deadline: self.job_deadline,
                 max_queued_jobs: self.max_queued_jobs,
-                cache_bytes: self.cache_bytes,
+                memory_budget: self.memory_budget,
+                max_jobs: self.max_jobs,
                 cache_ttl: self.cache_ttl,
                 job_retention: self.job_retention,
             },

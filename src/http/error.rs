@@ -4,16 +4,14 @@
 
 use axum::body::Body;
 use axum::extract::rejection::BytesRejection;
-use axum::extract::{FromRequest, Request};
-use axum::http::{header, HeaderMap, HeaderValue, StatusCode};
+use axum::http::{header, HeaderValue, StatusCode};
 use axum::response::{IntoResponse, Response};
-use bytes::Bytes;
 use serde::Serialize;
 use serde_json::Value;
 use utoipa::ToSchema;
 
 use crate::engine::EngineError;
-use crate::job::{input, FieldError, JobError};
+use crate::job::{FieldError, JobError};
 
 pub const PROBLEM_JSON: &str = "application/problem+json";
 
@@ -152,6 +150,10 @@ impl ApiError {
         ApiError::new(Kind::NotAcceptable, detail)
     }
 
+    pub fn unsupported_media_type(detail: impl Into<String>) -> Self {
+        ApiError::new(Kind::UnsupportedMediaType, detail)
+    }
+
     pub fn payload_too_large(detail: impl Into<String>) -> Self {
         ApiError::new(Kind::PayloadTooLarge, detail)
     }
@@ -274,41 +276,6 @@ impl IntoResponse for ApiError {
         }
         response
     }
-}
-
-/// A JSON body, any shape (the job layer reads it), parsed by the job layer so that a key
-/// sent twice is refused; a body that is not JSON is a problem.
-pub struct JsonBody(pub Value);
-
-impl<S: Send + Sync> FromRequest<S> for JsonBody {
-    type Rejection = ApiError;
-
-    async fn from_request(request: Request, state: &S) -> Result<Self, ApiError> {
-        if !is_json(request.headers()) {
-            return Err(ApiError::new(
-                Kind::UnsupportedMediaType,
-                "send the body with Content-Type: application/json",
-            ));
-        }
-        let body = Bytes::from_request(request, state).await?;
-        Ok(JsonBody(input::parse(&body)?))
-    }
-}
-
-/// Whether the body is declared JSON: `application/json` or `application/*+json`.
-fn is_json(headers: &HeaderMap) -> bool {
-    let Some(media_type) = headers
-        .get(header::CONTENT_TYPE)
-        .and_then(|v| v.to_str().ok())
-        .and_then(|v| v.split(';').next())
-        .map(|v| v.trim().to_ascii_lowercase())
-    else {
-        return false;
-    };
-    media_type == "application/json"
-        || media_type
-            .strip_prefix("application/")
-            .is_some_and(|subtype| subtype.ends_with("+json"))
 }
 
 /// Turns an error response that is not yet a problem (axum's 405, a timeout, a rejection

@@ -6,6 +6,7 @@
 //! signal, then drains. Tests and the binary start the service the same way.
 
 mod accept;
+mod body;
 pub mod config;
 pub mod error;
 mod observe;
@@ -54,6 +55,8 @@ struct Inner {
     config: Config,
     engine: Arc<Engine>,
     prometheus: PrometheusHandle,
+    /// Large request bodies read at once (see `body::offload`).
+    readers: Arc<tokio::sync::Semaphore>,
 }
 
 impl AppState {
@@ -74,11 +77,13 @@ impl AppState {
         let metrics = Metrics::new(Arc::new(recorder));
         observe::describe(&metrics);
         let engine = Engine::with_storage(config.engine.clone(), metrics, storage);
+        let readers = Arc::new(tokio::sync::Semaphore::new(config.engine.pool_size));
         AppState {
             inner: Arc::new(Inner {
                 config,
                 engine,
                 prometheus,
+                readers,
             }),
         }
     }
@@ -89,6 +94,11 @@ impl AppState {
 
     pub fn engine(&self) -> &Arc<Engine> {
         &self.inner.engine
+    }
+
+    /// A place to read a large request body, if one is free.
+    fn reader_permit(&self) -> Option<tokio::sync::OwnedSemaphorePermit> {
+        self.inner.readers.clone().try_acquire_owned().ok()
     }
 
     /// The metrics in the Prometheus text format.

@@ -1,14 +1,29 @@
 //! What a running job shares with whoever watches it: a cancel flag, a deadline and a count
 //! of work done. A job kind polls it between units of work ([`Control::check`], or the
-//! helpers that do it for it: [`Control::solve`], [`Control::map`]).
+//! helpers that do it for it: [`Control::solve`], [`Control::map`], [`Control::map_kept`]).
 
+use std::any::Any;
+use std::fmt;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
-use std::sync::Mutex;
+use std::sync::{Arc, Mutex};
 use std::thread;
 use std::time::Instant;
 
 use super::JobError;
 use crate::model::ModelError;
+
+/// A solved unit of work, as kept.
+pub type Kept = Arc<dyn Any + Send + Sync>;
+
+/// Units of work solved before, kept across runs: a job that ran out of time leaves the
+/// units it solved for its retry, and jobs that share units share their solves. The engine
+/// keeps them within its memory budget.
+pub trait Memo: fmt::Debug + Send + Sync {
+    /// The unit under `key`, if kept.
+    fn recall(&self, key: &str) -> Option<Kept>;
+    /// Keeps `value` (about `bytes` in memory) under `key`.
+    fn keep(&self, key: String, value: Kept, bytes: usize);
+}
 
 /// Shared between a running job and whoever watches it: progress, cancellation, deadline.
 #[derive(Debug)]
@@ -17,6 +32,7 @@ pub struct Control {
     deadline: Option<Instant>,
     done: AtomicUsize,
     threads: usize,
+    memo: Option<Arc<dyn Memo>>,
 }
 
 impl Default for Control {
@@ -34,7 +50,14 @@ impl Control {
             deadline,
             done: AtomicUsize::new(0),
             threads: threads.max(1),
+            memo: None,
         }
+    }
+
+    /// The same control, keeping solved units in `memo` ([`Control::map_kept`]).
+    pub fn with_memo(mut self, memo: Arc<dyn Memo>) -> Self {
+        self.memo = Some(memo);
+        self
     }
 
     /// Asks the job to stop at its next check.
@@ -70,6 +93,32 @@ impl Control {
         let solution = solve()?;
         self.advance(1);
         Ok(solution)
+    }
+
+    /// [`Control::map`] for units worth keeping: an item whose `key` is in the control's
+    /// memo is recalled rather than solved, and every item solved is kept there at once, so
+    /// that what a run solved before its deadline is not lost to its retry. `bytes` is what
+    /// one solution holds in memory. Without a memo it is [`Control::map`].
+    pub fn map_kept<T: Sync, R: Clone + Send + Sync + 'static>(
+        &self,
+        items: &[T],
+        key: impl Fn(&T) -> String + Sync,
+        bytes: impl Fn(&R) -> usize + Sync,
+        solve: impl Fn(&T) -> Result<R, ModelError> + Sync,
+    ) -> Result<Vec<R>, JobError> {
+        let Some(memo) = &self.memo else {
+            return self.map(items, solve);
+        };
+        self.map(items, |item| {
+            let key = key(item);
+            if let Some(kept) = memo.recall(&key).and_then(|k| k.downcast::<R>().ok()) {
+                return Ok((*kept).clone());
+            }
+            let solution = solve(item)?;
+            let size = bytes(&solution);
+            memo.keep(key, Arc::new(solution.clone()), size);
+            Ok(solution)
+        })
     }
 
     /// Applies `solve` to every item, in parallel over the control's threads, results in

@@ -20,7 +20,7 @@ pub mod sweep;
 pub mod three_body;
 pub mod validity;
 
-pub use control::Control;
+pub use control::{Control, Kept, Memo};
 pub use error::{FieldError, JobError};
 pub use figure::FigureJob;
 pub use input::Quantity;

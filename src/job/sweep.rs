@@ -14,8 +14,8 @@ use super::three_body::{
 };
 use super::validity::validity_units;
 use super::{Control, JobError, Kind, Limits, Meta, Reference, Validated, Work};
-use crate::model::three_body::{self, Diameters, OperatingPoint, ThreeBody};
-use crate::model::{self, Parameter, Rolling, SolveOptions};
+use crate::model::three_body::{self, Diameters, OperatingPoint, ThreeBody, ThreeBodySolution};
+use crate::model::{self, Parameter, Rolling, RollingSolution, SolveOptions, MODEL_VERSION};
 use crate::render::{Output, Table, Units};
 
 pub use super::rolling::SweepPoint;
@@ -169,7 +169,12 @@ impl Kind for SweepJob {
             SweepJob::Rolling(s) => {
                 let contacts = s.points();
                 let options = &s.base.options;
-                let solutions = control.map(&contacts, |p| model::solve(p, options))?;
+                let solutions = control.map_kept(
+                    &contacts,
+                    |p| format!("{MODEL_VERSION} rolling {p:?} {options:?}"),
+                    |_| std::mem::size_of::<RollingSolution>(),
+                    |p| model::solve(p, options),
+                )?;
                 let rows = contacts.iter().zip(&solutions).enumerate();
                 SweepPoints::Rolling(
                     rows.map(|(i, (p, s))| SweepPoint::new(p, s).map_err(|e| at_point(i, e)))
@@ -179,7 +184,12 @@ impl Kind for SweepJob {
             SweepJob::ThreeBody(s) => {
                 let systems = s.points();
                 let options = &s.base.options;
-                let solutions = control.map(&systems, |p| three_body::solve(p, options))?;
+                let solutions = control.map_kept(
+                    &systems,
+                    |p| format!("{MODEL_VERSION} three_body {p:?} {options:?}"),
+                    |_| std::mem::size_of::<ThreeBodySolution>(),
+                    |p| three_body::solve(p, options),
+                )?;
                 let rows = systems.iter().zip(&solutions).enumerate();
                 SweepPoints::ThreeBody(
                     rows.map(|(i, (p, s))| {

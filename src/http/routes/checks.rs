@@ -8,7 +8,8 @@ use serde_json::Value;
 use crate::check::{ChecksInput, Report, Suite};
 use crate::engine::EngineError;
 use crate::http::accept::Accept;
-use crate::http::error::{ApiError, JsonBody};
+use crate::http::body::JsonBody;
+use crate::http::error::ApiError;
 use crate::http::responses::{BadBody, Busy, NotAcceptable};
 use crate::http::AppState;
 use crate::job::JobError;
@@ -38,11 +39,16 @@ const FORMS: [&str; 2] = ["application/json", "application/xml"];
 pub async fn run(
     State(state): State<AppState>,
     headers: HeaderMap,
-    JsonBody(checks): JsonBody,
+    body: JsonBody,
 ) -> Result<Response, ApiError> {
     let accept = Accept::from_headers(&headers);
     let xml = accept.choose_media(&FORMS)? == FORMS[1];
-    let suite = Suite::from_value(checks, &state.config().limits)?;
+    let limits = state.config().limits;
+    let suite = body
+        .read(&state, move |checks| {
+            Ok(Suite::from_value(checks, &limits)?)
+        })
+        .await?;
     if let Some(spec) = suite
         .checks
         .iter()

@@ -22,13 +22,18 @@ use crate::engine::cache::Solved;
 use crate::engine::store::{JobRecord, JobState, JobStatus};
 use crate::engine::Engine;
 use crate::http::accept::{Accept, AcceptsJson};
-use crate::http::error::{ApiError, JsonBody, Problem};
+use crate::http::body::JsonBody;
+use crate::http::error::{ApiError, Problem};
 use crate::http::responses::{
     BadBody, Busy, Gone, JobFailure, NotAcceptable, NotFound, NotModified, Unfinished,
 };
 use crate::http::AppState;
 use crate::job::registry::{AnyOutput, Envelope, KindName};
 use crate::job::{Job, JobError, Work};
+
+/// What a job whose result was let go says.
+const DROPPED: &str = "the result was dropped to stay within the memory budget (the oldest \
+                       results go first): submit the job again";
 
 /// How often a progress stream looks at a running job's count of solves.
 const PROGRESS_INTERVAL: Duration = Duration::from_millis(100);
@@ -57,6 +62,10 @@ pub struct JobView {
     /// Why it failed, once `failed`.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub problem: Option<Problem>,
+    /// Why a `succeeded` job has no `result` (it was dropped to stay within the memory
+    /// budget).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub note: Option<&'static str>,
 }
 
 /// Writes a result as the JSON it was rendered to once, not serialized again.
@@ -90,6 +99,7 @@ impl JobView {
             },
             result,
             problem,
+            note: matches!(record.state, JobState::Dropped { .. }).then_some(DROPPED),
         }
     }
 }
@@ -149,9 +159,14 @@ impl FromRequestParts<AppState> for FoundJob {
 pub async fn submit(
     State(state): State<AppState>,
     _: AcceptsJson,
-    JsonBody(envelope): JsonBody,
+    body: JsonBody,
 ) -> Result<Response, ApiError> {
-    let job = Job::from_value(envelope, &state.config().limits)?;
+    let limits = state.config().limits;
+    let job = body
+        .read(&state, move |envelope| {
+            Ok(Job::from_value(envelope, &limits)?)
+        })
+        .await?;
     let record = state.engine().submit(job).await?;
     let location = format!("/v1/jobs/{}", record.id);
     let view = JobView::of(&record, true);
@@ -222,6 +237,7 @@ pub async fn result(headers: HeaderMap, FoundJob(record): FoundJob) -> Result<Re
         JobState::Succeeded(solved) => answering.respond(&solved, None),
         JobState::Failed(e) => Err(e.into()),
         JobState::Cancelled => Err(JobError::Cancelled.into()),
+        JobState::Dropped { .. } => Err(ApiError::not_found(DROPPED)),
         JobState::Interrupted => Err(ApiError::interrupted(format!(
             "job {} was interrupted: the service stopped before it finished. Submit it again",
             record.id

@@ -19,7 +19,8 @@ use utoipa_axum::router::OpenApiRouter;
 use utoipa_axum::routes;
 
 use super::accept::Accept;
-use super::error::{ApiError, JsonBody};
+use super::body::{offload, JsonBody};
+use super::error::ApiError;
 use super::AppState;
 use crate::engine::cache::Solved;
 use crate::engine::CacheStatus;
@@ -172,7 +173,7 @@ impl Answering {
 pub struct SolveRequest {
     state: AppState,
     answering: Answering,
-    input: Value,
+    body: JsonBody,
 }
 
 impl FromRequest<AppState> for SolveRequest {
@@ -180,11 +181,11 @@ impl FromRequest<AppState> for SolveRequest {
 
     async fn from_request(request: Request, state: &AppState) -> Result<Self, ApiError> {
         let answering = Answering::from_headers(request.headers())?;
-        let JsonBody(input) = JsonBody::from_request(request, state).await?;
+        let body = JsonBody::from_request(request, state).await?;
         Ok(SolveRequest {
             state: state.clone(),
             answering,
-            input,
+            body,
         })
     }
 }
@@ -193,16 +194,28 @@ impl SolveRequest {
     /// Validates the input as a job of the kind named `kind`, solves it and answers it. An
     /// input seen before (the same JSON up to key order and spacing) whose answer is cached
     /// is answered at once: validation and the cache key cost more than the lookup.
-    pub async fn solve(self, kind: &str) -> Result<Response, ApiError> {
-        let engine = self.state.engine();
-        let text = format!("{kind}\n{}", self.input);
+    pub async fn solve(self, kind: &'static str) -> Result<Response, ApiError> {
+        let state = &self.state;
+        let engine = state.engine();
+        let (input, text) = self
+            .body
+            .read(state, move |input: Value| {
+                let text = format!("{kind}\n{input}");
+                Ok((input, text))
+            })
+            .await?;
         if let Some(solved) = engine.cached_input(&text).await? {
             return self.answering.respond(&solved, Some(CacheStatus::Hit));
         }
-        let job = Job::from_input(kind, self.input, &self.state.config().limits)?;
-        let meta = job.meta();
+        let limits = state.config().limits;
+        let (job, meta) = offload(state, text.len(), move || {
+            let job = Job::from_input(kind, input, &limits)?;
+            let meta = job.meta();
+            Ok((job, meta))
+        })
+        .await?;
         engine.remember_input(text, meta.input_hash.clone()).await;
-        self.answering.solve(&self.state, job, meta).await
+        self.answering.solve(state, job, meta).await
     }
 }
 

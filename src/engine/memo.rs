@@ -1,0 +1,49 @@
+//! The solved points of sweeps, kept within their share of the memory budget: a sweep that
+//! runs past its deadline leaves what it solved for its retry, and sweeps that share points
+//! share their solves.
+
+use std::time::Duration;
+
+use moka::sync::Cache;
+
+use super::budget;
+use crate::job::{Kept, Memo};
+
+/// Solved points by key, bounded in bytes and in time.
+pub struct PointMemo {
+    points: Cache<String, (Kept, u32)>,
+}
+
+impl std::fmt::Debug for PointMemo {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("PointMemo")
+            .field("entries", &self.points.entry_count())
+            .finish()
+    }
+}
+
+impl PointMemo {
+    /// Holds about `max_bytes` of points, each for at most `ttl`.
+    pub fn new(max_bytes: u64, ttl: Duration) -> Self {
+        PointMemo {
+            points: Cache::builder()
+                .max_capacity(max_bytes)
+                .weigher(|key: &String, (_, bytes): &(Kept, u32)| {
+                    budget::weight(key.len() as u64 + u64::from(*bytes))
+                })
+                .time_to_live(ttl)
+                .build(),
+        }
+    }
+}
+
+impl Memo for PointMemo {
+    fn recall(&self, key: &str) -> Option<Kept> {
+        self.points.get(key).map(|(kept, _)| kept)
+    }
+
+    fn keep(&self, key: String, value: Kept, bytes: usize) {
+        let bytes = u32::try_from(bytes).unwrap_or(u32::MAX);
+        self.points.insert(key, (value, bytes));
+    }
+}
