@@ -388,6 +388,14 @@ impl Engine {
         Some(self.job(id).await.unwrap_or(before))
     }
 
+    /// Cancels the job `id` if it has not finished (see [`Engine::cancel`]) and forgets it;
+    /// returns it as it ended.
+    pub async fn delete(&self, id: Uuid) -> Option<JobRecord> {
+        let record = self.cancel(id).await?;
+        self.jobs.remove(id).await;
+        Some(record)
+    }
+
     /// Forgets the finished jobs past their retention.
     pub async fn purge_expired_jobs(&self) -> usize {
         self.jobs.purge_expired().await

@@ -125,6 +125,8 @@ pub trait JobStore: Send + Sync {
     /// Moves the job `id` to `state` with `done` units of work done; a finished state
     /// starts its retention.
     async fn update(&self, id: Uuid, state: JobState, done: usize);
+    /// Forgets the job `id`.
+    async fn remove(&self, id: Uuid);
     /// Forgets the jobs past their retention; returns how many.
     async fn purge_expired(&self) -> usize;
 }
@@ -249,6 +251,10 @@ impl JobStore for MemoryJobStore {
         }
         records.held += added;
         records.drop_results(self.result_bytes);
+    }
+
+    async fn remove(&self, id: Uuid) {
+        self.records().forget(&id);
     }
 
     async fn purge_expired(&self) -> usize {

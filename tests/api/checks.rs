@@ -101,7 +101,7 @@ async fn every_answer_says_where_it_comes_from_and_a_job_result_comes_as_csv() {
     let running = app.submit(&crate::helpers::long_sweep(21)).await;
     let not_ready = problem(app.get(&format!("{running}/result")).await, 409).await;
     assert_eq!(not_ready["type"], problem_type("not-ready"));
-    app.delete(&running).await;
+    app.cancel(&running).await;
     let cancelled = problem(app.get(&format!("{running}/result")).await, 409).await;
     assert_eq!(cancelled["type"], problem_type("cancelled"));
 }

@@ -93,6 +93,12 @@ impl TestApp {
         self.send(Method::DELETE, path, &[], None).await
     }
 
+    /// Cancels the job at `location`.
+    pub async fn cancel(&self, location: &str) -> Response {
+        let path = format!("{location}/cancel");
+        self.send(Method::POST, &path, &[], None).await
+    }
+
     /// POSTs `body` as it is, with `content_type`.
     pub async fn post_raw(&self, path: &str, content_type: &str, body: String) -> Response {
         self.client

@@ -21,7 +21,8 @@ use crate::job::{FigureJob, Job};
     path = "/v1/figures/{n}",
     operation_id = "get_figure",
     tag = "figures",
-    params(("n" = u8, Path, description = "The figure's number in the paper, 3 to 9")),
+    params(("n" = u8, Path, description = "The figure's number in the paper, 3 to 9",
+        minimum = 3, maximum = 9, example = 6)),
     responses(
         (status = 200, description = "The figure's axes and series", content(
             (FigureOutput = "application/json"), (String = "text/csv"))),

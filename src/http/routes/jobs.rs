@@ -126,7 +126,8 @@ impl FromRequestParts<AppState> for FoundJob {
         match engine.job(id).await {
             Some(record) => Ok(FoundJob(record)),
             None if engine.issued(id) => Err(ApiError::not_found(format!(
-                "no job {id}: it expired (it finished more than the retention time ago)"
+                "no job {id}: it was deleted, or it expired (it finished more than the \
+                 retention time ago)"
             ))),
             None => Err(ApiError::interrupted(format!(
                 "job {id} was accepted by an earlier run of the service, which stopped before \
@@ -193,11 +194,11 @@ pub async fn status(_: AcceptsJson, FoundJob(record): FoundJob) -> Json<JobView>
 /// Cancel a job.
 ///
 /// A queued job is cancelled at once, a running one at the solver's next check (between two
-/// rolling solves); the answer is the job once it stopped. A finished job is left as it
-/// is.
+/// rolling solves); the answer is the job once it stopped. The job stays, `cancelled`, for
+/// its retention time. A finished job is left as it is.
 #[utoipa::path(
-    delete,
-    path = "/v1/jobs/{id}",
+    post,
+    path = "/v1/jobs/{id}/cancel",
     operation_id = "cancel_job",
     tag = "jobs",
     params(JobId),
@@ -210,6 +211,28 @@ pub async fn cancel(
     FoundJob(record): FoundJob,
 ) -> Json<JobView> {
     let record = state.engine().cancel(record.id).await.unwrap_or(record);
+    Json(JobView::of(&record, true))
+}
+
+/// Delete a job.
+///
+/// Cancels it if it has not finished (as `POST /v1/jobs/{id}/cancel` does), then forgets
+/// it: the answer is the job as it ended, and its URL answers 404 from then on.
+#[utoipa::path(
+    delete,
+    path = "/v1/jobs/{id}",
+    operation_id = "delete_job",
+    tag = "jobs",
+    params(JobId),
+    responses((status = 200, description = "The job as it ended, now forgotten", body = JobView),
+        NotFound, Gone, NotAcceptable)
+)]
+pub async fn delete(
+    State(state): State<AppState>,
+    _: AcceptsJson,
+    FoundJob(record): FoundJob,
+) -> Json<JobView> {
+    let record = state.engine().delete(record.id).await.unwrap_or(record);
     Json(JobView::of(&record, true))
 }
 
@@ -250,6 +273,40 @@ pub async fn result(headers: HeaderMap, FoundJob(record): FoundJob) -> Result<Re
     }
 }
 
+/// One server-sent event of a job's stream.
+#[derive(ToSchema)]
+pub struct JobEvent {
+    /// `progress` (the job without its result) or `completion` (the job with its result or
+    /// problem; the last event).
+    event: JobEventName,
+    /// The job, a `JobView`, as JSON text.
+    #[schema(content_media_type = "application/json")]
+    data: String,
+}
+
+/// The names of a job's events.
+#[derive(Clone, Copy, ToSchema)]
+#[serde(rename_all = "lowercase")]
+pub enum JobEventName {
+    Progress,
+    Completion,
+}
+
+impl JobEvent {
+    fn new(event: JobEventName, view: &JobView) -> Result<JobEvent, axum::Error> {
+        let data = serde_json::to_string(view).map_err(axum::Error::new)?;
+        Ok(JobEvent { event, data })
+    }
+
+    fn into_sse(self) -> Event {
+        let name = match self.event {
+            JobEventName::Progress => "progress",
+            JobEventName::Completion => "completion",
+        };
+        Event::default().event(name).data(self.data)
+    }
+}
+
 /// Follow a job as server-sent events.
 ///
 /// `progress` events (the job without its result) whenever its status or count changes,
@@ -264,7 +321,7 @@ pub async fn result(headers: HeaderMap, FoundJob(record): FoundJob) -> Result<Re
     responses(
         (status = 200, description = "A text/event-stream of `progress` events and one \
             `completion` event, each with a JobView as data",
-            content_type = "text/event-stream", body = String),
+            content_type = "text/event-stream", body = JobEvent),
         NotFound, Gone, NotAcceptable,
     )
 )]
@@ -312,11 +369,11 @@ impl Watcher {
             let now = (status, self.record.done);
             if status.is_finished() {
                 self.finished = true;
-                return Some(self.event("completion", true));
+                return Some(self.event(JobEventName::Completion));
             }
             if self.last != Some(now) {
                 self.last = Some(now);
-                return Some(self.event("progress", false));
+                return Some(self.event(JobEventName::Progress));
             }
             let changed = async {
                 let closed = match &mut self.changes {
@@ -338,9 +395,9 @@ impl Watcher {
         }
     }
 
-    fn event(&self, name: &str, full: bool) -> Result<Event, axum::Error> {
-        Event::default()
-            .event(name)
-            .json_data(JobView::of(&self.record, full))
+    /// The event `name` for the job now (with its result once it completed).
+    fn event(&self, name: JobEventName) -> Result<Event, axum::Error> {
+        let full = matches!(name, JobEventName::Completion);
+        JobEvent::new(name, &JobView::of(&self.record, full)).map(JobEvent::into_sse)
     }
 }
