@@ -2,7 +2,7 @@
 //! per key in flight → a permit (or a refusal) → a blocking thread with a deadline and a
 //! cancel flag. Synchronous solves and asynchronous jobs both go through it.
 
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet, VecDeque};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex, MutexGuard};
 use std::time::{Duration, Instant};
@@ -134,6 +134,34 @@ impl LiveJob {
     }
 }
 
+/// Finished jobs no client has read finished yet, oldest first.
+#[derive(Debug, Default)]
+struct Uncollected {
+    ids: HashSet<Uuid>,
+    order: VecDeque<Uuid>,
+}
+
+impl Uncollected {
+    /// Adds `id`, giving up the oldest beyond `max` (their clients are long gone).
+    fn insert(&mut self, id: Uuid, max: usize) {
+        self.ids.insert(id);
+        self.order.push_back(id);
+        while self.ids.len() > max {
+            match self.order.pop_front() {
+                Some(old) => {
+                    self.ids.remove(&old);
+                }
+                None => break,
+            }
+        }
+        // Ids read since are still in `order`: drop them when they outnumber the rest.
+        if self.order.len() > 2 * self.ids.len() + 16 {
+            let ids = &self.ids;
+            self.order.retain(|id| ids.contains(id));
+        }
+    }
+}
+
 /// Ids of asynchronous jobs: a tag of the process that accepted the job, then random bits.
 /// A process that does not know an id can tell whether it is its own (expired, or never
 /// given) or another run's (whose unfinished jobs a shutdown interrupted).
@@ -176,6 +204,12 @@ pub struct Engine {
     jobs: Arc<dyn JobStore>,
     /// The jobs this process runs, by id.
     live: Mutex<HashMap<Uuid, Arc<LiveJob>>>,
+    /// Jobs finished that no client has read finished yet (at most `max_jobs`, the oldest
+    /// given up first).
+    uncollected: Mutex<Uncollected>,
+    /// The jobs unfinished or uncollected when the drain began, whose clients have not yet
+    /// read them finished: the drain waits for them (see [`Engine::jobs_collected`]).
+    owed: Mutex<HashSet<Uuid>>,
     ids: JobIds,
     /// Solver threads asynchronous jobs may hold at once: all but one, so that synchronous
     /// requests always find one that no job holds.
@@ -218,6 +252,8 @@ impl Engine {
             )),
             jobs: storage.jobs,
             live: Mutex::default(),
+            uncollected: Mutex::default(),
+            owed: Mutex::default(),
             ids: JobIds::new(),
             job_slots: Arc::new(tokio::sync::Semaphore::new(
                 config.pool_size.saturating_sub(1).max(1),
@@ -338,6 +374,7 @@ impl Engine {
                 };
                 tracing::info!(status = status.as_str(), "job finished");
                 engine.jobs.update(id, state, done).await;
+                engine.uncollected().insert(id, engine.config.max_jobs);
                 engine.live().remove(&id);
                 live.status.send_replace(status);
             }
@@ -350,6 +387,9 @@ impl Engine {
     /// its progress counted up to now.
     pub async fn job(&self, id: Uuid) -> Option<JobRecord> {
         let mut record = self.jobs.get(id).await?;
+        if record.state.status().is_finished() {
+            self.collected(id);
+        }
         if let JobState::Dropped { key } = &record.state {
             // The store let the result go; the cache may still hold the answer.
             if let Some(solved) = self.cache.get(key).await {
@@ -402,9 +442,39 @@ impl Engine {
     }
 
     /// Stops taking work: new solves and jobs are refused. The jobs accepted, queued or
-    /// running, go on; [`Engine::jobs_finished`] waits for them.
+    /// running, go on; [`Engine::jobs_finished`] waits for them to finish and
+    /// [`Engine::jobs_collected`] for their clients to read them.
     pub fn begin_drain(&self) {
         self.draining.store(true, Ordering::SeqCst);
+        let unfinished: Vec<Uuid> = self.live().keys().copied().collect();
+        let uncollected: Vec<Uuid> = self.uncollected().ids.iter().copied().collect();
+        self.owed()
+            .extend(unfinished.into_iter().chain(uncollected));
+    }
+
+    fn owed(&self) -> MutexGuard<'_, HashSet<Uuid>> {
+        self.owed.lock().unwrap_or_else(|p| p.into_inner())
+    }
+
+    fn uncollected(&self) -> MutexGuard<'_, Uncollected> {
+        self.uncollected.lock().unwrap_or_else(|p| p.into_inner())
+    }
+
+    /// A client read the job `id` finished: it owes its client nothing more.
+    fn collected(&self, id: Uuid) {
+        self.uncollected().ids.remove(&id);
+        self.owed().remove(&id);
+    }
+
+    /// Resolves when every job unfinished at the start of the drain has been read finished
+    /// by its client (polled, or followed to its completion event), so that none of their
+    /// answers is lost with the process.
+    pub async fn jobs_collected(&self) {
+        /// How often the drain looks.
+        const LOOK: Duration = Duration::from_millis(20);
+        while !self.owed().is_empty() {
+            tokio::time::sleep(LOOK).await;
+        }
     }
 
     pub fn is_draining(&self) -> bool {

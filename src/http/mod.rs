@@ -189,9 +189,10 @@ fn cors(origins: &CorsOrigins) -> Option<CorsLayer> {
 
 /// Serves `state` on `listener` until `shutdown` resolves, then drains: new work is refused
 /// (503, `/readyz` fails) while the jobs already accepted, queued or running, go on and their
-/// clients can still poll and follow them; after the drain delay and once those jobs are done,
-/// or the shutdown timeout is spent (what is left then ends `interrupted`), the listener
-/// closes and the requests in flight finish within what remains of the timeout.
+/// clients can still poll and follow them; after the drain delay, once those jobs are done
+/// and their clients have read them, or the shutdown timeout is spent (a job still running
+/// then ends `interrupted`), the listener closes and the requests in flight finish within
+/// what remains of the timeout.
 pub async fn run(
     listener: TcpListener,
     state: AppState,
@@ -238,6 +239,13 @@ pub async fn run(
         engine.interrupt_unfinished_jobs();
         // They stop at their next check, microseconds to milliseconds away.
         let _ = tokio::time::timeout(Duration::from_secs(1), engine.jobs_finished()).await;
+    }
+    // Their clients read them (within what is left of the timeout) before the port closes.
+    if tokio::time::timeout_at(end, engine.jobs_collected())
+        .await
+        .is_err()
+    {
+        tracing::warn!("some finished jobs were not collected before the shutdown timeout");
     }
     stop_accepting.cancel();
     let served = server.await;

@@ -152,7 +152,12 @@ async fn a_shutdown_finishes_the_accepted_jobs_and_keeps_answering_their_clients
         "1m",
     ])
     .await;
-    // A job running and one queued behind it when the shutdown starts: both finish.
+    // A job finished before the shutdown that its client has not read yet...
+    let unread = app
+        .submit(&json!({"kind": "rolling", "input": {"load": "1.02 nN"}}))
+        .await;
+    tokio::time::sleep(Duration::from_millis(200)).await;
+    // ...a job running and one queued behind it when the shutdown starts: both finish.
     let running = app.submit(&long_sweep(20)).await;
     app.wait_for_job(&running, |j| j["status"] == "running")
         .await;
@@ -175,6 +180,11 @@ async fn a_shutdown_finishes_the_accepted_jobs_and_keeps_answering_their_clients
         let (_, completion) = events.until_completion().await;
         assert_eq!(completion["status"], "succeeded");
     }
+    // The server waits for the unread job's client too.
+    tokio::time::sleep(Duration::from_millis(300)).await;
+    assert!(!app.server.is_finished());
+    let read: serde_json::Value = app.get(&unread).await.json().await.unwrap();
+    assert_eq!(read["status"], "succeeded");
     within(&mut app.server).await.unwrap().unwrap();
 }
 

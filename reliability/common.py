@@ -1,0 +1,98 @@
+"""What the reliability scripts share: start a `thirdbody serve` on a free loopback port,
+send requests with the standard library only, sample the server's memory, and summarise
+latencies. Every script takes the binary in THIRDBODY_BIN (default: the release build), so
+the same measurement runs against any build (RELIABILITY.md compares before and after)."""
+
+import http.client
+import json
+import os
+import socket
+import subprocess
+import time
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+BIN = os.environ.get("THIRDBODY_BIN", os.path.join(ROOT, "target", "release", "thirdbody"))
+
+
+def free_port():
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def supports(flag):
+    """Whether this build's `serve` has `flag` (older builds lack the newer limits)."""
+    out = subprocess.run([BIN, "serve", "--help"], capture_output=True, text=True).stdout
+    return flag in out
+
+
+class Server:
+    """A `thirdbody serve` on a loopback port, stopped when the `with` block ends."""
+
+    def __init__(self, *flags, preexec=None):
+        self.port = free_port()
+        self.log = open(os.devnull, "w")
+        self.proc = subprocess.Popen(
+            [BIN, "serve", "--bind", f"127.0.0.1:{self.port}", *flags],
+            stdout=self.log,
+            stderr=self.log,
+            env={**os.environ, "RUST_LOG": "warn"},
+            preexec_fn=preexec,
+        )
+        deadline = time.time() + 20
+        while time.time() < deadline:
+            try:
+                if request(self.port, "GET", "/healthz", timeout=1)[0] == 200:
+                    return
+            except OSError:
+                time.sleep(0.05)
+        raise RuntimeError("the server did not start")
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        if self.proc.poll() is None:
+            self.proc.kill()
+        self.proc.wait()
+        self.log.close()
+
+    def rss_mib(self):
+        """Resident memory of the server process (MiB)."""
+        with open(f"/proc/{self.proc.pid}/status") as status:
+            for line in status:
+                if line.startswith("VmRSS:"):
+                    return int(line.split()[1]) / 1024
+        return float("nan")
+
+
+def request(port, method, path, body=None, headers=None, timeout=30):
+    """One request on a new connection: (status, body bytes, seconds)."""
+    conn = http.client.HTTPConnection("127.0.0.1", port, timeout=timeout)
+    data = body if isinstance(body, (bytes, type(None))) else json.dumps(body).encode()
+    hdrs = {"content-type": "application/json"} if data is not None else {}
+    hdrs.update(headers or {})
+    start = time.perf_counter()
+    try:
+        conn.request(method, path, body=data, headers=hdrs)
+        response = conn.getresponse()
+        payload = response.read()
+        return response.status, payload, time.perf_counter() - start
+    finally:
+        conn.close()
+
+
+def percentile(values, p):
+    if not values:
+        return float("nan")
+    ordered = sorted(values)
+    index = min(len(ordered) - 1, max(0, round(p / 100 * (len(ordered) - 1))))
+    return ordered[index]
+
+
+def latency_line(name, seconds):
+    ms = [s * 1000 for s in seconds]
+    return (
+        f"{name}: {len(ms)} requests, p50 {percentile(ms, 50):.1f} ms, "
+        f"p99 {percentile(ms, 99):.1f} ms, max {max(ms) if ms else float('nan'):.1f} ms"
+    )

@@ -1,0 +1,62 @@
+"""Memory under sustained job submission: for 60 s, clients submit distinct sweep jobs as
+fast as they are taken and re-post one cached job, while the server's resident memory is
+sampled every second, with a small memory budget (8 MiB) so that growth beyond it shows.
+Prints the RSS at the start, its maximum and at the end. Usage: reliability/memory.py [s]"""
+
+import collections
+import sys
+import threading
+import time
+
+from common import Server, request, supports
+
+SECONDS = float(sys.argv[1]) if len(sys.argv) > 1 else 60
+BUDGET = 8 << 20
+
+stop = threading.Event()
+statuses = collections.Counter()
+
+
+def distinct(n):
+    i = 0
+    while not stop.is_set():
+        i += 1
+        loads = [f"{1 + ((n * 7919 + i) * 104729 + k) % 1_000_000 / 1e6} nN" for k in range(20)]
+        job = {"kind": "sweep", "input": {"vary": {"load": loads}}}
+        try:
+            statuses[f"distinct {request(port, 'POST', '/v1/jobs', job)[0]}"] += 1
+        except OSError as e:
+            statuses[f"distinct error {type(e).__name__}"] += 1
+
+
+def same():
+    job = {"kind": "rolling"}
+    while not stop.is_set():
+        try:
+            statuses[f"cached {request(port, 'POST', '/v1/jobs', job)[0]}"] += 1
+        except OSError as e:
+            statuses[f"cached error {type(e).__name__}"] += 1
+
+
+budget_flag = "--memory-budget" if supports("--memory-budget") else "--cache-bytes"
+with Server(budget_flag, str(BUDGET), "--max-queued-jobs", "64") as server:
+    port = server.port
+    start_rss = server.rss_mib()
+    threads = [threading.Thread(target=distinct, args=(n,)) for n in range(4)]
+    threads += [threading.Thread(target=same) for _ in range(4)]
+    for t in threads:
+        t.start()
+    samples = []
+    end = time.time() + SECONDS
+    while time.time() < end:
+        time.sleep(1)
+        samples.append(server.rss_mib())
+    stop.set()
+    for t in threads:
+        t.join()
+    print(f"memory: {budget_flag} {BUDGET >> 20} MiB, {SECONDS:.0f} s of submissions")
+    print(
+        f"RSS: start {start_rss:.0f} MiB, max {max(samples):.0f} MiB, "
+        f"end {samples[-1]:.0f} MiB"
+    )
+    print("answers: " + ", ".join(f"{k}: {v}" for k, v in sorted(statuses.items())))

@@ -1,0 +1,35 @@
+#!/usr/bin/env bash
+# The reliability measurements of RELIABILITY.md, each printing its figure, against the
+# release build (or THIRDBODY_BIN). `--bounded` runs shorter versions (as CI does) and fails
+# when a promise is broken: a lost job, an unanswered /healthz, a server that died.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+bounded=false
+[ "${1:-}" = "--bounded" ] && bounded=true
+if [ -z "${THIRDBODY_BIN:-}" ]; then
+  cargo build --release --locked --quiet --bin thirdbody
+fi
+if $bounded; then
+  durations=(10 10 15)
+else
+  durations=(30 60 40)
+fi
+out=$(mktemp)
+trap 'rm -f "$out"' EXIT
+python3 reliability/overload.py "${durations[0]}" | tee -a "$out"
+python3 reliability/memory.py "${durations[1]}" | tee -a "$out"
+python3 reliability/slowloris.py "${durations[2]}" | tee -a "$out"
+python3 reliability/sigterm.py | tee -a "$out"
+python3 reliability/sigkill.py | tee -a "$out"
+if $bounded; then
+  broken=0
+  grep -q "server alive at the end: True" "$out" || { echo "BROKEN: the server died"; broken=1; }
+  grep -q "lost 0:" "$out" || { echo "BROKEN: an accepted job was lost"; broken=1; }
+  grep -q ", 0 failed (5 s timeout)" "$out" || { echo "BROKEN: /healthz went unanswered"; broken=1; }
+  grep -q "answers 410 tag:thirdbody,2026:problems/interrupted" "$out" \
+    || { echo "BROKEN: a restarted server does not say interrupted"; broken=1; }
+  if grep -E "(solve|hostile|distinct|cached) 5[0-9][0-9]" "$out"; then
+    echo "BROKEN: a 5xx answer"; broken=1
+  fi
+  exit $broken
+fi

@@ -1,0 +1,22 @@
+"""SIGKILL and restart: a server takes a job, is killed, and a new one starts in its place;
+the job's client asks for it there. Prints what it is told. Usage: reliability/sigkill.py"""
+
+import json
+
+from common import Server, request
+
+with Server("--max-sweep-points", "1000000") as first:
+    sweep = {"kind": "sweep", "input": {"vary": {
+        "radius": [f"{25 + i} nm" for i in range(50)],
+        "load": [f"{1000 + i} pN" for i in range(50)]}}}
+    status, body, _ = request(first.port, "POST", "/v1/jobs", sweep)
+    job_id = json.loads(body)["id"]
+    first.proc.kill()
+    first.proc.wait()
+    port = first.port
+
+with Server() as second:
+    status, body, _ = request(second.port, "GET", f"/v1/jobs/{job_id}")
+    problem = json.loads(body)
+    print("sigkill: a job accepted, the server killed (SIGKILL) and started again")
+    print(f"the job's URL now answers {status} {problem.get('type', '')}: {problem.get('detail', '')}")

@@ -1,0 +1,51 @@
+"""SIGTERM with work in flight: a server with one solver thread takes a long job (running)
+and four short ones (queued behind it), then gets SIGTERM. Every job's client keeps polling
+it until it ends or the server is gone. Prints how many accepted jobs were answered and how
+many were lost. Usage: reliability/sigterm.py"""
+
+import json
+import signal
+import threading
+import time
+
+from common import Server, request
+
+with Server("--pool-size", "1", "--max-sweep-points", "1000000", "--shutdown-timeout", "60s") as server:
+    port = server.port
+    long_sweep = {"kind": "sweep", "input": {"vary": {
+        "radius": [f"{25 + i} nm" for i in range(20)],
+        "load": [f"{1000 + i} pN" for i in range(20)],
+        "velocity": [f"{1 + i} nm/s" for i in range(30)]}}}
+    jobs = [request(port, "POST", "/v1/jobs", long_sweep)]
+    for k in range(4):
+        jobs.append(request(port, "POST", "/v1/jobs", {"kind": "rolling", "input": {"load": f"{1 + k / 10} nN"}}))
+    ids = [json.loads(body)["id"] for status, body, _ in jobs if status == 202]
+    time.sleep(0.3)
+    server.proc.send_signal(signal.SIGTERM)
+    sent = time.time()
+    final = {}
+
+    def follow(job_id):
+        while True:
+            try:
+                status, body, _ = request(port, "GET", f"/v1/jobs/{job_id}", timeout=5)
+            except OSError:
+                final[job_id] = "lost (server gone before it answered)"
+                return
+            state = json.loads(body).get("status") if status == 200 else f"HTTP {status}"
+            if state not in ("queued", "running"):
+                final[job_id] = state
+                return
+            time.sleep(0.05)
+
+    threads = [threading.Thread(target=follow, args=(i,)) for i in ids]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    server.proc.wait(timeout=120)
+    exited = time.time() - sent
+    answered = sum(1 for s in final.values() if s == "succeeded")
+    print(f"sigterm: {len(ids)} jobs accepted (1 running, {len(ids) - 1} queued), then SIGTERM")
+    print(f"answered {answered}, lost {len(ids) - answered}: " + ", ".join(sorted(final.values())))
+    print(f"the server exited {exited:.1f} s after SIGTERM, status {server.proc.returncode}")
