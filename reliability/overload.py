@@ -42,6 +42,15 @@ def hostile():
             statuses[f"hostile error {type(e).__name__}"] += 1
 
 
+rss = []
+
+
+def sampler(server):
+    while not stop.is_set():
+        rss.append(server.rss_mib())
+        time.sleep(1)
+
+
 def prober():
     while not stop.is_set():
         start = time.perf_counter()
@@ -58,6 +67,7 @@ with Server() as server:
     threads = [threading.Thread(target=solver, args=(n,)) for n in range(10 * CORES)]
     threads += [threading.Thread(target=hostile) for _ in range(2)]
     threads.append(threading.Thread(target=prober))
+    threads.append(threading.Thread(target=sampler, args=(server,)))
     for t in threads:
         t.start()
     time.sleep(SECONDS)
@@ -68,4 +78,5 @@ with Server() as server:
     print(f"overload: {CORES} cores, {10 * CORES} solving clients, 2 hostile, {SECONDS:.0f} s")
     print(latency_line("/healthz", health))
     print("answers: " + ", ".join(f"{k}: {v}" for k, v in sorted(statuses.items())))
+    print(f"RSS: max {max(rss):.0f} MiB (default memory budget 256 MiB)")
     print(f"server alive at the end: {alive}")

@@ -339,6 +339,24 @@ impl Engine {
     /// is full or the service is draining.
     pub async fn submit(self: &Arc<Self>, job: Job) -> Result<JobRecord, EngineError> {
         self.admit()?;
+        let meta = job.meta();
+        // A job whose answer is cached is answered at once: it takes no place in the queue.
+        if let Some(solved) = self.cache.get(&meta.input_hash).await {
+            self.cache_hits.increment(1);
+            let mut record = JobRecord::queued(self.ids.next(), job.kind(), job.work());
+            let done = match job.work() {
+                Work::Known(total) => total,
+                Work::Unknown => 0,
+            };
+            self.jobs.insert(record.clone()).await;
+            self.jobs
+                .update(record.id, JobState::Succeeded(solved.clone()), done)
+                .await;
+            self.uncollected().insert(record.id, self.config.max_jobs);
+            record.state = JobState::Succeeded(solved);
+            record.done = done;
+            return Ok(record);
+        }
         let max = self.config.max_queued_jobs;
         if self
             .queued
@@ -366,7 +384,7 @@ impl Engine {
         self.tracker.spawn(
             async move {
                 let work = job.work();
-                let state = engine.run_job(&live, id, job).await;
+                let state = engine.run_job(&live, id, job, meta).await;
                 let status = state.status();
                 let done = match (status, work) {
                     (JobStatus::Succeeded, Work::Known(total)) => total,
@@ -555,8 +573,7 @@ impl Engine {
     }
 
     /// The life of an asynchronous job after its submission; returns its final state.
-    async fn run_job(&self, live: &LiveJob, id: Uuid, job: Job) -> JobState {
-        let meta = job.meta();
+    async fn run_job(&self, live: &LiveJob, id: Uuid, job: Job, meta: Meta) -> JobState {
         let permit = match self.cache.get(&meta.input_hash).await {
             Some(hit) => {
                 self.cache_hits.increment(1);

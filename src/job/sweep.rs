@@ -124,9 +124,11 @@ impl Kind for SweepJob {
         let mut checker = Checker::new();
         let (base, vary) = (field!(input.base), field!(input.vary));
         let job = match input.kind.unwrap_or_default() {
-            SweepOf::Rolling => SweepJob::Rolling(RollingSweep::read(base, vary, &mut checker)?),
+            SweepOf::Rolling => {
+                SweepJob::Rolling(RollingSweep::read(base, vary, limits, &mut checker)?)
+            }
             SweepOf::ThreeBody => {
-                SweepJob::ThreeBody(ThreeBodySweep::read(base, vary, &mut checker)?)
+                SweepJob::ThreeBody(ThreeBodySweep::read(base, vary, limits, &mut checker)?)
             }
         };
         let max = limits.max_sweep_points;
@@ -220,8 +222,10 @@ impl RollingSweep {
     fn read(
         base: Field<Value>,
         vary: Field<Value>,
+        limits: &Limits,
         checker: &mut Checker,
     ) -> Result<RollingSweep, JobError> {
+        let max = limits.max_sweep_points;
         let base_input: RollingInput = read_object(base)?;
         let vary_input: RollingVary = read_object(vary)?;
         let base_field = Field {
@@ -236,9 +240,9 @@ impl RollingSweep {
             value: Some(&vary_input),
         };
         Ok(checker.nested(vary_field, |c, vary| RollingSweep {
-            radius: c.list(field!(vary.radius), Parameter::Radius, r.radius),
-            load: c.list(field!(vary.load), Parameter::Load, r.load),
-            velocity: c.list(field!(vary.velocity), Parameter::Velocity, r.velocity),
+            radius: c.list(field!(vary.radius), Parameter::Radius, r.radius, max),
+            load: c.list(field!(vary.load), Parameter::Load, r.load, max),
+            velocity: c.list(field!(vary.velocity), Parameter::Velocity, r.velocity, max),
             base,
         }))
     }
@@ -282,8 +286,10 @@ impl ThreeBodySweep {
     fn read(
         base: Field<Value>,
         vary: Field<Value>,
+        limits: &Limits,
         checker: &mut Checker,
     ) -> Result<ThreeBodySweep, JobError> {
+        let max = limits.max_sweep_points;
         let mut base_input: ThreeBodyInput = read_object(base)?;
         let vary_input: ThreeBodyVary = read_object(vary)?;
         let v = &vary_input;
@@ -337,18 +343,19 @@ impl ThreeBodySweep {
             }
             let operating = match varied.first() {
                 Some(&&(list, parameter, point)) => c
-                    .list(list, parameter, f64::NAN)
+                    .list(list, parameter, f64::NAN, max)
                     .into_iter()
                     .map(point)
                     .collect(),
                 None => vec![s.operating],
             };
             let sweep = ThreeBodySweep {
-                velocity: c.list(field!(vary.velocity), Parameter::Velocity, s.velocity),
+                velocity: c.list(field!(vary.velocity), Parameter::Velocity, s.velocity, max),
                 mean_diameter: c.list(
                     field!(vary.mean_diameter),
                     Parameter::MeanDiameter,
                     s.diameters.mean,
+                    max,
                 ),
                 operating,
                 base: job,

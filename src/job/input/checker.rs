@@ -105,19 +105,25 @@ impl Checker {
         field.value.copied()
     }
 
-    /// A list of values of `parameter`, each checked against its range; absent, the list of
-    /// `base` alone.
+    /// A list of at most `max` values of `parameter`, each checked against its range;
+    /// absent, the list of `base` alone. A longer list is refused without reading its values.
     pub fn list(
         &mut self,
         field: Field<Vec<Quantity>>,
         parameter: Parameter,
         base: f64,
+        max: usize,
     ) -> Vec<f64> {
         let Some(values) = field.value else {
             return vec![base];
         };
         if values.is_empty() {
             self.invalid(field.name, json!([]), "a list of at least one value");
+        }
+        if values.len() > max {
+            let allowed = format!("at most {max} values (a sweep's points at most)");
+            self.invalid(field.name, json!(values.len()), &allowed);
+            return Vec::new();
         }
         let path = self.path(field.name);
         values
