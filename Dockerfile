@@ -23,12 +23,14 @@ COPY --from=build /src/target/release/thirdbody /usr/local/bin/thirdbody
 USER thirdbody
 # Every setting is a flag with an environment variable (`thirdbody serve --help`); these are
 # the ones a container needs: listen on all interfaces, JSON logs for the log collector, and
-# a shutdown bound below the orchestrator's grace period (deploy/kubernetes.yaml: 30 s).
+# a shutdown bound below the orchestrator's grace period (deploy/base/deployment.yaml: 40 s).
 ENV THIRDBODY_BIND=0.0.0.0:8080 \
     THIRDBODY_LOG_FORMAT=json \
     THIRDBODY_SHUTDOWN_TIMEOUT=25s \
     THIRDBODY_DRAIN_DELAY=2s
 EXPOSE 8080
+# Alive when /healthz answers (`thirdbody worker` has no HTTP: its compose service disables it).
+HEALTHCHECK --interval=10s --timeout=3s --start-period=5s --retries=3 CMD ["thirdbody", "healthcheck"]
 # SIGTERM drains: /readyz turns 503, in-flight requests and running jobs finish, then exit.
 STOPSIGNAL SIGTERM
 ENTRYPOINT ["thirdbody"]

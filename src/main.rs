@@ -4,11 +4,12 @@
 use std::io::{IsTerminal, Read, Write};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+use std::time::Duration;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
 
 use thirdbody::check;
-use thirdbody::http::{self, AppState, LogFormat, ServeArgs};
+use thirdbody::http::{self, AppState, Config, LogFormat, ServeArgs};
 use thirdbody::job::{Control, FigureJob, Job, JobError, Limits};
 use thirdbody::render::{Answer, Format};
 
@@ -52,8 +53,18 @@ enum Command {
     },
     /// Serve the HTTP API (see /docs once it runs); every flag has a THIRDBODY_* variable.
     Serve(Box<ServeArgs>),
+    /// Take work from the fleet's Redis stream, with no HTTP (needs --redis-url; the other
+    /// flags of `serve` that concern solving apply, those of HTTP are ignored).
+    Worker(Box<ServeArgs>),
     /// Print the OpenAPI description of the HTTP API.
     Openapi,
+    /// Exit 0 if the service on THIRDBODY_BIND answers /healthz (a container's health check:
+    /// the image has no curl).
+    Healthcheck {
+        /// The address the service listens on (0.0.0.0 is asked on 127.0.0.1).
+        #[arg(long, env = "THIRDBODY_BIND", default_value = "127.0.0.1:8080")]
+        bind: std::net::SocketAddr,
+    },
 }
 
 /// How an answer is printed.
@@ -99,7 +110,9 @@ fn main() -> ExitCode {
             update,
         } => return check(&checks, junit.as_deref(), update),
         Command::Serve(args) => return serve(*args),
+        Command::Worker(args) => return worker(*args),
         Command::Openapi => return print(&http::openapi::spec_json()),
+        Command::Healthcheck { bind } => return healthcheck(bind),
     };
     let result = job.and_then(|job| {
         for warning in job.warnings() {
@@ -166,22 +179,91 @@ fn print(text: &str) -> ExitCode {
     }
 }
 
+/// `thirdbody healthcheck`: one GET /healthz, answered 200 within two seconds.
+fn healthcheck(mut bind: std::net::SocketAddr) -> ExitCode {
+    if bind.ip().is_unspecified() {
+        bind.set_ip(std::net::Ipv4Addr::LOCALHOST.into());
+    }
+    let timeout = Duration::from_secs(2);
+    let answered = (|| -> std::io::Result<String> {
+        let mut stream = std::net::TcpStream::connect_timeout(&bind, timeout)?;
+        stream.set_read_timeout(Some(timeout))?;
+        stream.write_all(b"GET /healthz HTTP/1.0\r\nAccept: application/json\r\n\r\n")?;
+        let mut answer = String::new();
+        stream.read_to_string(&mut answer)?;
+        Ok(answer)
+    })();
+    match answered {
+        Ok(answer) if answer.starts_with("HTTP/1.1 200") || answer.starts_with("HTTP/1.0 200") => {
+            ExitCode::SUCCESS
+        }
+        Ok(answer) => {
+            eprintln!(
+                "thirdbody healthcheck: {}",
+                answer.lines().next().unwrap_or("")
+            );
+            ExitCode::FAILURE
+        }
+        Err(e) => {
+            eprintln!("thirdbody healthcheck: {bind}: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+/// The settings of `command` and a runtime to run it on; or the exit code saying why not.
+fn start(command: &str, args: ServeArgs) -> Result<(Config, tokio::runtime::Runtime), ExitCode> {
+    let config = args.validate().map_err(|e| {
+        eprintln!("thirdbody {command}: invalid setting: {e}");
+        ExitCode::from(INVALID_JOB)
+    })?;
+    init_logging(config.log_format);
+    let runtime = tokio::runtime::Runtime::new().map_err(|e| {
+        eprintln!("thirdbody {command}: cannot start the runtime: {e}");
+        ExitCode::FAILURE
+    })?;
+    Ok((config, runtime))
+}
+
+/// `thirdbody worker`: works the fleet's stream until SIGTERM or Ctrl-C, then finishes the
+/// part it holds (within the shutdown timeout; what it cannot finish, another process takes
+/// over).
+fn worker(args: ServeArgs) -> ExitCode {
+    if args.fleet.redis_url.is_none() {
+        eprintln!(
+            "thirdbody worker: invalid setting: --redis-url (or THIRDBODY_REDIS_URL) is required"
+        );
+        return ExitCode::from(INVALID_JOB);
+    }
+    let (config, runtime) = match start("worker", args) {
+        Ok(started) => started,
+        Err(code) => return code,
+    };
+    runtime.block_on(async {
+        let timeout = config.shutdown_timeout;
+        let pool_size = config.engine.pool_size;
+        let state = AppState::new(config);
+        let engine = state.engine();
+        engine.start_workers(pool_size, false);
+        tracing::info!(workers = pool_size, "taking work from Redis");
+        shutdown_signal().await;
+        engine.begin_drain();
+        if tokio::time::timeout(timeout, engine.jobs_finished())
+            .await
+            .is_err()
+        {
+            engine.interrupt_unfinished_jobs();
+            let _ = tokio::time::timeout(Duration::from_secs(1), engine.jobs_finished()).await;
+        }
+    });
+    ExitCode::SUCCESS
+}
+
 /// `thirdbody serve`: validates the settings, then serves until SIGTERM or Ctrl-C.
 fn serve(args: ServeArgs) -> ExitCode {
-    let config = match args.validate() {
-        Ok(config) => config,
-        Err(e) => {
-            eprintln!("thirdbody serve: invalid setting: {e}");
-            return ExitCode::from(INVALID_JOB);
-        }
-    };
-    init_logging(config.log_format);
-    let runtime = match tokio::runtime::Runtime::new() {
-        Ok(runtime) => runtime,
-        Err(e) => {
-            eprintln!("thirdbody serve: cannot start the runtime: {e}");
-            return ExitCode::FAILURE;
-        }
+    let (config, runtime) = match start("serve", args) {
+        Ok(started) => started,
+        Err(code) => return code,
     };
     let served = runtime.block_on(async {
         let bind = config.bind;

@@ -210,6 +210,28 @@ fn the_container_configuration_starts_a_service_that_drains_on_sigterm() {
     let health = health.expect("the service answers /healthz");
     assert!(health.starts_with("HTTP/1.1 200"), "{health}");
     assert!(get(port, "/readyz").unwrap().starts_with("HTTP/1.1 200"));
+    // The image's HEALTHCHECK command, with the container's bind address.
+    assert!(
+        text.contains(r#"HEALTHCHECK"#) && text.contains(r#"CMD ["thirdbody", "healthcheck"]"#)
+    );
+    let healthcheck = |bind: String| {
+        Command::new(env!("CARGO_BIN_EXE_thirdbody"))
+            .arg("healthcheck")
+            .env("THIRDBODY_BIND", bind)
+            .stderr(Stdio::null())
+            .status()
+            .unwrap()
+            .success()
+    };
+    assert!(healthcheck(format!("0.0.0.0:{port}")));
+    let closed = std::net::TcpListener::bind("127.0.0.1:0")
+        .unwrap()
+        .local_addr()
+        .unwrap();
+    assert!(
+        !healthcheck(closed.to_string()),
+        "nothing listens there once it is dropped"
+    );
     let status = Command::new("kill")
         .args(["-TERM", &child.id().to_string()])
         .status()

@@ -3,7 +3,7 @@
 //! into; [`MemoryCache`], bounded in bytes and in time, is the default.
 
 use std::sync::{Arc, OnceLock};
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 use async_trait::async_trait;
 use bytes::Bytes;
@@ -13,16 +13,18 @@ use super::budget;
 use crate::job::JobError;
 use crate::render::{Answer, Format, RenderError};
 
-/// A solved job as it is kept and sent: the answer, its JSON rendered once (a cache hit
-/// then costs no serialization: measured in BENCHMARKS.md, rendering a rolling answer
-/// costs more than a hit), and its CSV rendered the first time a client asks for it.
+/// A solved job as it is kept and sent: its JSON rendered once (a cache hit then costs no
+/// serialization: measured in BENCHMARKS.md, rendering a rolling answer costs more than a
+/// hit), and its CSV rendered the first time a client asks for it, from the typed answer
+/// kept for that; or both renderings as another process made them (Redis, assembled parts).
 #[derive(Debug)]
 pub struct Solved {
     /// The job's cache key.
     pub key: String,
-    pub answer: Answer,
     json: Bytes,
     csv: OnceLock<Bytes>,
+    /// The typed answer, while the CSV is still to render.
+    answer: Option<Answer>,
 }
 
 impl Solved {
@@ -32,10 +34,20 @@ impl Solved {
         let json = answer.render(Format::Json).map_err(internal)?;
         Ok(Solved {
             key,
-            answer,
             json: json.into(),
             csv: OnceLock::new(),
+            answer: Some(answer),
         })
+    }
+
+    /// An answer already rendered in every format.
+    pub fn rendered(key: String, json: Bytes, csv: Bytes) -> Solved {
+        Solved {
+            key,
+            json,
+            csv: OnceLock::from(csv),
+            answer: None,
+        }
     }
 
     /// The answer as compact JSON.
@@ -51,7 +63,10 @@ impl Solved {
                 if let Some(csv) = self.csv.get() {
                     return Ok(csv.clone());
                 }
-                let csv = Bytes::from(self.answer.render(Format::Csv)?);
+                let answer = self.answer.as_ref().ok_or_else(|| {
+                    RenderError::new("an answer rendered elsewhere came without its CSV")
+                })?;
+                let csv = Bytes::from(answer.render(Format::Csv)?);
                 Ok(self.csv.get_or_init(|| csv).clone())
             }
         }
@@ -69,6 +84,14 @@ fn internal(e: RenderError) -> JobError {
     JobError::Internal(e.to_string())
 }
 
+/// Who solves a key no cache holds yet.
+pub enum Claim {
+    /// This process: it solves, keeps the answer, then releases the claim.
+    Mine,
+    /// Another process sharing the cache solved it meanwhile.
+    Solved(Arc<Solved>),
+}
+
 /// Where solved jobs are kept.
 #[async_trait]
 pub trait ResultCache: Send + Sync {
@@ -76,6 +99,19 @@ pub trait ResultCache: Send + Sync {
     async fn get(&self, key: &str) -> Option<Arc<Solved>>;
     /// Keeps `solved` under its key.
     async fn insert(&self, solved: Arc<Solved>);
+
+    /// Claims the solve of `key` among the processes sharing the cache, waiting (until
+    /// `deadline`) while another holds it. One process's cache needs no claim: the engine
+    /// already shares one solve among its own callers.
+    async fn claim(&self, key: &str, deadline: Instant) -> Result<Claim, JobError> {
+        let _ = (key, deadline);
+        Ok(Claim::Mine)
+    }
+
+    /// Gives up the claim on `key` (its answer kept, or its solve failed).
+    async fn release(&self, key: &str) {
+        let _ = key;
+    }
 }
 
 /// The cache of one process, bounded in bytes and in time.

@@ -16,8 +16,14 @@ pub const CACHE_MISSES: &str = "thirdbody_cache_misses_total";
 pub const JOBS_QUEUED: &str = "thirdbody_jobs_queued";
 /// Asynchronous jobs being solved.
 pub const JOBS_RUNNING: &str = "thirdbody_jobs_running";
-/// Work refused, by reason (`overloaded`, `draining`).
+/// Work refused, by reason (`overloaded`, `draining`, `unavailable`).
 pub const REJECTIONS: &str = "thirdbody_rejections_total";
+/// Whether each Redis role (`cache`, `jobs`) was reachable at the last call (1 or 0).
+pub const REDIS_UP: &str = "thirdbody_redis_up";
+/// Entries of the fleet's work stream solved, by outcome.
+pub const PARTS: &str = "thirdbody_parts_total";
+/// Entries delivered again (their worker went silent).
+pub const REDELIVERIES: &str = "thirdbody_redeliveries_total";
 
 static METADATA: Metadata<'static> =
     Metadata::new(module_path!(), metrics::Level::INFO, Some(module_path!()));
@@ -72,8 +78,11 @@ impl Metrics {
     }
 
     pub fn gauge(&self, name: &'static str) -> Gauge {
-        self.recorder
-            .register_gauge(&Key::from_name(name), &METADATA)
+        self.labelled_gauge(name, &[])
+    }
+
+    pub fn labelled_gauge(&self, name: &'static str, labels: &[(&'static str, &str)]) -> Gauge {
+        self.recorder.register_gauge(&key(name, labels), &METADATA)
     }
 
     pub fn histogram(&self, name: &'static str, labels: &[(&'static str, &str)]) -> Histogram {

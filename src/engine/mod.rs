@@ -8,6 +8,7 @@
 mod budget;
 pub mod cache;
 mod coalesce;
+pub mod fleet;
 mod memo;
 pub mod metrics;
 pub mod pool;

@@ -16,8 +16,9 @@ use tracing::Instrument;
 use uuid::Uuid;
 
 use super::budget::{self, Budget};
-use super::cache::{MemoryCache, ResultCache, Solved};
+use super::cache::{Claim, MemoryCache, ResultCache, Solved};
 use super::coalesce::Coalescer;
+use super::fleet::Shared;
 use super::memo::PointMemo;
 use super::metrics::{self as names, Metrics};
 use super::pool::Pool;
@@ -55,6 +56,9 @@ pub struct EngineConfig {
 pub struct Storage {
     pub cache: Arc<dyn ResultCache>,
     pub jobs: Arc<dyn JobStore>,
+    /// The fleet the engine works in, if any ([`super::fleet`]): its jobs then run on the
+    /// fleet's work stream, not in this process's tasks.
+    pub fleet: Option<Arc<Shared>>,
 }
 
 impl Storage {
@@ -68,6 +72,7 @@ impl Storage {
                 config.max_jobs,
                 budget.job_results,
             )),
+            fleet: None,
         }
     }
 }
@@ -81,6 +86,9 @@ pub enum EngineError {
     Overloaded,
     /// The service is shutting down and takes no new work.
     Draining,
+    /// The shared job store cannot be reached (why): asynchronous work is refused rather
+    /// than accepted and possibly lost.
+    Unavailable(String),
 }
 
 impl From<JobError> for EngineError {
@@ -193,15 +201,17 @@ impl JobIds {
 /// The compute service: pool, cache and asynchronous jobs.
 pub struct Engine {
     config: EngineConfig,
-    pool: Pool,
-    cache: Arc<dyn ResultCache>,
+    pub(super) pool: Pool,
+    pub(super) cache: Arc<dyn ResultCache>,
     coalescer: Coalescer,
     /// The text of valid inputs (their kind and compact JSON with sorted keys) → their
     /// cache key, so that a repeated request is answered without being validated again.
     input_keys: moka::future::Cache<String, String>,
     /// Solved points of sweeps, for a retry after a deadline.
-    points: Arc<PointMemo>,
+    pub(super) points: Arc<PointMemo>,
     jobs: Arc<dyn JobStore>,
+    /// The fleet, when the engine works in one.
+    pub(super) fleet: Option<Arc<Shared>>,
     /// The jobs this process runs, by id.
     live: Mutex<HashMap<Uuid, Arc<LiveJob>>>,
     /// Jobs finished that no client has read finished yet (at most `max_jobs`, the oldest
@@ -213,17 +223,17 @@ pub struct Engine {
     ids: JobIds,
     /// Solver threads asynchronous jobs may hold at once: all but one, so that synchronous
     /// requests always find one that no job holds.
-    job_slots: Arc<tokio::sync::Semaphore>,
-    /// The tasks of asynchronous jobs, waited for on shutdown.
-    tracker: TaskTracker,
+    pub(super) job_slots: Arc<tokio::sync::Semaphore>,
+    /// The tasks of asynchronous jobs (and the fleet's workers), waited for on shutdown.
+    pub(super) tracker: TaskTracker,
     draining: AtomicBool,
     /// Asynchronous jobs waiting for a permit.
     queued: AtomicUsize,
-    metrics: Metrics,
+    pub(super) metrics: Metrics,
     cache_hits: Counter,
     cache_misses: Counter,
     jobs_queued: Gauge,
-    jobs_running: Gauge,
+    pub(super) jobs_running: Gauge,
 }
 
 impl Engine {
@@ -235,6 +245,11 @@ impl Engine {
 
     /// An engine that keeps answers and job records in `storage`.
     pub fn with_storage(config: EngineConfig, metrics: Metrics, storage: Storage) -> Arc<Engine> {
+        if let Some(shared) = &storage.fleet {
+            for link in [&shared.fleet.cache, &shared.fleet.jobs] {
+                link.report_to(metrics.labelled_gauge(names::REDIS_UP, &[("role", link.role)]));
+            }
+        }
         Arc::new(Engine {
             pool: Pool::new(config.pool_size),
             cache: storage.cache,
@@ -251,6 +266,7 @@ impl Engine {
                 config.cache_ttl,
             )),
             jobs: storage.jobs,
+            fleet: storage.fleet,
             live: Mutex::default(),
             uncollected: Mutex::default(),
             owed: Mutex::default(),
@@ -314,14 +330,18 @@ impl Engine {
             return Ok((solved, CacheStatus::Hit));
         }
         let engine = self.clone();
+        let key_claimed = key.clone();
         let solve = move || {
             async move {
-                let permit = engine.pool.try_acquire().ok_or(EngineError::Overloaded)?;
                 let deadline = Instant::now() + engine.config.solve_deadline;
-                let control = Arc::new(engine.control(deadline));
-                let solved = engine.execute(permit, job, meta, control).await?;
-                engine.cache.insert(solved.clone()).await;
-                Ok(solved)
+                if let Claim::Solved(solved) =
+                    engine.cache.claim(&meta.input_hash, deadline).await?
+                {
+                    return Ok(solved);
+                }
+                let solved = engine.solve_claimed(job, meta, deadline).await;
+                engine.cache.release(&key_claimed).await;
+                solved
             }
             .boxed()
         };
@@ -335,10 +355,25 @@ impl Engine {
         }
     }
 
+    /// Solves `job` now, this process holding the fleet's claim on it, and keeps the answer.
+    async fn solve_claimed(
+        &self,
+        job: Job,
+        meta: Meta,
+        deadline: Instant,
+    ) -> Result<Arc<Solved>, EngineError> {
+        let permit = self.pool.try_acquire().ok_or(EngineError::Overloaded)?;
+        let control = Arc::new(self.control(deadline));
+        let solved = self.execute(permit, job, meta, control).await?;
+        self.cache.insert(solved.clone()).await;
+        Ok(solved)
+    }
+
     /// Queues `job` to run in the background; returns its record. Refused when the queue
     /// is full or the service is draining.
     pub async fn submit(self: &Arc<Self>, job: Job) -> Result<JobRecord, EngineError> {
         self.admit()?;
+        self.store_reachable()?;
         let meta = job.meta();
         // A job whose answer is cached is answered at once: it takes no place in the queue.
         if let Some(solved) = self.cache.get(&meta.input_hash).await {
@@ -356,6 +391,9 @@ impl Engine {
             record.state = JobState::Succeeded(solved);
             record.done = done;
             return Ok(record);
+        }
+        if let Some(shared) = &self.fleet {
+            return self.enqueue(shared, job, meta).await;
         }
         let max = self.config.max_queued_jobs;
         if self
@@ -401,6 +439,50 @@ impl Engine {
         Ok(record)
     }
 
+    /// Puts `job` on the fleet's work stream (in parts, if it splits into more than a part's
+    /// points); refused when the stream holds more than 64 entries per queued job allowed.
+    async fn enqueue(
+        &self,
+        shared: &Shared,
+        job: Job,
+        meta: Meta,
+    ) -> Result<JobRecord, EngineError> {
+        let unavailable = |e: super::fleet::Failure| self.refused(EngineError::Unavailable(e.0));
+        let backlog = shared.backlog().await.map_err(unavailable)?;
+        if backlog >= self.config.max_queued_jobs.saturating_mul(64) {
+            return Err(self.refused(EngineError::Overloaded));
+        }
+        let per_part = shared.fleet.config.part_points;
+        let parts = job
+            .points()
+            .filter(|&n| n > per_part)
+            .map(|n| crate::job::parts::ranges(n, per_part))
+            .unwrap_or_default();
+        let record = JobRecord::queued(self.ids.next(), job.kind(), job.work());
+        let deadline = std::time::SystemTime::now() + self.config.job_deadline;
+        shared
+            .store
+            .enqueue(&record, &job.to_wire(), &meta.input_hash, deadline, &parts)
+            .await
+            .map_err(unavailable)?;
+        Ok(record)
+    }
+
+    /// `Unavailable` while the fleet's job store cannot be reached.
+    pub fn store_reachable(&self) -> Result<(), EngineError> {
+        match &self.fleet {
+            Some(shared) if !shared.fleet.jobs.is_up() => Err(EngineError::Unavailable(
+                "no answer from it at the last try".to_string(),
+            )),
+            _ => Ok(()),
+        }
+    }
+
+    /// The reachability of each Redis role, when the engine works in a fleet.
+    pub fn fleet_health(&self) -> Option<[(&'static str, bool); 2]> {
+        self.fleet.as_ref().map(|shared| shared.fleet.health())
+    }
+
     /// The asynchronous job `id`, unless unknown or expired; a job this process runs has
     /// its progress counted up to now.
     pub async fn job(&self, id: Uuid) -> Option<JobRecord> {
@@ -424,7 +506,7 @@ impl Engine {
 
     /// Whether `id` is the id of a job this process accepted (known or forgotten since).
     pub fn issued(&self, id: Uuid) -> bool {
-        self.ids.issued(id)
+        self.jobs.shared() || self.ids.issued(id)
     }
 
     /// A receiver of the status changes of the job `id`, if this process runs it.
@@ -437,6 +519,10 @@ impl Engine {
     pub async fn cancel(&self, id: Uuid) -> Option<JobRecord> {
         let before = self.job(id).await?;
         let live = self.live().get(&id).cloned();
+        if live.is_none() && self.jobs.shared() && !before.state.status().is_finished() {
+            // Run by a worker of the fleet: it sees the cancel at its next heartbeat.
+            self.jobs.update(id, JobState::Cancelled, before.done).await;
+        }
         if let Some(live) = live {
             live.cancel();
             let mut status = live.status.subscribe();
@@ -508,6 +594,9 @@ impl Engine {
     /// Stops every job not finished yet (the drain ran out of time): they end
     /// `interrupted`.
     pub fn interrupt_unfinished_jobs(&self) {
+        if let Some(shared) = &self.fleet {
+            shared.interrupt();
+        }
         for live in self.live().values() {
             live.interrupted.store(true, Ordering::SeqCst);
             live.cancel();
@@ -532,6 +621,7 @@ impl Engine {
         let reason = match e {
             EngineError::Overloaded => "overloaded",
             EngineError::Draining => "draining",
+            EngineError::Unavailable(_) => "unavailable",
             EngineError::Job(_) => return e,
         };
         self.metrics

@@ -129,6 +129,12 @@ pub trait JobStore: Send + Sync {
     async fn remove(&self, id: Uuid);
     /// Forgets the jobs past their retention; returns how many.
     async fn purge_expired(&self) -> usize;
+
+    /// Whether every process of the fleet shares the store (so any of them answers for any
+    /// job, and a job unknown to it is unknown to all).
+    fn shared(&self) -> bool {
+        false
+    }
 }
 
 /// The records of one process's jobs, at most `max_jobs` of them (the oldest finished are

@@ -10,6 +10,7 @@ use axum::http::HeaderValue;
 use clap::{Parser, ValueEnum};
 
 use super::server::ConnectionLimits;
+use crate::engine::fleet::FleetConfig;
 use crate::engine::EngineConfig;
 use crate::job::Limits;
 
@@ -97,6 +98,74 @@ pub struct ServeArgs {
     /// flight have to finish; what is left then is interrupted.
     #[arg(long, env = "THIRDBODY_SHUTDOWN_TIMEOUT", default_value = "30s", value_parser = duration)]
     pub shutdown_timeout: Duration,
+
+    #[command(flatten)]
+    pub fleet: FleetArgs,
+}
+
+/// Several processes on one Redis: absent, the service keeps everything in its own memory.
+#[derive(Clone, Debug, clap::Args)]
+pub struct FleetArgs {
+    /// Redis shared by the fleet's processes (e.g. redis://redis:6379): answers cached
+    /// there for every process, jobs recorded there and their work taken from a stream
+    /// there. Absent: this process alone, everything in its memory.
+    #[arg(long, env = "THIRDBODY_REDIS_URL")]
+    pub redis_url: Option<String>,
+
+    /// A second Redis for the jobs (no eviction, persisted), if the one of --redis-url is
+    /// only a cache (allkeys-lru); default: the same server.
+    #[arg(long, env = "THIRDBODY_REDIS_JOBS_URL", requires = "redis_url")]
+    pub redis_jobs_url: Option<String>,
+
+    /// How long a part of a job may go without its process's heartbeat before another
+    /// process takes it over.
+    #[arg(long, env = "THIRDBODY_CLAIM_IDLE", default_value = "30s", value_parser = duration)]
+    pub claim_idle: Duration,
+
+    /// Deliveries of one part of a job before the job fails (each time its process died).
+    #[arg(long, env = "THIRDBODY_MAX_DELIVERIES", default_value_t = 3)]
+    pub max_deliveries: u32,
+
+    /// Points per part of a sweep on the fleet's stream.
+    #[arg(long, env = "THIRDBODY_PART_POINTS", default_value_t = 250)]
+    pub part_points: usize,
+}
+
+impl FleetArgs {
+    /// The fleet's settings, if there is a fleet.
+    fn validate(&self) -> Result<Option<FleetConfig>, ConfigError> {
+        let Some(cache_url) = self.redis_url.clone() else {
+            return Ok(None);
+        };
+        let jobs_url = self
+            .redis_jobs_url
+            .clone()
+            .unwrap_or_else(|| cache_url.clone());
+        for (flag, url) in [("--redis-url", &cache_url), ("--redis-jobs-url", &jobs_url)] {
+            if let Err(e) = redis::Client::open(url.as_str()) {
+                return Err(ConfigError(format!("{flag} {url}: {e}")));
+            }
+        }
+        if self.claim_idle < Duration::from_secs(1) {
+            return Err(ConfigError(format!(
+                "--claim-idle {}: allowed 1s or more (a heartbeat every 200 ms keeps a \
+                 running part)",
+                humantime::format_duration(self.claim_idle)
+            )));
+        }
+        if self.max_deliveries == 0 || self.part_points == 0 {
+            return Err(ConfigError(
+                "--max-deliveries and --part-points: allowed at least 1".to_string(),
+            ));
+        }
+        Ok(Some(FleetConfig {
+            cache_url,
+            jobs_url,
+            claim_idle: self.claim_idle,
+            max_deliveries: self.max_deliveries,
+            part_points: self.part_points,
+        }))
+    }
 }
 
 /// How log lines are written.
@@ -121,6 +190,8 @@ pub enum CorsOrigins {
 #[derive(Clone, Debug)]
 pub struct Config {
     pub bind: SocketAddr,
+    /// The fleet on Redis, if any.
+    pub fleet: Option<FleetConfig>,
     pub connections: ConnectionLimits,
     pub engine: EngineConfig,
     pub limits: Limits,
@@ -202,6 +273,7 @@ impl ServeArgs {
         }
         Ok(Config {
             bind: self.bind,
+            fleet: self.fleet.validate()?,
             connections: ConnectionLimits {
                 max_connections: self.max_connections,
                 header_timeout: self.header_timeout,

@@ -32,7 +32,8 @@ pub struct Problem {
     /// `payload-too-large` (413), `not-found` (404), `interrupted` (410: the service stopped
     /// before the job finished), `not-ready` (409: the job has no result yet), `cancelled`
     /// (409), `overloaded` (429),
-    /// `draining` (503), `deadline-exceeded` (504), `internal` (500); or `about:blank` for a
+    /// `draining` (503), `unavailable` (503: the shared job store cannot be reached),
+    /// `deadline-exceeded` (504), `internal` (500); or `about:blank` for a
     /// status with no more to say than its title.
     #[serde(rename = "type")]
     pub problem_type: String,
@@ -64,6 +65,7 @@ enum Kind {
     Cancelled,
     Overloaded,
     Draining,
+    Unavailable,
     DeadlineExceeded,
     Internal,
     /// `about:blank`: the status says it all.
@@ -84,7 +86,7 @@ impl Kind {
             Kind::Interrupted => StatusCode::GONE,
             Kind::Cancelled | Kind::NotReady => StatusCode::CONFLICT,
             Kind::Overloaded => StatusCode::TOO_MANY_REQUESTS,
-            Kind::Draining => StatusCode::SERVICE_UNAVAILABLE,
+            Kind::Draining | Kind::Unavailable => StatusCode::SERVICE_UNAVAILABLE,
             Kind::DeadlineExceeded => StatusCode::GATEWAY_TIMEOUT,
             Kind::Internal => StatusCode::INTERNAL_SERVER_ERROR,
             Kind::Blank(status) => status,
@@ -107,6 +109,7 @@ impl Kind {
             Kind::Cancelled => ("cancelled", "The job was cancelled"),
             Kind::Overloaded => ("overloaded", "Every solver thread is busy"),
             Kind::Draining => ("draining", "The service is shutting down"),
+            Kind::Unavailable => ("unavailable", "The shared job store cannot be reached"),
             Kind::DeadlineExceeded => ("deadline-exceeded", "The solve ran past its deadline"),
             Kind::Internal => ("internal", "Internal error"),
             Kind::Blank(_) => return None,
@@ -120,6 +123,8 @@ impl Kind {
             Kind::Overloaded | Kind::NotReady => Some(1),
             // Another instance should have taken over by then.
             Kind::Draining => Some(5),
+            // Redis reconnects by itself within a second or two.
+            Kind::Unavailable => Some(2),
             _ => None,
         }
     }
@@ -246,6 +251,13 @@ impl From<EngineError> for ApiError {
             EngineError::Draining => ApiError::new(
                 Kind::Draining,
                 "the service is shutting down and takes no new work",
+            ),
+            EngineError::Unavailable(why) => ApiError::new(
+                Kind::Unavailable,
+                format!(
+                    "the job store (Redis) cannot be reached ({why}): the job was not \
+                     accepted, so that none is lost; synchronous solves still work"
+                ),
             ),
         }
     }

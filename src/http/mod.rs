@@ -63,7 +63,12 @@ impl AppState {
     /// A service with its own engine, its answers and jobs in its own memory, and its own
     /// metrics registry.
     pub fn new(config: Config) -> Self {
-        let storage = Storage::in_process(&config.engine);
+        let storage = match &config.fleet {
+            // The settings were checked at start-up (`ServeArgs::validate`).
+            Some(fleet) => crate::engine::fleet::storage(&config.engine, fleet.clone())
+                .expect("the Redis URLs were validated"),
+            None => Storage::in_process(&config.engine),
+        };
         AppState::with_storage(config, storage)
     }
 
@@ -199,6 +204,10 @@ pub async fn run(
     shutdown: impl Future<Output = ()> + Send + 'static,
 ) -> std::io::Result<()> {
     let config = state.config().clone();
+    // In a fleet, this process also works the fleet's stream, leaving a solver thread to
+    // synchronous requests.
+    let workers = config.engine.pool_size.saturating_sub(1).max(1);
+    state.engine().start_workers(workers, true);
     let stop_accepting = CancellationToken::new();
     let housekeeping = tokio::spawn(housekeeping(state.clone()));
     let deadline = Arc::new(std::sync::Mutex::new(None::<tokio::time::Instant>));

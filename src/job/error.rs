@@ -3,14 +3,14 @@
 
 use std::fmt;
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use serde_json::Value;
 use utoipa::ToSchema;
 
 use crate::model::ModelError;
 
 /// One invalid field: where, what was sent, and what is allowed.
-#[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, ToSchema)]
 pub struct FieldError {
     /// Path of the field in the input, e.g. `layer.thickness` or `vary.radius[2]`.
     pub field: String,
@@ -29,8 +29,9 @@ impl fmt::Display for FieldError {
     }
 }
 
-/// Why a job was not answered.
-#[derive(Clone, Debug, PartialEq)]
+/// Why a job was not answered. Serializable, so that a job failed in one process reads
+/// the same from another (`engine::fleet`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub enum JobError {
     /// The body is not JSON.
     Syntax(String),

@@ -6,6 +6,7 @@
 
 use std::any::Any;
 use std::fmt;
+use std::ops::Range;
 use std::sync::Arc;
 
 use serde_json::Value;
@@ -64,6 +65,25 @@ pub trait Kind: fmt::Debug + PartialEq + Send + Sync + Sized + 'static {
     /// Runs the job to its answer, whose `meta` is `meta`. A long job checks `control`
     /// between units of work, and counts them there.
     fn run(&self, meta: Meta, control: &Control) -> Result<Self::Output, JobError>;
+
+    /// The number of points the job splits into, for a job whose answer is one row per
+    /// point, `{"points": [...], "meta": {...}}` (a sweep): parts of it can then be solved
+    /// apart, by other processes, and assembled ([`super::parts`]). `None`: solved whole.
+    fn points(&self) -> Option<usize> {
+        None
+    }
+
+    /// The answer with the rows of points `range` only (for a job that splits: see
+    /// [`Kind::points`]).
+    fn run_points(
+        &self,
+        meta: Meta,
+        range: Range<usize>,
+        control: &Control,
+    ) -> Result<Self::Output, JobError> {
+        let _ = range;
+        self.run(meta, control)
+    }
 }
 
 /// What [`Job`] needs of a kind, object-safe.
@@ -73,6 +93,13 @@ trait Dispatch: fmt::Debug + Send + Sync {
     fn references(&self) -> &'static [Reference];
     fn work(&self) -> Work;
     fn run(&self, meta: Meta, control: &Control) -> Result<Answer, JobError>;
+    fn points(&self) -> Option<usize>;
+    fn run_points(
+        &self,
+        meta: Meta,
+        range: Range<usize>,
+        control: &Control,
+    ) -> Result<Answer, JobError>;
     fn units(&self) -> crate::render::Units;
     fn as_any(&self) -> &dyn Any;
     fn same(&self, other: &dyn Any) -> bool;
@@ -97,6 +124,19 @@ impl<K: Kind> Dispatch for K {
 
     fn run(&self, meta: Meta, control: &Control) -> Result<Answer, JobError> {
         Kind::run(self, meta, control).map(Answer::new)
+    }
+
+    fn points(&self) -> Option<usize> {
+        Kind::points(self)
+    }
+
+    fn run_points(
+        &self,
+        meta: Meta,
+        range: Range<usize>,
+        control: &Control,
+    ) -> Result<Answer, JobError> {
+        Kind::run_points(self, meta, range, control).map(Answer::new)
     }
 
     fn units(&self) -> crate::render::Units {
@@ -175,6 +215,28 @@ impl Job {
     /// Runs the job to its answer, whose `meta` is `meta` (see [`Job::meta`]).
     pub fn run(&self, meta: Meta, control: &Control) -> Result<Answer, JobError> {
         self.kind.run(meta, control)
+    }
+
+    /// The points the job splits into, if it does ([`Kind::points`]).
+    pub fn points(&self) -> Option<usize> {
+        self.kind.points()
+    }
+
+    /// The answer with the rows of points `range` only ([`Kind::run_points`]).
+    pub fn run_points(
+        &self,
+        meta: Meta,
+        range: Range<usize>,
+        control: &Control,
+    ) -> Result<Answer, JobError> {
+        self.kind.run_points(meta, range, control)
+    }
+
+    /// The same job, with `warnings` as its input's (a job read back from its wire form,
+    /// [`super::wire`], keeps the warnings of the input the client sent).
+    pub fn with_warnings(mut self, warnings: Vec<InputWarning>) -> Job {
+        self.warnings = warnings;
+        self
     }
 
     /// The job, if it is of kind `K`.

@@ -1,7 +1,7 @@
 //! What every answer says about itself: the model version, the canonical input and its hash,
 //! and the papers behind the numbers.
 
-use serde::{Serialize, Serializer};
+use serde::{Deserialize, Serialize, Serializer};
 use serde_json::Value;
 use sha2::{Digest, Sha256};
 use utoipa::ToSchema;
@@ -83,7 +83,7 @@ pub const SOFTWARE: Software = Software {
 };
 
 /// A valid value that is implausible as sent: a bare number far from its field's scale.
-#[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, ToSchema)]
 pub struct InputWarning {
     /// Path of the field in the input.
     pub field: String,

@@ -14,11 +14,13 @@ pub mod figure;
 pub mod input;
 mod kind;
 pub mod meta;
+pub mod parts;
 pub mod registry;
 pub mod rolling;
 pub mod sweep;
 pub mod three_body;
 pub mod validity;
+mod wire;
 
 pub use control::{Control, Kept, Memo};
 pub use error::{FieldError, JobError};

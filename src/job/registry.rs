@@ -29,6 +29,11 @@ pub struct Registered {
 }
 
 impl Registered {
+    /// The kind's name on the wire.
+    pub fn name(&self) -> &'static str {
+        self.name
+    }
+
     const fn of<K: Kind>() -> Registered {
         Registered {
             name: K::NAME,

@@ -2,6 +2,8 @@
 //! rolling jobs (radius, load, speed) and three-body jobs (operating point, speed, mean
 //! diameter).
 
+use std::ops::Range;
+
 use serde::{Deserialize, Serialize};
 use serde_json::{json, Value};
 use utoipa::ToSchema;
@@ -167,9 +169,24 @@ impl Kind for SweepJob {
     }
 
     fn run(&self, meta: Meta, control: &Control) -> Result<SweepOutput, JobError> {
+        let all = 0..self.size().unwrap_or(0);
+        self.run_points(meta, all, control)
+    }
+
+    fn points(&self) -> Option<usize> {
+        self.size()
+    }
+
+    fn run_points(
+        &self,
+        meta: Meta,
+        range: Range<usize>,
+        control: &Control,
+    ) -> Result<SweepOutput, JobError> {
+        let first = range.start;
         let points = match self {
             SweepJob::Rolling(s) => {
-                let contacts = s.points();
+                let contacts = part(s.points(), range)?;
                 let options = &s.base.options;
                 let solutions = control.map_kept(
                     &contacts,
@@ -179,12 +196,14 @@ impl Kind for SweepJob {
                 )?;
                 let rows = contacts.iter().zip(&solutions).enumerate();
                 SweepPoints::Rolling(
-                    rows.map(|(i, (p, s))| SweepPoint::new(p, s).map_err(|e| at_point(i, e)))
-                        .collect::<Result<_, _>>()?,
+                    rows.map(|(i, (p, s))| {
+                        SweepPoint::new(p, s).map_err(|e| at_point(first + i, e))
+                    })
+                    .collect::<Result<_, _>>()?,
                 )
             }
             SweepJob::ThreeBody(s) => {
-                let systems = s.points();
+                let systems = part(s.points(), range)?;
                 let options = &s.base.options;
                 let solutions = control.map_kept(
                     &systems,
@@ -195,7 +214,7 @@ impl Kind for SweepJob {
                 let rows = systems.iter().zip(&solutions).enumerate();
                 SweepPoints::ThreeBody(
                     rows.map(|(i, (p, s))| {
-                        ThreeBodySweepPoint::new(p, s).map_err(|e| at_point(i, e))
+                        ThreeBodySweepPoint::new(p, s).map_err(|e| at_point(first + i, e))
                     })
                     .collect::<Result<_, _>>()?,
                 )
@@ -203,6 +222,18 @@ impl Kind for SweepJob {
         };
         Ok(SweepOutput { points, meta })
     }
+}
+
+/// The points `range` of `points`.
+fn part<T>(mut points: Vec<T>, range: Range<usize>) -> Result<Vec<T>, JobError> {
+    if range.start > range.end || range.end > points.len() {
+        return Err(JobError::Internal(format!(
+            "points {range:?} of a sweep of {} points",
+            points.len()
+        )));
+    }
+    points.truncate(range.end);
+    Ok(points.split_off(range.start))
 }
 
 /// The error of point `index` of a sweep, said so.

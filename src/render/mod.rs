@@ -68,6 +68,12 @@ impl fmt::Display for RenderError {
 
 impl std::error::Error for RenderError {}
 
+impl RenderError {
+    pub fn new(message: impl Into<String>) -> RenderError {
+        RenderError(message.into())
+    }
+}
+
 /// The unit of each numeric field of an answer, by path (`a.b`, `list[].c`): SI, `""` for
 /// plain numbers and counts; in groups, so that the parts answers share are declared once.
 pub type Units = &'static [&'static [(&'static str, &'static str)]];

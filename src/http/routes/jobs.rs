@@ -125,6 +125,10 @@ impl FromRequestParts<AppState> for FoundJob {
         let engine = state.engine();
         match engine.job(id).await {
             Some(record) => Ok(FoundJob(record)),
+            // Unknown here may be unknown only while the fleet's store is away.
+            None if engine.store_reachable().is_err() => Err(ApiError::from(
+                engine.store_reachable().expect_err("checked in the guard"),
+            )),
             None if engine.issued(id) => Err(ApiError::not_found(format!(
                 "no job {id}: it was deleted, or it expired (it finished more than the \
                  retention time ago)"

@@ -1,5 +1,7 @@
 //! Operations: liveness, readiness (fails while draining) and Prometheus metrics.
 
+use std::collections::BTreeMap;
+
 use axum::extract::State;
 use axum::http::header;
 use axum::response::IntoResponse;
@@ -15,8 +17,13 @@ use crate::http::AppState;
 /// A probe's answer.
 #[derive(Serialize, ToSchema)]
 pub struct Health {
-    /// `ok` (alive) or `ready` (taking work).
+    /// `ok` (alive), `ready` (taking work), or `degraded` (taking work, but a Redis of the
+    /// fleet is unreachable: synchronous solves answer from this process alone and job
+    /// submissions are refused with 503 until it is back).
     pub status: &'static str,
+    /// In a fleet: each Redis role (`cache`, `jobs`) with `up` or `down`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub redis: Option<BTreeMap<&'static str, &'static str>>,
 }
 
 /// Liveness: the process answers requests.
@@ -28,10 +35,14 @@ pub struct Health {
     responses((status = 200, description = "Alive", body = Health), NotAcceptable)
 )]
 pub async fn healthz(_: AcceptsJson) -> Json<Health> {
-    Json(Health { status: "ok" })
+    Json(Health {
+        status: "ok",
+        redis: None,
+    })
 }
 
-/// Readiness: the service takes new work; 503 once it is shutting down.
+/// Readiness: the service takes new work (`degraded` when a Redis of its fleet is
+/// unreachable: it still answers synchronous solves); 503 once it is shutting down.
 #[utoipa::path(
     get,
     path = "/readyz",
@@ -43,11 +54,24 @@ pub async fn readyz(
     State(state): State<AppState>,
     _: AcceptsJson,
 ) -> Result<Json<Health>, ApiError> {
-    if state.engine().is_draining() {
-        Err(ApiError::draining())
-    } else {
-        Ok(Json(Health { status: "ready" }))
+    let engine = state.engine();
+    if engine.is_draining() {
+        return Err(ApiError::draining());
     }
+    let redis = engine.fleet_health().map(|roles| {
+        let state = |up| if up { "up" } else { "down" };
+        roles
+            .into_iter()
+            .map(|(role, up)| (role, state(up)))
+            .collect()
+    });
+    let degraded = engine
+        .fleet_health()
+        .is_some_and(|roles| roles.iter().any(|(_, up)| !up));
+    Ok(Json(Health {
+        status: if degraded { "degraded" } else { "ready" },
+        redis,
+    }))
 }
 
 /// Metrics in the Prometheus text format.
@@ -55,7 +79,9 @@ pub async fn readyz(
 /// `http_requests_total` and `http_request_duration_seconds` by method, route and status;
 /// `thirdbody_solve_duration_seconds` by job kind and outcome (its `_count` is the number of
 /// solves); `thirdbody_cache_hits_total`, `thirdbody_cache_misses_total`;
-/// `thirdbody_jobs_queued`, `thirdbody_jobs_running`; `thirdbody_rejections_total` by reason.
+/// `thirdbody_jobs_queued`, `thirdbody_jobs_running`; `thirdbody_rejections_total` by reason;
+/// in a fleet, `thirdbody_redis_up` by role, `thirdbody_parts_total` by outcome and
+/// `thirdbody_redeliveries_total`.
 #[utoipa::path(
     get,
     path = "/metrics",

@@ -1,0 +1,419 @@
+//! The fleet's workers: each takes one entry of the work stream at a time (a job, or a
+//! range of a sweep's points), solves it on a solver thread, stores the result, and only
+//! then acknowledges the entry. While it runs, a heartbeat keeps the entry its own, passes a
+//! cancel on to the solver, and counts progress; an entry whose process died goes idle and
+//! is taken over by another worker (`XAUTOCLAIM`); one delivered more than
+//! `max_deliveries` times fails its job, saying so.
+
+use std::collections::HashMap;
+use std::ops::Range;
+use std::sync::{Arc, Mutex, MutexGuard};
+use std::time::{Duration, Instant};
+
+use bytes::Bytes;
+use redis::streams::{StreamAutoClaimReply, StreamId, StreamReadReply};
+use redis::Value;
+use uuid::Uuid;
+
+use super::store::RedisJobStore;
+use super::{keys, Failure, Fleet};
+use crate::engine::cache::Solved;
+use crate::engine::metrics as names;
+use crate::engine::pool::Pool;
+use crate::engine::store::JobState;
+use crate::engine::Engine;
+use crate::job::parts::{self, RenderedPart};
+use crate::job::{Control, Job, JobError, Work};
+
+/// How long an idle worker waits before looking at the stream again.
+const IDLE: Duration = Duration::from_millis(20);
+/// How often a running entry's heartbeat looks for a cancel and counts progress.
+const HEARTBEAT: Duration = Duration::from_millis(200);
+
+/// What an engine in a fleet holds: the fleet, its job store, and the entries this process
+/// is solving (so that a drain that runs out of time can stop them).
+pub struct Shared {
+    pub fleet: Arc<Fleet>,
+    pub store: Arc<RedisJobStore>,
+    running: Mutex<HashMap<String, Arc<Control>>>,
+}
+
+impl Shared {
+    pub fn new(fleet: Arc<Fleet>, store: Arc<RedisJobStore>) -> Shared {
+        Shared {
+            fleet,
+            store,
+            running: Mutex::default(),
+        }
+    }
+
+    fn running(&self) -> MutexGuard<'_, HashMap<String, Arc<Control>>> {
+        self.running.lock().unwrap_or_else(|p| p.into_inner())
+    }
+
+    /// Stops every entry this process is solving; they stay unacknowledged, so that another
+    /// process takes them over.
+    pub fn interrupt(&self) {
+        for control in self.running().values() {
+            control.cancel();
+        }
+    }
+
+    /// Entries on the stream not yet finished (waiting or being solved).
+    pub async fn backlog(&self) -> Result<usize, Failure> {
+        self.fleet
+            .jobs
+            .query(redis::cmd("XLEN").arg(keys::STREAM))
+            .await
+    }
+}
+
+/// One entry of the work stream.
+struct Entry {
+    /// The stream entry's id.
+    id: String,
+    job: Uuid,
+    /// The part (index and points), or `None` for a job solved whole.
+    part: Option<(usize, Range<usize>)>,
+}
+
+impl Entry {
+    fn read(entry: &StreamId) -> Option<Entry> {
+        let text = |name: &str| match entry.map.get(name) {
+            Some(Value::BulkString(bytes)) => String::from_utf8(bytes.clone()).ok(),
+            Some(Value::SimpleString(text)) => Some(text.clone()),
+            _ => None,
+        };
+        let number = |name: &str| text(name).and_then(|t| t.parse::<usize>().ok());
+        let part = match (number("part"), number("start"), number("end")) {
+            (Some(index), Some(start), Some(end)) => Some((index, start..end)),
+            _ => None,
+        };
+        Some(Entry {
+            id: entry.id.clone(),
+            job: text("job")?.parse().ok()?,
+            part,
+        })
+    }
+
+    /// The part's name among the job's deliveries.
+    fn part_name(&self) -> String {
+        self.part
+            .as_ref()
+            .map_or_else(|| "whole".to_string(), |(i, _)| i.to_string())
+    }
+}
+
+/// What a solver thread gives back.
+enum Outcome {
+    Whole(Arc<Solved>),
+    Part(RenderedPart),
+}
+
+impl Engine {
+    /// Starts `loops` workers on the fleet's stream (none without a fleet). With
+    /// `share_with_requests` (a process that also serves HTTP) they take the job slots, so
+    /// that a synchronous request always finds a solver thread. They stop when the engine
+    /// drains.
+    pub fn start_workers(self: &Arc<Self>, loops: usize, share_with_requests: bool) {
+        let Some(shared) = self.fleet.clone() else {
+            return;
+        };
+        let watcher = shared.fleet.clone();
+        tokio::spawn(async move { watcher.watch().await });
+        for _ in 0..loops.max(1) {
+            let (engine, shared) = (self.clone(), shared.clone());
+            self.tracker
+                .spawn(async move { engine.work(&shared, share_with_requests).await });
+        }
+    }
+
+    /// One worker's loop.
+    async fn work(self: Arc<Self>, shared: &Shared, share_with_requests: bool) {
+        let mut looked_for_orphans = Instant::now();
+        while !self.is_draining() {
+            let slot = if share_with_requests {
+                Some(self.job_slots.clone().acquire_owned().await)
+            } else {
+                None
+            };
+            match next_entry(&shared.fleet, &mut looked_for_orphans).await {
+                Ok(Some(entry)) => self.process(shared, entry).await,
+                Ok(None) => tokio::time::sleep(IDLE).await,
+                Err(e) => {
+                    tracing::debug!(error = %e, "no work from Redis");
+                    tokio::time::sleep(super::link::RETRY_EVERY).await;
+                }
+            }
+            drop(slot);
+        }
+    }
+
+    /// Solves `entry` and stores its result; acknowledges it unless it should run again.
+    async fn process(&self, shared: &Shared, entry: Entry) {
+        let store = &shared.store;
+        let id = entry.job;
+        let deliveries = match store.delivered(id, &entry.part_name()).await {
+            Ok(n) => n,
+            Err(_) => return, // Redis is away: the entry stays ours, and is taken over later.
+        };
+        if deliveries > 1 {
+            self.metrics.counter(names::REDELIVERIES, &[]).increment(1);
+        }
+        let runnable = match store.runnable(id).await {
+            Ok(Some(r)) if !r.status.is_finished() => r,
+            Ok(_) => return acknowledge(&shared.fleet, &entry).await, // gone or finished
+            Err(_) => return,
+        };
+        let max = shared.fleet.config.max_deliveries;
+        if deliveries > u64::from(max) {
+            let error = JobError::Internal(format!(
+                "part {} of the job was delivered {} times and each time its worker stopped \
+                 before finishing it (killed, or out of memory): the job is given up",
+                entry.part_name(),
+                deliveries - 1
+            ));
+            return self
+                .finish(shared, &entry, JobState::Failed(error), None)
+                .await;
+        }
+        let job = match Job::from_wire(&runnable.wire) {
+            Ok(job) => job,
+            Err(e) => return self.finish(shared, &entry, JobState::Failed(e), None).await,
+        };
+        let meta = job.meta();
+        if meta.input_hash != runnable.key {
+            let error = JobError::Internal(
+                "the job read back from the job store is not the job accepted".to_string(),
+            );
+            return self
+                .finish(shared, &entry, JobState::Failed(error), None)
+                .await;
+        }
+        let control =
+            Arc::new(Control::new(Some(runnable.deadline), 1).with_memo(self.points.clone()));
+        shared.running().insert(entry.id.clone(), control.clone());
+        let heartbeat = tokio::spawn(heartbeat(
+            shared.fleet.clone(),
+            store.clone(),
+            entry.id.clone(),
+            id,
+            control.clone(),
+            entry.part.is_none(),
+        ));
+        tracing::info!(entry = entry.id, job = %id, part = entry.part_name(), deliveries, "solving a part");
+        let _ = store.set_state(id, &JobState::Running, None).await;
+        let permit = self.pool.acquire().await;
+        self.jobs_running.increment(1.0);
+        let key = runnable.key.clone();
+        let part = entry.part.clone();
+        let result = Pool::run(permit, control.clone(), move |control| match part {
+            None => Ok(Outcome::Whole(Arc::new(Solved::new(
+                key,
+                job.run(meta, control)?,
+            )?))),
+            Some((_, range)) => Ok(Outcome::Part(parts::render(
+                &job.run_points(meta, range, control)?,
+            )?)),
+        })
+        .await;
+        self.jobs_running.decrement(1.0);
+        heartbeat.abort();
+        shared.running().remove(&entry.id);
+        let outcome = match &result {
+            Ok(_) => "succeeded",
+            Err(JobError::Cancelled) => "cancelled",
+            Err(_) => "failed",
+        };
+        self.metrics
+            .counter(names::PARTS, &[("outcome", outcome)])
+            .increment(1);
+        match result {
+            Ok(Outcome::Whole(solved)) => {
+                self.cache.insert(solved.clone()).await;
+                let total = match Job::from_wire(&runnable.wire).map(|j| j.work()) {
+                    Ok(Work::Known(total)) => Some(total),
+                    _ => Some(control.done()),
+                };
+                self.finish(shared, &entry, JobState::Succeeded(solved), total)
+                    .await;
+            }
+            Ok(Outcome::Part(rendered)) => {
+                let points = entry.part.as_ref().map_or(0, |(_, r)| r.len());
+                let index = entry.part.as_ref().map_or(0, |(i, _)| *i);
+                match store.part_done(id, index, &rendered, points).await {
+                    Ok(Some(all)) => self.assemble(shared, &entry, &runnable.key, &all).await,
+                    Ok(None) => acknowledge(&shared.fleet, &entry).await,
+                    Err(_) => {} // taken over later
+                }
+            }
+            // Stopped by the drain: left to another process.
+            Err(JobError::Cancelled) if self.is_draining() => {}
+            Err(JobError::Cancelled) => acknowledge(&shared.fleet, &entry).await,
+            Err(e) => {
+                self.finish(shared, &entry, JobState::Failed(e), Some(control.done()))
+                    .await;
+            }
+        }
+    }
+
+    /// Assembles a split job from all its parts and finishes it.
+    async fn assemble(&self, shared: &Shared, entry: &Entry, key: &str, all: &[RenderedPart]) {
+        let state = match Job::from_wire(&match shared.store.runnable(entry.job).await {
+            Ok(Some(r)) => r.wire,
+            _ => return,
+        })
+        .and_then(|job| parts::assemble(&job.meta(), all).map(|a| (job, a)))
+        {
+            Ok((job, assembled)) => {
+                let solved = Arc::new(Solved::rendered(
+                    key.to_string(),
+                    Bytes::from(assembled.json),
+                    Bytes::from(assembled.csv),
+                ));
+                self.cache.insert(solved.clone()).await;
+                let done = match job.work() {
+                    Work::Known(n) => Some(n),
+                    Work::Unknown => None,
+                };
+                return self
+                    .finish(shared, entry, JobState::Succeeded(solved), done)
+                    .await;
+            }
+            Err(e) => JobState::Failed(e),
+        };
+        self.finish(shared, entry, state, None).await;
+    }
+
+    /// Stores the job's final `state`, then acknowledges the entry (left for another worker
+    /// if the state could not be stored).
+    async fn finish(&self, shared: &Shared, entry: &Entry, state: JobState, done: Option<usize>) {
+        tracing::info!(id = %entry.job, status = state.status().as_str(), "job finished");
+        if shared
+            .store
+            .set_state(entry.job, &state, done)
+            .await
+            .is_ok()
+        {
+            acknowledge(&shared.fleet, entry).await;
+        }
+    }
+}
+
+/// The next entry for this worker: one whose worker went silent for the idle bound (looked
+/// for every half of it), else a new one.
+async fn next_entry(fleet: &Fleet, looked: &mut Instant) -> Result<Option<Entry>, Failure> {
+    let idle = fleet.config.claim_idle;
+    if looked.elapsed() >= idle / 2 {
+        let claim = redis::cmd("XAUTOCLAIM")
+            .arg(keys::STREAM)
+            .arg(keys::GROUP)
+            .arg(&fleet.consumer)
+            .arg(super::cache::millis(idle))
+            .arg("0-0")
+            .arg("COUNT")
+            .arg(1)
+            .clone();
+        match fleet.jobs.query::<StreamAutoClaimReply>(&claim).await {
+            Ok(reply) => {
+                if let Some(entry) = reply.claimed.first().and_then(Entry::read) {
+                    tracing::info!(entry = entry.id, job = %entry.job, "took over an entry");
+                    return Ok(Some(entry));
+                }
+                *looked = Instant::now();
+            }
+            Err(e) if e.0.contains("NOGROUP") => create_group(fleet).await?,
+            Err(e) => return Err(e),
+        }
+    }
+    let read = redis::cmd("XREADGROUP")
+        .arg("GROUP")
+        .arg(keys::GROUP)
+        .arg(&fleet.consumer)
+        .arg("COUNT")
+        .arg(1)
+        .arg("STREAMS")
+        .arg(keys::STREAM)
+        .arg(">")
+        .clone();
+    match fleet.jobs.query::<Option<StreamReadReply>>(&read).await {
+        Ok(reply) => Ok(reply
+            .and_then(|r| r.keys.into_iter().next())
+            .and_then(|k| k.ids.first().and_then(Entry::read))),
+        Err(e) if e.0.contains("NOGROUP") => create_group(fleet).await.map(|()| None),
+        Err(e) => Err(e),
+    }
+}
+
+/// Creates the stream and its consumer group (once in the fleet; later calls find it).
+async fn create_group(fleet: &Fleet) -> Result<(), Failure> {
+    let create = redis::cmd("XGROUP")
+        .arg("CREATE")
+        .arg(keys::STREAM)
+        .arg(keys::GROUP)
+        .arg("0")
+        .arg("MKSTREAM")
+        .clone();
+    match fleet.jobs.query::<()>(&create).await {
+        Err(e) if !e.0.contains("BUSYGROUP") => Err(e),
+        _ => Ok(()),
+    }
+}
+
+/// Acknowledges `entry` and deletes it from the stream (whose length is then the backlog).
+async fn acknowledge(fleet: &Fleet, entry: &Entry) {
+    let mut pipe = redis::pipe();
+    pipe.cmd("XACK")
+        .arg(keys::STREAM)
+        .arg(keys::GROUP)
+        .arg(&entry.id)
+        .ignore()
+        .cmd("XDEL")
+        .arg(keys::STREAM)
+        .arg(&entry.id)
+        .ignore();
+    if let Err(e) = fleet.jobs.pipe::<()>(&pipe).await {
+        tracing::warn!(error = %e, "an entry was not acknowledged: it will run again");
+    }
+}
+
+/// While an entry runs: keeps it this worker's (resetting its idle time well within the
+/// bound), stops the solver if the job was cancelled or finished elsewhere, and counts the
+/// progress of a job solved whole.
+async fn heartbeat(
+    fleet: Arc<Fleet>,
+    store: Arc<RedisJobStore>,
+    entry: String,
+    id: Uuid,
+    control: Arc<Control>,
+    whole: bool,
+) {
+    let keep_every = (fleet.config.claim_idle / 3).max(HEARTBEAT);
+    let mut kept = Instant::now();
+    loop {
+        tokio::time::sleep(HEARTBEAT).await;
+        match store.runnable(id).await {
+            Ok(Some(r)) if !r.status.is_finished() => {}
+            Ok(_) => control.cancel(),
+            Err(_) => {}
+        }
+        if whole {
+            let _ = store
+                .set_state(id, &JobState::Running, Some(control.done()))
+                .await;
+        }
+        if kept.elapsed() >= keep_every {
+            let keep = redis::cmd("XCLAIM")
+                .arg(keys::STREAM)
+                .arg(keys::GROUP)
+                .arg(&fleet.consumer)
+                .arg(0)
+                .arg(&entry)
+                .arg("JUSTID")
+                .clone();
+            if fleet.jobs.query::<Value>(&keep).await.is_ok() {
+                kept = Instant::now();
+            }
+        }
+    }
+}

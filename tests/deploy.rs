@@ -1,0 +1,143 @@
+//! The deployment files, checked offline (no cluster, no Docker engine here): every file the
+//! kustomization names parses, and the invariants between them hold: probes on the
+//! service's own endpoints, a preStop drain within the grace period, resources, the Redis
+//! URL pointing at the Redis Service, the autoscaler and the disruption budget on the
+//! Deployment; the compose file runs two replicas, a worker, Redis and Prometheus scraping
+//! both replicas.
+
+use std::path::Path;
+
+use serde_yaml::Value;
+
+fn read(path: &str) -> Vec<Value> {
+    let full = Path::new(env!("CARGO_MANIFEST_DIR")).join(path);
+    let text = std::fs::read_to_string(&full).unwrap_or_else(|e| panic!("{path}: {e}"));
+    serde_yaml::Deserializer::from_str(&text)
+        .map(|d| serde::Deserialize::deserialize(d).unwrap_or_else(|e| panic!("{path}: {e}")))
+        .collect()
+}
+
+fn one(path: &str) -> Value {
+    read(path).remove(0)
+}
+
+fn find<'a>(docs: &'a [Value], kind: &str) -> &'a Value {
+    docs.iter()
+        .find(|d| d["kind"] == kind)
+        .unwrap_or_else(|| panic!("no {kind}"))
+}
+
+#[test]
+fn the_kustomize_base_wires_probes_drain_redis_autoscaler_and_budget() {
+    let kustomization = one("deploy/base/kustomization.yaml");
+    let mut docs = Vec::new();
+    for resource in kustomization["resources"].as_sequence().unwrap() {
+        docs.extend(read(&format!("deploy/base/{}", resource.as_str().unwrap())));
+    }
+    let deployments: Vec<&Value> = docs.iter().filter(|d| d["kind"] == "Deployment").collect();
+    let app = deployments
+        .iter()
+        .find(|d| d["metadata"]["name"] == "thirdbody")
+        .unwrap();
+    let pod = &app["spec"]["template"]["spec"];
+    let container = &pod["containers"][0];
+    assert_eq!(container["readinessProbe"]["httpGet"]["path"], "/readyz");
+    assert_eq!(container["livenessProbe"]["httpGet"]["path"], "/healthz");
+    for bound in ["requests", "limits"] {
+        assert!(
+            container["resources"][bound]["cpu"].is_string(),
+            "{bound} cpu"
+        );
+        assert!(
+            container["resources"][bound]["memory"].is_string(),
+            "{bound} memory"
+        );
+    }
+    let pre_stop = &container["lifecycle"]["preStop"]["exec"]["command"];
+    assert_eq!(pre_stop[0], "sleep");
+    let sleep: u64 = pre_stop[1].as_str().unwrap().parse().unwrap();
+    // The image's THIRDBODY_SHUTDOWN_TIMEOUT (25 s) after the preStop sleep.
+    let grace = pod["terminationGracePeriodSeconds"].as_u64().unwrap();
+    assert!(grace > sleep + 25, "grace {grace} s");
+
+    // The configuration reaches the pods and names the Redis Service.
+    let config = &kustomization["configMapGenerator"][0];
+    assert_eq!(
+        container["envFrom"][0]["configMapRef"]["name"],
+        config["name"]
+    );
+    let literals: Vec<&str> = config["literals"]
+        .as_sequence()
+        .unwrap()
+        .iter()
+        .map(|l| l.as_str().unwrap())
+        .collect();
+    let url = literals
+        .iter()
+        .find_map(|l| l.strip_prefix("THIRDBODY_REDIS_URL="))
+        .expect("the Redis URL is configured");
+    let redis_service = docs
+        .iter()
+        .find(|d| d["kind"] == "Service" && d["metadata"]["name"] == "thirdbody-redis")
+        .unwrap();
+    let port = redis_service["spec"]["ports"][0]["port"].as_u64().unwrap();
+    assert_eq!(url, format!("redis://thirdbody-redis:{port}"));
+    let redis = deployments
+        .iter()
+        .find(|d| d["metadata"]["name"] == "thirdbody-redis")
+        .unwrap();
+    let args: Vec<&str> = redis["spec"]["template"]["spec"]["containers"][0]["args"]
+        .as_sequence()
+        .unwrap()
+        .iter()
+        .map(|a| a.as_str().unwrap())
+        .collect();
+    // Jobs live there: never evicted, persisted.
+    assert!(args
+        .windows(2)
+        .any(|w| w == ["--maxmemory-policy", "noeviction"]));
+    assert!(args.windows(2).any(|w| w == ["--appendonly", "yes"]));
+
+    // The autoscaler and the budget act on the API's Deployment.
+    let hpa = find(&docs, "HorizontalPodAutoscaler");
+    assert_eq!(hpa["spec"]["scaleTargetRef"]["name"], "thirdbody");
+    assert_eq!(hpa["spec"]["metrics"][0]["resource"]["name"], "cpu");
+    let pdb = find(&docs, "PodDisruptionBudget");
+    assert_eq!(
+        pdb["spec"]["selector"]["matchLabels"],
+        app["spec"]["selector"]["matchLabels"]
+    );
+    let service = docs
+        .iter()
+        .find(|d| d["kind"] == "Service" && d["metadata"]["name"] == "thirdbody")
+        .unwrap();
+    assert_eq!(
+        service["spec"]["selector"],
+        app["spec"]["selector"]["matchLabels"]
+    );
+}
+
+#[test]
+fn compose_runs_two_replicas_a_worker_redis_and_prometheus_scraping_both() {
+    let compose = one("deploy/compose.yaml");
+    let services = compose["services"].as_mapping().unwrap();
+    let get = |name: &str| &services[&Value::from(name)];
+    let anchor = &compose["x-thirdbody"];
+    assert_eq!(
+        anchor["environment"]["THIRDBODY_REDIS_URL"],
+        "redis://redis:6379"
+    );
+    assert!(services.contains_key(Value::from("redis")));
+    for replica in ["thirdbody-a", "thirdbody-b"] {
+        assert!(get(replica)["ports"][0]
+            .as_str()
+            .unwrap()
+            .ends_with(":8080"));
+    }
+    assert_eq!(get("worker")["command"][0], "worker");
+    let prometheus = one("deploy/prometheus.yml");
+    let targets = &prometheus["scrape_configs"][0]["static_configs"][0]["targets"];
+    assert_eq!(targets[0], "thirdbody-a:8080");
+    assert_eq!(targets[1], "thirdbody-b:8080");
+    assert_eq!(prometheus["scrape_configs"][0]["metrics_path"], "/metrics");
+}

@@ -1,0 +1,349 @@
+//! Several processes on one real Redis (`redis-server` from the machine's packages: `.ci/run`
+//! installs it; without it these tests say they were skipped): two `thirdbody serve` and one
+//! `thirdbody worker`, as `deploy/compose.yaml` runs them.
+
+use std::io::{BufRead, BufReader};
+use std::net::TcpListener;
+use std::process::{Child, Command, Stdio};
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+
+use serde_json::{json, Value};
+
+/// A child process, killed when dropped.
+struct Process(Child);
+
+impl Drop for Process {
+    fn drop(&mut self) {
+        let _ = self.0.kill();
+        let _ = self.0.wait();
+    }
+}
+
+fn free_port() -> u16 {
+    TcpListener::bind("127.0.0.1:0")
+        .unwrap()
+        .local_addr()
+        .unwrap()
+        .port()
+}
+
+fn redis_server_available() -> bool {
+    Command::new("redis-server")
+        .arg("--version")
+        .output()
+        .is_ok_and(|o| o.status.success())
+}
+
+/// A Redis server on `port`, without persistence.
+fn start_redis(port: u16) -> Process {
+    let child = Command::new("redis-server")
+        .args([
+            "--port",
+            &port.to_string(),
+            "--save",
+            "",
+            "--appendonly",
+            "no",
+        ])
+        .args(["--bind", "127.0.0.1"])
+        .stdout(Stdio::null())
+        .spawn()
+        .expect("redis-server starts");
+    let start = Instant::now();
+    while std::net::TcpStream::connect(("127.0.0.1", port)).is_err() {
+        assert!(
+            start.elapsed() < Duration::from_secs(10),
+            "redis-server did not start"
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    Process(child)
+}
+
+fn redis_cli(port: u16, args: &[&str]) -> String {
+    let out = Command::new("redis-cli")
+        .args(["-p", &port.to_string()])
+        .args(args)
+        .output()
+        .expect("redis-cli runs");
+    String::from_utf8_lossy(&out.stdout).into_owned()
+}
+
+/// Starts `thirdbody <command>` on the fleet of Redis `redis`; its log lines are collected.
+fn start(command: &str, redis: u16, port: Option<u16>) -> (Process, Arc<Mutex<Vec<String>>>) {
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_thirdbody"));
+    cmd.arg(command)
+        .args(["--redis-url", &format!("redis://127.0.0.1:{redis}")])
+        .args([
+            "--claim-idle",
+            "2s",
+            "--part-points",
+            "100",
+            "--log-format",
+            "text",
+        ])
+        .args(["--pool-size", "2"])
+        .env("RUST_LOG", "info")
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped());
+    if let Some(port) = port {
+        cmd.args(["--bind", &format!("127.0.0.1:{port}")]);
+    }
+    let mut child = cmd.spawn().expect("thirdbody starts");
+    let lines = Arc::new(Mutex::new(Vec::new()));
+    let stderr = child.stderr.take().unwrap();
+    let sink = lines.clone();
+    std::thread::spawn(move || {
+        for line in BufReader::new(stderr).lines().map_while(Result::ok) {
+            sink.lock().unwrap().push(line);
+        }
+    });
+    (Process(child), lines)
+}
+
+struct Service {
+    base: String,
+    _process: Process,
+}
+
+async fn serve(redis: u16, http: &reqwest::Client) -> Service {
+    let port = free_port();
+    let (process, _) = start("serve", redis, Some(port));
+    let base = format!("http://127.0.0.1:{port}");
+    let start = Instant::now();
+    while http.get(format!("{base}/healthz")).send().await.is_err() {
+        assert!(
+            start.elapsed() < Duration::from_secs(20),
+            "serve did not start"
+        );
+        tokio::time::sleep(Duration::from_millis(50)).await;
+    }
+    Service {
+        base,
+        _process: process,
+    }
+}
+
+/// The value of the metric `name` (summed over its label sets matching `filter`).
+async fn metric(http: &reqwest::Client, base: &str, name: &str, filter: &str) -> f64 {
+    let text = http
+        .get(format!("{base}/metrics"))
+        .send()
+        .await
+        .unwrap()
+        .text()
+        .await
+        .unwrap();
+    text.lines()
+        .filter(|l| l.starts_with(name) && l.contains(filter))
+        .filter_map(|l| l.rsplit(' ').next()?.parse::<f64>().ok())
+        .sum()
+}
+
+async fn post(http: &reqwest::Client, url: String, body: &Value) -> reqwest::Response {
+    http.post(url).json(body).send().await.unwrap()
+}
+
+/// Polls job `id` on `base` until it finished; returns its view.
+async fn finished(http: &reqwest::Client, base: &str, id: &str) -> Value {
+    let start = Instant::now();
+    loop {
+        let view: Value = http
+            .get(format!("{base}/v1/jobs/{id}"))
+            .send()
+            .await
+            .unwrap()
+            .json()
+            .await
+            .unwrap();
+        if !matches!(view["status"].as_str(), Some("queued" | "running")) {
+            return view;
+        }
+        assert!(
+            start.elapsed() < Duration::from_secs(60),
+            "job {id} never finished"
+        );
+        tokio::time::sleep(Duration::from_millis(50)).await;
+    }
+}
+
+async fn submit(http: &reqwest::Client, base: &str, job: Value) -> String {
+    let response = post(http, format!("{base}/v1/jobs"), &job).await;
+    let status = response.status();
+    let view: Value = response.json().await.unwrap();
+    assert_eq!(status, 202, "{view}");
+    view["id"].as_str().unwrap().to_string()
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn two_services_and_a_worker_share_answers_jobs_and_sweeps_through_redis() {
+    if !redis_server_available() {
+        eprintln!("SKIPPED: redis-server is not on PATH (`.ci/run` installs it)");
+        return;
+    }
+    let redis_port = free_port();
+    let redis = start_redis(redis_port);
+    let http = reqwest::Client::new();
+    let a = serve(redis_port, &http).await;
+    let b = serve(redis_port, &http).await;
+    let (worker, worker_log) = start("worker", redis_port, None);
+
+    // A job submitted to A is polled and followed on B.
+    let id = submit(
+        &http,
+        &a.base,
+        json!({"kind": "rolling", "input": {"load": "1.5 nN"}}),
+    )
+    .await;
+    let view = finished(&http, &b.base, &id).await;
+    assert_eq!(view["status"], "succeeded", "{view}");
+    assert!(view["result"]["friction_coefficient"].as_f64().unwrap() > 0.0);
+    let events = http
+        .get(format!("{}/v1/jobs/{id}/events", b.base))
+        .header("accept", "text/event-stream")
+        .send()
+        .await
+        .unwrap()
+        .text()
+        .await
+        .unwrap();
+    assert!(events.contains("event: completion"), "{events}");
+
+    // An answer solved on A is a hit on B.
+    let body = json!({"load": "1.7 nN"});
+    let on_a = post(&http, format!("{}/v1/rolling", a.base), &body).await;
+    assert_eq!(on_a.headers()["x-cache"], "miss");
+    let solved_a: Value = on_a.json().await.unwrap();
+    let on_b = post(&http, format!("{}/v1/rolling", b.base), &body).await;
+    assert_eq!(on_b.headers()["x-cache"], "hit");
+    assert_eq!(on_b.json::<Value>().await.unwrap(), solved_a);
+
+    // A burst of 50 identical requests across A and B solves once in the fleet.
+    let misses = |http: reqwest::Client, a: String, b: String| async move {
+        metric(&http, &a, "thirdbody_cache_misses_total", "").await
+            + metric(&http, &b, "thirdbody_cache_misses_total", "").await
+    };
+    let before = misses(http.clone(), a.base.clone(), b.base.clone()).await;
+    let body = json!({"load": "1.9 nN", "radius": "30 nm"});
+    let burst: Vec<_> = (0..50)
+        .map(|i| {
+            let url = format!("{}/v1/rolling", if i % 2 == 0 { &a.base } else { &b.base });
+            let (http, body) = (http.clone(), body.clone());
+            tokio::spawn(async move { post(&http, url, &body).await.status() })
+        })
+        .collect();
+    for request in burst {
+        assert_eq!(request.await.unwrap(), 200);
+    }
+    let after = misses(http.clone(), a.base.clone(), b.base.clone()).await;
+    assert_eq!(
+        after - before,
+        1.0,
+        "50 identical requests solved {} times",
+        after - before
+    );
+
+    // A 2,000-point sweep is worked by all three, and SIGKILL of the worker mid-run loses no
+    // point: its part is delivered again.
+    let loads: Vec<String> = (0..40)
+        .map(|i| format!("{} nN", 1.0 + 0.05 * f64::from(i)))
+        .collect();
+    let speeds: Vec<String> = (0..50).map(|i| format!("{} nm/s", f64::from(i))).collect();
+    let sweep = json!({"kind": "sweep", "input": {
+        "base": {"options": {"strips": 1024}},
+        "vary": {"load": loads, "velocity": speeds}}});
+    let id = submit(&http, &a.base, sweep.clone()).await;
+    let start = Instant::now();
+    let taken = |l: &String| l.contains("solving a part") && l.contains(&id);
+    while !worker_log.lock().unwrap().iter().any(taken) {
+        assert!(
+            start.elapsed() < Duration::from_secs(30),
+            "the worker took no part"
+        );
+        tokio::time::sleep(Duration::from_millis(5)).await;
+    }
+    drop(worker); // SIGKILL
+    let view = finished(&http, &b.base, &id).await;
+    assert_eq!(view["status"], "succeeded", "{view}");
+    let points = view["result"]["points"].as_array().unwrap();
+    assert_eq!(points.len(), 2000);
+    let whole: Value = post(&http, format!("{}/v1/sweeps", b.base), &sweep["input"])
+        .await
+        .json()
+        .await
+        .unwrap();
+    assert_eq!(
+        view["result"], whole,
+        "the sweep assembled from parts is the sweep"
+    );
+    let deliveries = redis_cli(
+        redis_port,
+        &["HVALS", &format!("thirdbody:job:{id}:deliveries")],
+    );
+    assert!(
+        deliveries.lines().any(|n| n.trim() == "2"),
+        "deliveries: {deliveries}"
+    );
+    for service in [&a, &b] {
+        let parts = metric(&http, &service.base, "thirdbody_parts_total", "succeeded").await;
+        assert!(parts >= 1.0, "{} solved no part", service.base);
+    }
+
+    // Redis stopped: synchronous solves still answer, submissions are refused with 503.
+    drop(redis);
+    let body = json!({"load": "2.1 nN"});
+    let solved = post(&http, format!("{}/v1/rolling", a.base), &body).await;
+    assert_eq!(solved.status(), 200);
+    let refused = post(
+        &http,
+        format!("{}/v1/jobs", a.base),
+        &json!({"kind": "rolling"}),
+    )
+    .await;
+    assert_eq!(refused.status(), 503);
+    let problem: Value = refused.json().await.unwrap();
+    assert_eq!(problem["type"], "tag:thirdbody,2026:problems/unavailable");
+    let ready: Value = http
+        .get(format!("{}/readyz", a.base))
+        .send()
+        .await
+        .unwrap()
+        .json()
+        .await
+        .unwrap();
+    assert_eq!(ready["status"], "degraded", "{ready}");
+
+    // Redis back: sharing resumes without a restart.
+    let _redis = start_redis(redis_port);
+    let start = Instant::now();
+    for base in [&a.base, &b.base] {
+        loop {
+            let ready: Value = http
+                .get(format!("{base}/readyz"))
+                .send()
+                .await
+                .unwrap()
+                .json()
+                .await
+                .unwrap();
+            if ready["status"] == "ready" {
+                break;
+            }
+            assert!(start.elapsed() < Duration::from_secs(15), "{ready}");
+            tokio::time::sleep(Duration::from_millis(100)).await;
+        }
+    }
+    let body = json!({"load": "2.3 nN"});
+    let on_a = post(&http, format!("{}/v1/rolling", a.base), &body).await;
+    assert_eq!(on_a.headers()["x-cache"], "miss");
+    let on_b = post(&http, format!("{}/v1/rolling", b.base), &body).await;
+    assert_eq!(on_b.headers()["x-cache"], "hit");
+    let id = submit(
+        &http,
+        &b.base,
+        json!({"kind": "rolling", "input": {"load": "2.5 nN"}}),
+    )
+    .await;
+    assert_eq!(finished(&http, &a.base, &id).await["status"], "succeeded");
+}
