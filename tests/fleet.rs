@@ -145,18 +145,15 @@ async fn post(http: &reqwest::Client, url: String, body: &Value) -> reqwest::Res
     http.post(url).json(body).send().await.unwrap()
 }
 
+async fn get_json(http: &reqwest::Client, url: String) -> Value {
+    http.get(url).send().await.unwrap().json().await.unwrap()
+}
+
 /// Polls job `id` on `base` until it finished; returns its view.
 async fn finished(http: &reqwest::Client, base: &str, id: &str) -> Value {
     let start = Instant::now();
     loop {
-        let view: Value = http
-            .get(format!("{base}/v1/jobs/{id}"))
-            .send()
-            .await
-            .unwrap()
-            .json()
-            .await
-            .unwrap();
+        let view = get_json(http, format!("{base}/v1/jobs/{id}")).await;
         if !matches!(view["status"].as_str(), Some("queued" | "running")) {
             return view;
         }
@@ -304,14 +301,7 @@ async fn two_services_and_a_worker_share_answers_jobs_and_sweeps_through_redis()
     assert_eq!(refused.status(), 503);
     let problem: Value = refused.json().await.unwrap();
     assert_eq!(problem["type"], "tag:thirdbody,2026:problems/unavailable");
-    let ready: Value = http
-        .get(format!("{}/readyz", a.base))
-        .send()
-        .await
-        .unwrap()
-        .json()
-        .await
-        .unwrap();
+    let ready = get_json(&http, format!("{}/readyz", a.base)).await;
     assert_eq!(ready["status"], "degraded", "{ready}");
 
     // Redis back: sharing resumes without a restart.
@@ -319,14 +309,7 @@ async fn two_services_and_a_worker_share_answers_jobs_and_sweeps_through_redis()
     let start = Instant::now();
     for base in [&a.base, &b.base] {
         loop {
-            let ready: Value = http
-                .get(format!("{base}/readyz"))
-                .send()
-                .await
-                .unwrap()
-                .json()
-                .await
-                .unwrap();
+            let ready = get_json(&http, format!("{base}/readyz")).await;
             if ready["status"] == "ready" {
                 break;
             }
