@@ -130,7 +130,7 @@ fn service(c: &mut Criterion) {
     group.bench_function("render_json", |b| {
         b.iter_batched(
             || engine::run(&job, &control).unwrap(),
-            |answer| black_box(Solved::new(job.cache_key(), answer).unwrap()),
+            |answer| black_box(Solved::new(job.cache_key(), job.kind(), answer).unwrap()),
             criterion::BatchSize::SmallInput,
         )
     });

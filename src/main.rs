@@ -84,6 +84,8 @@ struct OutputArgs {
 enum OutputFormat {
     Json,
     Csv,
+    /// The answer's picture.
+    Svg,
 }
 
 impl OutputFormat {
@@ -91,6 +93,7 @@ impl OutputFormat {
         match self {
             OutputFormat::Json => Format::Json,
             OutputFormat::Csv => Format::Csv,
+            OutputFormat::Svg => Format::Svg,
         }
     }
 }
@@ -270,7 +273,9 @@ fn serve(args: ServeArgs) -> ExitCode {
         let listener = tokio::net::TcpListener::bind(bind)
             .await
             .map_err(|e| format!("cannot listen on {bind}: {e}"))?;
-        tracing::info!(address = %bind, "listening; API docs at /docs");
+        // The address bound (the port the system chose, for `--bind 127.0.0.1:0`).
+        let address = listener.local_addr().unwrap_or(bind);
+        tracing::info!(%address, "listening; dashboard at /, API docs at /docs");
         http::run(listener, AppState::new(config), shutdown_signal())
             .await
             .map_err(|e| format!("the server failed: {e}"))

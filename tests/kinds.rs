@@ -13,6 +13,7 @@ use thirdbody::engine::{self, Engine, EngineConfig};
 use thirdbody::job::{
     Control, Job, JobError, Kind, Limits, Meta, Reference, Validated, Work, ROLLING_REFERENCES,
 };
+use thirdbody::render::svg::{Axis, Chart, Layer};
 use thirdbody::render::{Column, Format, Output, Table, Units};
 use utoipa::ToSchema;
 
@@ -60,6 +61,24 @@ impl Kind for Countdown {
 
     fn work(&self) -> Work {
         Work::Unknown
+    }
+
+    /// The steps as one bar.
+    fn picture(answer: &Value) -> Result<Chart, String> {
+        let steps = answer["steps"].as_f64().ok_or("no steps")?;
+        Ok(Chart {
+            title: "countdown".to_string(),
+            x: Axis::new("step", ""),
+            y: Axis::new("steps", ""),
+            layers: vec![Layer::Line {
+                name: "steps".to_string(),
+                group: "steps".to_string(),
+                points: vec![(0.0, 0.0), (steps, steps)],
+                dashed: false,
+            }],
+            equal_aspect: false,
+            notes: Vec::new(),
+        })
     }
 
     fn run(&self, meta: Meta, control: &Control) -> Result<CountdownOutput, JobError> {

@@ -26,6 +26,9 @@ use crate::job::{Job, JobError, Limits};
 /// A checks document: `{"checks": [...]}`.
 #[derive(Clone, Debug, Deserialize, ToSchema)]
 #[serde(deny_unknown_fields)]
+#[schema(example = json!({"checks": [{"name": "mu stays low",
+    "job": {"kind": "rolling", "input": {"load": "1.2 nN"}},
+    "expect": {"friction_coefficient": {"max": 0.1}}}]}))]
 pub struct ChecksInput {
     pub checks: Vec<CheckInput>,
 }

@@ -10,8 +10,9 @@ use bytes::Bytes;
 use moka::future::Cache;
 
 use super::budget;
+use crate::job::registry;
 use crate::job::JobError;
-use crate::render::{Answer, Format, RenderError};
+use crate::render::{draw_svg, Answer, Format, RenderError};
 
 /// A solved job as it is kept and sent: its JSON rendered once (a cache hit then costs no
 /// serialization: measured in BENCHMARKS.md, rendering a rolling answer costs more than a
@@ -21,8 +22,12 @@ use crate::render::{Answer, Format, RenderError};
 pub struct Solved {
     /// The job's cache key.
     pub key: String,
+    /// The job's kind (which draws its picture).
+    pub kind: &'static str,
     json: Bytes,
     csv: OnceLock<Bytes>,
+    /// The picture, drawn the first time a client asks for it.
+    svg: OnceLock<Bytes>,
     /// The typed answer, while the CSV is still to render.
     answer: Option<Answer>,
 }
@@ -30,22 +35,27 @@ pub struct Solved {
 impl Solved {
     /// Renders `answer` as JSON; an answer that cannot be rendered (a non-finite number)
     /// is an internal error, never a silent `null` for the client.
-    pub fn new(key: String, answer: Answer) -> Result<Solved, JobError> {
+    pub fn new(key: String, kind: &'static str, answer: Answer) -> Result<Solved, JobError> {
         let json = answer.render(Format::Json).map_err(internal)?;
         Ok(Solved {
             key,
+            kind,
             json: json.into(),
             csv: OnceLock::new(),
+            svg: OnceLock::new(),
             answer: Some(answer),
         })
     }
 
-    /// An answer already rendered in every format.
-    pub fn rendered(key: String, json: Bytes, csv: Bytes) -> Solved {
+    /// An answer of `kind` already rendered as JSON and CSV (its picture is drawn from the
+    /// JSON).
+    pub fn rendered(key: String, kind: &'static str, json: Bytes, csv: Bytes) -> Solved {
         Solved {
             key,
+            kind,
             json,
             csv: OnceLock::from(csv),
+            svg: OnceLock::new(),
             answer: None,
         }
     }
@@ -68,6 +78,16 @@ impl Solved {
                 })?;
                 let csv = Bytes::from(answer.render(Format::Csv)?);
                 Ok(self.csv.get_or_init(|| csv).clone())
+            }
+            Format::Svg => {
+                if let Some(svg) = self.svg.get() {
+                    return Ok(svg.clone());
+                }
+                let draw = registry::find(self.kind)
+                    .map_err(|e| RenderError::new(e.to_string()))?
+                    .picture();
+                let svg = Bytes::from(draw_svg(draw, &self.json)?);
+                Ok(self.svg.get_or_init(|| svg).clone())
             }
         }
     }

@@ -644,7 +644,7 @@ impl Engine {
         let start = Instant::now();
         let result = Pool::run(permit, control, move |control| {
             let key = meta.input_hash.clone();
-            Solved::new(key, job.run(meta, control)?).map(Arc::new)
+            Solved::new(key, job.kind(), job.run(meta, control)?).map(Arc::new)
         })
         .await;
         let outcome = match &result {

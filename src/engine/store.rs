@@ -303,7 +303,7 @@ mod tests {
         let blob = Blob {
             text: "x".repeat(bytes),
         };
-        Arc::new(Solved::new(key.to_string(), Answer::new(blob)).unwrap())
+        Arc::new(Solved::new(key.to_string(), "rolling", Answer::new(blob)).unwrap())
     }
 
     #[tokio::test]

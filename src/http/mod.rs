@@ -8,6 +8,7 @@
 mod accept;
 mod body;
 pub mod config;
+mod dashboard;
 pub mod error;
 mod observe;
 pub mod openapi;
@@ -121,6 +122,7 @@ pub fn app(state: AppState) -> Router {
     // each response leaves through the problem mapping (inside CORS, so that errors carry
     // CORS headers too).
     api.merge(SwaggerUi::new("/docs").url("/openapi.json", spec))
+        .merge(dashboard::router())
         .route_layer(middleware::from_fn(observe::tag_route))
         .fallback(not_found)
         .layer(DefaultBodyLimit::max(config.body_limit))

@@ -1,5 +1,7 @@
 //! The figure job: the data of one of the paper's Figures 3–9 (docs/model.md §5).
 
+use super::pictures::PictureError;
+use crate::render::svg::Chart;
 use serde::{Deserialize, Serialize};
 use serde_json::{json, Value};
 use utoipa::ToSchema;
@@ -61,6 +63,10 @@ impl Kind for FigureJob {
 
     fn references(&self) -> &'static [Reference] {
         ROLLING_REFERENCES
+    }
+
+    fn picture(answer: &Value) -> Result<Chart, PictureError> {
+        super::pictures::figure(answer)
     }
 
     fn work(&self) -> Work {

@@ -13,7 +13,9 @@ use serde_json::Value;
 use utoipa::ToSchema;
 
 use super::meta::{InputWarning, Meta, Reference};
+use super::pictures::PictureError;
 use super::{Control, JobError, Limits};
+use crate::render::svg::Chart;
 use crate::render::{Answer, Output};
 
 /// How much work a job takes, in the units its [`Control`] counts (rolling solves for the
@@ -65,6 +67,10 @@ pub trait Kind: fmt::Debug + PartialEq + Send + Sync + Sized + 'static {
     /// Runs the job to its answer, whose `meta` is `meta`. A long job checks `control`
     /// between units of work, and counts them there.
     fn run(&self, meta: Meta, control: &Control) -> Result<Self::Output, JobError>;
+
+    /// The picture of an answer of this kind, drawn from its JSON (so that an answer made
+    /// in another process is drawn the same).
+    fn picture(answer: &Value) -> Result<Chart, PictureError>;
 
     /// The number of points the job splits into, for a job whose answer is one row per
     /// point, `{"points": [...], "meta": {...}}` (a sweep): parts of it can then be solved
@@ -123,7 +129,7 @@ impl<K: Kind> Dispatch for K {
     }
 
     fn run(&self, meta: Meta, control: &Control) -> Result<Answer, JobError> {
-        Kind::run(self, meta, control).map(Answer::new)
+        Kind::run(self, meta, control).map(|o| Answer::new(o).drawn_by(K::picture))
     }
 
     fn points(&self) -> Option<usize> {
@@ -136,7 +142,7 @@ impl<K: Kind> Dispatch for K {
         range: Range<usize>,
         control: &Control,
     ) -> Result<Answer, JobError> {
-        Kind::run_points(self, meta, range, control).map(Answer::new)
+        Kind::run_points(self, meta, range, control).map(|o| Answer::new(o).drawn_by(K::picture))
     }
 
     fn units(&self) -> crate::render::Units {

@@ -15,6 +15,7 @@ pub mod input;
 mod kind;
 pub mod meta;
 pub mod parts;
+pub mod pictures;
 pub mod registry;
 pub mod rolling;
 pub mod sweep;

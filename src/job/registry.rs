@@ -16,6 +16,7 @@ use super::rolling::RollingJob;
 use super::sweep::SweepJob;
 use super::three_body::ThreeBodyJob;
 use super::{JobError, Limits};
+use crate::render::Draw;
 
 /// Schemas as utoipa collects them: (name, schema).
 type Schemas = Vec<(String, RefOr<Schema>)>;
@@ -25,6 +26,7 @@ type Schemas = Vec<(String, RefOr<Schema>)>;
 pub struct Registered {
     name: &'static str,
     validate: fn(Value, &Limits) -> Result<Job, JobError>,
+    picture: Draw,
     output_schema: fn(&mut Schemas) -> RefOr<Schema>,
 }
 
@@ -34,10 +36,16 @@ impl Registered {
         self.name
     }
 
+    /// How an answer of this kind is drawn ([`Kind::picture`]).
+    pub fn picture(&self) -> Draw {
+        self.picture
+    }
+
     const fn of<K: Kind>() -> Registered {
         Registered {
             name: K::NAME,
             validate: validate::<K>,
+            picture: K::picture,
             output_schema: output_schema::<K>,
         }
     }
@@ -171,6 +179,8 @@ impl ToSchema for KindName {
 /// The envelope `{"kind": ..., "input": {...}}`; a missing input means all defaults.
 #[derive(Deserialize, ToSchema)]
 #[serde(deny_unknown_fields)]
+#[schema(example = json!({"kind": "sweep", "input": {
+    "vary": {"load": ["0.5 nN", "1 nN", "2 nN"], "velocity": ["0 nm/s", "4 nm/s"]}}}))]
 pub struct Envelope {
     pub kind: KindName,
     /// The input of the job's kind: a `RollingInput`, `ThreeBodyInput`, `SweepInput` or

@@ -1,5 +1,7 @@
 //! The rolling job: one particle rolling over the layer (docs/model.md §3).
 
+use super::pictures::PictureError;
+use crate::render::svg::Chart;
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
 use utoipa::ToSchema;
@@ -15,6 +17,9 @@ use crate::render::{Column, Output, Table, Units};
 /// Input of a rolling job; every field optional (docs/model.md §5 defaults).
 #[derive(Clone, Debug, Default, PartialEq, Deserialize, Serialize, ToSchema)]
 #[serde(deny_unknown_fields)]
+#[schema(example = json!({"radius": "25 nm", "load": "1 nN", "velocity": "4 nm/s",
+    "layer": {"elastic_modulus": "3 GPa", "thickness": "100 nm", "poisson_ratio": 0.35,
+              "relaxation_time": "100 ms", "retardation_time": "500 ms"}}))]
 pub struct RollingInput {
     /// R, particle radius (m; default 25 nm).
     pub radius: Option<Quantity>,
@@ -118,6 +123,10 @@ impl Kind for RollingJob {
 
     fn references(&self) -> &'static [Reference] {
         ROLLING_REFERENCES
+    }
+
+    fn picture(answer: &Value) -> Result<Chart, PictureError> {
+        super::pictures::rolling(answer)
     }
 
     fn work(&self) -> Work {

@@ -2,6 +2,8 @@
 //! rolling jobs (radius, load, speed) and three-body jobs (operating point, speed, mean
 //! diameter).
 
+use super::pictures::PictureError;
+use crate::render::svg::Chart;
 use std::ops::Range;
 
 use serde::{Deserialize, Serialize};
@@ -26,6 +28,8 @@ pub use super::three_body::ThreeBodySweepPoint;
 /// Input of a sweep: what is swept, a base input of that kind and the lists to vary.
 #[derive(Clone, Debug, Default, PartialEq, Deserialize, Serialize, ToSchema)]
 #[serde(deny_unknown_fields)]
+#[schema(example = json!({"kind": "rolling", "base": {"radius": "25 nm"},
+    "vary": {"load": ["0.5 nN", "1 nN", "2 nN"], "velocity": ["0 nm/s", "4 nm/s", "8 nm/s"]}}))]
 pub struct SweepInput {
     /// The kind of the base job: `rolling` (default) or `three_body`.
     pub kind: Option<SweepOf>,
@@ -162,6 +166,10 @@ impl Kind for SweepJob {
             SweepJob::Rolling(_) => ROLLING_REFERENCES,
             SweepJob::ThreeBody(_) => &REFERENCES,
         }
+    }
+
+    fn picture(answer: &Value) -> Result<Chart, PictureError> {
+        super::pictures::sweep(answer)
     }
 
     fn work(&self) -> Work {

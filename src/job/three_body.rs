@@ -1,6 +1,8 @@
 //! The three-body job: a population of particles between the upper surface and the layer
 //! (docs/model.md §4).
 
+use super::pictures::PictureError;
+use crate::render::svg::Chart;
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
 use utoipa::ToSchema;
@@ -19,6 +21,8 @@ use crate::render::{Column, Output, Table, Units};
 /// Input of a three-body job; every field optional but the operating point.
 #[derive(Clone, Debug, Default, PartialEq, Deserialize, Serialize, ToSchema)]
 #[serde(deny_unknown_fields)]
+#[schema(example = json!({"distribution": {"mean_diameter": "50 nm", "std_diameter": "5 nm",
+    "areal_density": "1e12 1/m^2"}, "operating": {"total_load": "1 mN"}, "velocity": "4 nm/s"}))]
 pub struct ThreeBodyInput {
     pub distribution: Option<DistributionInput>,
     /// A_n (m²).
@@ -412,6 +416,10 @@ impl Kind for ThreeBodyJob {
 
     fn references(&self) -> &'static [Reference] {
         &REFERENCES
+    }
+
+    fn picture(answer: &Value) -> Result<Chart, PictureError> {
+        super::pictures::three_body(answer)
     }
 
     fn work(&self) -> Work {

@@ -5,6 +5,7 @@
 
 mod negotiate;
 mod number;
+pub mod svg;
 mod table;
 
 use std::any::Any;
@@ -22,18 +23,35 @@ pub use table::{Cell, Column, Heading, Table};
 pub enum Format {
     Json,
     Csv,
+    /// The answer's picture ([`svg`]).
+    Svg,
 }
 
 impl Format {
     /// Every format, in the service's order of preference (the first when the client
     /// accepts any).
-    pub const ALL: [Format; 2] = [Format::Json, Format::Csv];
+    pub const ALL: [Format; 3] = [Format::Json, Format::Csv, Format::Svg];
+
+    /// The format named `name` (`json`, `csv`, `svg`), as a `?format=` query gives it.
+    pub fn from_name(name: &str) -> Option<Format> {
+        Format::ALL.into_iter().find(|f| f.name() == name)
+    }
+
+    /// The format's short name, also the extension of a file of it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Format::Json => "json",
+            Format::Csv => "csv",
+            Format::Svg => "svg",
+        }
+    }
 
     /// The media type a client names in `Accept`.
     pub fn media_type(self) -> &'static str {
         match self {
             Format::Json => "application/json",
             Format::Csv => "text/csv",
+            Format::Svg => "image/svg+xml",
         }
     }
 
@@ -42,6 +60,7 @@ impl Format {
         match self {
             Format::Json => "application/json",
             Format::Csv => "text/csv; charset=utf-8; header=present",
+            Format::Svg => "image/svg+xml",
         }
     }
 
@@ -122,19 +141,35 @@ impl<T: Output> Render for T {
     }
 }
 
-/// The answer to any job, whatever its kind.
+/// Draws an answer from its JSON (each job kind has its own).
+pub type Draw = fn(&serde_json::Value) -> Result<svg::Chart, String>;
+
+/// The answer to any job, whatever its kind, and how to draw it.
 #[derive(Debug)]
-pub struct Answer(Box<dyn Render>);
+pub struct Answer(Box<dyn Render>, Option<Draw>);
 
 impl Answer {
     pub fn new<T: Output>(output: T) -> Answer {
-        Answer(Box::new(output))
+        Answer(Box::new(output), None)
     }
 
-    /// The answer in `format`: compact JSON, or CSV.
+    /// The same answer, drawn by `draw` as SVG.
+    pub fn drawn_by(mut self, draw: Draw) -> Answer {
+        self.1 = Some(draw);
+        self
+    }
+
+    /// The answer in `format`: compact JSON, CSV, or its picture.
     pub fn render(&self, format: Format) -> Result<Vec<u8>, RenderError> {
         match format {
             Format::Json => self.json(false),
+            Format::Svg => {
+                let draw = self
+                    .1
+                    .ok_or_else(|| RenderError::new("this answer has no picture"))?;
+                let json = self.json(false)?;
+                draw_svg(draw, &json).map(String::into_bytes)
+            }
             Format::Csv => {
                 let table = self.0.table();
                 let finite = table.rows.iter().flatten().all(|cell| match cell {
@@ -206,6 +241,15 @@ impl Serialize for Answer {
         let raw = RawValue::from_string(text).map_err(serde::ser::Error::custom)?;
         raw.serialize(s)
     }
+}
+
+/// The picture `draw` makes of the answer whose JSON is `json`, as SVG.
+pub fn draw_svg(draw: Draw, json: &[u8]) -> Result<String, RenderError> {
+    let value: serde_json::Value =
+        serde_json::from_slice(json).map_err(|e| RenderError(e.to_string()))?;
+    draw(&value)
+        .map(|chart| chart.to_svg())
+        .map_err(|e| RenderError(format!("cannot draw the answer: {e}")))
 }
 
 fn non_finite() -> RenderError {

@@ -9,5 +9,6 @@ mod in_process;
 mod jobs;
 mod limits;
 mod ops;
+mod pictures;
 mod solve;
 mod storage;

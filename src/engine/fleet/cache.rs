@@ -12,7 +12,7 @@ use redis::Script;
 
 use super::{keys, Fleet};
 use crate::engine::cache::{Claim, MemoryCache, ResultCache, Solved};
-use crate::job::JobError;
+use crate::job::{registry, JobError};
 use crate::render::Format;
 
 /// How often a process waiting for another's solve looks for the answer.
@@ -54,10 +54,14 @@ impl TieredCache {
             .arg(keys::answer(key))
             .arg("json")
             .arg("csv")
+            .arg("kind")
             .clone();
-        let (json, csv): (Option<Vec<u8>>, Option<Vec<u8>>) = link.query(&cmd).await.ok()?;
+        type Fields = (Option<Vec<u8>>, Option<Vec<u8>>, Option<String>);
+        let (json, csv, kind): Fields = link.query(&cmd).await.ok()?;
+        let kind = registry::find(&kind?).ok()?.name();
         let solved = Arc::new(Solved::rendered(
             key.to_string(),
+            kind,
             Bytes::from(json?),
             Bytes::from(csv?),
         ));
@@ -93,6 +97,8 @@ impl ResultCache for TieredCache {
             .arg(solved.json().as_ref())
             .arg("csv")
             .arg(csv.as_ref())
+            .arg("kind")
+            .arg(solved.kind)
             .ignore()
             .cmd("PEXPIRE")
             .arg(&key)

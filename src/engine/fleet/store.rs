@@ -302,6 +302,7 @@ impl RedisJobStore {
             JobStatus::Succeeded => match (json, csv) {
                 (Some(json), Some(csv)) => JobState::Succeeded(Arc::new(Solved::rendered(
                     text("key"),
+                    kind,
                     Bytes::from(json),
                     Bytes::from(csv),
                 ))),

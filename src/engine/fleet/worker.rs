@@ -210,6 +210,7 @@ impl Engine {
         let result = Pool::run(permit, control.clone(), move |control| match part {
             None => Ok(Outcome::Whole(Arc::new(Solved::new(
                 key,
+                job.kind(),
                 job.run(meta, control)?,
             )?))),
             Some((_, range)) => Ok(Outcome::Part(parts::render(
@@ -268,6 +269,7 @@ impl Engine {
             Ok((job, assembled)) => {
                 let solved = Arc::new(Solved::rendered(
                     key.to_string(),
+                    job.kind(),
                     Bytes::from(assembled.json),
                     Bytes::from(assembled.csv),
                 ));

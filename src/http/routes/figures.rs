@@ -1,10 +1,9 @@
 //! `GET /v1/figures/{n}`: the data behind one of the paper's figures; JSON or CSV.
 
 use axum::extract::{Path, State};
-use axum::http::HeaderMap;
 use axum::response::Response;
 
-use super::Answering;
+use super::{Answering, FormatQuery};
 use crate::http::error::ApiError;
 use crate::http::responses::{Busy, NotAcceptable, NotFound, NotModified, SolveErrors};
 use crate::http::AppState;
@@ -22,19 +21,19 @@ use crate::job::{FigureJob, Job};
     operation_id = "get_figure",
     tag = "figures",
     params(("n" = u8, Path, description = "The figure's number in the paper, 3 to 9",
-        minimum = 3, maximum = 9, example = 6)),
+        minimum = 3, maximum = 9, example = 6), FormatQuery),
     responses(
-        (status = 200, description = "The figure's axes and series", content(
-            (FigureOutput = "application/json"), (String = "text/csv"))),
+        (status = 200, description = "The figure's axes and series, or its picture", content(
+            (FigureOutput = "application/json"), (String = "text/csv"),
+            (String = "image/svg+xml"))),
         NotModified, NotFound, NotAcceptable, Busy, SolveErrors,
     )
 )]
 pub async fn figure(
     State(state): State<AppState>,
     Path(n): Path<String>,
-    headers: HeaderMap,
+    answering: Answering,
 ) -> Result<Response, ApiError> {
-    let answering = Answering::from_headers(&headers)?;
     let job = n
         .parse()
         .ok()

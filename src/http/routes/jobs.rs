@@ -6,7 +6,7 @@ use std::time::Duration;
 
 use axum::extract::{FromRequestParts, Path, State};
 use axum::http::request::Parts;
-use axum::http::{header, HeaderMap, StatusCode};
+use axum::http::{header, StatusCode};
 use axum::response::sse::{Event, KeepAlive, Sse};
 use axum::response::{IntoResponse, Response};
 use axum::Json;
@@ -17,7 +17,7 @@ use tokio::sync::watch;
 use utoipa::{IntoParams, ToSchema};
 use uuid::Uuid;
 
-use super::Answering;
+use super::{Answering, FormatQuery};
 use crate::engine::cache::Solved;
 use crate::engine::store::{JobRecord, JobState, JobStatus};
 use crate::engine::Engine;
@@ -251,15 +251,18 @@ pub async fn delete(
     path = "/v1/jobs/{id}/result",
     operation_id = "get_job_result",
     tag = "jobs",
-    params(JobId),
+    params(JobId, FormatQuery),
     responses(
-        (status = 200, description = "The job's answer", content(
-            (AnyOutput = "application/json"), (String = "text/csv"))),
+        (status = 200, description = "The job's answer, or its picture", content(
+            (AnyOutput = "application/json"), (String = "text/csv"),
+            (String = "image/svg+xml"))),
         NotModified, NotFound, Gone, NotAcceptable, Unfinished, JobFailure,
     )
 )]
-pub async fn result(headers: HeaderMap, FoundJob(record): FoundJob) -> Result<Response, ApiError> {
-    let answering = Answering::from_headers(&headers)?;
+pub async fn result(
+    answering: Answering,
+    FoundJob(record): FoundJob,
+) -> Result<Response, ApiError> {
     match record.state {
         JobState::Succeeded(solved) => answering.respond(&solved, None),
         JobState::Failed(e) => Err(e.into()),

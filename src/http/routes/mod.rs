@@ -78,9 +78,11 @@ macro_rules! solve_endpoint {
             operation_id = $operation,
             tag = "solve",
             request_body(content = $input, content_type = "application/json"),
+            params($crate::http::routes::FormatQuery),
             responses(
                 (status = 200, description = $answer, content(
-                    ($output = "application/json"), (String = "text/csv"))),
+                    ($output = "application/json"), (String = "text/csv"),
+                    (String = "image/svg+xml"))),
                 $crate::http::responses::NotModified,
                 $crate::http::responses::BadBody,
                 $crate::http::responses::NotAcceptable,
@@ -97,16 +99,49 @@ macro_rules! solve_endpoint {
 }
 use solve_endpoint;
 
+/// `?format=`: the form of the answer, for links (overrides `Accept`).
+#[derive(utoipa::IntoParams)]
+#[into_params(parameter_in = Query)]
+pub struct FormatQuery {
+    /// `json`, `csv` or `svg` (the answer's picture).
+    #[allow(dead_code)]
+    format: Option<String>,
+}
+
 /// How an answer is to be sent: the form the client accepts, and the validator it holds.
+/// As an extractor: from the request's headers and query.
 pub struct Answering {
     format: Format,
     if_none_match: Vec<String>,
 }
 
+impl<S: Send + Sync> axum::extract::FromRequestParts<S> for Answering {
+    type Rejection = ApiError;
+
+    async fn from_request_parts(
+        parts: &mut axum::http::request::Parts,
+        _: &S,
+    ) -> Result<Self, ApiError> {
+        Answering::read(&parts.headers, parts.uri.query())
+    }
+}
+
 impl Answering {
-    /// Reads `Accept` (406 if no form of an answer is acceptable) and `If-None-Match`.
-    pub fn from_headers(headers: &HeaderMap) -> Result<Answering, ApiError> {
-        let format = Accept::from_headers(headers).choose(&Format::ALL)?;
+    /// Reads the form asked: `?format=` (for links, where no header can be set), else
+    /// `Accept` (406 if no form of an answer is acceptable); and `If-None-Match`.
+    pub fn read(headers: &HeaderMap, query: Option<&str>) -> Result<Answering, ApiError> {
+        let asked = query
+            .into_iter()
+            .flat_map(|q| q.split('&'))
+            .find_map(|pair| pair.strip_prefix("format="));
+        let format = match asked {
+            Some(name) => Format::from_name(name).ok_or_else(|| {
+                ApiError::not_acceptable(format!(
+                    "format={name}: the forms of an answer are json, csv and svg"
+                ))
+            })?,
+            None => Accept::from_headers(headers).choose(&Format::ALL)?,
+        };
         let if_none_match = headers
             .get_all(header::IF_NONE_MATCH)
             .iter()
@@ -129,7 +164,7 @@ impl Answering {
     ) -> Result<Response, ApiError> {
         let etag = match self.format {
             Format::Json => format!("\"{}\"", solved.key),
-            Format::Csv => format!("\"{}.csv\"", solved.key),
+            other => format!("\"{}.{}\"", solved.key, other.name()),
         };
         let mut response = if if_none_match(&self.if_none_match, &etag) {
             StatusCode::NOT_MODIFIED.into_response()
@@ -181,7 +216,7 @@ impl FromRequest<AppState> for SolveRequest {
     type Rejection = ApiError;
 
     async fn from_request(request: Request, state: &AppState) -> Result<Self, ApiError> {
-        let answering = Answering::from_headers(request.headers())?;
+        let answering = Answering::read(request.headers(), request.uri().query())?;
         let body = JsonBody::from_request(request, state).await?;
         Ok(SolveRequest {
             state: state.clone(),
@@ -247,17 +282,16 @@ mod tests {
             ("*/*", false),
             ("text/csv;q=0", false),
         ] {
-            let format =
-                Answering::from_headers(&headers(header::ACCEPT, accept)).map(|a| a.format);
+            let format = Answering::read(&headers(header::ACCEPT, accept), None).map(|a| a.format);
             assert_eq!(format.is_ok_and(|f| f == Format::Csv), csv, "{accept}");
         }
-        let none = Answering::from_headers(&HeaderMap::new()).unwrap();
+        let none = Answering::read(&HeaderMap::new(), None).unwrap();
         assert_eq!(none.format, Format::Json);
     }
 
     #[test]
     fn an_unacceptable_form_is_406() {
-        let refused = Answering::from_headers(&headers(header::ACCEPT, "image/png"));
+        let refused = Answering::read(&headers(header::ACCEPT, "image/png"), None);
         assert_eq!(
             refused.err().map(|e| e.status()),
             Some(StatusCode::NOT_ACCEPTABLE)

@@ -1,0 +1,264 @@
+// The dashboard: forms that post jobs to the API, the answer as a table and a picture.
+// Plain JavaScript, no dependency: everything it loads comes from this server.
+"use strict";
+
+const $ = (selector) => document.querySelector(selector);
+
+// ---- Forms to job inputs -------------------------------------------------------------
+
+/** A form's fields as the input object of its job: `a.b` names nest, lists split on commas,
+ *  plain numbers become numbers, anything else is sent as typed (a value with its unit). */
+function inputOf(form) {
+  const input = {};
+  for (const field of form.querySelectorAll("input[name]")) {
+    const text = field.value.trim();
+    if (text === "") continue;
+    const path = field.name.split(".");
+    let value;
+    if (path[0] === "vary") {
+      value = text.split(",").map((t) => t.trim()).filter((t) => t !== "").map(typed);
+    } else {
+      value = typed(text);
+    }
+    if (field.name === "options.pressure_grid" && value === 0) continue;
+    let node = input;
+    for (const key of path.slice(0, -1)) node = node[key] ??= {};
+    node[path[path.length - 1]] = value;
+  }
+  return input;
+}
+
+function typed(text) {
+  return /^[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$/.test(text) ? Number(text) : text;
+}
+
+/** The request a form makes: where, and the body. Sweeps go through /v1/jobs. */
+function requestOf(form) {
+  const input = inputOf(form);
+  const kind = form.dataset.kind;
+  const body = kind === "sweep" ? { kind: "sweep", input } : input;
+  return { url: form.dataset.endpoint, body, job: { kind, input } };
+}
+
+// ---- Showing answers -----------------------------------------------------------------
+
+const UNIT_SHOWN = { m: [1e9, "nm"], N: [1e9, "nN"], "m/s": [1e9, "nm/s"], "m^2": [1e18, "nm²"], "m²": [1e18, "nm²"], Pa: [1e-6, "MPa"] };
+
+function status(text, error = false) {
+  const p = $("#status");
+  p.textContent = text;
+  p.className = error ? "error" : "";
+}
+
+function showProblem(problem) {
+  const fields = (problem.errors || []).map((e) => e.message).join("; ");
+  status(`${problem.title}: ${fields || problem.detail}`, true);
+}
+
+/** Scalars of an answer (nested objects flattened, lists left out) with their units. */
+function rows(answer, units, prefix = "") {
+  const out = [];
+  for (const [key, value] of Object.entries(answer)) {
+    if (key === "meta") continue;
+    const path = prefix + key;
+    if (typeof value === "number") {
+      const [factor, unit] = UNIT_SHOWN[units[path]] || [1, units[path] || ""];
+      out.push([path, Number((value * factor).toPrecision(6)), unit]);
+    } else if (value && typeof value === "object" && !Array.isArray(value)) {
+      out.push(...rows(value, units, path + "."));
+    }
+  }
+  return out;
+}
+
+function showTable(answer) {
+  const table = $("#table");
+  table.replaceChildren();
+  const head = table.insertRow();
+  for (const name of ["quantity", "value", "unit"]) {
+    const th = document.createElement("th");
+    th.textContent = name;
+    head.append(th);
+  }
+  const units = (answer.meta && answer.meta.units) || {};
+  const shown = answer.points ? { points: answer.points.length } : answer;
+  for (const [name, value, unit] of rows(shown, units)) {
+    const row = table.insertRow();
+    for (const cell of [name, value, unit]) row.insertCell().textContent = cell;
+  }
+}
+
+function showWarnings(answer) {
+  const box = $("#warnings");
+  box.replaceChildren();
+  const meta = answer.meta || {};
+  const notes = (meta.warnings || []).map((w) => w.message);
+  for (const a of (meta.validity && meta.validity.assumptions) || []) {
+    if (a.status !== "ok") {
+      notes.push(`${a.status}: ${a.assumption} (${a.ratio} = ${Number(a.value).toPrecision(3)}; ${a.rule})`);
+    }
+  }
+  for (const text of notes) {
+    const p = document.createElement("p");
+    p.className = "warning";
+    p.textContent = "⚠ " + text;
+    box.append(p);
+  }
+}
+
+/** Puts an SVG document into the page (inline, so the page's CSP allows it). */
+function showPicture(svgText) {
+  const doc = new DOMParser().parseFromString(svgText, "image/svg+xml");
+  const svg = doc.documentElement;
+  svg.setAttribute("role", "img");
+  $("#picture").replaceChildren(document.importNode(svg, true));
+}
+
+/** Download buttons: each fetches the answer in its form and saves it. */
+function showDownloads(fetchIn, name) {
+  const box = $("#downloads");
+  box.replaceChildren();
+  for (const [label, accept, ext] of [["JSON", "application/json", "json"], ["CSV", "text/csv", "csv"], ["SVG", "image/svg+xml", "svg"]]) {
+    const button = document.createElement("button");
+    button.type = "button";
+    button.textContent = `Download ${label}`;
+    button.addEventListener("click", async () => {
+      const response = await fetchIn(accept);
+      const blob = await response.blob();
+      const link = document.createElement("a");
+      link.href = URL.createObjectURL(blob);
+      link.download = `${name}.${ext}`;
+      link.click();
+      URL.revokeObjectURL(link.href);
+    });
+    box.append(button);
+  }
+}
+
+async function post(url, body, accept = "application/json") {
+  return fetch(url, { method: "POST", headers: { "content-type": "application/json", accept }, body: JSON.stringify(body) });
+}
+
+async function solve(form) {
+  const { url, body } = requestOf(form);
+  status("Solving…");
+  const response = await post(url, body);
+  const answer = await response.json();
+  if (!response.ok) return showProblem(answer);
+  status(`Solved (${response.headers.get("x-cache") || "miss"}).`);
+  showTable(answer);
+  showWarnings(answer);
+  const picture = await post(url, body, "image/svg+xml");
+  if (picture.ok) showPicture(await picture.text());
+  showDownloads((accept) => post(url, body, accept), form.dataset.kind);
+}
+
+// ---- Jobs: progress from the event stream, cancel -------------------------------------
+
+let following = null;
+
+async function runJob(form) {
+  const { url, body } = requestOf(form);
+  status("Submitting…");
+  const response = await post(url, body);
+  const view = await response.json();
+  if (!response.ok) return showProblem(view);
+  follow(view.id);
+}
+
+function follow(id) {
+  const progress = $("#progress");
+  const text = $("#progress-text");
+  const cancel = $("#cancel");
+  cancel.disabled = false;
+  cancel.onclick = () => fetch(`/v1/jobs/${id}/cancel`, { method: "POST", headers: { accept: "application/json" } });
+  if (following) following.close();
+  const events = new EventSource(`/v1/jobs/${id}/events`);
+  following = events;
+  const update = (view) => {
+    const { done, total } = view.progress;
+    progress.max = Math.max(total, 1);
+    progress.value = done;
+    text.textContent = total ? `${done} / ${total} (${Math.round((100 * done) / total)} %)` : `${done}`;
+    status(`Job ${view.status}.`);
+  };
+  events.addEventListener("progress", (e) => update(JSON.parse(e.data)));
+  events.addEventListener("completion", async (e) => {
+    events.close();
+    following = null;
+    cancel.disabled = true;
+    const view = JSON.parse(e.data);
+    update(view);
+    if (view.status !== "succeeded") {
+      if (view.problem) showProblem(view.problem);
+      return;
+    }
+    const result = `/v1/jobs/${id}/result`;
+    const answer = await (await fetch(result, { headers: { accept: "application/json" } })).json();
+    showTable(answer);
+    showWarnings(answer);
+    const picture = await fetch(`${result}?format=svg`);
+    if (picture.ok) showPicture(await picture.text());
+    showDownloads((accept) => fetch(result, { headers: { accept } }), `job-${id}`);
+  });
+}
+
+// ---- Copying a form as a command ----------------------------------------------------
+
+async function copy(form, what) {
+  const { url, body, job } = requestOf(form);
+  const text = what === "job"
+    ? JSON.stringify(job, null, 2)
+    : `curl -s -X POST ${location.origin}${url} -H 'content-type: application/json' -d '${JSON.stringify(body)}'`;
+  try {
+    await navigator.clipboard.writeText(text);
+    status(`Copied ${what === "job" ? "the job as JSON" : "the curl command"}.`);
+  } catch {
+    status(text);
+  }
+}
+
+// ---- Figures, tabs, start-up ---------------------------------------------------------
+
+async function figure(n) {
+  status(`Figure ${n}…`);
+  const response = await fetch(`/v1/figures/${n}?format=svg`);
+  if (!response.ok) return showProblem(await response.json());
+  showPicture(await response.text());
+  const answer = await (await fetch(`/v1/figures/${n}`, { headers: { accept: "application/json" } })).json();
+  showTable({ figure: answer.figure, series: answer.series.length, meta: answer.meta });
+  $("#warnings").replaceChildren();
+  status(`Figure ${n}: ${answer.title}`);
+  showDownloads((accept) => fetch(`/v1/figures/${n}`, { headers: { accept } }), `figure-${n}`);
+}
+
+function selectTab(tab) {
+  for (const other of document.querySelectorAll("[role=tab]")) {
+    const selected = other === tab;
+    other.setAttribute("aria-selected", String(selected));
+    document.getElementById(other.getAttribute("aria-controls")).hidden = !selected;
+  }
+}
+
+document.addEventListener("DOMContentLoaded", () => {
+  for (const tab of document.querySelectorAll("[role=tab]")) {
+    tab.addEventListener("click", () => selectTab(tab));
+  }
+  for (const form of document.querySelectorAll("form")) {
+    form.addEventListener("submit", (event) => {
+      event.preventDefault();
+      (form.dataset.kind === "sweep" ? runJob(form) : solve(form)).catch((e) => status(String(e), true));
+    });
+    for (const button of form.querySelectorAll("[data-copy]")) {
+      button.addEventListener("click", () => copy(form, button.dataset.copy));
+    }
+  }
+  const buttons = $("#figure-buttons");
+  for (let n = 3; n <= 9; n++) {
+    const button = document.createElement("button");
+    button.type = "button";
+    button.textContent = `Figure ${n}`;
+    button.addEventListener("click", () => figure(n).catch((e) => status(String(e), true)));
+    buttons.append(button);
+  }
+});

@@ -1,0 +1,670 @@
+//! Pictures of answers as SVG, written by hand: a chart (two axes with ticks and labels in
+//! the units a person reads, a title, a legend) holding lines, markers, filled outlines,
+//! circles and heat maps. Text is left to the viewer's sans-serif font (no font files);
+//! colours are presentation attributes, not `style`, so a page with
+//! `Content-Security-Policy: default-src 'self'` can inline the picture.
+
+use std::fmt::Write;
+
+use super::number::format_number;
+
+/// Width and height of every picture (px): readable on a screen and in print.
+pub const WIDTH: f64 = 800.0;
+pub const HEIGHT: f64 = 500.0;
+/// The plot area: left, top, right, bottom margins leave room for labels and the legend.
+const LEFT: f64 = 80.0;
+const TOP: f64 = 50.0;
+const RIGHT: f64 = 230.0;
+const BOTTOM: f64 = 60.0;
+
+/// Colours of successive series (a palette distinguishable by most readers).
+const PALETTE: [&str; 8] = [
+    "#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2", "#17becf",
+];
+
+/// An axis: the quantity it shows and its SI unit; its range follows the data.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Axis {
+    pub quantity: String,
+    /// SI unit (`m`, `N`, `m/s`, `m^2`, `Pa`, or "" for a plain number).
+    pub unit: String,
+    /// A logarithmic scale (all values must be positive).
+    pub log: bool,
+}
+
+impl Axis {
+    pub fn new(quantity: &str, unit: &str) -> Axis {
+        Axis {
+            quantity: quantity.to_string(),
+            unit: unit.to_string(),
+            log: false,
+        }
+    }
+
+    pub fn log(mut self) -> Axis {
+        self.log = true;
+        self
+    }
+}
+
+/// What a chart draws.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Layer {
+    /// A polyline through `points`; lines of one `group` share a colour (a curve at rest
+    /// dashed beside the same curve rolling).
+    Line {
+        name: String,
+        group: String,
+        points: Vec<(f64, f64)>,
+        dashed: bool,
+    },
+    /// A marker at each point: filled, or hollow.
+    Markers {
+        name: String,
+        points: Vec<(f64, f64)>,
+        hollow: bool,
+    },
+    /// A closed outline, filled lightly.
+    Area {
+        name: String,
+        outline: Vec<(f64, f64)>,
+    },
+    /// A circle (drawn dashed).
+    Circle {
+        name: String,
+        centre: (f64, f64),
+        radius: f64,
+    },
+    /// Values on a grid, `values[j][i]` at (`x[i]`, `y[j]`), with a colour bar.
+    Heatmap {
+        name: String,
+        x: Vec<f64>,
+        y: Vec<f64>,
+        values: Vec<Vec<f64>>,
+        unit: String,
+    },
+}
+
+impl Layer {
+    fn name(&self) -> &str {
+        match self {
+            Layer::Line { name, .. }
+            | Layer::Markers { name, .. }
+            | Layer::Area { name, .. }
+            | Layer::Circle { name, .. }
+            | Layer::Heatmap { name, .. } => name,
+        }
+    }
+
+    /// The points that set the axes' ranges.
+    fn extent(&self) -> Vec<(f64, f64)> {
+        match self {
+            Layer::Line { points, .. } | Layer::Markers { points, .. } => points.clone(),
+            Layer::Area { outline, .. } => outline.clone(),
+            Layer::Circle { centre, radius, .. } => vec![
+                (centre.0 - radius, centre.1 - radius),
+                (centre.0 + radius, centre.1 + radius),
+            ],
+            Layer::Heatmap { x, y, .. } => match (x.first(), x.last(), y.first(), y.last()) {
+                (Some(&x0), Some(&x1), Some(&y0), Some(&y1)) => vec![(x0, y0), (x1, y1)],
+                _ => Vec::new(),
+            },
+        }
+    }
+}
+
+/// A chart: title, axes, layers.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Chart {
+    pub title: String,
+    pub x: Axis,
+    pub y: Axis,
+    pub layers: Vec<Layer>,
+    /// One unit on x as long as one on y (contact shapes).
+    pub equal_aspect: bool,
+    /// Lines of text under the legend (figures the picture has no axis for).
+    pub notes: Vec<String>,
+}
+
+/// A unit a person reads for an SI unit and the size of the numbers shown: the factor that
+/// turns SI values into it, and its name.
+pub fn display_unit(si: &str, largest: f64) -> (f64, String) {
+    let (base, power) = match si {
+        "m" => ("m", 1),
+        "m^2" | "m²" => ("m", 2),
+        "m/s" => ("m/s", 1),
+        "N" => ("N", 1),
+        "Pa" => ("Pa", 1),
+        _ => return (1.0, si.to_string()),
+    };
+    // Powers of ten of each prefix, largest first.
+    let prefixes: &[(i32, &str)] = if base == "Pa" {
+        &[(9, "GPa"), (6, "MPa"), (3, "kPa"), (0, "Pa")]
+    } else {
+        &[(0, ""), (-3, "m"), (-6, "µ"), (-9, "n"), (-12, "p")]
+    };
+    let largest = largest.abs();
+    let last = prefixes.len() - 1;
+    for (k, &(exponent, prefix)) in prefixes.iter().enumerate() {
+        let exponent = exponent * power;
+        // Areas step by 10⁶ between prefixes: show 0.2 µm² rather than 2e5 nm².
+        let least = if power == 2 { 1e-2 } else { 1.0 };
+        if largest >= least * 10f64.powi(exponent) || k == last {
+            let name = match (base, power) {
+                ("Pa", _) => prefix.to_string(),
+                ("m/s", _) => format!("{prefix}m/s"),
+                (_, 2) => format!("{prefix}{base}²"),
+                _ => format!("{prefix}{base}"),
+            };
+            return (10f64.powi(-exponent), name);
+        }
+    }
+    (1.0, si.to_string())
+}
+
+/// "Nice" tick values covering [lo, hi]: steps of 1, 2 or 5 × 10^k, about six of them.
+fn ticks(lo: f64, hi: f64) -> Vec<f64> {
+    let span = hi - lo;
+    if span.is_nan() || span <= 0.0 || !span.is_finite() {
+        return vec![lo];
+    }
+    let raw = span / 6.0;
+    let magnitude = 10f64.powf(raw.log10().floor());
+    let step = [1.0, 2.0, 5.0, 10.0]
+        .iter()
+        .map(|m| m * magnitude)
+        .find(|s| span / s <= 7.0)
+        .unwrap_or(10.0 * magnitude);
+    let first = (lo / step).ceil() as i64;
+    let last = (hi / step).floor() as i64;
+    (first..=last).map(|i| i as f64 * step).collect()
+}
+
+fn label(value: f64) -> String {
+    if value.abs() < 1e-12 {
+        return "0".to_string();
+    }
+    let text = format!("{}", (value * 1e6).round() / 1e6);
+    if text.len() > 8 {
+        format_number(value)
+    } else {
+        text
+    }
+}
+
+fn escape(text: &str) -> String {
+    text.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+        .replace('"', "&quot;")
+}
+
+/// A linear or logarithmic map from data (display units) to pixels.
+struct Scale {
+    lo: f64,
+    hi: f64,
+    from: f64,
+    to: f64,
+    log: bool,
+}
+
+impl Scale {
+    fn at(&self, value: f64) -> f64 {
+        let (v, lo, hi) = if self.log {
+            (value.max(1e-300).log10(), self.lo.log10(), self.hi.log10())
+        } else {
+            (value, self.lo, self.hi)
+        };
+        self.from + (v - lo) / (hi - lo) * (self.to - self.from)
+    }
+}
+
+/// The range of `values`, padded a little (and never empty).
+fn range(values: impl Iterator<Item = f64>, log: bool) -> (f64, f64) {
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    for v in values.filter(|v| v.is_finite() && (!log || *v > 0.0)) {
+        lo = lo.min(v);
+        hi = hi.max(v);
+    }
+    if !lo.is_finite() {
+        return if log { (1.0, 10.0) } else { (0.0, 1.0) };
+    }
+    if log {
+        return (lo / 1.2, hi * 1.2);
+    }
+    if hi - lo <= f64::EPSILON * hi.abs().max(lo.abs()) {
+        let pad = if lo == 0.0 { 1.0 } else { lo.abs() * 0.1 };
+        return (lo - pad, hi + pad);
+    }
+    let pad = 0.05 * (hi - lo);
+    (lo - pad, hi + pad)
+}
+
+/// A colour from blue (0) to red (1), for heat maps.
+fn heat(t: f64) -> String {
+    let t = t.clamp(0.0, 1.0);
+    let stops = [
+        (49, 54, 149),
+        (116, 173, 209),
+        (255, 255, 191),
+        (244, 109, 67),
+        (165, 0, 38),
+    ];
+    let position = t * (stops.len() - 1) as f64;
+    let i = (position.floor() as usize).min(stops.len() - 2);
+    let f = position - i as f64;
+    let mix = |a: u8, b: u8| (f64::from(a) + f * (f64::from(b) - f64::from(a))).round() as u8;
+    let (a, b) = (stops[i], stops[i + 1]);
+    let (a, b) = (
+        (a.0 as u8, a.1 as u8, a.2 as u8),
+        (b.0 as u8, b.1 as u8, b.2 as u8),
+    );
+    format!(
+        "#{:02x}{:02x}{:02x}",
+        mix(a.0, b.0),
+        mix(a.1, b.1),
+        mix(a.2, b.2)
+    )
+}
+
+impl Chart {
+    /// The chart as an SVG document.
+    pub fn to_svg(&self) -> String {
+        let points: Vec<(f64, f64)> = self.layers.iter().flat_map(Layer::extent).collect();
+        let largest =
+            |f: fn(&(f64, f64)) -> f64| points.iter().map(f).map(f64::abs).fold(0.0, f64::max);
+        let (x_factor, x_unit) = display_unit(&self.x.unit, largest(|p| p.0));
+        let (y_factor, y_unit) = display_unit(&self.y.unit, largest(|p| p.1));
+        let (mut x_lo, mut x_hi) = range(points.iter().map(|p| p.0 * x_factor), self.x.log);
+        let (mut y_lo, mut y_hi) = range(points.iter().map(|p| p.1 * y_factor), self.y.log);
+        let (mut left, mut right) = (LEFT, WIDTH - RIGHT);
+        let (top, bottom) = (TOP, HEIGHT - BOTTOM);
+        if self.equal_aspect {
+            // Same data span per pixel on both axes: widen the narrower range.
+            let per_px = ((x_hi - x_lo) / (right - left)).max((y_hi - y_lo) / (bottom - top));
+            let (xc, yc) = ((x_lo + x_hi) / 2.0, (y_lo + y_hi) / 2.0);
+            let width = per_px * (bottom - top);
+            // A square plot, centred in the space left of the legend.
+            let side = bottom - top;
+            left += ((right - left) - side) / 2.0;
+            right = left + side;
+            x_lo = xc - width / 2.0;
+            x_hi = xc + width / 2.0;
+            y_lo = yc - width / 2.0;
+            y_hi = yc + width / 2.0;
+        }
+        let sx = Scale {
+            lo: x_lo,
+            hi: x_hi,
+            from: left,
+            to: right,
+            log: self.x.log,
+        };
+        let sy = Scale {
+            lo: y_lo,
+            hi: y_hi,
+            from: bottom,
+            to: top,
+            log: self.y.log,
+        };
+        let mut svg = String::new();
+        let _ = write!(
+            svg,
+            r##"<svg xmlns="http://www.w3.org/2000/svg" width="{WIDTH}" height="{HEIGHT}" viewBox="0 0 {WIDTH} {HEIGHT}" font-family="sans-serif" font-size="13"><title>{}</title><rect width="100%" height="100%" fill="#ffffff"/>"##,
+            escape(&self.title)
+        );
+        let _ = write!(
+            svg,
+            r##"<text class="title" x="20" y="28" font-size="15" font-weight="bold">{}</text>"##,
+            escape(&self.title)
+        );
+        self.write_axes(&mut svg, &sx, &sy, (&x_unit, &y_unit));
+        let _ = write!(
+            svg,
+            r#"<defs><clipPath id="plot"><rect x="{left}" y="{top}" width="{}" height="{}"/></clipPath></defs><g clip-path="url(#plot)">"#,
+            right - left,
+            bottom - top
+        );
+        let mut legend = Vec::new();
+        let mut colour = 0;
+        let mut groups: Vec<&str> = Vec::new();
+        for layer in &self.layers {
+            let mut c = PALETTE[colour % PALETTE.len()];
+            if let Layer::Line { group, .. } = layer {
+                match groups.iter().position(|g| g == group) {
+                    Some(i) => c = PALETTE[i % PALETTE.len()],
+                    None => {
+                        groups.push(group);
+                        c = PALETTE[(groups.len() - 1) % PALETTE.len()];
+                    }
+                }
+            }
+            let px = |&(x, y): &(f64, f64)| (sx.at(x * x_factor), sy.at(y * y_factor));
+            match layer {
+                Layer::Line { points, dashed, .. } => {
+                    let dash = if *dashed {
+                        r#" stroke-dasharray="6 4""#
+                    } else {
+                        ""
+                    };
+                    let _ = write!(
+                        svg,
+                        r#"<path class="series" data-name="{}" d="{}" fill="none" stroke="{c}" stroke-width="2"{dash}/>"#,
+                        escape(layer.name()),
+                        path(points.iter().map(px), false)
+                    );
+                    legend.push((layer.name(), c, if *dashed { "dashed" } else { "line" }));
+                    colour = colour.max(groups.len());
+                }
+                Layer::Markers { points, hollow, .. } => {
+                    let fill = if *hollow { "#ffffff" } else { c };
+                    let _ = write!(
+                        svg,
+                        r#"<g class="series" data-name="{}">"#,
+                        escape(layer.name())
+                    );
+                    for (x, y) in points.iter().map(px) {
+                        let _ = write!(
+                            svg,
+                            r#"<circle cx="{x:.1}" cy="{y:.1}" r="4" fill="{fill}" stroke="{c}" stroke-width="1.5"/>"#
+                        );
+                    }
+                    svg.push_str("</g>");
+                    legend.push((layer.name(), c, if *hollow { "hollow" } else { "marker" }));
+                    colour += 1;
+                }
+                Layer::Area { outline, .. } => {
+                    let _ = write!(
+                        svg,
+                        r#"<path class="series area" data-name="{}" d="{}" fill="{c}" fill-opacity="0.25" stroke="{c}" stroke-width="2"/>"#,
+                        escape(layer.name()),
+                        path(outline.iter().map(px), true)
+                    );
+                    legend.push((layer.name(), c, "area"));
+                    colour += 1;
+                }
+                Layer::Circle { centre, radius, .. } => {
+                    let (cx, cy) = px(centre);
+                    let r = (sx.at((centre.0 + radius) * x_factor) - cx).abs();
+                    let _ = write!(
+                        svg,
+                        r#"<circle class="series" data-name="{}" cx="{cx:.1}" cy="{cy:.1}" r="{r:.1}" fill="none" stroke="{c}" stroke-width="2" stroke-dasharray="6 4"/>"#,
+                        escape(layer.name())
+                    );
+                    legend.push((layer.name(), c, "dashed"));
+                    colour += 1;
+                }
+                Layer::Heatmap {
+                    x, y, values, unit, ..
+                } => {
+                    self.write_heatmap(
+                        &mut svg,
+                        (&sx, &sy),
+                        (x_factor, y_factor),
+                        (x, y, values),
+                        unit,
+                    );
+                }
+            }
+        }
+        svg.push_str("</g>");
+        let shown = write_legend(&mut svg, &legend);
+        let mut y = TOP + 10.0 + 22.0 * shown as f64 + 10.0;
+        svg.push_str(r#"<g class="notes">"#);
+        for note in &self.notes {
+            let _ = write!(
+                svg,
+                r#"<text x="{}" y="{y}" font-size="11">{}</text>"#,
+                WIDTH - RIGHT + 20.0,
+                escape(note)
+            );
+            y += 18.0;
+        }
+        svg.push_str("</g></svg>");
+        svg
+    }
+
+    fn write_axes(&self, svg: &mut String, sx: &Scale, sy: &Scale, units: (&str, &str)) {
+        let (left, right, top, bottom) = (sx.from, sx.to, sy.to, sy.from);
+        let _ = write!(
+            svg,
+            r##"<rect x="{left}" y="{top}" width="{}" height="{}" fill="none" stroke="#444444"/>"##,
+            right - left,
+            bottom - top
+        );
+        let x_ticks = if self.x.log {
+            log_ticks(sx.lo, sx.hi)
+        } else {
+            ticks(sx.lo, sx.hi)
+        };
+        let _ = write!(svg, r#"<g class="axis x">"#);
+        for t in x_ticks {
+            let x = sx.at(t);
+            let _ = write!(
+                svg,
+                r##"<line x1="{x:.1}" y1="{bottom}" x2="{x:.1}" y2="{:.1}" stroke="#444444"/><line x1="{x:.1}" y1="{top}" x2="{x:.1}" y2="{bottom}" stroke="#dddddd" stroke-width="0.5"/><text x="{x:.1}" y="{:.1}" text-anchor="middle">{}</text>"##,
+                bottom + 5.0,
+                bottom + 20.0,
+                label(t)
+            );
+        }
+        let _ = write!(
+            svg,
+            r#"<text class="label" x="{:.1}" y="{:.1}" text-anchor="middle">{}</text></g>"#,
+            (left + right) / 2.0,
+            HEIGHT - 15.0,
+            escape(&axis_label(&self.x, units.0))
+        );
+        let y_ticks = if self.y.log {
+            log_ticks(sy.lo, sy.hi)
+        } else {
+            ticks(sy.lo, sy.hi)
+        };
+        let _ = write!(svg, r#"<g class="axis y">"#);
+        for t in y_ticks {
+            let y = sy.at(t);
+            let _ = write!(
+                svg,
+                r##"<line x1="{:.1}" y1="{y:.1}" x2="{left}" y2="{y:.1}" stroke="#444444"/><line x1="{left}" y1="{y:.1}" x2="{right}" y2="{y:.1}" stroke="#dddddd" stroke-width="0.5"/><text x="{:.1}" y="{:.1}" text-anchor="end">{}</text>"##,
+                left - 5.0,
+                left - 8.0,
+                y + 4.0,
+                label(t)
+            );
+        }
+        let (cx, cy) = (18.0, (top + bottom) / 2.0);
+        let _ = write!(
+            svg,
+            r#"<text class="label" x="{cx}" y="{cy}" text-anchor="middle" transform="rotate(-90 {cx} {cy})">{}</text></g>"#,
+            escape(&axis_label(&self.y, units.1))
+        );
+    }
+
+    fn write_heatmap(
+        &self,
+        svg: &mut String,
+        (sx, sy): (&Scale, &Scale),
+        (x_factor, y_factor): (f64, f64),
+        (x, y, values): (&[f64], &[f64], &[Vec<f64>]),
+        unit: &str,
+    ) {
+        let finite = values.iter().flatten().copied().filter(|v| v.is_finite());
+        let top_value = finite.fold(0.0, f64::max);
+        if x.len() < 2 || y.len() < 2 || top_value <= 0.0 {
+            return;
+        }
+        let (factor, unit) = display_unit(unit, top_value);
+        let half = |v: &[f64], i: usize| {
+            let lo = if i == 0 {
+                v[0]
+            } else {
+                (v[i - 1] + v[i]) / 2.0
+            };
+            let hi = if i + 1 == v.len() {
+                v[i]
+            } else {
+                (v[i] + v[i + 1]) / 2.0
+            };
+            (lo, hi)
+        };
+        svg.push_str(r#"<g class="heatmap">"#);
+        for (j, row) in values.iter().enumerate().take(y.len()) {
+            for (i, &value) in row.iter().enumerate().take(x.len()) {
+                if value.is_nan() || value <= 0.0 {
+                    continue;
+                }
+                let (x0, x1) = half(x, i);
+                let (y0, y1) = half(y, j);
+                let (px0, px1) = (sx.at(x0 * x_factor), sx.at(x1 * x_factor));
+                let (py0, py1) = (sy.at(y1 * y_factor), sy.at(y0 * y_factor));
+                let _ = write!(
+                    svg,
+                    r#"<rect x="{px0:.1}" y="{py0:.1}" width="{:.2}" height="{:.2}" fill="{}"/>"#,
+                    (px1 - px0).abs() + 0.5,
+                    (py1 - py0).abs() + 0.5,
+                    heat(value / top_value)
+                );
+            }
+        }
+        svg.push_str("</g>");
+        // The colour bar, right of the plot under the legend.
+        let (bx, by, height) = (WIDTH - RIGHT + 30.0, HEIGHT - BOTTOM - 180.0, 180.0);
+        let _ = write!(svg, r#"</g><g class="colourbar">"#);
+        for k in 0..30 {
+            let t = f64::from(k) / 29.0;
+            let _ = write!(
+                svg,
+                r#"<rect x="{bx}" y="{:.1}" width="16" height="{:.1}" fill="{}"/>"#,
+                by + height * (1.0 - t) - height / 30.0,
+                height / 30.0 + 0.5,
+                heat(t)
+            );
+        }
+        for t in ticks(0.0, top_value * factor) {
+            let y = by + height * (1.0 - t / (top_value * factor));
+            let _ = write!(
+                svg,
+                r#"<text x="{}" y="{:.1}">{}</text>"#,
+                bx + 22.0,
+                y + 4.0,
+                label(t)
+            );
+        }
+        let _ = write!(
+            svg,
+            r#"<text class="label" x="{bx}" y="{:.1}">pressure [{}]</text></g><g clip-path="url(#plot)">"#,
+            by - 8.0,
+            escape(&unit)
+        );
+    }
+}
+
+fn log_ticks(lo: f64, hi: f64) -> Vec<f64> {
+    let (a, b) = (lo.log10().ceil() as i32, hi.log10().floor() as i32);
+    (a..=b).map(|k| 10f64.powi(k)).collect()
+}
+
+fn axis_label(axis: &Axis, unit: &str) -> String {
+    let name = axis.quantity.replace('_', " ");
+    if unit.is_empty() {
+        name
+    } else {
+        format!("{name} [{unit}]")
+    }
+}
+
+fn path(points: impl Iterator<Item = (f64, f64)>, closed: bool) -> String {
+    let mut d = String::new();
+    for (i, (x, y)) in points.enumerate() {
+        let _ = write!(d, "{}{x:.2},{y:.2} ", if i == 0 { "M" } else { "L" });
+    }
+    if closed {
+        d.push('Z');
+    }
+    d.trim_end().to_string()
+}
+
+/// The legend, right of the plot: at most [`LEGEND_ROWS`] rows (the rest counted on the
+/// last). Returns the rows written.
+fn write_legend(svg: &mut String, entries: &[(&str, &str, &str)]) -> usize {
+    let x = WIDTH - RIGHT + 20.0;
+    let entries: Vec<_> = entries.iter().filter(|e| !e.0.is_empty()).collect();
+    let _ = write!(svg, r#"<g class="legend">"#);
+    let (shown, more) = if entries.len() > LEGEND_ROWS {
+        (
+            &entries[..LEGEND_ROWS - 1],
+            entries.len() - (LEGEND_ROWS - 1),
+        )
+    } else {
+        (&entries[..], 0)
+    };
+    for (i, (name, colour, mark)) in shown.iter().enumerate() {
+        let y = TOP + 10.0 + 22.0 * i as f64;
+        let symbol = match *mark {
+            "marker" | "hollow" => format!(
+                r#"<circle cx="{}" cy="{y}" r="4" fill="{}" stroke="{colour}" stroke-width="1.5"/>"#,
+                x + 12.0,
+                if *mark == "hollow" { "#ffffff" } else { colour }
+            ),
+            "area" => format!(
+                r#"<rect x="{x}" y="{}" width="24" height="10" fill="{colour}" fill-opacity="0.25" stroke="{colour}"/>"#,
+                y - 5.0
+            ),
+            "dashed" => format!(
+                r#"<line x1="{x}" y1="{y}" x2="{}" y2="{y}" stroke="{colour}" stroke-width="2" stroke-dasharray="6 4"/>"#,
+                x + 24.0
+            ),
+            _ => format!(
+                r#"<line x1="{x}" y1="{y}" x2="{}" y2="{y}" stroke="{colour}" stroke-width="2"/>"#,
+                x + 24.0
+            ),
+        };
+        // Long names in a smaller type, to stay within the picture.
+        let size = if name.chars().count() > 24 { 11 } else { 13 };
+        let _ = write!(
+            svg,
+            r#"{symbol}<text class="entry" x="{}" y="{}" font-size="{size}">{}</text>"#,
+            x + 32.0,
+            y + 4.0,
+            escape(name)
+        );
+    }
+    if more > 0 {
+        let y = TOP + 10.0 + 22.0 * shown.len() as f64;
+        let _ = write!(
+            svg,
+            r#"<text class="entry" x="{x}" y="{}">and {more} more</text>"#,
+            y + 4.0
+        );
+    }
+    svg.push_str("</g>");
+    shown.len() + usize::from(more > 0)
+}
+
+/// Rows of a legend.
+const LEGEND_ROWS: usize = 14;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn units_a_person_reads() {
+        assert_eq!(display_unit("m", 2.5e-8), (1e9, "nm".to_string()));
+        assert_eq!(display_unit("m^2", 8.5e-17), (1e18, "nm²".to_string()));
+        assert_eq!(display_unit("N", 1e-9).1, "nN");
+        assert_eq!(display_unit("m/s", 4e-9).1, "nm/s");
+        assert_eq!(display_unit("Pa", 3e8).1, "MPa");
+        assert_eq!(display_unit("", 0.1), (1.0, String::new()));
+    }
+
+    #[test]
+    fn ticks_are_round_and_cover_the_range() {
+        assert_eq!(
+            ticks(0.0, 1.0),
+            vec![0.0, 0.2, 0.4, 0.6000000000000001, 0.8, 1.0]
+        );
+        let t = ticks(-5.6, 5.6);
+        assert!(t.contains(&0.0) && t.len() >= 4 && t.len() <= 8, "{t:?}");
+    }
+}

@@ -1,0 +1,144 @@
+//! Pictures over HTTP: `Accept: image/svg+xml` (or `?format=svg` for links) on every route
+//! that answers, finished jobs included; an unknown form is 406; the dashboard at `/`.
+
+use reqwest::Method;
+use serde_json::json;
+
+use crate::helpers::{problem, problem_type, spawn_app};
+
+fn is_svg(content_type: &str, body: &str) {
+    assert_eq!(content_type, "image/svg+xml");
+    assert!(
+        body.starts_with("<svg xmlns=\"http://www.w3.org/2000/svg\""),
+        "{body:.80}"
+    );
+    assert!(body.ends_with("</svg>"));
+}
+
+async fn svg(response: reqwest::Response) -> (String, String) {
+    assert_eq!(response.status(), 200);
+    let content_type = response.headers()["content-type"]
+        .to_str()
+        .unwrap()
+        .to_string();
+    let etag = response.headers()["etag"].to_str().unwrap().to_string();
+    let body = response.text().await.unwrap();
+    is_svg(&content_type, &body);
+    (etag, body)
+}
+
+#[tokio::test]
+async fn every_answer_is_a_picture_when_asked_by_accept_or_by_query() {
+    let app = spawn_app(&[]).await;
+    let accept = [("accept", "image/svg+xml")];
+    let body = json!({"load": "1.1 nN"});
+    let (etag, picture) = svg(app
+        .send(Method::POST, "/v1/rolling", &accept, Some(&body))
+        .await)
+    .await;
+    assert!(etag.ends_with(".svg\""), "{etag}");
+    assert!(picture.contains("Contact region, R = 25 nm, P = 1.1 nN"));
+    let (_, by_query) = svg(app
+        .send(Method::POST, "/v1/rolling?format=svg", &[], Some(&body))
+        .await)
+    .await;
+    assert_eq!(by_query, picture);
+    svg(app.get("/v1/figures/6?format=svg").await).await;
+    let three_body = json!({"operating": {"total_load": "1 mN"}});
+    svg(app
+        .send(Method::POST, "/v1/three-body", &accept, Some(&three_body))
+        .await)
+    .await;
+    let sweep = json!({"vary": {"load": ["1 nN", "2 nN"]}});
+    svg(app
+        .send(Method::POST, "/v1/sweeps", &accept, Some(&sweep))
+        .await)
+    .await;
+
+    // A finished job's result, too.
+    let location = app.submit(&json!({"kind": "sweep", "input": sweep})).await;
+    app.wait_for_job(&location, |job| job["status"] == "succeeded")
+        .await;
+    let result = format!("{location}/result");
+    let (_, job_picture) = svg(app.send(Method::GET, &result, &accept, None).await).await;
+    assert!(job_picture.contains("Sweep: friction coefficient against load"));
+
+    // A form the service does not draw.
+    let png = app
+        .send(
+            Method::GET,
+            "/v1/figures/3",
+            &[("accept", "image/png")],
+            None,
+        )
+        .await;
+    let refused = problem(png, 406).await;
+    assert_eq!(refused["type"], problem_type("not-acceptable"));
+    let unknown = problem(app.get("/v1/figures/3?format=png").await, 406).await;
+    assert!(unknown["detail"]
+        .as_str()
+        .unwrap()
+        .contains("json, csv and svg"));
+}
+
+#[tokio::test]
+async fn the_dashboard_is_served_with_its_assets_under_a_strict_policy() {
+    let app = spawn_app(&[]).await;
+    for (path, content_type) in [
+        ("/", "text/html; charset=utf-8"),
+        ("/assets/app.js", "text/javascript; charset=utf-8"),
+        ("/assets/app.css", "text/css; charset=utf-8"),
+        ("/assets/icon.svg", "image/svg+xml"),
+    ] {
+        let response = app.get(path).await;
+        assert_eq!(response.status(), 200, "{path}");
+        let headers = response.headers();
+        assert_eq!(headers["content-type"], content_type, "{path}");
+        assert_eq!(
+            headers["content-security-policy"], "default-src 'self'",
+            "{path}"
+        );
+    }
+    let page = app.get("/").await.text().await.unwrap();
+    for form in ["form-rolling", "form-three-body", "form-sweep"] {
+        assert!(page.contains(&format!("id=\"{form}\"")), "{form}");
+    }
+    // Nothing from elsewhere, nothing inline.
+    assert!(!page.contains("http://") && !page.contains("https://"));
+    assert!(!page.contains("<script>") && !page.contains("style="));
+}
+
+/// Swagger's "Try it out" starts from each request body's example: every one is a job the
+/// service accepts, with values in units.
+#[tokio::test]
+async fn every_request_body_example_in_the_spec_is_accepted() {
+    let app = spawn_app(&[]).await;
+    let spec: serde_json::Value =
+        serde_json::from_str(&thirdbody::http::openapi::spec_json()).unwrap();
+    let mut tried = 0;
+    for (path, operations) in spec["paths"].as_object().unwrap() {
+        let Some(body) = operations["post"].get("requestBody") else {
+            continue;
+        };
+        let reference = body["content"]["application/json"]["schema"]["$ref"]
+            .as_str()
+            .unwrap();
+        let name = reference.rsplit('/').next().unwrap();
+        let example = &spec["components"]["schemas"][name]["example"];
+        assert!(example.is_object(), "{name} has no example");
+        let response = app.post(path, example).await;
+        assert!(
+            response.status().is_success(),
+            "{path}: {}",
+            response.status()
+        );
+        tried += 1;
+        if path != "/v1/checks" {
+            assert!(
+                example.to_string().contains(" nm"),
+                "{name}'s example has unit strings"
+            );
+        }
+    }
+    assert_eq!(tried, 5);
+}

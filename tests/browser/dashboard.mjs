@@ -1,0 +1,101 @@
+// The dashboard end to end, as a user at a browser: Debian's chromium driven by
+// playwright-core against `thirdbody serve` on a port the system chooses. Fails on a console
+// error or on any request that leaves the server. Screenshots go to target/browser/.
+import { spawn } from "node:child_process";
+import { mkdirSync } from "node:fs";
+import { chromium } from "playwright-core";
+
+const root = new URL("../../", import.meta.url).pathname;
+const bin = process.env.THIRDBODY_BIN || `${root}target/release/thirdbody`;
+const shots = `${root}target/browser`;
+mkdirSync(shots, { recursive: true });
+
+function fail(message) {
+  console.error(`FAILED: ${message}`);
+  process.exitCode = 1;
+}
+
+/** Starts the service on 127.0.0.1:0 and resolves with its base URL (from its log). */
+function serve() {
+  const child = spawn(bin, ["serve", "--bind", "127.0.0.1:0", "--log-format", "json"], {
+    stdio: ["ignore", "ignore", "pipe"],
+  });
+  return new Promise((resolve, reject) => {
+    let log = "";
+    child.stderr.on("data", (chunk) => {
+      log += chunk;
+      const found = log.match(/"address":"(127\.0\.0\.1:\d+)"/);
+      if (found) resolve({ child, base: `http://${found[1]}` });
+    });
+    child.on("exit", (code) => reject(new Error(`thirdbody serve exited ${code}: ${log}`)));
+  });
+}
+
+const { child, base } = await serve();
+const browser = await chromium.launch({
+  executablePath: process.env.CHROMIUM || "/usr/bin/chromium",
+  args: ["--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
+         "--disable-background-networking", "--disable-component-update", "--disable-sync"],
+});
+try {
+  const page = await browser.newPage({ viewport: { width: 1366, height: 900 } });
+  const errors = [];
+  page.on("console", (message) => { if (message.type() === "error") errors.push(message.text()); });
+  page.on("pageerror", (error) => errors.push(String(error)));
+  const outside = [];
+  page.on("request", (request) => {
+    const url = request.url();
+    if (!url.startsWith(base) && !url.startsWith("blob:") && !url.startsWith("data:")) outside.push(url);
+  });
+
+  // The default rolling contact: a table and its picture.
+  await page.goto(`${base}/`);
+  const csp = (await page.request.get(`${base}/`)).headers()["content-security-policy"];
+  if (csp !== "default-src 'self'") fail(`Content-Security-Policy is ${csp}`);
+  await page.locator("#form-rolling").getByRole("button", { name: "Solve" }).click();
+  await page.waitForSelector("#picture svg .series");
+  const mu = await page.locator("#table tr", { hasText: "friction_coefficient" }).first().textContent();
+  if (!/0\.0947/.test(mu)) fail(`the default friction coefficient is shown as ${mu}`);
+  await page.screenshot({ path: `${shots}/rolling.png`, fullPage: true });
+
+  // A three-body system: its distribution of diameters.
+  await page.getByRole("tab", { name: "Three-body system" }).click();
+  await page.locator("#form-three-body").getByRole("button", { name: "Solve" }).click();
+  await page.waitForFunction(() => (document.querySelector("#picture svg title") || {}).textContent?.startsWith("Three-body"));
+  await page.screenshot({ path: `${shots}/three-body.png`, fullPage: true });
+
+  // A 200-point sweep as a job: the progress bar reaches 100 %.
+  await page.getByRole("tab", { name: "Sweep" }).click();
+  const loads = Array.from({ length: 10 }, (_, i) => `${(0.5 + 0.25 * i).toFixed(2)} nN`).join(", ");
+  const speeds = Array.from({ length: 20 }, (_, i) => `${i} nm/s`).join(", ");
+  await page.fill("input[name='vary.load']", loads);
+  await page.fill("input[name='vary.velocity']", speeds);
+  await page.getByRole("button", { name: "Run" }).click();
+  await page.waitForFunction(() => {
+    const bar = document.querySelector("#progress");
+    return bar.max === 200 && bar.value === 200 && document.querySelector("#picture svg .series");
+  }, null, { timeout: 60000 });
+  const progress = await page.locator("#progress-text").textContent();
+  if (!progress.includes("200 / 200 (100 %)")) fail(`progress reads ${progress}`);
+  await page.screenshot({ path: `${shots}/sweep.png`, fullPage: true });
+
+  // Figure 6 from the gallery.
+  await page.getByRole("tab", { name: "Figures 3–9" }).click();
+  await page.getByRole("button", { name: "Figure 6" }).click();
+  await page.waitForFunction(() => (document.querySelector("#picture svg title") || {}).textContent?.startsWith("Fig. 6"));
+  const entries = await page.locator("#picture svg .legend .entry").count();
+  if (entries !== 10) fail(`Figure 6 has ${entries} legend entries, not 10`);
+  await page.screenshot({ path: `${shots}/figure-6.png`, fullPage: true });
+
+  // The keyboard reaches the forms: Tab from the page start lands on a link or a control.
+  await page.keyboard.press("Tab");
+  const focused = await page.evaluate(() => document.activeElement.tagName);
+  if (!["A", "BUTTON", "INPUT"].includes(focused)) fail(`Tab focuses a ${focused}`);
+
+  if (errors.length) fail(`console errors: ${errors.join(" | ")}`);
+  if (outside.length) fail(`requests left the server: ${outside.join(", ")}`);
+  if (!process.exitCode) console.log(`dashboard: rolling, three-body, a 200-point sweep and Figure 6 work; screenshots in ${shots}`);
+} finally {
+  await browser.close();
+  child.kill();
+}

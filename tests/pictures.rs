@@ -1,0 +1,192 @@
+//! Every answer has a picture: SVG that parses, with axes, one path per series and a legend
+//! naming each, drawn from the answer's own numbers; Figures 3 and 6 are snapshot-tested
+//! (`UPDATE_SNAPSHOTS=1 cargo test --test pictures` rewrites them after a deliberate change).
+
+use serde_json::{json, Value};
+use thirdbody::job::{pictures, Control, Job, Limits};
+use thirdbody::render::svg::Layer;
+use thirdbody::render::Format;
+
+/// The answer to `job` as JSON and as SVG.
+fn solve(job: Value) -> (Value, String) {
+    let job = Job::from_value(job, &Limits::default()).unwrap();
+    let answer = job.run(job.meta(), &Control::default()).unwrap();
+    let json = serde_json::from_slice(&answer.render(Format::Json).unwrap()).unwrap();
+    let svg = String::from_utf8(answer.render(Format::Svg).unwrap()).unwrap();
+    (json, svg)
+}
+
+/// Checks the SVG's structure; returns the names of its series and its legend entries.
+fn parts(svg: &str) -> (Vec<String>, Vec<String>) {
+    let doc = roxmltree::Document::parse(svg).expect("the picture is XML");
+    let root = doc.root_element();
+    assert_eq!(root.tag_name().name(), "svg");
+    assert_eq!(root.attribute("width"), Some("800"));
+    assert_eq!(root.attribute("height"), Some("500"));
+    let class = |node: &roxmltree::Node, name: &str| {
+        node.attribute("class")
+            .is_some_and(|c| c.split(' ').any(|c| c == name))
+    };
+    for axis in ["x", "y"] {
+        let found = doc
+            .descendants()
+            .find(|n| class(n, "axis") && class(n, axis))
+            .unwrap_or_else(|| panic!("no {axis} axis"));
+        let label = found.descendants().find(|n| class(n, "label")).unwrap();
+        assert!(
+            !label.text().unwrap_or("").is_empty(),
+            "the {axis} axis has a label"
+        );
+        assert!(
+            found.children().filter(|n| n.has_tag_name("text")).count() >= 3,
+            "ticks"
+        );
+    }
+    assert!(doc.descendants().any(|n| class(&n, "title")));
+    let series = doc
+        .descendants()
+        .filter(|n| class(n, "series"))
+        .map(|n| n.attribute("data-name").unwrap_or("").to_string())
+        .collect();
+    let legend = doc
+        .descendants()
+        .filter(|n| class(n, "entry"))
+        .map(|n| n.text().unwrap_or("").to_string())
+        .collect();
+    (series, legend)
+}
+
+#[test]
+fn a_rolling_contact_is_its_contact_region_at_its_size() {
+    let (answer, svg) = solve(json!({"kind": "rolling", "input": {}}));
+    let (series, legend) = parts(&svg);
+    assert_eq!(
+        series,
+        [
+            "contact, V = 4 nm/s",
+            "at rest, V = 0",
+            "pressure centre",
+            "centroid"
+        ]
+    );
+    assert_eq!(legend, series);
+    let chart = pictures::rolling(&answer).unwrap();
+    let Layer::Area { outline, .. } = &chart.layers[0] else {
+        panic!("the contact region comes first");
+    };
+    let half_width = answer["half_width"].as_f64().unwrap();
+    let extent = outline.iter().map(|p| p.1.abs()).fold(0.0, f64::max);
+    assert!(
+        (extent - half_width).abs() <= 1e-12 * half_width,
+        "{extent} vs {half_width}"
+    );
+    let leading = outline.iter().map(|p| p.0).fold(f64::MIN, f64::max);
+    let edge = answer["boundary"].as_array().unwrap().iter();
+    let entry = edge
+        .map(|p| p["entry"].as_f64().unwrap())
+        .fold(f64::MIN, f64::max);
+    assert_eq!(leading, entry);
+    let Layer::Circle { radius, .. } = &chart.layers[1] else {
+        panic!("then the contact at rest");
+    };
+    let at_rest = answer["static"]["contact_area"].as_f64().unwrap();
+    assert!((std::f64::consts::PI * radius * radius / at_rest - 1.0).abs() < 1e-12);
+}
+
+#[test]
+fn a_pressure_grid_is_a_heat_map_with_a_colour_bar() {
+    let (_, svg) = solve(json!({"kind": "rolling", "input": {"options": {"pressure_grid": 20}}}));
+    parts(&svg);
+    assert!(svg.contains(r#"<g class="heatmap">"#) && svg.contains(r#"<g class="colourbar">"#));
+    assert!(svg.contains("pressure [MPa]"));
+}
+
+#[test]
+fn a_sweep_has_a_curve_per_other_value_and_marks_points_at_rest() {
+    let (answer, svg) = solve(json!({"kind": "sweep", "input": {"vary": {
+        "load": ["0.5 nN", "1 nN", "2 nN"], "velocity": ["0 nm/s", "2 nm/s", "4 nm/s"]}}}));
+    let (series, legend) = parts(&svg);
+    assert_eq!(
+        series,
+        ["P = 500 pN", "P = 1 nN", "P = 2 nN", "at rest, V = 0"]
+    );
+    assert_eq!(legend, series);
+    let chart = pictures::sweep(&answer).unwrap();
+    let Layer::Line { points, .. } = &chart.layers[1] else {
+        panic!()
+    };
+    let rows: Vec<&Value> = answer["points"].as_array().unwrap()[3..6].iter().collect();
+    for (p, row) in points.iter().zip(rows) {
+        assert_eq!(p.0, row["velocity"].as_f64().unwrap());
+        assert_eq!(p.1, row["friction_coefficient"].as_f64().unwrap());
+    }
+    assert_eq!(chart.x.quantity, "velocity");
+    assert!(svg.contains("velocity [nm/s]"));
+}
+
+#[test]
+fn a_three_body_system_shades_the_particles_in_contact_and_splits_the_area() {
+    let (answer, svg) = solve(json!({"kind": "three_body",
+        "input": {"operating": {"total_load": "1 mN"}}}));
+    let (series, _) = parts(&svg);
+    assert_eq!(series[0], "diameters");
+    assert_eq!(series[1], "in contact (x > d)");
+    let chart = pictures::three_body(&answer).unwrap();
+    let Layer::Area { outline, .. } = &chart.layers[1] else {
+        panic!()
+    };
+    let separation = answer["separation"].as_f64().unwrap();
+    assert!(outline.iter().all(|p| p.0 >= separation));
+    assert!(svg.contains("particle diameter [nm]") && svg.contains("particle–upper: 100.0 %"));
+}
+
+#[test]
+fn each_figure_draws_every_series_of_its_answer() {
+    for number in 3..=9 {
+        let (answer, svg) = solve(json!({"kind": "figure", "input": {"number": number}}));
+        let (series, legend) = parts(&svg);
+        let expected = answer["series"].as_array().unwrap();
+        assert_eq!(series.len(), expected.len(), "Fig. {number}");
+        assert_eq!(legend.len(), expected.len(), "Fig. {number}");
+        for (label, name) in expected.iter().zip(&legend) {
+            assert!(
+                label["label"].as_str().unwrap().ends_with(name.as_str()),
+                "Fig. {number}"
+            );
+        }
+        let chart = pictures::figure(&answer).unwrap();
+        for (layer, curve) in chart.layers.iter().zip(expected) {
+            let Layer::Line { points, dashed, .. } = layer else {
+                panic!()
+            };
+            let data: Vec<(f64, f64)> = curve["points"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|p| (p[0].as_f64().unwrap(), p[1].as_f64().unwrap()))
+                .collect();
+            assert_eq!(points, &data, "Fig. {number}");
+            assert_eq!(
+                *dashed,
+                curve["velocity"] == 0.0,
+                "Fig. {number}: at rest dashed"
+            );
+        }
+    }
+}
+
+#[test]
+fn figures_3_and_6_match_their_snapshots() {
+    for number in [3, 6] {
+        let (_, svg) = solve(json!({"kind": "figure", "input": {"number": number}}));
+        let path = format!(
+            "{}/tests/snapshots/figure-{number}.svg",
+            env!("CARGO_MANIFEST_DIR")
+        );
+        if std::env::var_os("UPDATE_SNAPSHOTS").is_some() {
+            std::fs::write(&path, &svg).unwrap();
+        }
+        let snapshot = std::fs::read_to_string(&path).expect("the snapshot is committed");
+        assert!(svg == snapshot, "Fig. {number} differs from {path}");
+    }
+}
