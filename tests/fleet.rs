@@ -274,6 +274,18 @@ async fn two_services_and_a_worker_share_answers_jobs_and_sweeps_through_redis()
         view["result"], whole,
         "the sweep assembled from parts is the sweep"
     );
+    // Drawn from its JSON, though no process holds it typed.
+    let picture = http
+        .get(format!("{}/v1/jobs/{id}/result?format=svg", a.base))
+        .send()
+        .await
+        .unwrap();
+    assert_eq!(picture.headers()["content-type"], "image/svg+xml");
+    assert!(picture
+        .text()
+        .await
+        .unwrap()
+        .contains("Sweep: friction coefficient"));
     let deliveries = redis_cli(
         redis_port,
         &["HVALS", &format!("thirdbody:job:{id}:deliveries")],
