@@ -128,7 +128,8 @@ impl StripRule {
     fn new(quadrature: Quadrature) -> StripRule {
         match quadrature {
             Quadrature::Gauss { nodes } => {
-                let (x, w) = gauss_legendre(nodes);
+                let rule = gauss_legendre(nodes);
+                let (x, w) = &*rule;
                 // θ = (π/4)(x + 1) ∈ (0, π/2); dy = r cos θ dθ.
                 let theta: Vec<f64> = x.iter().map(|x| FRAC_PI_4 * (x + 1.0)).collect();
                 StripRule {
@@ -136,7 +137,7 @@ impl StripRule {
                     cos: theta.iter().map(|t| t.cos()).collect(),
                     weight: theta
                         .iter()
-                        .zip(&w)
+                        .zip(w)
                         .map(|(t, w)| FRAC_PI_4 * w * t.cos())
                         .collect(),
                 }
@@ -171,13 +172,45 @@ fn lock<T>(mutex: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
         .unwrap_or_else(|poisoned| poisoned.into_inner())
 }
 
+/// A Gauss–Legendre rule on [−1, 1]: its nodes, ascending, and their weights.
+pub type GaussRule = Arc<(Vec<f64>, Vec<f64>)>;
+
+/// The Gauss–Legendre rule of `n` nodes, computed once per process and shared (it is pure
+/// data, and computing it costs an eigen-solve: 64 % of an asperity job's instructions
+/// when it was rebuilt on every use, BENCHMARKS.md).
+pub fn gauss_legendre(n: usize) -> GaussRule {
+    /// The sizes in use: strip rules, diameter rules and their halves, asperity regimes.
+    const CACHED_RULES: usize = 32;
+    type Cache = Mutex<Vec<(usize, GaussRule)>>;
+    static CACHE: OnceLock<Cache> = OnceLock::new();
+    let cache = CACHE.get_or_init(|| Mutex::new(Vec::new()));
+    if let Some((_, rule)) = lock(cache).iter().find(|(size, _)| *size == n) {
+        return rule.clone();
+    }
+    let rule = Arc::new(compute_gauss_legendre(n));
+    let mut rules = lock(cache);
+    if rules.len() >= CACHED_RULES {
+        rules.remove(0);
+    }
+    rules.push((n, rule.clone()));
+    rule
+}
+
+/// The 16-point Gauss–Legendre rule on [−1, 1], without even a lock (the strip solver
+/// uses it in its inner loop).
+pub fn gauss_legendre_16() -> (&'static [f64], &'static [f64]) {
+    static RULE: OnceLock<GaussRule> = OnceLock::new();
+    let rule = RULE.get_or_init(|| gauss_legendre(16));
+    (&rule.0, &rule.1)
+}
+
 /// Gauss–Legendre nodes and weights on [−1, 1], ascending.
 ///
 /// Golub–Welsch: the nodes are the eigenvalues of the symmetric Jacobi matrix of the
 /// Legendre recurrence (nalgebra's symmetric eigen-solver). Each node is then polished by
 /// Newton steps on Pₙ, and the weights come from 2/((1 − x²) Pₙ′(x)²), which is accurate to
 /// the last bit where eigenvector weights lose a few digits.
-pub fn gauss_legendre(n: usize) -> (Vec<f64>, Vec<f64>) {
+fn compute_gauss_legendre(n: usize) -> (Vec<f64>, Vec<f64>) {
     let jacobi = DMatrix::from_fn(n, n, |i, j| {
         if i.abs_diff(j) == 1 {
             let k = i.max(j) as f64;
@@ -198,13 +231,6 @@ pub fn gauss_legendre(n: usize) -> (Vec<f64>, Vec<f64>) {
         weights.push(2.0 / ((1.0 - *x * *x) * dp * dp));
     }
     (nodes, weights)
-}
-
-/// The 16-point Gauss–Legendre rule on [−1, 1], computed once.
-pub fn gauss_legendre_16() -> (&'static [f64], &'static [f64]) {
-    static RULE: OnceLock<(Vec<f64>, Vec<f64>)> = OnceLock::new();
-    let (x, w) = RULE.get_or_init(|| gauss_legendre(16));
-    (x, w)
 }
 
 /// Pₙ(x) and Pₙ′(x) by the three-term recurrence.
@@ -230,13 +256,14 @@ mod tests {
     #[test]
     fn gauss_legendre_integrates_polynomials_of_degree_2n_minus_1_exactly() {
         for n in [2usize, 5, 16, 64, 128] {
-            let (x, w) = gauss_legendre(n);
+            let rule = gauss_legendre(n);
+            let (x, w) = &*rule;
             let total: f64 = w.iter().sum();
             assert!((total - 2.0).abs() < 1e-14, "n = {n}: Σw = {total}");
             let degree = 2 * n - 2; // even, so the exact integral is 2/(degree + 1)
             let integral: f64 = x
                 .iter()
-                .zip(&w)
+                .zip(w)
                 .map(|(x, w)| w * x.powi(degree as i32))
                 .sum();
             let exact = 2.0 / (degree as f64 + 1.0);

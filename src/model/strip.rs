@@ -291,7 +291,7 @@ mod tests {
     /// edge (where slow strips have a boundary layer of width V T_σ), against the closed forms.
     #[test]
     fn exact_strip_load_and_moment_equal_a_quadrature_of_the_pressure() {
-        let (x16, w16) = crate::model::quadrature::gauss_legendre(16);
+        let (x16, w16) = crate::model::quadrature::gauss_legendre_16();
         for &beta in &[0.1, 1.0, 10.0, 100.0] {
             let s = strip(beta, 4.0);
             let rho = s.exit_root(None).unwrap().rho;
@@ -307,7 +307,7 @@ mod tests {
             let (mut load, mut moment) = (0.0, 0.0);
             for pair in edges.windows(2) {
                 let (lo, hi) = (pair[0], pair[1]);
-                for (x, w) in x16.iter().zip(&w16) {
+                for (x, w) in x16.iter().zip(w16) {
                     let xm = 0.5 * (lo + hi) + 0.5 * (hi - lo) * x;
                     let p = s.pressure(xm, rho) / 2.0; // p·R/k
                     load += 0.5 * (hi - lo) * w * p;

@@ -84,7 +84,8 @@ impl Zmc {
         let sigma = self.asperities.height_std;
         let top = HEIGHT_RANGE * sigma;
         let breaks = [0.0, self.critical_elastic, self.critical_plastic, top];
-        let (x, w) = gauss_legendre(NODES_PER_REGIME);
+        let rule = gauss_legendre(NODES_PER_REGIME);
+        let (x, w) = &*rule;
         let heights = |z: f64| {
             let u = z / sigma;
             (-0.5 * u * u).exp() * FRAC_1_SQRT_2 / (sigma * PI.sqrt())
@@ -95,7 +96,7 @@ impl Zmc {
             if hi <= lo {
                 continue;
             }
-            for (t, wt) in x.iter().zip(&w) {
+            for (t, wt) in x.iter().zip(w) {
                 // First regime: w = hi·τ², τ ∈ (0, 1); others: linear.
                 let (interference, jacobian) = if i == 0 {
                     let tau = 0.5 * (t + 1.0);

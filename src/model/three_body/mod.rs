@@ -12,7 +12,7 @@ pub use contact::{squeeze, LayerLaw, Squeeze, UpperLaw};
 pub use distribution::Diameters;
 
 use super::kelvin_map::KelvinMap;
-use super::quadrature::{gauss_legendre, StripRule};
+use super::quadrature::{gauss_legendre, GaussRule, StripRule};
 use super::roots::brent;
 use super::{Layer, ModelError, OptionError, Parameter, ParameterError, Quadrature, SolveOption};
 
@@ -430,7 +430,7 @@ struct Model<'a> {
     /// τ_a of the layer and τ_s of the softer surface (Pa).
     shear_strengths: (f64, f64),
     /// Gauss–Legendre nodes and weights on [−1, 1] for the diameters.
-    nodes: (Vec<f64>, Vec<f64>),
+    nodes: GaussRule,
 }
 
 impl<'a> Model<'a> {
@@ -502,7 +502,7 @@ impl<'a> Model<'a> {
                 // x = d + L τ⁴ over τ ∈ [τ_lo, 1].
                 let span = d.max - separation;
                 let tau_lo = ((lo - separation) / span).powf(1.0 / f64::from(EDGE_POWER));
-                let (x, w) = &self.nodes;
+                let (x, w) = &*self.nodes;
                 for (t, w) in x.iter().zip(w) {
                     let tau = tau_lo + (1.0 - tau_lo) * 0.5 * (t + 1.0);
                     let omega = span * tau.powi(EDGE_POWER);
