@@ -42,7 +42,27 @@ function requestOf(form) {
 
 // ---- Showing answers -----------------------------------------------------------------
 
-const UNIT_SHOWN = { m: [1e9, "nm"], N: [1e9, "nN"], "m/s": [1e9, "nm/s"], "m^2": [1e18, "nm²"], "m²": [1e18, "nm²"], Pa: [1e-6, "MPa"] };
+/** `value` (SI `unit`) in the unit a person reads: 25 nm, 1 mN, 0.208 µm² (as the pictures). */
+function readable(value, unit) {
+  const bases = { m: ["m", 1], N: ["N", 1], "m/s": ["m/s", 1], "m^2": ["m²", 2], "m²": ["m²", 2] };
+  if (unit === "Pa") {
+    for (const [size, name] of [[1e9, "GPa"], [1e6, "MPa"], [1e3, "kPa"]]) {
+      if (Math.abs(value) >= size) return [value / size, name];
+    }
+    return [value, "Pa"];
+  }
+  const base = bases[unit];
+  if (!base || value === 0) return [value, base ? base[0] : unit || ""];
+  const [name, power] = base;
+  for (const [size, prefix] of [[1, ""], [1e-3, "m"], [1e-6, "µ"], [1e-9, "n"], [1e-12, "p"]]) {
+    const scale = size ** power;
+    const least = power === 2 ? 1e-2 : 1;
+    if (Math.abs(value) >= least * scale || prefix === "p") {
+      return [value / scale, name === "m/s" ? `${prefix}m/s` : prefix + name];
+    }
+  }
+  return [value, unit];
+}
 
 function status(text, error = false) {
   const p = $("#status");
@@ -62,8 +82,8 @@ function rows(answer, units, prefix = "") {
     if (key === "meta") continue;
     const path = prefix + key;
     if (typeof value === "number") {
-      const [factor, unit] = UNIT_SHOWN[units[path]] || [1, units[path] || ""];
-      out.push([path, Number((value * factor).toPrecision(6)), unit]);
+      const [shown, unit] = readable(value, units[path]);
+      out.push([path, Number(shown.toPrecision(6)), unit]);
     } else if (value && typeof value === "object" && !Array.isArray(value)) {
       out.push(...rows(value, units, path + "."));
     }
