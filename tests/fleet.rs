@@ -299,6 +299,34 @@ async fn two_services_and_a_worker_share_answers_jobs_and_sweeps_through_redis()
         assert!(parts >= 1.0, "{} solved no part", service.base);
     }
 
+    // A cancel sent to B stops the parts running on A: the job ends cancelled everywhere.
+    let mut long = sweep.clone();
+    long["input"]["vary"]["velocity"] = json!((0..50)
+        .map(|i| format!("{} nm/s", 100 + i))
+        .collect::<Vec<_>>());
+    let id = submit(&http, &a.base, long).await;
+    while metric(&http, &a.base, "thirdbody_jobs_running", "").await < 1.0 {
+        tokio::time::sleep(Duration::from_millis(5)).await;
+    }
+    let cancelled = http
+        .post(format!("{}/v1/jobs/{id}/cancel", b.base))
+        .send()
+        .await
+        .unwrap();
+    assert_eq!(cancelled.status(), 200);
+    assert_eq!(finished(&http, &a.base, &id).await["status"], "cancelled");
+    let start = Instant::now();
+    while metric(&http, &a.base, "thirdbody_jobs_running", "").await
+        + metric(&http, &b.base, "thirdbody_jobs_running", "").await
+        > 0.0
+    {
+        assert!(
+            start.elapsed() < Duration::from_secs(5),
+            "the cancelled parts still run"
+        );
+        tokio::time::sleep(Duration::from_millis(20)).await;
+    }
+
     // Redis stopped: synchronous solves still answer, submissions are refused with 503.
     drop(redis);
     let body = json!({"load": "2.1 nN"});
