@@ -71,7 +71,12 @@ fn redis_cli(port: u16, args: &[&str]) -> String {
 }
 
 /// Starts `thirdbody <command>` on the fleet of Redis `redis`; its log lines are collected.
-fn start(command: &str, redis: u16, port: Option<u16>) -> (Process, Arc<Mutex<Vec<String>>>) {
+fn start(
+    command: &str,
+    redis: u16,
+    port: Option<u16>,
+    flags: &[&str],
+) -> (Process, Arc<Mutex<Vec<String>>>) {
     let mut cmd = Command::new(env!("CARGO_BIN_EXE_thirdbody"));
     cmd.arg(command)
         .args(["--redis-url", &format!("redis://127.0.0.1:{redis}")])
@@ -86,7 +91,8 @@ fn start(command: &str, redis: u16, port: Option<u16>) -> (Process, Arc<Mutex<Ve
         .args(["--pool-size", "2"])
         .env("RUST_LOG", "info")
         .stdout(Stdio::null())
-        .stderr(Stdio::piped());
+        .stderr(Stdio::piped())
+        .args(flags);
     if let Some(port) = port {
         cmd.args(["--bind", &format!("127.0.0.1:{port}")]);
     }
@@ -107,9 +113,9 @@ struct Service {
     _process: Process,
 }
 
-async fn serve(redis: u16, http: &reqwest::Client) -> Service {
+async fn serve(redis: u16, http: &reqwest::Client, flags: &[&str]) -> Service {
     let port = free_port();
-    let (process, _) = start("serve", redis, Some(port));
+    let (process, _) = start("serve", redis, Some(port), flags);
     let base = format!("http://127.0.0.1:{port}");
     let start = Instant::now();
     while http.get(format!("{base}/healthz")).send().await.is_err() {
@@ -165,6 +171,30 @@ async fn finished(http: &reqwest::Client, base: &str, id: &str) -> Value {
     }
 }
 
+/// Waits until the process whose log is `log` is solving a part of job `id`.
+async fn taken_by(log: &Mutex<Vec<String>>, id: &str) {
+    let start = Instant::now();
+    let taken = |l: &String| l.contains("solving a part") && l.contains(id);
+    while !log.lock().unwrap().iter().any(taken) {
+        assert!(
+            start.elapsed() < Duration::from_secs(30),
+            "the worker took no part"
+        );
+        tokio::time::sleep(Duration::from_millis(5)).await;
+    }
+}
+
+/// A sweep of 2,000 points with a fine rule, parts long enough to kill a worker in one.
+fn heavy_sweep() -> Value {
+    let loads: Vec<String> = (0..40)
+        .map(|i| format!("{} nN", 1.0 + 0.05 * f64::from(i)))
+        .collect();
+    let speeds: Vec<String> = (0..50).map(|i| format!("{} nm/s", f64::from(i))).collect();
+    json!({"kind": "sweep", "input": {
+        "base": {"options": {"strips": 1024}},
+        "vary": {"load": loads, "velocity": speeds}}})
+}
+
 async fn submit(http: &reqwest::Client, base: &str, job: Value) -> String {
     let response = post(http, format!("{base}/v1/jobs"), &job).await;
     let status = response.status();
@@ -182,9 +212,9 @@ async fn two_services_and_a_worker_share_answers_jobs_and_sweeps_through_redis()
     let redis_port = free_port();
     let redis = start_redis(redis_port);
     let http = reqwest::Client::new();
-    let a = serve(redis_port, &http).await;
-    let b = serve(redis_port, &http).await;
-    let (worker, worker_log) = start("worker", redis_port, None);
+    let a = serve(redis_port, &http, &[]).await;
+    let b = serve(redis_port, &http, &[]).await;
+    let (worker, worker_log) = start("worker", redis_port, None, &[]);
 
     // A job submitted to A is polled and followed on B.
     let id = submit(
@@ -243,23 +273,9 @@ async fn two_services_and_a_worker_share_answers_jobs_and_sweeps_through_redis()
 
     // A 2,000-point sweep is worked by all three, and SIGKILL of the worker mid-run loses no
     // point: its part is delivered again.
-    let loads: Vec<String> = (0..40)
-        .map(|i| format!("{} nN", 1.0 + 0.05 * f64::from(i)))
-        .collect();
-    let speeds: Vec<String> = (0..50).map(|i| format!("{} nm/s", f64::from(i))).collect();
-    let sweep = json!({"kind": "sweep", "input": {
-        "base": {"options": {"strips": 1024}},
-        "vary": {"load": loads, "velocity": speeds}}});
+    let sweep = heavy_sweep();
     let id = submit(&http, &a.base, sweep.clone()).await;
-    let start = Instant::now();
-    let taken = |l: &String| l.contains("solving a part") && l.contains(&id);
-    while !worker_log.lock().unwrap().iter().any(taken) {
-        assert!(
-            start.elapsed() < Duration::from_secs(30),
-            "the worker took no part"
-        );
-        tokio::time::sleep(Duration::from_millis(5)).await;
-    }
+    taken_by(&worker_log, &id).await;
     drop(worker); // SIGKILL
     let view = finished(&http, &b.base, &id).await;
     assert_eq!(view["status"], "succeeded", "{view}");
@@ -369,4 +385,28 @@ async fn two_services_and_a_worker_share_answers_jobs_and_sweeps_through_redis()
     )
     .await;
     assert_eq!(finished(&http, &a.base, &id).await["status"], "succeeded");
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_part_whose_worker_keeps_dying_fails_its_job_saying_so() {
+    if !redis_server_available() {
+        eprintln!("SKIPPED: redis-server is not on PATH (`.ci/run` installs it)");
+        return;
+    }
+    let redis_port = free_port();
+    let _redis = start_redis(redis_port);
+    let http = reqwest::Client::new();
+    // One delivery allowed: the part of a killed worker is not tried again.
+    let a = serve(redis_port, &http, &["--max-deliveries", "1"]).await;
+    let (worker, log) = start("worker", redis_port, None, &[]);
+    let id = submit(&http, &a.base, heavy_sweep()).await;
+    taken_by(&log, &id).await;
+    drop(worker); // SIGKILL
+    let view = finished(&http, &a.base, &id).await;
+    assert_eq!(view["status"], "failed", "{view}");
+    let detail = view["problem"]["detail"].as_str().unwrap();
+    assert!(
+        detail.contains("was delivered once and every worker that took it stopped"),
+        "{detail}"
+    );
 }

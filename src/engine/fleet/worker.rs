@@ -167,11 +167,14 @@ impl Engine {
         };
         let max = shared.fleet.config.max_deliveries;
         if deliveries > u64::from(max) {
+            let times = match deliveries - 1 {
+                1 => "once".to_string(),
+                n => format!("{n} times"),
+            };
             let error = JobError::Internal(format!(
-                "part {} of the job was delivered {} times and each time its worker stopped \
+                "part {} of the job was delivered {times} and every worker that took it stopped \
                  before finishing it (killed, or out of memory): the job is given up",
                 entry.part_name(),
-                deliveries - 1
             ));
             return self
                 .finish(shared, &entry, JobState::Failed(error), None)
