@@ -103,9 +103,20 @@ use solve_endpoint;
 #[derive(utoipa::IntoParams)]
 #[into_params(parameter_in = Query)]
 pub struct FormatQuery {
-    /// `json`, `csv` or `svg` (the answer's picture).
+    /// The answer's form: its JSON, its CSV table, or its picture (SVG).
     #[allow(dead_code)]
-    format: Option<String>,
+    #[param(inline)]
+    format: Option<FormatName>,
+}
+
+/// The forms of an answer, by name.
+#[derive(utoipa::ToSchema)]
+#[allow(dead_code)]
+#[schema(rename_all = "lowercase")]
+pub enum FormatName {
+    Json,
+    Csv,
+    Svg,
 }
 
 /// How an answer is to be sent: the form the client accepts, and the validator it holds.
