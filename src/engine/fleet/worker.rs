@@ -210,14 +210,15 @@ impl Engine {
         self.jobs_running.increment(1.0);
         let key = runnable.key.clone();
         let part = entry.part.clone();
+        let solving = job.clone();
         let result = Pool::run(permit, control.clone(), move |control| match part {
             None => Ok(Outcome::Whole(Arc::new(Solved::new(
                 key,
-                job.kind(),
-                job.run(meta, control)?,
+                solving.kind(),
+                solving.run(meta, control)?,
             )?))),
             Some((_, range)) => Ok(Outcome::Part(parts::render(
-                &job.run_points(meta, range, control)?,
+                &solving.run_points(meta, range, control)?,
             )?)),
         })
         .await;
@@ -235,18 +236,21 @@ impl Engine {
         match result {
             Ok(Outcome::Whole(solved)) => {
                 self.cache.insert(solved.clone()).await;
-                let total = match Job::from_wire(&runnable.wire).map(|j| j.work()) {
-                    Ok(Work::Known(total)) => Some(total),
-                    _ => Some(control.done()),
+                let total = match job.work() {
+                    Work::Known(total) => total,
+                    Work::Unknown => control.done(),
                 };
-                self.finish(shared, &entry, JobState::Succeeded(solved), total)
+                self.finish(shared, &entry, JobState::Succeeded(solved), Some(total))
                     .await;
             }
             Ok(Outcome::Part(rendered)) => {
                 let points = entry.part.as_ref().map_or(0, |(_, r)| r.len());
                 let index = entry.part.as_ref().map_or(0, |(i, _)| *i);
                 match store.part_done(id, index, &rendered, points).await {
-                    Ok(Some(all)) => self.assemble(shared, &entry, &runnable.key, &all).await,
+                    Ok(Some(all)) => {
+                        self.assemble(shared, &entry, &job, &runnable.key, &all)
+                            .await
+                    }
                     Ok(None) => acknowledge(&shared.fleet, &entry).await,
                     Err(_) => {} // taken over later
                 }
@@ -261,15 +265,17 @@ impl Engine {
         }
     }
 
-    /// Assembles a split job from all its parts and finishes it.
-    async fn assemble(&self, shared: &Shared, entry: &Entry, key: &str, all: &[RenderedPart]) {
-        let state = match Job::from_wire(&match shared.store.runnable(entry.job).await {
-            Ok(Some(r)) => r.wire,
-            _ => return,
-        })
-        .and_then(|job| parts::assemble(&job.meta(), all).map(|a| (job, a)))
-        {
-            Ok((job, assembled)) => {
+    /// Assembles the split `job` from all its parts and finishes it.
+    async fn assemble(
+        &self,
+        shared: &Shared,
+        entry: &Entry,
+        job: &Job,
+        key: &str,
+        all: &[RenderedPart],
+    ) {
+        let state = match parts::assemble(&job.meta(), all) {
+            Ok(assembled) => {
                 let solved = Arc::new(Solved::rendered(
                     key.to_string(),
                     job.kind(),
@@ -277,17 +283,15 @@ impl Engine {
                     Bytes::from(assembled.csv),
                 ));
                 self.cache.insert(solved.clone()).await;
-                let done = match job.work() {
-                    Work::Known(n) => Some(n),
-                    Work::Unknown => None,
-                };
-                return self
-                    .finish(shared, entry, JobState::Succeeded(solved), done)
-                    .await;
+                JobState::Succeeded(solved)
             }
             Err(e) => JobState::Failed(e),
         };
-        self.finish(shared, entry, state, None).await;
+        let done = match (&state, job.work()) {
+            (JobState::Succeeded(_), Work::Known(n)) => Some(n),
+            _ => None,
+        };
+        self.finish(shared, entry, state, done).await;
     }
 
     /// Stores the job's final `state`, then acknowledges the entry (left for another worker
