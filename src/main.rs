@@ -251,13 +251,9 @@ fn worker(args: ServeArgs) -> ExitCode {
         tracing::info!(workers = pool_size, "taking work from Redis");
         shutdown_signal().await;
         engine.begin_drain();
-        if tokio::time::timeout(timeout, engine.jobs_finished())
-            .await
-            .is_err()
-        {
-            engine.interrupt_unfinished_jobs();
-            let _ = tokio::time::timeout(Duration::from_secs(1), engine.jobs_finished()).await;
-        }
+        engine
+            .finish_jobs(tokio::time::Instant::now() + timeout)
+            .await;
     });
     ExitCode::SUCCESS
 }

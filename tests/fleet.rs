@@ -61,6 +61,17 @@ fn start_redis(port: u16) -> Process {
     Process(child)
 }
 
+/// A Redis server of its own on a free port; `None` (the test saying it is skipped) when
+/// redis-server is not installed.
+fn fresh_redis() -> Option<(u16, Process)> {
+    if !redis_server_available() {
+        eprintln!("SKIPPED: redis-server is not on PATH (`.ci/run` installs it)");
+        return None;
+    }
+    let port = free_port();
+    Some((port, start_redis(port)))
+}
+
 fn redis_cli(port: u16, args: &[&str]) -> String {
     let out = Command::new("redis-cli")
         .args(["-p", &port.to_string()])
@@ -205,12 +216,9 @@ async fn submit(http: &reqwest::Client, base: &str, job: Value) -> String {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn two_services_and_a_worker_share_answers_jobs_and_sweeps_through_redis() {
-    if !redis_server_available() {
-        eprintln!("SKIPPED: redis-server is not on PATH (`.ci/run` installs it)");
+    let Some((redis_port, redis)) = fresh_redis() else {
         return;
-    }
-    let redis_port = free_port();
-    let redis = start_redis(redis_port);
+    };
     let http = reqwest::Client::new();
     let a = serve(redis_port, &http, &[]).await;
     let b = serve(redis_port, &http, &[]).await;
@@ -389,12 +397,9 @@ async fn two_services_and_a_worker_share_answers_jobs_and_sweeps_through_redis()
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn a_part_whose_worker_keeps_dying_fails_its_job_saying_so() {
-    if !redis_server_available() {
-        eprintln!("SKIPPED: redis-server is not on PATH (`.ci/run` installs it)");
+    let Some((redis_port, _redis)) = fresh_redis() else {
         return;
-    }
-    let redis_port = free_port();
-    let _redis = start_redis(redis_port);
+    };
     let http = reqwest::Client::new();
     // One delivery allowed: the part of a killed worker is not tried again.
     let a = serve(redis_port, &http, &["--max-deliveries", "1"]).await;

@@ -141,6 +141,14 @@ pub struct MemoryCache {
 }
 
 impl MemoryCache {
+    /// The cache of an engine with `config`: its share of the memory budget, its TTL.
+    pub fn for_engine(config: &super::EngineConfig) -> Self {
+        MemoryCache::new(
+            budget::Budget::split(config.memory_budget).answers,
+            config.cache_ttl,
+        )
+    }
+
     /// Holds at most about `max_bytes` of answers, each for at most `ttl`.
     pub fn new(max_bytes: u64, ttl: Duration) -> Self {
         MemoryCache {

@@ -66,7 +66,7 @@ impl Storage {
     pub fn in_process(config: &EngineConfig) -> Storage {
         let budget = Budget::split(config.memory_budget);
         Storage {
-            cache: Arc::new(MemoryCache::new(budget.answers, config.cache_ttl)),
+            cache: Arc::new(MemoryCache::for_engine(config)),
             jobs: Arc::new(MemoryJobStore::new(
                 config.job_retention,
                 config.max_jobs,
@@ -589,6 +589,22 @@ impl Engine {
     pub async fn jobs_finished(&self) {
         self.tracker.close();
         self.tracker.wait().await;
+    }
+
+    /// Waits (after `begin_drain`) for the jobs to finish until `end`; what is still running
+    /// then is interrupted ([`Engine::interrupt_unfinished_jobs`]) and given a second to stop.
+    /// Returns whether every job finished in time.
+    pub async fn finish_jobs(&self, end: tokio::time::Instant) -> bool {
+        if tokio::time::timeout_at(end, self.jobs_finished())
+            .await
+            .is_ok()
+        {
+            return true;
+        }
+        self.interrupt_unfinished_jobs();
+        // They stop at their next check, microseconds to milliseconds away.
+        let _ = tokio::time::timeout(Duration::from_secs(1), self.jobs_finished()).await;
+        false
     }
 
     /// Stops every job not finished yet (the drain ran out of time): they end

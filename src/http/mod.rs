@@ -242,14 +242,8 @@ pub async fn run(
     tracing::info!("shutting down: draining");
     engine.begin_drain();
     tokio::time::sleep(config.drain_delay).await;
-    if tokio::time::timeout_at(end, engine.jobs_finished())
-        .await
-        .is_err()
-    {
-        tracing::warn!("the drain ran out of time: interrupting the jobs left");
-        engine.interrupt_unfinished_jobs();
-        // They stop at their next check, microseconds to milliseconds away.
-        let _ = tokio::time::timeout(Duration::from_secs(1), engine.jobs_finished()).await;
+    if !engine.finish_jobs(end).await {
+        tracing::warn!("the drain ran out of time: the jobs left were interrupted");
     }
     // Their clients read them (within what is left of the timeout) before the port closes.
     if tokio::time::timeout_at(end, engine.jobs_collected())

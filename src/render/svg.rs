@@ -209,6 +209,15 @@ struct Scale {
 }
 
 impl Scale {
+    /// The values to mark on the axis: powers of ten on a log scale, round steps else.
+    fn ticks(&self) -> Vec<f64> {
+        if self.log {
+            log_ticks(self.lo, self.hi)
+        } else {
+            ticks(self.lo, self.hi)
+        }
+    }
+
     fn at(&self, value: f64) -> f64 {
         let (v, lo, hi) = if self.log {
             (value.max(1e-300).log10(), self.lo.log10(), self.hi.log10())
@@ -242,29 +251,21 @@ fn range(values: impl Iterator<Item = f64>, log: bool) -> (f64, f64) {
 
 /// A colour from blue (0) to red (1), for heat maps.
 fn heat(t: f64) -> String {
-    let t = t.clamp(0.0, 1.0);
-    let stops = [
-        (49, 54, 149),
-        (116, 173, 209),
-        (255, 255, 191),
-        (244, 109, 67),
-        (165, 0, 38),
+    const STOPS: [[u8; 3]; 5] = [
+        [49, 54, 149],
+        [116, 173, 209],
+        [255, 255, 191],
+        [244, 109, 67],
+        [165, 0, 38],
     ];
-    let position = t * (stops.len() - 1) as f64;
-    let i = (position.floor() as usize).min(stops.len() - 2);
+    let position = t.clamp(0.0, 1.0) * (STOPS.len() - 1) as f64;
+    let i = (position.floor() as usize).min(STOPS.len() - 2);
     let f = position - i as f64;
-    let mix = |a: u8, b: u8| (f64::from(a) + f * (f64::from(b) - f64::from(a))).round() as u8;
-    let (a, b) = (stops[i], stops[i + 1]);
-    let (a, b) = (
-        (a.0 as u8, a.1 as u8, a.2 as u8),
-        (b.0 as u8, b.1 as u8, b.2 as u8),
-    );
-    format!(
-        "#{:02x}{:02x}{:02x}",
-        mix(a.0, b.0),
-        mix(a.1, b.1),
-        mix(a.2, b.2)
-    )
+    let mix = |k: usize| {
+        let (a, b) = (f64::from(STOPS[i][k]), f64::from(STOPS[i + 1][k]));
+        (a + f * (b - a)).round() as u8
+    };
+    format!("#{:02x}{:02x}{:02x}", mix(0), mix(1), mix(2))
 }
 
 impl Chart {
@@ -432,11 +433,7 @@ impl Chart {
             right - left,
             bottom - top
         );
-        let x_ticks = if self.x.log {
-            log_ticks(sx.lo, sx.hi)
-        } else {
-            ticks(sx.lo, sx.hi)
-        };
+        let x_ticks = sx.ticks();
         let _ = write!(svg, r#"<g class="axis x">"#);
         for t in x_ticks {
             let x = sx.at(t);
@@ -455,11 +452,7 @@ impl Chart {
             HEIGHT - 15.0,
             escape(&axis_label(&self.x, units.0))
         );
-        let y_ticks = if self.y.log {
-            log_ticks(sy.lo, sy.hi)
-        } else {
-            ticks(sy.lo, sy.hi)
-        };
+        let y_ticks = sy.ticks();
         let _ = write!(svg, r#"<g class="axis y">"#);
         for t in y_ticks {
             let y = sy.at(t);

@@ -22,7 +22,6 @@ pub use link::{Failure, Link};
 pub use store::RedisJobStore;
 pub use worker::Shared;
 
-use super::budget::Budget;
 use super::cache::MemoryCache;
 use super::{EngineConfig, Storage};
 
@@ -130,10 +129,7 @@ impl Fleet {
 /// answers, Redis for jobs and their work.
 pub fn storage(config: &EngineConfig, fleet: FleetConfig) -> Result<Storage, String> {
     let fleet = Arc::new(Fleet::open(fleet)?);
-    let l1 = MemoryCache::new(
-        Budget::split(config.memory_budget).answers,
-        config.cache_ttl,
-    );
+    let l1 = MemoryCache::for_engine(config);
     let store = Arc::new(RedisJobStore::new(fleet.clone(), config.job_retention));
     Ok(Storage {
         cache: Arc::new(TieredCache::new(l1, fleet.clone(), config.cache_ttl)),

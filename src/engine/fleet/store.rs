@@ -144,6 +144,17 @@ impl RedisJobStore {
         self.fleet.jobs.pipe::<()>(&pipe).await
     }
 
+    /// The status of job `id`; `None` if it is gone (deleted or expired). A running part's
+    /// heartbeat asks it five times a second, so it reads that one field only.
+    pub async fn status(&self, id: Uuid) -> Result<Option<JobStatus>, Failure> {
+        let cmd = redis::cmd("HGET")
+            .arg(keys::job(id).record)
+            .arg("status")
+            .clone();
+        let status: Option<String> = self.fleet.jobs.query(&cmd).await?;
+        Ok(status.as_deref().map(parse_status))
+    }
+
     /// The job `id` as a worker runs it; `None` if it is gone (deleted or expired).
     pub async fn runnable(&self, id: Uuid) -> Result<Option<Runnable>, Failure> {
         let cmd = redis::cmd("HMGET")
@@ -326,8 +337,7 @@ impl RedisJobStore {
 #[async_trait]
 impl JobStore for RedisJobStore {
     async fn insert(&self, record: JobRecord) {
-        let mut pipe = redis::pipe();
-        pipe.cmd("HSET")
+        let cmd = redis::cmd("HSET")
             .arg(keys::job(record.id).record)
             .arg("kind")
             .arg(record.kind)
@@ -340,8 +350,9 @@ impl JobStore for RedisJobStore {
             .arg("parts")
             .arg(1)
             .arg("parts_done")
-            .arg(0);
-        if let Err(e) = self.fleet.jobs.pipe::<()>(&pipe).await {
+            .arg(0)
+            .clone();
+        if let Err(e) = self.fleet.jobs.query::<()>(&cmd).await {
             tracing::warn!(error = %e, id = %record.id, "a job record was not stored");
         }
     }

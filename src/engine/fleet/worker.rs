@@ -401,8 +401,8 @@ async fn heartbeat(
     let mut kept = Instant::now();
     loop {
         tokio::time::sleep(HEARTBEAT).await;
-        match store.runnable(id).await {
-            Ok(Some(r)) if !r.status.is_finished() => {}
+        match store.status(id).await {
+            Ok(Some(status)) if !status.is_finished() => {}
             Ok(_) => control.cancel(),
             Err(_) => {}
         }

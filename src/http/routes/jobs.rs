@@ -123,21 +123,22 @@ impl FromRequestParts<AppState> for FoundJob {
             .await
             .map_err(|_| ApiError::not_found("no such job: its id is a UUID"))?;
         let engine = state.engine();
-        match engine.job(id).await {
-            Some(record) => Ok(FoundJob(record)),
-            // Unknown here may be unknown only while the fleet's store is away.
-            None if engine.store_reachable().is_err() => Err(ApiError::from(
-                engine.store_reachable().expect_err("checked in the guard"),
-            )),
-            None if engine.issued(id) => Err(ApiError::not_found(format!(
+        if let Some(record) = engine.job(id).await {
+            return Ok(FoundJob(record));
+        }
+        // Unknown here may be unknown only while the fleet's store is away.
+        engine.store_reachable()?;
+        if engine.issued(id) {
+            Err(ApiError::not_found(format!(
                 "no job {id}: it was deleted, or it expired (it finished more than the \
                  retention time ago)"
-            ))),
-            None => Err(ApiError::interrupted(format!(
+            )))
+        } else {
+            Err(ApiError::interrupted(format!(
                 "job {id} was accepted by an earlier run of the service, which stopped before \
                  this one started: unless it had finished and been collected, it was \
                  interrupted. Submit it again"
-            ))),
+            )))
         }
     }
 }
