@@ -11,10 +11,12 @@ use criterion::{criterion_group, criterion_main, Criterion};
 use serde_json::json;
 use thirdbody::engine::{self, cache::Solved};
 use thirdbody::job::{Control, Job, Kind, Limits, RollingJob, Work};
-use thirdbody::model::kelvin_map::KelvinMap;
 use thirdbody::model::quadrature::StripRule;
+use thirdbody::model::rolling::penetration_contact;
+use thirdbody::model::similarity::SimilarityTable;
+use thirdbody::model::tables::{self, Use};
 use thirdbody::model::three_body::{
-    self, LayerContact, OperatingPoint, ThreeBody, ThreeBodyOptions,
+    self, Asperities, LayerContact, OperatingPoint, ThreeBody, ThreeBodyOptions,
 };
 use thirdbody::model::{solve, Quadrature, Rolling, SolveOptions};
 
@@ -44,6 +46,37 @@ fn rolling(c: &mut Criterion) {
         let options = SolveOptions::integrals_only(Quadrature::Midpoint { strips: 40 });
         b.iter(|| solve(black_box(&default), &options).unwrap())
     });
+    // Through the layer's similarity table, once built (as every answer after the first
+    // on a layer is in the service).
+    tables::get_or_build(default.layer.kappa(), Quadrature::default()).unwrap();
+    group.bench_function("tabulated_default_job", |b| {
+        let options = SolveOptions::default();
+        b.iter(|| tables::solve(black_box(&default), &options, Use::IfBuilt).unwrap())
+    });
+    group.bench_function("tabulated_integrals_only", |b| {
+        let options = SolveOptions::integrals_only(Quadrature::default());
+        b.iter(|| tables::solve(black_box(&default), &options, Use::IfBuilt).unwrap())
+    });
+    group.finish();
+}
+
+/// A rolling sweep job on one thread, whole (validation aside): its marginal cost per point
+/// is the difference of the two sizes over the difference of their points.
+fn sweep(c: &mut Criterion) {
+    let mut group = c.benchmark_group("sweep");
+    group.sample_size(20);
+    for (loads, speeds) in [(10, 100), (100, 100)] {
+        let job = Job::from_value(
+            json!({"kind": "sweep", "input": {"vary": {
+                "load": (0..loads).map(|i| format!("{} nN", 0.5 + 0.01 * f64::from(i))).collect::<Vec<_>>(),
+                "velocity": (0..speeds).map(|i| format!("{} nm/s", 0.1 * f64::from(i))).collect::<Vec<_>>()}}}),
+            &Limits::default(),
+        )
+        .unwrap();
+        group.bench_function(format!("rolling_{}_points", loads * speeds), |b| {
+            b.iter(|| black_box(engine::run(&job, &Control::new(None, 1)).unwrap()))
+        });
+    }
     group.finish();
 }
 
@@ -96,6 +129,18 @@ fn three_body(c: &mut Criterion) {
         };
         b.iter(|| three_body::solve(black_box(&at), &options).unwrap())
     });
+    group.bench_function("kelvin_layer_asperities", |b| {
+        let rough = ThreeBody {
+            asperities: Some(Asperities {
+                density: 1e11,
+                tip_radius: 1e-6,
+                height_std: 5e-9,
+                hardness: 1e9,
+            }),
+            ..kelvin
+        };
+        b.iter(|| three_body::solve(black_box(&rough), &options).unwrap())
+    });
     group.bench_function("hertz_total_load", |b| {
         let hertz = ThreeBody {
             layer_contact: LayerContact::Hertz,
@@ -103,9 +148,15 @@ fn three_body(c: &mut Criterion) {
         };
         b.iter(|| three_body::solve(black_box(&hertz), &options).unwrap())
     });
-    group.bench_function("kelvin_table_build", |b| {
+    group.bench_function("similarity_table_build", |b| {
         let rule = StripRule::shared(Quadrature::default()).unwrap();
-        b.iter(|| KelvinMap::new(black_box(4.0), &rule).unwrap())
+        let companion = StripRule::shared(Quadrature::default().companion()).unwrap();
+        b.iter(|| {
+            SimilarityTable::build(black_box(4.0), |xi| {
+                penetration_contact(xi, 4.0, &rule, &companion)
+            })
+            .unwrap()
+        })
     });
     group.finish();
 }
@@ -137,5 +188,5 @@ fn service(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, rolling, figures, three_body, service);
+criterion_group!(benches, rolling, sweep, figures, three_body, service);
 criterion_main!(benches);

@@ -6,7 +6,7 @@ import json
 from common import Server, request
 
 with Server("--max-sweep-points", "1000000") as first:
-    sweep = {"kind": "sweep", "input": {"vary": {
+    sweep = {"kind": "sweep", "input": {"base": {"options": {"strips": 128}}, "vary": {
         "radius": [f"{25 + i} nm" for i in range(50)],
         "load": [f"{1000 + i} pN" for i in range(50)]}}}
     status, body, _ = request(first.port, "POST", "/v1/jobs", sweep)

@@ -12,7 +12,8 @@ from common import Server, request
 
 with Server("--pool-size", "1", "--max-sweep-points", "1000000", "--shutdown-timeout", "60s") as server:
     port = server.port
-    long_sweep = {"kind": "sweep", "input": {"vary": {
+    # Its own rule keeps every point an exact strip solve (not a table look-up): long.
+    long_sweep = {"kind": "sweep", "input": {"base": {"options": {"strips": 128}}, "vary": {
         "radius": [f"{25 + i} nm" for i in range(20)],
         "load": [f"{1000 + i} pN" for i in range(20)],
         "velocity": [f"{1 + i} nm/s" for i in range(30)]}}}

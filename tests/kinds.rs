@@ -262,10 +262,13 @@ impl thirdbody::job::Memo for CountingMemo {
 
 #[test]
 fn a_sweep_cut_by_its_deadline_leaves_its_solved_points_to_its_retry() {
-    let sweep = job(json!({"kind": "sweep", "input": {"vary": {
+    // Points solved exactly (its own rule) are kept; table points cost less than keeping.
+    let sweep = job(
+        json!({"kind": "sweep", "input": {"base": {"options": {"strips": 128}}, "vary": {
         "radius": (1..=20).map(|i| format!("{} nm", 20 + i)).collect::<Vec<_>>(),
         "load": (0..10).map(|i| format!("{} pN", 1000 + 40 * i)).collect::<Vec<_>>(),
-        "velocity": (1..=10).map(|i| format!("{i} nm/s")).collect::<Vec<_>>()}}}));
+        "velocity": (1..=10).map(|i| format!("{i} nm/s")).collect::<Vec<_>>()}}}),
+    );
     let memo = Arc::new(CountingMemo::default());
     let cut =
         Control::new(Some(Instant::now() + Duration::from_millis(20)), 1).with_memo(memo.clone());

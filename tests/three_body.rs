@@ -91,7 +91,7 @@ fn kelvin_layer_at_rest_is_the_closed_form_per_particle() {
     let law = LayerLaw::Kelvin {
         stiffness: layer.stiffness(),
         relaxation_length: 0.0,
-        map: None,
+        table: None,
     };
     let upper = UpperLaw::Elastic {
         modulus: 210e9 / 0.91,

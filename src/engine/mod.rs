@@ -5,6 +5,7 @@
 //! jobs ([`store`]). The cache and the store are traits, so that a shared backend can take
 //! the place of the in-process ones.
 
+mod background;
 mod budget;
 pub mod cache;
 mod coalesce;

@@ -15,6 +15,7 @@ use tokio_util::task::TaskTracker;
 use tracing::Instrument;
 use uuid::Uuid;
 
+use super::background::Background;
 use super::budget::{self, Budget};
 use super::cache::{Claim, MemoryCache, ResultCache, Solved};
 use super::coalesce::Coalescer;
@@ -209,6 +210,8 @@ pub struct Engine {
     input_keys: moka::future::Cache<String, String>,
     /// Solved points of sweeps, for a retry after a deadline.
     pub(super) points: Arc<PointMemo>,
+    /// Work jobs leave for later (tables to build); `None` if its thread could not start.
+    background: Option<Arc<Background>>,
     jobs: Arc<dyn JobStore>,
     /// The fleet, when the engine works in one.
     pub(super) fleet: Option<Arc<Shared>>,
@@ -265,6 +268,11 @@ impl Engine {
                 Budget::split(config.memory_budget).points,
                 config.cache_ttl,
             )),
+            background: Background::start()
+                .inspect_err(|e| {
+                    tracing::warn!("no background thread ({e}): no tables built later")
+                })
+                .ok(),
             jobs: storage.jobs,
             fleet: storage.fleet,
             live: Mutex::default(),
@@ -619,9 +627,14 @@ impl Engine {
         }
     }
 
-    /// The control of a job run by this engine: one thread, `deadline`, and the point memo.
-    fn control(&self, deadline: Instant) -> Control {
-        Control::new(Some(deadline), 1).with_memo(self.points.clone())
+    /// The control of a job run by this engine: one thread, `deadline`, the point memo and
+    /// the background thread.
+    pub(super) fn control(&self, deadline: Instant) -> Control {
+        let control = Control::new(Some(deadline), 1).with_memo(self.points.clone());
+        match &self.background {
+            Some(background) => control.with_later(background.clone()),
+            None => control,
+        }
     }
 
     fn admit(&self) -> Result<(), EngineError> {

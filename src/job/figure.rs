@@ -9,8 +9,8 @@ use utoipa::ToSchema;
 use super::input::{self, Checker};
 use super::meta::ROLLING_REFERENCES;
 use super::{Control, JobError, Kind, Limits, Meta, Reference, Validated, Work};
-use crate::model;
 use crate::model::figures::{Axis, Figure, Plan, FIGURES};
+use crate::model::tables::{self, Use};
 use crate::render::{Column, Output, Table, Units};
 
 /// Input of a figure job.
@@ -75,7 +75,10 @@ impl Kind for FigureJob {
 
     fn run(&self, meta: Meta, control: &Control) -> Result<FigureOutput, JobError> {
         let plan = &self.plan;
-        let solutions = control.map(&plan.contacts, |p| model::solve(p, &plan.options))?;
+        // Every figure is on the default layer: its table serves them all.
+        let solutions = control.map(&plan.contacts, |p| {
+            tables::solve(p, &plan.options, Use::Build)
+        })?;
         Ok(FigureOutput::new(plan.assemble(&solutions), meta))
     }
 }

@@ -23,7 +23,7 @@ pub mod three_body;
 pub mod validity;
 mod wire;
 
-pub use control::{Control, Kept, Memo};
+pub use control::{Control, Kept, Later, Memo};
 pub use error::{FieldError, JobError};
 pub use figure::FigureJob;
 pub use input::Quantity;

@@ -18,8 +18,9 @@ use super::three_body::{
 };
 use super::validity::validity_units;
 use super::{Control, JobError, Kind, Limits, Meta, Reference, Validated, Work};
+use crate::model::tables::{self, Use};
 use crate::model::three_body::{self, Diameters, OperatingPoint, ThreeBody, ThreeBodySolution};
-use crate::model::{self, Parameter, Rolling, RollingSolution, SolveOptions, MODEL_VERSION};
+use crate::model::{Parameter, Rolling, RollingSolution, SolveOptions, MODEL_VERSION};
 use crate::render::{Output, Table, Units};
 
 pub use super::rolling::SweepPoint;
@@ -194,14 +195,22 @@ impl Kind for SweepJob {
         let first = range.start;
         let points = match self {
             SweepJob::Rolling(s) => {
-                let contacts = part(s.points(), range)?;
+                let all = s.points();
                 let options = &s.base.options;
-                let solutions = control.map_kept(
-                    &contacts,
-                    |p| format!("{MODEL_VERSION} rolling {p:?} {options:?}"),
-                    |_| std::mem::size_of::<RollingSolution>(),
-                    |p| model::solve(p, options),
-                )?;
+                let method = Use::for_solves(all.len(), options.quadrature);
+                let contacts = part(all, range)?;
+                let solve = |p: &Rolling| tables::solve(p, options, method);
+                let solutions = if method == Use::Build {
+                    // A point costs a microsecond: cheaper to solve again than to keep.
+                    control.map(&contacts, solve)?
+                } else {
+                    control.map_kept(
+                        &contacts,
+                        |p| format!("{MODEL_VERSION} rolling {p:?} {options:?}"),
+                        |_| std::mem::size_of::<RollingSolution>(),
+                        solve,
+                    )?
+                };
                 let rows = contacts.iter().zip(&solutions).enumerate();
                 SweepPoints::Rolling(
                     rows.map(|(i, (p, s))| {

@@ -4,14 +4,15 @@
 
 mod error;
 pub mod figures;
-pub mod kelvin_map;
 mod layer;
 pub mod limits;
 pub mod quadrature;
 pub mod rolling;
 mod roots;
+pub mod similarity;
 mod special;
 pub mod strip;
+pub mod tables;
 pub mod three_body;
 pub mod validity;
 

@@ -9,6 +9,7 @@ use std::f64::consts::{FRAC_PI_2, FRAC_PI_4, PI};
 
 use super::limits::{relaxed, ElasticContact};
 use super::quadrature::StripRule;
+use super::similarity::{ExactRatios, Ratios, SimilarityTable};
 use super::strip::Strip;
 use super::{Layer, ModelError, OptionError, Parameter, Quadrature, SolveOption};
 
@@ -155,6 +156,10 @@ pub struct Verification {
     pub exit_root_iterations: u32,
     /// Whether every root converged (a solution is only returned when it did).
     pub converged: bool,
+    /// When the load equation was solved through the layer's similarity table rather than
+    /// by strip sums: the table's certified bound on the relative difference from the exact
+    /// solve ([`SimilarityTable::error`]).
+    pub table_error: Option<f64>,
 }
 
 /// The rolling contact (docs/model.md §3), in SI units.
@@ -186,6 +191,18 @@ pub struct RollingSolution {
 /// Fails, never panics nor returns a non-finite number, on parameters outside their ranges,
 /// scales beyond double precision, or a root that does not converge.
 pub fn solve(rolling: &Rolling, options: &SolveOptions) -> Result<RollingSolution, ModelError> {
+    solve_with(rolling, options, None)
+}
+
+/// [`solve`], with the load equation solved through `table` (the similarity table of the
+/// layer's κ under the same rule) instead of strip sums: the answer then differs from the
+/// exact one by at most `verification.table_error`. The contact boundary and the pressure
+/// are still the exact strip solutions at the table's penetration.
+pub(super) fn solve_with(
+    rolling: &Rolling,
+    options: &SolveOptions,
+    table: Option<&SimilarityTable>,
+) -> Result<RollingSolution, ModelError> {
     if let Some(error) = rolling.violations().into_iter().next() {
         return Err(error.into());
     }
@@ -209,28 +226,19 @@ pub fn solve(rolling: &Rolling, options: &SolveOptions) -> Result<RollingSolutio
     }
 
     let rule = StripRule::shared(options.quadrature)?;
-    let shape = Shape::solve(xi, kappa, &rule)?;
-
-    let section = Section::new(shape.half_width, xi, kappa);
-    let half_width = shape.half_width * r0;
-    let contact_area = shape.integrals.area * r0 * r0;
-    let pressure_moment = section.pressure_moment(&rule, &shape.exit_roots);
-    let pressure_centre_shift = pressure_moment / shape.integrals.load * r0;
-    let companion = StripRule::shared(options.quadrature.companion())?;
-    let mut companion_roots = vec![f64::NAN; companion.len()];
-    let companion_integrals = section.integrate(&companion, Some(&mut companion_roots))?;
-    let quadrature_error_estimate = quadrature_error(
-        (&shape.integrals, pressure_moment),
-        (
-            &companion_integrals,
-            section.pressure_moment(&companion, &companion_roots),
-        ),
-    );
+    let contact = match table {
+        Some(table) if xi > 0.0 => Contact::tabulated(xi, table)?,
+        _ => Contact::exact(xi, kappa, &rule, options.quadrature)?,
+    };
+    let section = Section::new(contact.half_width, xi, kappa);
+    let half_width = contact.half_width * r0;
+    let contact_area = contact.area * r0 * r0;
+    let pressure_centre_shift = contact.pressure_centre * r0;
     let solution = RollingSolution {
         penetration: half_width * half_width / (2.0 * rolling.radius),
         contact_area,
         half_width,
-        centroid_shift: shape.integrals.centroid() * r0,
+        centroid_shift: contact.centroid * r0,
         pressure_centre_shift,
         rolling_resistance_coefficient: pressure_centre_shift / rolling.radius,
         friction_coefficient: layer.interfacial_shear_strength() * contact_area / rolling.load,
@@ -241,12 +249,8 @@ pub fn solve(rolling: &Rolling, options: &SolveOptions) -> Result<RollingSolutio
             None => None,
         },
         verification: Verification {
-            load_residual: shape.load_residual,
-            quadrature_error_estimate,
             quadrature_nodes: rule.len(),
-            iterations: shape.iterations,
-            exit_root_iterations: shape.integrals.exit_root_iterations,
-            converged: true,
+            ..contact.verification
         },
     };
     ensure_finite(&solution)?;
@@ -254,13 +258,34 @@ pub fn solve(rolling: &Rolling, options: &SolveOptions) -> Result<RollingSolutio
 }
 
 /// The contact at a given penetration δ rather than a given load (the forward map of the
-/// three-body model, docs/model.md §4), as ratios to the static contact at the same δ:
-/// P = π k R δ² Φ_P and A = 2π R δ Φ_A, where Φ_P and Φ_A depend only on
-/// ξ = V T_σ/√(2Rδ) and κ (the similarity law). Φ_P runs from 1 (ξ = 0) to 1 + κ (ξ → ∞);
-/// Φ_A is 1 at both ends and dips in between.
-pub fn penetration_ratios(xi: f64, kappa: f64, rule: &StripRule) -> Result<(f64, f64), ModelError> {
-    let integrals = Section::new(1.0, xi, kappa).integrate(rule, None)?;
-    Ok((integrals.load / FRAC_PI_4, integrals.area / PI))
+/// three-body model, docs/model.md §4, and the builder of the similarity tables), as the
+/// ratios of the similarity law ([`Ratios`]), which depend only on ξ = V T_σ/√(2Rδ) and κ,
+/// with the quadrature error estimate a rolling answer would report there. Φ_P runs from 1
+/// (ξ = 0) to 1 + κ (ξ → ∞); Φ_A is 1 at both ends and dips in between.
+pub fn penetration_contact(
+    xi: f64,
+    kappa: f64,
+    rule: &StripRule,
+    companion: &StripRule,
+) -> Result<ExactRatios, ModelError> {
+    let section = Section::new(1.0, xi, kappa);
+    let mut roots = vec![f64::NAN; rule.len()];
+    let integrals = section.integrate(rule, Some(&mut roots))?;
+    let moment = section.pressure_moment(rule, &roots);
+    let mut companion_roots = vec![f64::NAN; companion.len()];
+    let companion_integrals = section.integrate(companion, Some(&mut companion_roots))?;
+    let companion_moment = section.pressure_moment(companion, &companion_roots);
+    let ratios = Ratios {
+        load: integrals.load / FRAC_PI_4,
+        area: integrals.area / PI,
+        centroid: integrals.centroid(),
+        pressure_centre: moment / integrals.load,
+    };
+    let error = quadrature_error(
+        (&integrals, moment),
+        (&companion_integrals, companion_moment),
+    );
+    Ok((ratios, error))
 }
 
 /// A bound on the relative quadrature error of every reported integral quantity (δ, A,
@@ -335,6 +360,92 @@ fn ensure_finite(s: &RollingSolution) -> Result<(), ModelError> {
     }
 }
 
+/// The solved contact in units of r₀ (P̂(r̂) = π/4) and how far to trust it.
+struct Contact {
+    /// r̂ = √(2Rδ)/r₀ = √(δ/δ₀).
+    half_width: f64,
+    /// A/r₀².
+    area: f64,
+    /// x_c/r₀.
+    centroid: f64,
+    /// x_p/r₀.
+    pressure_centre: f64,
+    verification: Verification,
+}
+
+impl Contact {
+    /// By strip sums: the load root, then the pressure moment, then the same integrals under
+    /// the companion rule for the quadrature error estimate.
+    fn exact(
+        xi: f64,
+        kappa: f64,
+        rule: &StripRule,
+        quadrature: Quadrature,
+    ) -> Result<Contact, ModelError> {
+        let shape = Shape::solve(xi, kappa, rule)?;
+        let section = Section::new(shape.half_width, xi, kappa);
+        let pressure_moment = section.pressure_moment(rule, &shape.exit_roots);
+        let companion = StripRule::shared(quadrature.companion())?;
+        let mut companion_roots = vec![f64::NAN; companion.len()];
+        let companion_integrals = section.integrate(&companion, Some(&mut companion_roots))?;
+        let quadrature_error_estimate = quadrature_error(
+            (&shape.integrals, pressure_moment),
+            (
+                &companion_integrals,
+                section.pressure_moment(&companion, &companion_roots),
+            ),
+        );
+        Ok(Contact {
+            half_width: shape.half_width,
+            area: shape.integrals.area,
+            centroid: shape.integrals.centroid(),
+            pressure_centre: pressure_moment / shape.integrals.load,
+            verification: Verification {
+                load_residual: shape.load_residual,
+                quadrature_error_estimate,
+                quadrature_nodes: rule.len(),
+                iterations: shape.iterations,
+                exit_root_iterations: shape.integrals.exit_root_iterations,
+                converged: true,
+                table_error: None,
+            },
+        })
+    }
+
+    /// Through the similarity table: at r̂ the contact is the table's at ξ/r̂ scaled by r̂
+    /// (P̂ = (π/4) r̂⁴ Φ_P, Â = π r̂² Φ_A, x/r₀ = r̂ · x/r), so the load equation is
+    /// f(t) = 4t + ln Φ_P(ξ e^{−t}) = 0 in t = ln r̂, solved by the secant method from
+    /// t = −¼ ln Φ_P(ξ) ([`load_root`]; f′ lies between 3 and 4).
+    fn tabulated(xi: f64, table: &SimilarityTable) -> Result<Contact, ModelError> {
+        let start = -0.25 * table.ratios(xi).load.ln();
+        let root = load_root(
+            table.kappa(),
+            start,
+            "penetration (load equation through the similarity table)",
+            |t| {
+                let ratios = table.ratios(xi * (-t).exp());
+                Ok((4.0 * t + ratios.load.ln(), ratios))
+            },
+        )?;
+        let (r, ratios) = (root.t.exp(), root.at);
+        Ok(Contact {
+            half_width: r,
+            area: PI * r * r * ratios.area,
+            centroid: r * ratios.centroid,
+            pressure_centre: r * ratios.pressure_centre,
+            verification: Verification {
+                load_residual: root.residual,
+                quadrature_error_estimate: table.quadrature_error(xi / r),
+                quadrature_nodes: 0,
+                iterations: root.iterations,
+                exit_root_iterations: 0,
+                converged: true,
+                table_error: Some(table.error()),
+            },
+        })
+    }
+}
+
 /// The contact in units of r₀ with its load solved: P̂(r̂) = π/4.
 struct Shape {
     /// r̂ = √(2Rδ)/r₀ = √(δ/δ₀).
@@ -347,65 +458,89 @@ struct Shape {
 }
 
 impl Shape {
-    /// Solves ln P̂(e^u) = ln(π/4) for u = ln r̂ by the secant method, guarded by the bracket
-    /// δ ∈ [0.9 δ_∞, 1.05 δ₀] of docs/model.md §3. ln P̂ is nearly linear in u (slope 4 at both
-    /// limits), so the secant converges in a handful of steps; the exit roots of every strip
-    /// are warm-started from the previous step.
+    /// Solves ln P̂(e^t) = ln(π/4) for t = ln r̂ ([`load_root`]) from the static answer t = 0
+    /// (exact at V = 0); the exit roots of every strip are warm-started from the previous
+    /// step.
     fn solve(xi: f64, kappa: f64, rule: &StripRule) -> Result<Shape, ModelError> {
         let target = FRAC_PI_4.ln();
         let mut rho = vec![f64::NAN; rule.len()];
         let mut exit_root_iterations = 0;
-        let mut evaluate = |u: f64, rho: &mut [f64]| -> Result<(f64, Integrals), ModelError> {
-            let integrals = Section::new(u.exp(), xi, kappa).integrate(rule, Some(rho))?;
+        let root = load_root(kappa, 0.0, "penetration (load equation P(δ) = P)", |t| {
+            let integrals = Section::new(t.exp(), xi, kappa).integrate(rule, Some(&mut rho))?;
             exit_root_iterations += integrals.exit_root_iterations;
             Ok((integrals.load.ln() - target, integrals))
-        };
-        let (mut lo, mut hi) = (
-            0.5 * 0.9_f64.ln() - 0.25 * (1.0 + kappa).ln(),
-            0.5 * 1.05_f64.ln(),
-        );
-        let (mut u_prev, mut f_prev) = (f64::NAN, f64::NAN);
-        let mut u = 0.0_f64; // the static answer, exact at V = 0
-        let mut iterations = 0;
-        loop {
-            iterations += 1;
-            let (f, mut integrals) = evaluate(u, &mut rho)?;
-            if f > 0.0 {
-                hi = hi.min(u);
-            } else {
-                lo = lo.max(u);
-            }
-            let collapsed = hi - lo <= 4.0 * f64::EPSILON * u.abs().max(1.0);
-            if f.abs() <= LOAD_TOLERANCE || collapsed && f.abs() <= LOAD_ROUNDING {
-                integrals.exit_root_iterations = exit_root_iterations;
-                return Ok(Shape {
-                    half_width: u.exp(),
-                    integrals,
-                    exit_roots: rho,
-                    load_residual: f.exp_m1().abs(),
-                    iterations,
-                });
-            }
-            // Secant; the first step assumes the slope 4 of the elastic limits.
-            let slope = if iterations == 1 || f == f_prev {
-                4.0
-            } else {
-                (f - f_prev) / (u - u_prev)
-            };
-            let mut next = u - f / slope;
-            if !(next > lo && next < hi) {
-                next = 0.5 * (lo + hi);
-            }
-            if collapsed || iterations >= MAX_LOAD_ITERATIONS {
-                // Out of iterations, or the bracket collapsed onto a point that does not
-                // carry the load.
-                return Err(ModelError::NoConvergence {
-                    what: "penetration (load equation P(δ) = P)",
-                    iterations,
-                });
-            }
-            (u_prev, f_prev, u) = (u, f, next);
+        })?;
+        let mut integrals = root.at;
+        integrals.exit_root_iterations = exit_root_iterations;
+        Ok(Shape {
+            half_width: root.t.exp(),
+            integrals,
+            exit_roots: rho,
+            load_residual: root.residual,
+            iterations: root.iterations,
+        })
+    }
+}
+
+/// The root of a load equation f(t) = ln P̂(e^t) − ln(π/4) in t = ln r̂ and what was
+/// computed there.
+struct LoadRoot<T> {
+    t: f64,
+    at: T,
+    /// |P̂/(π/4) − 1| at the root.
+    residual: f64,
+    iterations: u32,
+}
+
+/// Solves a load equation `f` (returning f(t) and what it computed at t) by the secant
+/// method from `start`, guarded by the bracket δ ∈ [0.9 δ_∞, 1.05 δ₀] of docs/model.md §3.
+/// f is nearly linear (slope 4 at both elastic limits), so the secant converges in a
+/// handful of steps; its first step assumes that slope.
+fn load_root<T>(
+    kappa: f64,
+    start: f64,
+    what: &'static str,
+    mut f: impl FnMut(f64) -> Result<(f64, T), ModelError>,
+) -> Result<LoadRoot<T>, ModelError> {
+    let (mut lo, mut hi) = (
+        0.5 * 0.9_f64.ln() - 0.25 * (1.0 + kappa).ln(),
+        0.5 * 1.05_f64.ln(),
+    );
+    let (mut t_prev, mut f_prev) = (f64::NAN, f64::NAN);
+    let mut t = start.clamp(lo, hi);
+    let mut iterations = 0;
+    loop {
+        iterations += 1;
+        let (value, at) = f(t)?;
+        if value > 0.0 {
+            hi = hi.min(t);
+        } else {
+            lo = lo.max(t);
         }
+        let collapsed = hi - lo <= 4.0 * f64::EPSILON * t.abs().max(1.0);
+        if value.abs() <= LOAD_TOLERANCE || collapsed && value.abs() <= LOAD_ROUNDING {
+            return Ok(LoadRoot {
+                t,
+                at,
+                residual: value.exp_m1().abs(),
+                iterations,
+            });
+        }
+        let slope = if iterations == 1 || value == f_prev {
+            4.0
+        } else {
+            (value - f_prev) / (t - t_prev)
+        };
+        let mut next = t - value / slope;
+        if !(next > lo && next < hi) {
+            next = 0.5 * (lo + hi);
+        }
+        if collapsed || iterations >= MAX_LOAD_ITERATIONS {
+            // Out of iterations, or the bracket collapsed onto a point that does not
+            // carry the load.
+            return Err(ModelError::NoConvergence { what, iterations });
+        }
+        (t_prev, f_prev, t) = (t, value, next);
     }
 }
 

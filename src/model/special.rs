@@ -10,6 +10,10 @@
 /// series are kept longer for E₃ (`EXPREL3_LIMIT`), which only fast strips evaluate.
 const SERIES_LIMIT: f64 = 0.5;
 const EXPREL3_LIMIT: f64 = 2.0;
+/// Beyond this |z| the quotients are divided by z twice rather than by z², which would
+/// overflow near |z| = 1e154 (a strip about 1e150 times slower than its relaxation length:
+/// V a hundred orders of magnitude below the contact's own scale, still a valid input).
+const HUGE: f64 = 1e100;
 /// Terms of the series; the remainder is below 2²⁶/28! ≈ 2e-22 of the leading term.
 const SERIES_TERMS: usize = 26;
 
@@ -61,6 +65,8 @@ const SHORT_SERIES: usize = 16;
 pub fn exprel2(z: f64) -> f64 {
     if z.abs() < SERIES_LIMIT {
         series(z, &EXPREL2, SHORT_SERIES)
+    } else if z.abs() > HUGE {
+        (z.exp_m1() / z - 1.0) / z
     } else {
         (z.exp_m1() - z) / (z * z)
     }
@@ -83,6 +89,14 @@ pub fn exprel_kernels(z: f64) -> (f64, f64, f64) {
         let e2 = series(z, &EXPREL2, SHORT_SERIES);
         let prime = series(z, &EXPREL_PRIME, SHORT_SERIES);
         (1.0 + z * e2, e2, prime)
+    } else if z.abs() > HUGE {
+        let em1 = z.exp_m1();
+        let e1 = em1 / z;
+        (
+            e1,
+            (e1 - 1.0) / z,
+            ((em1 + 1.0) * (z - 1.0) / z + 1.0 / z) / z,
+        )
     } else {
         let em1 = z.exp_m1();
         let z2 = z * z;
@@ -114,6 +128,18 @@ mod tests {
             assert!((exprel2(z) / direct2 - 1.0).abs() < 1e-13, "exprel2({z})");
             assert!((exprel3(z) / direct3 - 1.0).abs() < 1e-12, "exprel3({z})");
             assert!((prime / direct_prime - 1.0).abs() < 1e-13, "exprel'({z})");
+        }
+    }
+
+    #[test]
+    fn kernels_stay_finite_and_right_where_z_squared_overflows() {
+        // For z → −∞: exprel → −1/z, exprel2 → −1/z − 1/z², exprel' → 1/z² (here 0).
+        for z in [-1e120_f64, -1e200, -f64::MAX] {
+            let (e1, e2, prime) = exprel_kernels(z);
+            assert!((e1 * -z - 1.0).abs() < 1e-15, "exprel({z})");
+            assert!((e2 * -z - 1.0).abs() < 1e-15, "exprel2({z})");
+            assert!((exprel2(z) * -z - 1.0).abs() < 1e-15, "exprel2({z})");
+            assert!((0.0..=1e-239).contains(&prime), "exprel'({z}) = {prime}");
         }
     }
 

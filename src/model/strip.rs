@@ -178,7 +178,7 @@ impl Strip {
 
     /// Pressure p·2R/k at x (any x; zero outside [a, b]):
     /// p = (k/2R){b² − x² + 2Δλ[(x + λ_σ) − (b + λ_σ)e^{(x−b)/λ_σ}]}, Δλ = κλ_σ,
-    /// with the bracket written as −λ_σ u² E₂(u) − b·expm1(u), u = (x − b)/λ_σ, so it does not
+    /// with the bracket written as −(x − b) u E₂(u) − b·expm1(u), u = (x − b)/λ_σ, so it does not
     /// cancel. `rho` is the strip's exit root.
     pub fn pressure(&self, x: f64, rho: f64) -> f64 {
         let b = self.entry;
@@ -192,7 +192,8 @@ impl Strip {
         }
         let lambda = self.relaxation_length;
         let u = (x - b) / lambda;
-        let bracket = -lambda * u * u * exprel2(u) - b * u.exp_m1();
+        // λu² E₂(u) = (x − b)·u E₂(u): u² itself would overflow for very slow strips.
+        let bracket = -(x - b) * (u * exprel2(u)) - b * u.exp_m1();
         (elastic + 2.0 * self.kappa * lambda * bracket).max(0.0)
     }
 }

@@ -193,8 +193,7 @@ impl Engine {
                 .finish(shared, &entry, JobState::Failed(error), None)
                 .await;
         }
-        let control =
-            Arc::new(Control::new(Some(runnable.deadline), 1).with_memo(self.points.clone()));
+        let control = Arc::new(self.control(runnable.deadline));
         shared.running().insert(entry.id.clone(), control.clone());
         let heartbeat = tokio::spawn(heartbeat(
             shared.fleet.clone(),

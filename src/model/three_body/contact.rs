@@ -3,9 +3,10 @@
 //! at which both contacts carry the same force.
 
 use std::f64::consts::PI;
+use std::sync::Arc;
 
-use crate::model::kelvin_map::KelvinMap;
 use crate::model::roots::brent;
+use crate::model::similarity::SimilarityTable;
 use crate::model::ModelError;
 
 /// How the upper surface takes a particle of radius R = x/2.
@@ -57,8 +58,8 @@ pub enum LayerLaw {
         stiffness: f64,
         /// λ_σ = V T_σ (0 at rest).
         relaxation_length: f64,
-        /// The tabulated ratios; `None` at rest.
-        map: Option<KelvinMap>,
+        /// The layer's similarity table; `None` at rest.
+        table: Option<Arc<SimilarityTable>>,
     },
     /// Hertz with E_s2a: F = (4/3)E_s2a R^{1/2} δ^{3/2}, A₂ = πRδ.
     Hertz { modulus: f64 },
@@ -71,12 +72,13 @@ impl LayerLaw {
             LayerLaw::Kelvin {
                 stiffness,
                 relaxation_length,
-                map,
+                table,
             } => {
-                let (phi_p, phi_a) = match map {
-                    Some(map) if *relaxation_length > 0.0 => {
+                let (phi_p, phi_a) = match table {
+                    Some(table) if *relaxation_length > 0.0 => {
                         let half_width = (2.0 * radius * delta).sqrt();
-                        map.ratios(relaxation_length / half_width)
+                        let ratios = table.ratios(relaxation_length / half_width);
+                        (ratios.load, ratios.area)
                     }
                     _ => (1.0, 1.0),
                 };

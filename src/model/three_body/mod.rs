@@ -11,9 +11,12 @@ pub use asperities::{Asperities, Zmc};
 pub use contact::{squeeze, LayerLaw, Squeeze, UpperLaw};
 pub use distribution::Diameters;
 
-use super::kelvin_map::KelvinMap;
-use super::quadrature::{gauss_legendre, GaussRule, StripRule};
+use std::sync::Arc;
+
+use super::quadrature::{gauss_legendre, GaussRule};
 use super::roots::brent;
+use super::similarity::SimilarityTable;
+use super::tables;
 use super::{Layer, ModelError, OptionError, Parameter, ParameterError, Quadrature, SolveOption};
 
 /// Diameter nodes used when a job does not ask for a number: the particle sums then agree
@@ -351,16 +354,15 @@ pub fn solve(
     if let Some(e) = options.violations().into_iter().next() {
         return Err(ModelError::InvalidOption(e));
     }
-    let rule = StripRule::shared(options.quadrature)?;
     let kappa = system.layer.kappa();
-    let map = match system.layer_contact {
+    let table = match system.layer_contact {
         LayerContact::KelvinLayer if system.velocity > 0.0 && kappa > 0.0 => {
-            Some(KelvinMap::new(kappa, &rule)?)
+            Some(tables::get_or_build(kappa, options.quadrature)?)
         }
         _ => None,
     };
-    let layer_table_error = map.as_ref().map(|m| m.check(&rule)).transpose()?;
-    let rolling = Model::new(system, system.velocity, map, options.diameter_nodes);
+    let layer_table_error = table.as_ref().map(|t| t.error());
+    let rolling = Model::new(system, system.velocity, table, options.diameter_nodes);
     let fixed = Model::new(system, 0.0, None, options.diameter_nodes);
     let (state, iterations, residual) = rolling.operate()?;
     let (static_state, ..) =
@@ -434,7 +436,12 @@ struct Model<'a> {
 }
 
 impl<'a> Model<'a> {
-    fn new(system: &'a ThreeBody, velocity: f64, map: Option<KelvinMap>, nodes: usize) -> Self {
+    fn new(
+        system: &'a ThreeBody,
+        velocity: f64,
+        table: Option<Arc<SimilarityTable>>,
+        nodes: usize,
+    ) -> Self {
         let compliance = |e: f64, nu: f64| (1.0 - nu * nu) / e;
         let upper = &system.upper;
         let layer = &system.layer;
@@ -468,7 +475,7 @@ impl<'a> Model<'a> {
                 LayerContact::KelvinLayer => LayerLaw::Kelvin {
                     stiffness: layer.stiffness(),
                     relaxation_length: velocity * layer.relaxation_time,
-                    map,
+                    table,
                 },
                 LayerContact::Hertz => LayerLaw::Hertz {
                     modulus: layer_modulus,

@@ -1,0 +1,365 @@
+//! The similarity law as a table: the rolling contact at a given penetration, for one κ, as
+//! four smooth functions of one variable (docs/model.md §3).
+//!
+//! At a penetration δ, with r = √(2Rδ), the ratios Φ_P = P/(πkRδ²), Φ_A = A/(2πRδ),
+//! x_c/r and x_p/r depend only on ξ = V T_σ/r and κ. The strip solver computes them exactly
+//! (≈ 10 µs for the four); this table evaluates them in well under a microsecond, so that a
+//! rolling answer at a given load ([`super::rolling`]) and every diameter of a three-body
+//! system ([`super::three_body`]) cost a few table look-ups instead of strip sums.
+//!
+//! The variable is v = (u − 1)/(u + 1), u = √((1 + κ)ξ), which maps ξ ∈ [0, ∞] onto [−1, 1],
+//! centres the viscous transition (it starts where V T_ε ≈ r) and keeps both ends smooth
+//! (expansions in √ξ near 0 and in 1/√ξ near ∞). The two shifts vanish at both ends like ξ and
+//! 1/ξ, so they are tabulated divided by w(v) = (1 − v²)²: then their *relative* error stays
+//! as small as the others' right up to the ends.
+//!
+//! Building: the exact ratios at N Chebyshev points of the first kind, one global Chebyshev
+//! series through them, then that series re-expanded on [`PANELS`] panels (equal in θ, v = cos θ) as short local
+//! series (truncated where their coefficients fall below rounding), which is what an
+//! evaluation sums. The table is then certified against exact solves at points between its
+//! own ([`SimilarityTable::error`]).
+
+use std::f64::consts::PI;
+
+use super::ModelError;
+
+/// The four ratios of the contact at a given penetration (see the module doc).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Ratios {
+    /// Φ_P = P/(πkRδ²): 1 at ξ = 0, 1 + κ at ξ = ∞.
+    pub load: f64,
+    /// Φ_A = A/(2πRδ): 1 at both ends, below in between.
+    pub area: f64,
+    /// x_c/r, r = √(2Rδ): 0 at both ends, positive in between.
+    pub centroid: f64,
+    /// x_p/r: 0 at both ends, positive in between.
+    pub pressure_centre: f64,
+}
+
+impl Ratios {
+    /// ξ = 0: the relaxed elastic contact.
+    pub const STATIC: Ratios = Ratios {
+        load: 1.0,
+        area: 1.0,
+        centroid: 0.0,
+        pressure_centre: 0.0,
+    };
+
+    fn as_array(&self) -> [f64; 4] {
+        [self.load, self.area, self.centroid, self.pressure_centre]
+    }
+}
+
+/// The exact ratios at one ξ and the quadrature error estimate of the rule that computed them
+/// (what [`super::rolling::Verification::quadrature_error_estimate`] would report there).
+pub type ExactRatios = (Ratios, f64);
+
+/// Panels on which the table is evaluated, equal in θ = arccos v.
+const PANELS: usize = 16;
+/// Samples (and so the largest number of coefficients) of each panel's local series.
+const PANEL_SAMPLES: usize = 24;
+/// A panel's series stops where the coefficients left out add up to less than this part of
+/// the function's size there: far below the 1e-9 promised, and above the rounding noise of
+/// the global series, which would otherwise keep every coefficient.
+const TRUNCATION: f64 = 1e-14;
+/// Points between the table's own at which [`SimilarityTable::build`] compares it with exact
+/// solves.
+const CHECK_POINTS: usize = 32;
+/// The certified error is this many times the largest difference found at the check points:
+/// a rolling answer carries a ratio's error through the load equation into δ, A, x_c and x_p
+/// at most about twice, and the exact solve it is compared with stops its own load root at a
+/// residual of 1e-14, which at the table's level of error (≈ 1e-14) doubles it again.
+const PROPAGATION: f64 = 4.0;
+
+/// Chebyshev points of the global series for viscosity strength κ. The transition of Φ
+/// spans ξ from about 1/(1 + κ) to 1, wider as κ grows; these sizes keep every ratio within
+/// 1e-12 of the exact solve over all ξ for κ up to 1e4 (tested), and larger κ get the
+/// largest table.
+pub fn table_points(kappa: f64) -> usize {
+    if kappa <= 100.0 {
+        128
+    } else if kappa <= 1e4 {
+        256
+    } else {
+        512
+    }
+}
+
+/// The four ratios of one κ as functions of ξ (see the module doc).
+#[derive(Clone, Debug)]
+pub struct SimilarityTable {
+    kappa: f64,
+    /// Local Chebyshev coefficients, `PANEL_SAMPLES` per panel, each for the four functions
+    /// (Φ_P, Φ_A, x_c/(r w), x_p/(r w)).
+    coefficients: Vec<[f64; 4]>,
+    /// Coefficients in use on each panel (the rest are below rounding).
+    lengths: [usize; PANELS],
+    /// The quadrature error estimate at each global point, v descending.
+    quadrature_errors: Vec<f64>,
+    /// See [`SimilarityTable::error`].
+    error: f64,
+}
+
+impl SimilarityTable {
+    /// Tabulates the ratios of viscosity strength κ > 0 from `exact`, which solves the contact
+    /// at a given ξ (with the rule the table then stands for), and certifies the result.
+    pub fn build(
+        kappa: f64,
+        exact: impl Fn(f64) -> Result<ExactRatios, ModelError>,
+    ) -> Result<SimilarityTable, ModelError> {
+        let n = table_points(kappa);
+        let mut values = Vec::with_capacity(n);
+        let mut quadrature_errors = Vec::with_capacity(n);
+        for j in 0..n {
+            // v = cos θ: u = (1 + v)/(1 − v) = cot²(θ/2), w = sin⁴θ, without cancellation.
+            let theta = PI * (j as f64 + 0.5) / n as f64;
+            let u = 1.0 / (0.5 * theta).tan().powi(2);
+            let (ratios, quadrature_error) = exact(u * u / (1.0 + kappa))?;
+            values.push(normalised(&ratios, theta.sin().powi(4)));
+            quadrature_errors.push(quadrature_error);
+        }
+        let global = chebyshev_coefficients(&values);
+        let mut coefficients = Vec::with_capacity(PANELS * PANEL_SAMPLES);
+        let mut lengths = [0; PANELS];
+        for (panel, length) in lengths.iter_mut().enumerate() {
+            let samples: Vec<[f64; 4]> = (0..PANEL_SAMPLES)
+                .map(|i| {
+                    let t = (PI * (i as f64 + 0.5) / PANEL_SAMPLES as f64).cos();
+                    clenshaw(&global, panel_angle(panel, t).cos())
+                })
+                .collect();
+            let local = chebyshev_coefficients(&samples);
+            *length = significant_terms(&local);
+            coefficients.extend(local);
+        }
+        let mut table = SimilarityTable {
+            kappa,
+            coefficients,
+            lengths,
+            quadrature_errors,
+            error: 0.0,
+        };
+        table.error = table.certify(&exact)?;
+        Ok(table)
+    }
+
+    /// κ the table was built for.
+    pub fn kappa(&self) -> f64 {
+        self.kappa
+    }
+
+    /// A bound on the relative difference between what the table gives and what the exact
+    /// solver (with the same rule) gives, for every ratio and every quantity of a rolling
+    /// answer derived from them: [`PROPAGATION`] times the largest relative difference of
+    /// any ratio at the check points, which lie between the table's own points over the
+    /// whole range of ξ. Never below rounding.
+    pub fn error(&self) -> f64 {
+        self.error
+    }
+
+    /// The four ratios at ξ ≥ 0 (∞ allowed).
+    pub fn ratios(&self, xi: f64) -> Ratios {
+        if xi == 0.0 {
+            return Ratios::STATIC;
+        }
+        if xi.is_infinite() {
+            return Ratios {
+                load: 1.0 + self.kappa,
+                ..Ratios::STATIC
+            };
+        }
+        let u = (xi * (1.0 + self.kappa)).sqrt();
+        let v = (u - 1.0) / (u + 1.0);
+        let theta = v.clamp(-1.0, 1.0).acos();
+        let panel = ((theta / PI * PANELS as f64) as usize).min(PANELS - 1);
+        let start = panel * PANEL_SAMPLES;
+        let [load, area, centroid, pressure_centre] = clenshaw(
+            &self.coefficients[start..start + self.lengths[panel]],
+            panel_coordinate(panel, theta),
+        );
+        // w = (1 − v²)² = (4u/(1 + u)²)², exact where 1 − v would lose digits.
+        let w = (4.0 * u / ((1.0 + u) * (1.0 + u))).powi(2);
+        Ratios {
+            load,
+            area,
+            centroid: centroid * w,
+            pressure_centre: pressure_centre * w,
+        }
+    }
+
+    /// The exact solver's quadrature error estimate near ξ: the largest at the four table
+    /// points around it.
+    pub fn quadrature_error(&self, xi: f64) -> f64 {
+        let n = self.quadrature_errors.len();
+        let v = if xi.is_infinite() {
+            1.0
+        } else {
+            let u = (xi * (1.0 + self.kappa)).sqrt();
+            (u - 1.0) / (u + 1.0)
+        };
+        // Point j sits at θ = π(j + ½)/n, v = cos θ.
+        let position = v.clamp(-1.0, 1.0).acos() * n as f64 / PI - 0.5;
+        let below = (position.max(0.0) as usize).min(n - 1);
+        self.quadrature_errors[below.saturating_sub(1)..(below + 3).min(n)]
+            .iter()
+            .fold(0.0, |worst, e| worst.max(*e))
+    }
+
+    /// [`PROPAGATION`] times the largest relative difference between the table and `exact`
+    /// at [`CHECK_POINTS`] points halfway (in θ) between the table's own, spread over the
+    /// range.
+    fn certify(
+        &self,
+        exact: &impl Fn(f64) -> Result<ExactRatios, ModelError>,
+    ) -> Result<f64, ModelError> {
+        /// The table never claims less than rounding.
+        const ROUNDING: f64 = 4.0 * f64::EPSILON;
+        let n = self.quadrature_errors.len();
+        let mut worst: f64 = 0.0;
+        for k in 0..CHECK_POINTS {
+            let j = (2 * k + 1) * (n - 1) / (2 * CHECK_POINTS);
+            let theta = PI * (j as f64 + 1.0) / n as f64;
+            let u = 1.0 / (0.5 * theta).tan().powi(2);
+            let xi = u * u / (1.0 + self.kappa);
+            let (truth, _) = exact(xi)?;
+            let table = self.ratios(xi);
+            for (t, e) in table.as_array().into_iter().zip(truth.as_array()) {
+                if e != t {
+                    worst = worst.max(((t - e) / e).abs());
+                }
+            }
+        }
+        Ok((PROPAGATION * worst).max(ROUNDING))
+    }
+}
+
+/// The tabulated functions at one point: the shifts divided by w = (1 − v²)².
+fn normalised(ratios: &Ratios, w: f64) -> [f64; 4] {
+    [
+        ratios.load,
+        ratios.area,
+        ratios.centroid / w,
+        ratios.pressure_centre / w,
+    ]
+}
+
+/// The angle θ (v = cos θ) at local coordinate t ∈ [−1, 1] of `panel`: panels are π/PANELS
+/// wide in θ, so they are as fine near the ends of v as the global points are.
+fn panel_angle(panel: usize, t: f64) -> f64 {
+    PI / PANELS as f64 * (panel as f64 + 0.5 * (1.0 + t))
+}
+
+/// The local coordinate t ∈ [−1, 1] of θ in `panel` (the inverse of [`panel_angle`]).
+fn panel_coordinate(panel: usize, theta: f64) -> f64 {
+    (2.0 * (theta * PANELS as f64 / PI - panel as f64) - 1.0).clamp(-1.0, 1.0)
+}
+
+/// Chebyshev coefficients cₖ of the series Σ cₖ Tₖ(x) through values at the n points of the
+/// first kind xⱼ = cos(π(j + ½)/n) (a discrete cosine transform).
+fn chebyshev_coefficients(values: &[[f64; 4]]) -> Vec<[f64; 4]> {
+    let n = values.len();
+    (0..n)
+        .map(|k| {
+            let scale = if k == 0 { 1.0 } else { 2.0 } / n as f64;
+            let mut c = [0.0; 4];
+            for (j, value) in values.iter().enumerate() {
+                let basis = (PI * (k * (2 * j + 1)) as f64 / (2 * n) as f64).cos();
+                for (c, v) in c.iter_mut().zip(value) {
+                    *c += basis * v;
+                }
+            }
+            c.map(|c| c * scale)
+        })
+        .collect()
+}
+
+/// The number of leading coefficients that matter: trailing ones whose magnitudes add up to
+/// less than [`TRUNCATION`] of every function's size on the panel are dropped.
+fn significant_terms(coefficients: &[[f64; 4]]) -> usize {
+    let size = coefficients.iter().fold([0.0_f64; 4], |size, c| {
+        [0, 1, 2, 3].map(|f| size[f].max(c[f].abs()))
+    });
+    let mut dropped = [0.0; 4];
+    let mut length = coefficients.len();
+    while length > 1 {
+        let c = coefficients[length - 1];
+        let next = [0, 1, 2, 3].map(|f| dropped[f] + c[f].abs());
+        if (0..4).any(|f| next[f] > TRUNCATION * size[f]) {
+            break;
+        }
+        dropped = next;
+        length -= 1;
+    }
+    length
+}
+
+/// Σ cₖ Tₖ(x) for the four functions at once (Clenshaw's recurrence).
+fn clenshaw(coefficients: &[[f64; 4]], x: f64) -> [f64; 4] {
+    let (mut b1, mut b2) = ([0.0; 4], [0.0; 4]);
+    for c in coefficients.iter().skip(1).rev() {
+        let b0 = [0, 1, 2, 3].map(|f| c[f] + 2.0 * x * b1[f] - b2[f]);
+        (b2, b1) = (b1, b0);
+    }
+    let c0 = coefficients[0];
+    [0, 1, 2, 3].map(|f| c0[f] + x * b1[f] - b2[f])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A smooth stand-in for the contact: the table must reproduce it to rounding.
+    fn stand_in(xi: f64) -> Result<ExactRatios, ModelError> {
+        let (s, rest) = (xi / (1.0 + xi), 1.0 / (1.0 + xi)); // s and 1 − s
+        Ok((
+            Ratios {
+                load: 1.0 + 4.0 * s,
+                area: 1.0 - 0.3 * s * rest,
+                centroid: s * rest,
+                pressure_centre: 2.0 * s * rest / (1.0 + s),
+            },
+            1e-12 * (1.0 + s),
+        ))
+    }
+
+    #[test]
+    fn a_smooth_stand_in_is_reproduced_to_1e_12_with_exact_ends() {
+        let table = SimilarityTable::build(4.0, stand_in).unwrap();
+        assert!(table.error() < 1e-12, "{:e}", table.error());
+        for i in 0..=400 {
+            let xi = 10f64.powf(-12.0 + 24.0 * f64::from(i) / 400.0 + 0.0071);
+            let (truth, _) = stand_in(xi).unwrap();
+            let got = table.ratios(xi);
+            for (t, e) in got.as_array().into_iter().zip(truth.as_array()) {
+                assert!(((t - e) / e).abs() < 1e-12, "ξ = {xi:e}: {t} vs {e}");
+            }
+        }
+        assert_eq!(table.ratios(0.0), Ratios::STATIC);
+        assert_eq!(table.ratios(f64::INFINITY).load, 5.0);
+        assert_eq!(table.ratios(f64::INFINITY).centroid, 0.0);
+    }
+
+    #[test]
+    fn the_quadrature_error_is_the_largest_of_the_nearby_points() {
+        let table = SimilarityTable::build(4.0, stand_in).unwrap();
+        for xi in [0.0, 1e-9, 0.2, 1.0, 1e9, f64::INFINITY] {
+            let (_, near) = stand_in(xi.min(1e300)).unwrap();
+            let reported = table.quadrature_error(xi);
+            assert!(
+                reported >= near * (1.0 - 1e-3) && reported <= 2e-12,
+                "ξ = {xi:e}: {reported:e} vs {near:e}"
+            );
+        }
+    }
+
+    #[test]
+    fn a_failing_exact_solve_fails_the_build() {
+        let failing = |_: f64| -> Result<ExactRatios, ModelError> {
+            Err(ModelError::NoConvergence {
+                what: "test",
+                iterations: 1,
+            })
+        };
+        assert!(SimilarityTable::build(4.0, failing).is_err());
+    }
+}

@@ -1,0 +1,125 @@
+//! The process's similarity tables ([`SimilarityTable`]), one per κ and strip rule: built
+//! once from the exact strip solver, shared by every answer that uses that layer, and
+//! bounded in number.
+//!
+//! Building a table costs about two hundred exact solves at a given penetration (≈ 2 ms for
+//! κ ≤ 100; BENCHMARKS.md), so who builds when is the caller's choice ([`Use`]): a sweep or a
+//! figure builds at once, a single rolling answer uses a table only if one is built and
+//! otherwise solves exactly (and may have one built in the background).
+
+use std::sync::{Arc, Mutex, OnceLock};
+
+use super::quadrature::StripRule;
+use super::rolling::{penetration_contact, solve_with};
+use super::similarity::SimilarityTable;
+use super::{ModelError, Quadrature, Rolling, RollingSolution, SolveOptions};
+
+/// Tables kept at once; the least recently used goes beyond this. A table holds about 20 kB
+/// (60 kB for κ > 1e4).
+const KEPT_TABLES: usize = 32;
+
+/// The table of κ under `quadrature`, if this process has built it.
+pub fn built(kappa: f64, quadrature: Quadrature) -> Option<Arc<SimilarityTable>> {
+    let mut tables = lock();
+    let position = tables
+        .iter()
+        .position(|(key, _)| *key == (kappa.to_bits(), quadrature))?;
+    let entry = tables.remove(position);
+    let table = entry.1.clone();
+    tables.push(entry);
+    Some(table)
+}
+
+/// The table of κ > 0 under `quadrature`, built now if this process has not built it yet.
+pub fn get_or_build(
+    kappa: f64,
+    quadrature: Quadrature,
+) -> Result<Arc<SimilarityTable>, ModelError> {
+    if let Some(table) = built(kappa, quadrature) {
+        return Ok(table);
+    }
+    let rule = StripRule::shared(quadrature)?;
+    let companion = StripRule::shared(quadrature.companion())?;
+    let table = Arc::new(SimilarityTable::build(kappa, |xi| {
+        penetration_contact(xi, kappa, &rule, &companion)
+    })?);
+    let mut tables = lock();
+    let key = (kappa.to_bits(), quadrature);
+    if let Some((_, kept)) = tables.iter().find(|(k, _)| *k == key) {
+        return Ok(kept.clone()); // built meanwhile by another thread
+    }
+    if tables.len() >= KEPT_TABLES {
+        tables.remove(0);
+    }
+    tables.push((key, table.clone()));
+    Ok(table)
+}
+
+/// How a rolling solve may use the similarity tables.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Use {
+    /// Strip sums only.
+    Exact,
+    /// The layer's table if this process has built it; strip sums otherwise.
+    IfBuilt,
+    /// The layer's table, built now if need be.
+    Build,
+}
+
+impl Use {
+    /// Exact solves a table costs to build, about (≈ 200 at a given penetration, each a
+    /// fifth of a solve at a given load).
+    const TABLE_COST: usize = 64;
+
+    /// For a job of `solves` rolling solves on one layer under `quadrature`: build its
+    /// table when that costs less than the solves it saves and the rule is the default one
+    /// (see [`solve`]), solve exactly otherwise. A function of the job alone, so that every
+    /// part of a split job decides alike.
+    pub fn for_solves(solves: usize, quadrature: Quadrature) -> Use {
+        if solves >= Self::TABLE_COST && quadrature == Quadrature::default() {
+            Use::Build
+        } else {
+            Use::Exact
+        }
+    }
+}
+
+/// The largest certified error ([`SimilarityTable::error`]) with which a table answers a
+/// rolling job: a table is good to ≈ 1e-13 for κ ≤ 1e4 (tests/similarity.rs) but less for
+/// stronger viscosity, where the exact solve answers instead.
+const ACCEPTED_TABLE_ERROR: f64 = 1e-10;
+
+/// Solves `rolling` ([`super::rolling::solve`]), through the layer's similarity table as
+/// `tables` allows. Only the default rule is tabulated for rolling answers (a job that
+/// chooses its rule gets that rule's strip sums), and a layer without viscosity (κ = 0)
+/// needs no table.
+pub fn solve(
+    rolling: &Rolling,
+    options: &SolveOptions,
+    tables: Use,
+) -> Result<RollingSolution, ModelError> {
+    let kappa = rolling.layer.kappa();
+    let table = match tables {
+        _ if kappa <= 0.0 || !rolling.violations().is_empty() => None,
+        // A job that names its own rule is studying that rule's strip sums.
+        _ if options.quadrature != Quadrature::default() => None,
+        Use::Exact => None,
+        Use::IfBuilt => built(kappa, options.quadrature),
+        Use::Build => Some(get_or_build(kappa, options.quadrature)?),
+    }
+    .filter(|table| table.error() <= ACCEPTED_TABLE_ERROR);
+    solve_with(rolling, options, table.as_deref())
+}
+
+/// A table under its key: κ (its bits) and the strip rule.
+type Entry = ((u64, Quadrature), Arc<SimilarityTable>);
+
+/// The tables, least recently used first. They hold only immutable data, so a poisoned lock
+/// is still consistent.
+fn lock() -> std::sync::MutexGuard<'static, Vec<Entry>> {
+    static TABLES: OnceLock<Mutex<Vec<Entry>>> = OnceLock::new();
+    TABLES
+        .get_or_init(|| Mutex::new(Vec::new()))
+        .lock()
+        .unwrap_or_else(|poisoned| poisoned.into_inner())
+}

@@ -1,0 +1,115 @@
+//! Rolling answers through the similarity tables (src/model/similarity.rs) against the exact
+//! strip solver over the whole range the service promises: ξ = V T_σ/r₀ ∈ [0, ∞) and
+//! κ ∈ [0, 1e4], every integral quantity within 1e-9 (relative) and within the bound each
+//! answer reports in `verification.table_error`.
+
+use thirdbody::model::quadrature::StripRule;
+use thirdbody::model::rolling::penetration_contact;
+use thirdbody::model::tables::{self, Use};
+use thirdbody::model::{self, Layer, Quadrature, Rolling, RollingSolution, SolveOptions};
+
+/// A rolling contact on the default layer with viscosity strength κ at ξ = V T_σ/r₀.
+fn contact(kappa: f64, xi: f64) -> Rolling {
+    let base = Rolling::default();
+    let layer = Layer {
+        retardation_time: (1.0 + kappa) * base.layer.relaxation_time,
+        ..base.layer
+    };
+    let r0 = (2.0
+        * base.radius
+        * (base.load / (std::f64::consts::PI * layer.stiffness() * base.radius)).sqrt())
+    .sqrt();
+    Rolling {
+        velocity: xi * r0 / layer.relaxation_time,
+        layer,
+        ..base
+    }
+}
+
+/// The largest relative difference of the integral quantities of two answers.
+fn difference(a: &RollingSolution, b: &RollingSolution) -> f64 {
+    [
+        (a.penetration, b.penetration),
+        (a.contact_area, b.contact_area),
+        (a.half_width, b.half_width),
+        (a.centroid_shift, b.centroid_shift),
+        (a.pressure_centre_shift, b.pressure_centre_shift),
+        (a.friction_coefficient, b.friction_coefficient),
+    ]
+    .into_iter()
+    .map(|(x, y)| if x == y { 0.0 } else { ((x - y) / y).abs() })
+    .fold(0.0, f64::max)
+}
+
+#[test]
+fn table_answers_match_exact_solves_to_1e_9_over_xi_0_to_infinity_and_kappa_0_to_1e4() {
+    let options = SolveOptions::integrals_only(Quadrature::default());
+    let mut report = Vec::new();
+    for kappa in [0.0, 1e-6, 0.01, 0.5, 4.0, 37.0, 100.0, 1e3, 1e4] {
+        let mut worst: f64 = 0.0;
+        let mut worst_over_bound: f64 = 0.0;
+        let xis = (0..=80)
+            .map(|i| 10f64.powf(-9.0 + 18.0 * f64::from(i) / 80.0 + 0.0137))
+            .chain([0.0, 1e-200, 1e30]);
+        for xi in xis {
+            let rolling = contact(kappa, xi);
+            let exact = model::solve(&rolling, &options).unwrap();
+            let table = tables::solve(&rolling, &options, Use::Build).unwrap();
+            let d = difference(&table, &exact);
+            worst = worst.max(d);
+            if let Some(bound) = table.verification.table_error {
+                worst_over_bound = worst_over_bound.max(d / bound);
+            }
+            assert!(
+                d <= 1e-9,
+                "κ = {kappa}, ξ = {xi:e}: relative difference {d:e}"
+            );
+        }
+        report.push(format!(
+            "κ = {kappa}: worst {worst:.1e}, worst/bound {worst_over_bound:.2}"
+        ));
+        assert!(
+            worst_over_bound <= 1.0,
+            "κ = {kappa}: an answer differs by more than its table_error ({worst_over_bound})"
+        );
+    }
+    println!("{}", report.join("\n"));
+}
+
+#[test]
+fn the_ratios_at_a_given_penetration_match_the_strip_solver_between_the_table_points() {
+    let quadrature = Quadrature::default();
+    let rule = StripRule::shared(quadrature).unwrap();
+    let companion = StripRule::shared(quadrature.companion()).unwrap();
+    for kappa in [0.01, 4.0, 1e3, 1e4, 1e5] {
+        let table = tables::get_or_build(kappa, quadrature).unwrap();
+        // Within the promised range the table is good to 1e-11; beyond it, it says how good.
+        if kappa <= 1e4 {
+            assert!(table.error() < 1e-11, "κ = {kappa}: {:e}", table.error());
+        }
+        let mut worst: f64 = 0.0;
+        for i in 0..=300 {
+            let xi = 10f64.powf(-10.0 + 20.0 * f64::from(i) / 300.0 + 0.0123);
+            let (exact, quadrature_error) =
+                penetration_contact(xi, kappa, &rule, &companion).unwrap();
+            let got = table.ratios(xi);
+            for (t, e) in [
+                (got.load, exact.load),
+                (got.area, exact.area),
+                (got.centroid, exact.centroid),
+                (got.pressure_centre, exact.pressure_centre),
+            ] {
+                worst = worst.max(((t - e) / e).abs());
+            }
+            assert!(
+                table.quadrature_error(xi) >= 0.5 * quadrature_error,
+                "κ = {kappa}, ξ = {xi:e}"
+            );
+        }
+        assert!(
+            worst <= table.error(),
+            "κ = {kappa}: {worst:e} against the certified {:e}",
+            table.error()
+        );
+    }
+}
