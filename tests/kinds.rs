@@ -281,3 +281,18 @@ fn a_sweep_cut_by_its_deadline_leaves_its_solved_points_to_its_retry() {
     assert_eq!(recalled, solved_before);
     assert_eq!(answer, engine::run(&sweep, &Control::new(None, 1)).unwrap());
 }
+
+#[test]
+fn only_jobs_certain_to_be_quick_run_on_the_callers_thread() {
+    assert!(job(json!({"kind": "rolling"})).is_small());
+    for heavy in [
+        json!({"kind": "rolling", "input": {"options": {"pressure_grid": 501}}}),
+        json!({"kind": "rolling", "input": {"options": {"boundary_points": 10001}}}),
+        json!({"kind": "rolling", "input": {"options": {"strips": 1024}}}),
+        json!({"kind": "sweep", "input": {"vary": {"load": ["1 nN", "2 nN"]}}}),
+        json!({"kind": "three_body", "input": {"operating": {"total_load": "1 mN"}}}),
+        json!({"kind": "figure", "input": {"number": 3}}),
+    ] {
+        assert!(!job(heavy.clone()).is_small(), "{heavy}");
+    }
+}

@@ -113,3 +113,24 @@ fn the_ratios_at_a_given_penetration_match_the_strip_solver_between_the_table_po
         );
     }
 }
+
+proptest::proptest! {
+    #![proptest_config(proptest::prelude::ProptestConfig::with_cases(48))]
+
+    /// Any κ in the promised range (a new table for each), any ξ: the table answer is the
+    /// exact one to 1e-9 and within its own bound.
+    #[test]
+    fn any_layer_and_speed_in_range_agree_with_the_exact_solve(
+        log_kappa in -6.0f64..4.0,
+        log_xi in -12.0f64..12.0,
+    ) {
+        let (kappa, xi) = (10f64.powf(log_kappa), 10f64.powf(log_xi));
+        let options = SolveOptions::integrals_only(Quadrature::default());
+        let rolling = contact(kappa, xi);
+        let exact = model::solve(&rolling, &options).unwrap();
+        let table = tables::solve(&rolling, &options, Use::Build).unwrap();
+        let bound = table.verification.table_error.unwrap();
+        let d = difference(&table, &exact);
+        proptest::prop_assert!(d <= 1e-9 && d <= bound, "κ = {kappa:e}, ξ = {xi:e}: {d:e} (bound {bound:e})");
+    }
+}

@@ -79,6 +79,13 @@ pub trait Kind: fmt::Debug + PartialEq + Send + Sync + Sized + 'static {
         None
     }
 
+    /// Whether the job is certain to take no more than about a hundred microseconds: the
+    /// engine then runs it on the request's own thread, which is cheaper than handing it to
+    /// a solver thread and back (BENCHMARKS.md). No by default.
+    fn small(&self) -> bool {
+        false
+    }
+
     /// The answer with the rows of points `range` only (for a job that splits: see
     /// [`Kind::points`]).
     fn run_points(
@@ -98,6 +105,7 @@ trait Dispatch: fmt::Debug + Send + Sync {
     fn canonical(&self) -> Value;
     fn references(&self) -> &'static [Reference];
     fn work(&self) -> Work;
+    fn small(&self) -> bool;
     fn run(&self, meta: Meta, control: &Control) -> Result<Answer, JobError>;
     fn points(&self) -> Option<usize>;
     fn run_points(
@@ -126,6 +134,10 @@ impl<K: Kind> Dispatch for K {
 
     fn work(&self) -> Work {
         Kind::work(self)
+    }
+
+    fn small(&self) -> bool {
+        Kind::small(self)
     }
 
     fn run(&self, meta: Meta, control: &Control) -> Result<Answer, JobError> {
@@ -216,6 +228,11 @@ impl Job {
     /// The work the job takes.
     pub fn work(&self) -> Work {
         self.kind.work()
+    }
+
+    /// Whether the job is small enough to run on the caller's thread ([`Kind::small`]).
+    pub fn is_small(&self) -> bool {
+        self.kind.small()
     }
 
     /// Runs the job to its answer, whose `meta` is `meta` (see [`Job::meta`]).

@@ -631,7 +631,9 @@ impl Section {
     }
 
     /// `n` boundary points spread evenly in θ ∈ [−π/2, π/2], y = r sin θ, in metres.
+    /// Neighbouring strips have close exit roots: each root starts from the previous one.
     fn boundary(&self, n: usize, scale: f64) -> Result<Vec<BoundaryPoint>, ModelError> {
+        let mut previous = None;
         (0..n)
             .map(|j| {
                 let theta = if n == 1 {
@@ -643,7 +645,8 @@ impl Section {
                     (theta.sin() * self.half_width, 0.0, 0.0)
                 } else {
                     let strip = self.strip(theta.cos());
-                    let rho = strip.exit_root(None)?.rho;
+                    let rho = strip.exit_root(previous)?.rho;
+                    previous = Some(rho);
                     (
                         theta.sin() * self.half_width,
                         (rho - 1.0) * strip.entry,
