@@ -225,10 +225,9 @@ pub(super) fn solve_with(
         }
     }
 
-    let rule = StripRule::shared(options.quadrature)?;
     let contact = match table {
         Some(table) if xi > 0.0 => Contact::tabulated(xi, table)?,
-        _ => Contact::exact(xi, kappa, &rule, options.quadrature)?,
+        _ => Contact::exact(xi, kappa, options.quadrature)?,
     };
     let section = Section::new(contact.half_width, xi, kappa);
     let half_width = contact.half_width * r0;
@@ -249,7 +248,7 @@ pub(super) fn solve_with(
             None => None,
         },
         verification: Verification {
-            quadrature_nodes: rule.len(),
+            quadrature_nodes: options.quadrature.size(),
             ..contact.verification
         },
     };
@@ -376,12 +375,9 @@ struct Contact {
 impl Contact {
     /// By strip sums: the load root, then the pressure moment, then the same integrals under
     /// the companion rule for the quadrature error estimate.
-    fn exact(
-        xi: f64,
-        kappa: f64,
-        rule: &StripRule,
-        quadrature: Quadrature,
-    ) -> Result<Contact, ModelError> {
+    fn exact(xi: f64, kappa: f64, quadrature: Quadrature) -> Result<Contact, ModelError> {
+        let rule = StripRule::shared(quadrature)?;
+        let rule = &*rule;
         let shape = Shape::solve(xi, kappa, rule)?;
         let section = Section::new(shape.half_width, xi, kappa);
         let pressure_moment = section.pressure_moment(rule, &shape.exit_roots);
@@ -414,17 +410,19 @@ impl Contact {
 
     /// Through the similarity table: at r̂ the contact is the table's at ξ/r̂ scaled by r̂
     /// (P̂ = (π/4) r̂⁴ Φ_P, Â = π r̂² Φ_A, x/r₀ = r̂ · x/r), so the load equation is
-    /// f(t) = 4t + ln Φ_P(ξ e^{−t}) = 0 in t = ln r̂, solved by the secant method from
-    /// t = −¼ ln Φ_P(ξ) ([`load_root`]; f′ lies between 3 and 4).
+    /// f(t) = 4t + ln Φ_P(ξ e^{−t}) = 0 in t = ln r̂ (nearly linear: f′ lies between 3 and
+    /// 4; in r̂ itself the secant needs one or two steps more), solved by the secant method
+    /// ([`load_root`]) from t = −¼ ln Φ_P(ξ) and the known f(0) = ln Φ_P(ξ).
     fn tabulated(xi: f64, table: &SimilarityTable) -> Result<Contact, ModelError> {
-        let start = -0.25 * table.ratios(xi).load.ln();
+        let at_rest = table.log_ratios(xi).log_load;
         let root = load_root(
-            table.kappa(),
-            start,
+            log_bracket(table.kappa()),
+            -0.25 * at_rest,
+            Some((0.0, at_rest)),
             "penetration (load equation through the similarity table)",
             |t| {
-                let ratios = table.ratios(xi * (-t).exp());
-                Ok((4.0 * t + ratios.load.ln(), ratios))
+                let ratios = table.log_ratios(xi * (-t).exp());
+                Ok((4.0 * t + ratios.log_load, ratios))
             },
         )?;
         let (r, ratios) = (root.t.exp(), root.at);
@@ -434,7 +432,7 @@ impl Contact {
             centroid: r * ratios.centroid,
             pressure_centre: r * ratios.pressure_centre,
             verification: Verification {
-                load_residual: root.residual,
+                load_residual: root.value.exp_m1().abs(),
                 quadrature_error_estimate: table.quadrature_error(xi / r),
                 quadrature_nodes: 0,
                 iterations: root.iterations,
@@ -465,7 +463,22 @@ impl Shape {
         let target = FRAC_PI_4.ln();
         let mut rho = vec![f64::NAN; rule.len()];
         let mut exit_root_iterations = 0;
-        let root = load_root(kappa, 0.0, "penetration (load equation P(δ) = P)", |t| {
+        // The step and roots of the evaluation before the last, for extrapolating each
+        // strip's root to the next step; the step of the last evaluation.
+        let mut before: Option<(f64, Vec<f64>)> = None;
+        let mut last: Option<f64> = None;
+        let what = "penetration (load equation P(δ) = P)";
+        let root = load_root(log_bracket(kappa), 0.0, None, what, |t| {
+            let roots = last.map(|t1| (t1, rho.clone()));
+            if let (Some(t1), Some((t0, rho0))) = (last, &before) {
+                // Each root is a smooth function of t: linear extrapolation from the last
+                // two steps lands within the secant's own (shrinking) error of the new root.
+                let ratio = (t - t1) / (t1 - t0);
+                for (r, r0) in rho.iter_mut().zip(rho0) {
+                    *r += (*r - r0) * ratio;
+                }
+            }
+            (before, last) = (roots, Some(t));
             let integrals = Section::new(t.exp(), xi, kappa).integrate(rule, Some(&mut rho))?;
             exit_root_iterations += integrals.exit_root_iterations;
             Ok((integrals.load.ln() - target, integrals))
@@ -476,37 +489,44 @@ impl Shape {
             half_width: root.t.exp(),
             integrals,
             exit_roots: rho,
-            load_residual: root.residual,
+            load_residual: root.value.exp_m1().abs(),
             iterations: root.iterations,
         })
     }
 }
 
-/// The root of a load equation f(t) = ln P̂(e^t) − ln(π/4) in t = ln r̂ and what was
-/// computed there.
+/// The root of a load equation and what was computed there.
 struct LoadRoot<T> {
     t: f64,
     at: T,
-    /// |P̂/(π/4) − 1| at the root.
-    residual: f64,
+    /// The equation's value at the root.
+    value: f64,
     iterations: u32,
 }
 
-/// Solves a load equation `f` (returning f(t) and what it computed at t) by the secant
-/// method from `start`, guarded by the bracket δ ∈ [0.9 δ_∞, 1.05 δ₀] of docs/model.md §3.
-/// f is nearly linear (slope 4 at both elastic limits), so the secant converges in a
-/// handful of steps; its first step assumes that slope.
+/// The bracket δ ∈ [0.9 δ_∞, 1.05 δ₀] of docs/model.md §3, in t = ln r̂ (r̂ = √(δ/δ₀)).
+fn log_bracket(kappa: f64) -> (f64, f64) {
+    (
+        0.5 * 0.9_f64.ln() - 0.25 * (1.0 + kappa).ln(),
+        0.5 * 1.05_f64.ln(),
+    )
+}
+
+/// Solves a load equation `f` (returning f(t) and what it computed at t; f is a relative
+/// residual of the load, increasing in t) by the secant method from `start` (and from a
+/// point `known` = (t, f(t)) already computed, if any), guarded by `bracket`.
+/// The equations in use are ln P̂/(π/4) in t = ln r̂, nearly linear with slope 4 at both
+/// elastic limits, so the secant converges in a handful of steps; without a known point its
+/// first step assumes that slope.
 fn load_root<T>(
-    kappa: f64,
+    bracket: (f64, f64),
     start: f64,
+    known: Option<(f64, f64)>,
     what: &'static str,
     mut f: impl FnMut(f64) -> Result<(f64, T), ModelError>,
 ) -> Result<LoadRoot<T>, ModelError> {
-    let (mut lo, mut hi) = (
-        0.5 * 0.9_f64.ln() - 0.25 * (1.0 + kappa).ln(),
-        0.5 * 1.05_f64.ln(),
-    );
-    let (mut t_prev, mut f_prev) = (f64::NAN, f64::NAN);
+    let (mut lo, mut hi) = bracket;
+    let (mut t_prev, mut f_prev) = known.unwrap_or((f64::NAN, f64::NAN));
     let mut t = start.clamp(lo, hi);
     let mut iterations = 0;
     loop {
@@ -522,11 +542,11 @@ fn load_root<T>(
             return Ok(LoadRoot {
                 t,
                 at,
-                residual: value.exp_m1().abs(),
+                value,
                 iterations,
             });
         }
-        let slope = if iterations == 1 || value == f_prev {
+        let slope = if f_prev.is_nan() || value == f_prev || t == t_prev {
             4.0
         } else {
             (value - f_prev) / (t - t_prev)
@@ -598,10 +618,18 @@ impl Section {
         mut warm: Option<&mut [f64]>,
     ) -> Result<Integrals, ModelError> {
         let mut sum = Integrals::default();
+        let mut neighbour = None;
         for i in 0..rule.len() {
             let strip = self.strip(rule.cos[i]);
-            let guess = warm.as_deref().map(|rho| rho[i]).filter(|r| r.is_finite());
+            // A strip without a root from before starts from its neighbour's: the strips
+            // are in order of θ, and the root varies smoothly with it.
+            let guess = warm
+                .as_deref()
+                .map(|rho| rho[i])
+                .filter(|r| r.is_finite())
+                .or(neighbour);
             let root = strip.exit_root(guess)?;
+            neighbour = Some(root.rho);
             if let Some(rho) = warm.as_deref_mut() {
                 rho[i] = root.rho;
             }

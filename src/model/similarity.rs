@@ -14,12 +14,15 @@
 //! as small as the others' right up to the ends.
 //!
 //! Building: the exact ratios at N Chebyshev points of the first kind, one global Chebyshev
-//! series through them, then that series re-expanded on [`PANELS`] panels (equal in θ, v = cos θ) as short local
+//! series through them, then that series re-expanded on [`PANELS`] panels (equal in
+//! s = (√u − 1)/(√u + 1)) as short local
 //! series (truncated where their coefficients fall below rounding), which is what an
 //! evaluation sums. The table is then certified against exact solves at points between its
 //! own ([`SimilarityTable::error`]).
 
 use std::f64::consts::PI;
+
+use nalgebra::DMatrix;
 
 use super::ModelError;
 
@@ -50,12 +53,44 @@ impl Ratios {
     }
 }
 
+/// [`Ratios`] with Φ_P as its logarithm ([`SimilarityTable::log_ratios`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LogRatios {
+    /// ln Φ_P.
+    pub log_load: f64,
+    pub area: f64,
+    pub centroid: f64,
+    pub pressure_centre: f64,
+}
+
+impl LogRatios {
+    pub fn ratios(&self) -> Ratios {
+        Ratios {
+            load: self.log_load.exp(),
+            area: self.area,
+            centroid: self.centroid,
+            pressure_centre: self.pressure_centre,
+        }
+    }
+}
+
+impl From<Ratios> for LogRatios {
+    fn from(r: Ratios) -> Self {
+        LogRatios {
+            log_load: r.load.ln(),
+            area: r.area,
+            centroid: r.centroid,
+            pressure_centre: r.pressure_centre,
+        }
+    }
+}
+
 /// The exact ratios at one ξ and the quadrature error estimate of the rule that computed them
 /// (what [`super::rolling::Verification::quadrature_error_estimate`] would report there).
 pub type ExactRatios = (Ratios, f64);
 
-/// Panels on which the table is evaluated, equal in θ = arccos v.
-const PANELS: usize = 16;
+/// Panels on which the table is evaluated, equal in s = (√u − 1)/(√u + 1).
+const PANELS: usize = 128;
 /// Samples (and so the largest number of coefficients) of each panel's local series.
 const PANEL_SAMPLES: usize = 24;
 /// A panel's series stops where the coefficients left out add up to less than this part of
@@ -64,7 +99,7 @@ const PANEL_SAMPLES: usize = 24;
 const TRUNCATION: f64 = 1e-14;
 /// Points between the table's own at which [`SimilarityTable::build`] compares it with exact
 /// solves.
-const CHECK_POINTS: usize = 32;
+const CHECK_POINTS: usize = 64;
 /// The certified error is this many times the largest difference found at the check points:
 /// a rolling answer carries a ratio's error through the load equation into δ, A, x_c and x_p
 /// at most about twice, and the exact solve it is compared with stops its own load root at a
@@ -73,8 +108,9 @@ const PROPAGATION: f64 = 4.0;
 
 /// Chebyshev points of the global series for viscosity strength κ. The transition of Φ
 /// spans ξ from about 1/(1 + κ) to 1, wider as κ grows; these sizes keep every ratio within
-/// 1e-12 of the exact solve over all ξ for κ up to 1e4 (tested), and larger κ get the
-/// largest table.
+/// 1e-11 of the exact solve over all ξ for κ up to 1e4 (tested; at κ = 1e4 what is left is
+/// the exact solver's own rounding, 384 points do no better), and larger κ get the largest
+/// table.
 pub fn table_points(kappa: f64) -> usize {
     if kappa <= 100.0 {
         128
@@ -89,13 +125,14 @@ pub fn table_points(kappa: f64) -> usize {
 #[derive(Clone, Debug)]
 pub struct SimilarityTable {
     kappa: f64,
-    /// Local Chebyshev coefficients, `PANEL_SAMPLES` per panel, each for the four functions
-    /// (Φ_P, Φ_A, x_c/(r w), x_p/(r w)).
+    /// Local Chebyshev coefficients, panel after panel, each for the four functions
+    /// (ln Φ_P, Φ_A, x_c/(r w), x_p/(r w)); only those that matter are kept.
     coefficients: Vec<[f64; 4]>,
-    /// Coefficients in use on each panel (the rest are below rounding).
-    lengths: [usize; PANELS],
-    /// The quadrature error estimate at each global point, v descending.
-    quadrature_errors: Vec<f64>,
+    /// Where each panel's coefficients start in `coefficients` (and, last, where they end).
+    starts: [usize; PANELS + 1],
+    /// The largest quadrature error estimate of the global points on each panel and on its
+    /// two neighbours.
+    quadrature_errors: [f64; PANELS],
     /// See [`SimilarityTable::error`].
     error: f64,
 }
@@ -109,33 +146,40 @@ impl SimilarityTable {
     ) -> Result<SimilarityTable, ModelError> {
         let n = table_points(kappa);
         let mut values = Vec::with_capacity(n);
-        let mut quadrature_errors = Vec::with_capacity(n);
+        let mut on_panel = [0.0_f64; PANELS];
         for j in 0..n {
             // v = cos θ: u = (1 + v)/(1 − v) = cot²(θ/2), w = sin⁴θ, without cancellation.
             let theta = PI * (j as f64 + 0.5) / n as f64;
             let u = 1.0 / (0.5 * theta).tan().powi(2);
             let (ratios, quadrature_error) = exact(u * u / (1.0 + kappa))?;
             values.push(normalised(&ratios, theta.sin().powi(4)));
-            quadrature_errors.push(quadrature_error);
+            let panel = panel_of((0.25 * PI - 0.5 * theta).tan());
+            on_panel[panel] = on_panel[panel].max(quadrature_error);
         }
+        let quadrature_errors: [f64; PANELS] = std::array::from_fn(|p| {
+            on_panel[p.saturating_sub(1)..(p + 2).min(PANELS)]
+                .iter()
+                .fold(0.0_f64, |worst, e| worst.max(*e))
+        });
         let global = chebyshev_coefficients(&values);
         let mut coefficients = Vec::with_capacity(PANELS * PANEL_SAMPLES);
-        let mut lengths = [0; PANELS];
-        for (panel, length) in lengths.iter_mut().enumerate() {
+        let mut starts = [0; PANELS + 1];
+        for panel in 0..PANELS {
             let samples: Vec<[f64; 4]> = (0..PANEL_SAMPLES)
                 .map(|i| {
                     let t = (PI * (i as f64 + 0.5) / PANEL_SAMPLES as f64).cos();
-                    clenshaw(&global, panel_angle(panel, t).cos())
+                    let s = panel_centre(panel) + t / PANELS as f64;
+                    clenshaw(&global, 2.0 * s / (1.0 + s * s))
                 })
                 .collect();
             let local = chebyshev_coefficients(&samples);
-            *length = significant_terms(&local);
-            coefficients.extend(local);
+            coefficients.extend_from_slice(&local[..significant_terms(&local)]);
+            starts[panel + 1] = coefficients.len();
         }
         let mut table = SimilarityTable {
             kappa,
             coefficients,
-            lengths,
+            starts,
             quadrature_errors,
             error: 0.0,
         };
@@ -159,50 +203,57 @@ impl SimilarityTable {
 
     /// The four ratios at ξ ≥ 0 (∞ allowed).
     pub fn ratios(&self, xi: f64) -> Ratios {
+        self.end(xi).unwrap_or_else(|| self.log_ratios(xi).ratios())
+    }
+
+    /// The exact ratios at the ends ξ = 0 (the relaxed contact) and ξ = ∞ (the
+    /// instantaneous one); `None` between.
+    fn end(&self, xi: f64) -> Option<Ratios> {
         if xi == 0.0 {
-            return Ratios::STATIC;
-        }
-        if xi.is_infinite() {
-            return Ratios {
+            Some(Ratios::STATIC)
+        } else if xi.is_infinite() {
+            Some(Ratios {
                 load: 1.0 + self.kappa,
                 ..Ratios::STATIC
-            };
+            })
+        } else {
+            None
+        }
+    }
+
+    /// The four ratios at ξ ≥ 0 (∞ allowed), with Φ_P as its logarithm, as the table holds
+    /// it: the load equation of a rolling answer is in ln Φ_P, and taking the logarithm
+    /// there on every step was a fifth of the answer's time.
+    pub fn log_ratios(&self, xi: f64) -> LogRatios {
+        if let Some(end) = self.end(xi) {
+            return end.into();
         }
         let u = (xi * (1.0 + self.kappa)).sqrt();
-        let v = (u - 1.0) / (u + 1.0);
-        let theta = v.clamp(-1.0, 1.0).acos();
-        let panel = ((theta / PI * PANELS as f64) as usize).min(PANELS - 1);
-        let start = panel * PANEL_SAMPLES;
-        let [load, area, centroid, pressure_centre] = clenshaw(
-            &self.coefficients[start..start + self.lengths[panel]],
-            panel_coordinate(panel, theta),
+        let s = panel_variable(u);
+        let panel = panel_of(s);
+        let [log_load, area, centroid, pressure_centre] = clenshaw(
+            &self.coefficients[self.starts[panel]..self.starts[panel + 1]],
+            ((s - panel_centre(panel)) * PANELS as f64).clamp(-1.0, 1.0),
         );
         // w = (1 − v²)² = (4u/(1 + u)²)², exact where 1 − v would lose digits.
         let w = (4.0 * u / ((1.0 + u) * (1.0 + u))).powi(2);
-        Ratios {
-            load,
+        LogRatios {
+            log_load,
             area,
             centroid: centroid * w,
             pressure_centre: pressure_centre * w,
         }
     }
 
-    /// The exact solver's quadrature error estimate near ξ: the largest at the four table
-    /// points around it.
+    /// The exact solver's quadrature error estimate near ξ: the largest at the table points
+    /// of ξ's panel and of the panels on either side.
     pub fn quadrature_error(&self, xi: f64) -> f64 {
-        let n = self.quadrature_errors.len();
-        let v = if xi.is_infinite() {
+        let s = if xi.is_infinite() {
             1.0
         } else {
-            let u = (xi * (1.0 + self.kappa)).sqrt();
-            (u - 1.0) / (u + 1.0)
+            panel_variable((xi * (1.0 + self.kappa)).sqrt())
         };
-        // Point j sits at θ = π(j + ½)/n, v = cos θ.
-        let position = v.clamp(-1.0, 1.0).acos() * n as f64 / PI - 0.5;
-        let below = (position.max(0.0) as usize).min(n - 1);
-        self.quadrature_errors[below.saturating_sub(1)..(below + 3).min(n)]
-            .iter()
-            .fold(0.0, |worst, e| worst.max(*e))
+        self.quadrature_errors[panel_of(s)]
     }
 
     /// [`PROPAGATION`] times the largest relative difference between the table and `exact`
@@ -214,7 +265,7 @@ impl SimilarityTable {
     ) -> Result<f64, ModelError> {
         /// The table never claims less than rounding.
         const ROUNDING: f64 = 4.0 * f64::EPSILON;
-        let n = self.quadrature_errors.len();
+        let n = table_points(self.kappa);
         let mut worst: f64 = 0.0;
         for k in 0..CHECK_POINTS {
             let j = (2 * k + 1) * (n - 1) / (2 * CHECK_POINTS);
@@ -233,43 +284,48 @@ impl SimilarityTable {
     }
 }
 
-/// The tabulated functions at one point: the shifts divided by w = (1 − v²)².
+/// The tabulated functions at one point: ln Φ_P, Φ_A, and the shifts divided by
+/// w = (1 − v²)².
 fn normalised(ratios: &Ratios, w: f64) -> [f64; 4] {
     [
-        ratios.load,
+        ratios.load.ln(),
         ratios.area,
         ratios.centroid / w,
         ratios.pressure_centre / w,
     ]
 }
 
-/// The angle θ (v = cos θ) at local coordinate t ∈ [−1, 1] of `panel`: panels are π/PANELS
-/// wide in θ, so they are as fine near the ends of v as the global points are.
-fn panel_angle(panel: usize, t: f64) -> f64 {
-    PI / PANELS as f64 * (panel as f64 + 0.5 * (1.0 + t))
+/// s = (√u − 1)/(√u + 1) ∈ [−1, 1], the variable the panels divide equally.
+fn panel_variable(u: f64) -> f64 {
+    let q = u.sqrt();
+    (q - 1.0) / (q + 1.0)
 }
 
-/// The local coordinate t ∈ [−1, 1] of θ in `panel` (the inverse of [`panel_angle`]).
-fn panel_coordinate(panel: usize, theta: f64) -> f64 {
-    (2.0 * (theta * PANELS as f64 / PI - panel as f64) - 1.0).clamp(-1.0, 1.0)
+/// The panel of s ∈ [−1, 1].
+fn panel_of(s: f64) -> usize {
+    (((s + 1.0) * 0.5 * PANELS as f64) as usize).min(PANELS - 1)
+}
+
+/// The centre of `panel` in s = (√u − 1)/(√u + 1) = tan(π/4 − θ/2) (v = cos θ = 2s/(1 + s²)).
+/// Panels are 2/PANELS wide in s: within a factor 2 of equal in θ, so as fine near the ends
+/// of v as the global points are, and found without an inverse cosine.
+fn panel_centre(panel: usize) -> f64 {
+    -1.0 + (2 * panel + 1) as f64 / PANELS as f64
 }
 
 /// Chebyshev coefficients cₖ of the series Σ cₖ Tₖ(x) through values at the n points of the
-/// first kind xⱼ = cos(π(j + ½)/n) (a discrete cosine transform).
+/// first kind xⱼ = cos(π(j + ½)/n): the discrete cosine transform, as one matrix product
+/// for the four functions.
 fn chebyshev_coefficients(values: &[[f64; 4]]) -> Vec<[f64; 4]> {
     let n = values.len();
-    (0..n)
-        .map(|k| {
-            let scale = if k == 0 { 1.0 } else { 2.0 } / n as f64;
-            let mut c = [0.0; 4];
-            for (j, value) in values.iter().enumerate() {
-                let basis = (PI * (k * (2 * j + 1)) as f64 / (2 * n) as f64).cos();
-                for (c, v) in c.iter_mut().zip(value) {
-                    *c += basis * v;
-                }
-            }
-            c.map(|c| c * scale)
-        })
+    let transform = DMatrix::from_fn(n, n, |k, j| {
+        let scale = if k == 0 { 1.0 } else { 2.0 } / n as f64;
+        scale * (PI * (k * (2 * j + 1)) as f64 / (2 * n) as f64).cos()
+    });
+    let coefficients = transform * DMatrix::from_fn(n, 4, |j, f| values[j][f]);
+    coefficients
+        .row_iter()
+        .map(|c| [c[0], c[1], c[2], c[3]])
         .collect()
 }
 

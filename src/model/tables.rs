@@ -14,8 +14,8 @@ use super::rolling::{penetration_contact, solve_with};
 use super::similarity::SimilarityTable;
 use super::{ModelError, Quadrature, Rolling, RollingSolution, SolveOptions};
 
-/// Tables kept at once; the least recently used goes beyond this. A table holds about 20 kB
-/// (60 kB for κ > 1e4).
+/// Tables kept at once; the least recently used goes beyond this. A table holds 55–80 kB
+/// (its panels' coefficients), so at most ≈ 2.5 MB.
 const KEPT_TABLES: usize = 32;
 
 /// The table of κ under `quadrature`, if this process has built it.
@@ -24,9 +24,11 @@ pub fn built(kappa: f64, quadrature: Quadrature) -> Option<Arc<SimilarityTable>>
     let position = tables
         .iter()
         .position(|(key, _)| *key == (kappa.to_bits(), quadrature))?;
-    let entry = tables.remove(position);
-    let table = entry.1.clone();
-    tables.push(entry);
+    let table = tables[position].1.clone();
+    if position + 1 < tables.len() {
+        let entry = tables.remove(position);
+        tables.push(entry);
+    }
     Some(table)
 }
 
@@ -100,12 +102,17 @@ pub fn solve(
 ) -> Result<RollingSolution, ModelError> {
     let kappa = rolling.layer.kappa();
     let table = match tables {
-        _ if kappa <= 0.0 || !rolling.violations().is_empty() => None,
         // A job that names its own rule is studying that rule's strip sums.
-        _ if options.quadrature != Quadrature::default() => None,
+        _ if kappa <= 0.0 || options.quadrature != Quadrature::default() => None,
         Use::Exact => None,
         Use::IfBuilt => built(kappa, options.quadrature),
-        Use::Build => Some(get_or_build(kappa, options.quadrature)?),
+        // Never build for an invalid input: its solve reports what is wrong.
+        Use::Build => match built(kappa, options.quadrature) {
+            None if rolling.violations().is_empty() => {
+                Some(get_or_build(kappa, options.quadrature)?)
+            }
+            found => found,
+        },
     }
     .filter(|table| table.error() <= ACCEPTED_TABLE_ERROR);
     solve_with(rolling, options, table.as_deref())
