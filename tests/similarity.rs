@@ -3,6 +3,7 @@
 //! κ ∈ [0, 1e4], every integral quantity within 1e-9 (relative) and within the bound each
 //! answer reports in `verification.table_error`.
 
+use thirdbody::model::limits;
 use thirdbody::model::quadrature::StripRule;
 use thirdbody::model::rolling::penetration_contact;
 use thirdbody::model::tables::{self, Use};
@@ -15,10 +16,7 @@ fn contact(kappa: f64, xi: f64) -> Rolling {
         retardation_time: (1.0 + kappa) * base.layer.relaxation_time,
         ..base.layer
     };
-    let r0 = (2.0
-        * base.radius
-        * (base.load / (std::f64::consts::PI * layer.stiffness() * base.radius)).sqrt())
-    .sqrt();
+    let r0 = limits::relaxed(base.radius, base.load, &layer).half_width;
     Rolling {
         velocity: xi * r0 / layer.relaxation_time,
         layer,

@@ -147,18 +147,13 @@ impl Kind for RollingJob {
     fn run(&self, meta: Meta, control: &Control) -> Result<RollingOutput, JobError> {
         let solution =
             control.solve(|| tables::solve(&self.rolling, &self.options, Use::IfBuilt))?;
-        if solution.verification.table_error.is_none() {
-            // Solved exactly, as the first answer on a layer is: the table for the answers
-            // after it is built off this request's path.
-            let (kappa, quadrature) = (self.rolling.layer.kappa(), self.options.quadrature);
-            if kappa > 0.0 {
-                control.later(
-                    format!("similarity table κ = {kappa:e}, {quadrature:?}"),
-                    move || {
-                        let _ = tables::get_or_build(kappa, quadrature);
-                    },
-                );
-            }
+        // Solved exactly, as the first answer on a layer is: the table for the answers after
+        // it is built off this request's path.
+        if let Some(kappa) = tables::wanted(&self.rolling, &self.options) {
+            let quadrature = self.options.quadrature;
+            control.later(format!("similarity table κ = {kappa:e}"), move || {
+                let _ = tables::get_or_build(kappa, quadrature);
+            });
         }
         RollingOutput::new(&self.rolling, &solution, meta)
     }

@@ -270,20 +270,13 @@ pub fn penetration_contact(
     let section = Section::new(1.0, xi, kappa);
     let mut roots = vec![f64::NAN; rule.len()];
     let integrals = section.integrate(rule, Some(&mut roots))?;
-    let moment = section.pressure_moment(rule, &roots);
-    let mut companion_roots = vec![f64::NAN; companion.len()];
-    let companion_integrals = section.integrate(companion, Some(&mut companion_roots))?;
-    let companion_moment = section.pressure_moment(companion, &companion_roots);
+    let (moment, error) = section.moment_and_error(rule, &roots, &integrals, companion)?;
     let ratios = Ratios {
         load: integrals.load / FRAC_PI_4,
         area: integrals.area / PI,
         centroid: integrals.centroid(),
         pressure_centre: moment / integrals.load,
     };
-    let error = quadrature_error(
-        (&integrals, moment),
-        (&companion_integrals, companion_moment),
-    );
     Ok((ratios, error))
 }
 
@@ -379,18 +372,13 @@ impl Contact {
         let rule = StripRule::shared(quadrature)?;
         let rule = &*rule;
         let shape = Shape::solve(xi, kappa, rule)?;
-        let section = Section::new(shape.half_width, xi, kappa);
-        let pressure_moment = section.pressure_moment(rule, &shape.exit_roots);
         let companion = StripRule::shared(quadrature.companion())?;
-        let mut companion_roots = vec![f64::NAN; companion.len()];
-        let companion_integrals = section.integrate(&companion, Some(&mut companion_roots))?;
-        let quadrature_error_estimate = quadrature_error(
-            (&shape.integrals, pressure_moment),
-            (
-                &companion_integrals,
-                section.pressure_moment(&companion, &companion_roots),
-            ),
-        );
+        let (pressure_moment, quadrature_error_estimate) = Section::new(
+            shape.half_width,
+            xi,
+            kappa,
+        )
+        .moment_and_error(rule, &shape.exit_roots, &shape.integrals, &companion)?;
         Ok(Contact {
             half_width: shape.half_width,
             area: shape.integrals.area,
@@ -645,6 +633,27 @@ impl Section {
         sum.area *= 2.0 * r;
         sum.area_moment *= r;
         Ok(sum)
+    }
+
+    /// The pressure moment under `rule` (whose exit roots `rho` and `integrals` are known)
+    /// and the quadrature error estimate of everything reported ([`quadrature_error`]),
+    /// from the same integrals under `companion`.
+    fn moment_and_error(
+        &self,
+        rule: &StripRule,
+        rho: &[f64],
+        integrals: &Integrals,
+        companion: &StripRule,
+    ) -> Result<(f64, f64), ModelError> {
+        let moment = self.pressure_moment(rule, rho);
+        let mut companion_roots = vec![f64::NAN; companion.len()];
+        let companion_integrals = self.integrate(companion, Some(&mut companion_roots))?;
+        let companion_moment = self.pressure_moment(companion, &companion_roots);
+        let error = quadrature_error(
+            (integrals, moment),
+            (&companion_integrals, companion_moment),
+        );
+        Ok((moment, error))
     }
 
     /// ∬ x p dA = 2∫m dy in units of k r₀⁵/R, given each strip's exit root `rho` under `rule`.

@@ -148,10 +148,9 @@ impl SimilarityTable {
         let mut values = Vec::with_capacity(n);
         let mut on_panel = [0.0_f64; PANELS];
         for j in 0..n {
-            // v = cos θ: u = (1 + v)/(1 − v) = cot²(θ/2), w = sin⁴θ, without cancellation.
+            // v = cos θ, w = (1 − v²)² = sin⁴θ, without cancellation.
             let theta = PI * (j as f64 + 0.5) / n as f64;
-            let u = 1.0 / (0.5 * theta).tan().powi(2);
-            let (ratios, quadrature_error) = exact(u * u / (1.0 + kappa))?;
+            let (ratios, quadrature_error) = exact(xi_at(theta, kappa))?;
             values.push(normalised(&ratios, theta.sin().powi(4)));
             let panel = panel_of((0.25 * PI - 0.5 * theta).tan());
             on_panel[panel] = on_panel[panel].max(quadrature_error);
@@ -269,9 +268,7 @@ impl SimilarityTable {
         let mut worst: f64 = 0.0;
         for k in 0..CHECK_POINTS {
             let j = (2 * k + 1) * (n - 1) / (2 * CHECK_POINTS);
-            let theta = PI * (j as f64 + 1.0) / n as f64;
-            let u = 1.0 / (0.5 * theta).tan().powi(2);
-            let xi = u * u / (1.0 + self.kappa);
+            let xi = xi_at(PI * (j as f64 + 1.0) / n as f64, self.kappa);
             let (truth, _) = exact(xi)?;
             let table = self.ratios(xi);
             for (t, e) in table.as_array().into_iter().zip(truth.as_array()) {
@@ -293,6 +290,13 @@ fn normalised(ratios: &Ratios, w: f64) -> [f64; 4] {
         ratios.centroid / w,
         ratios.pressure_centre / w,
     ]
+}
+
+/// ξ at the angle θ of v = cos θ: u = (1 + v)/(1 − v) = cot²(θ/2) (without the
+/// cancellation of 1 − v), ξ = u²/(1 + κ).
+fn xi_at(theta: f64, kappa: f64) -> f64 {
+    let u = 1.0 / (0.5 * theta).tan().powi(2);
+    u * u / (1.0 + kappa)
 }
 
 /// s = (√u − 1)/(√u + 1) ∈ [−1, 1], the variable the panels divide equally.

@@ -2,10 +2,10 @@
 //! once from the exact strip solver, shared by every answer that uses that layer, and
 //! bounded in number.
 //!
-//! Building a table costs about two hundred exact solves at a given penetration (≈ 2 ms for
-//! κ ≤ 100; BENCHMARKS.md), so who builds when is the caller's choice ([`Use`]): a sweep or a
+//! Building a table costs about 7 ms for κ ≤ 100, as much as some 200 exact solves at a given
+//! load (BENCHMARKS.md), so who builds when is the caller's choice ([`Use`]): a sweep or a
 //! figure builds at once, a single rolling answer uses a table only if one is built and
-//! otherwise solves exactly (and may have one built in the background).
+//! otherwise solves exactly (and may have one built in the background, [`wanted`]).
 
 use std::sync::{Arc, Mutex, OnceLock};
 
@@ -69,13 +69,14 @@ pub enum Use {
 }
 
 impl Use {
-    /// Exact solves a table costs to build, about (≈ 200 at a given penetration, each a
-    /// fifth of a solve at a given load).
+    /// Solves from which a job builds its layer's table. A table costs about 200 exact
+    /// solves to build, but it is kept for every later job on the layer (a sweep is rarely
+    /// alone), so jobs smaller than that build it too.
     const TABLE_COST: usize = 64;
 
     /// For a job of `solves` rolling solves on one layer under `quadrature`: build its
-    /// table when that costs less than the solves it saves and the rule is the default one
-    /// (see [`solve`]), solve exactly otherwise. A function of the job alone, so that every
+    /// table when the job is large enough ([`Use::TABLE_COST`]) and the rule is the default
+    /// one (see [`solve`]), solve exactly otherwise. A function of the job alone, so that every
     /// part of a split job decides alike.
     pub fn for_solves(solves: usize, quadrature: Quadrature) -> Use {
         if solves >= Self::TABLE_COST && quadrature == Quadrature::default() {
@@ -102,8 +103,7 @@ pub fn solve(
 ) -> Result<RollingSolution, ModelError> {
     let kappa = rolling.layer.kappa();
     let table = match tables {
-        // A job that names its own rule is studying that rule's strip sums.
-        _ if kappa <= 0.0 || options.quadrature != Quadrature::default() => None,
+        _ if !tabulable(kappa, options) => None,
         Use::Exact => None,
         Use::IfBuilt => built(kappa, options.quadrature),
         // Never build for an invalid input: its solve reports what is wrong.
@@ -116,6 +116,23 @@ pub fn solve(
     }
     .filter(|table| table.error() <= ACCEPTED_TABLE_ERROR);
     solve_with(rolling, options, table.as_deref())
+}
+
+/// The κ of a table that would serve `rolling` but is not built yet, if any: what a single
+/// answer solved exactly asks to have built for the answers after it.
+pub fn wanted(rolling: &Rolling, options: &SolveOptions) -> Option<f64> {
+    let kappa = rolling.layer.kappa();
+    (tabulable(kappa, options)
+        && built(kappa, options.quadrature).is_none()
+        && rolling.violations().is_empty())
+    .then_some(kappa)
+}
+
+/// Whether a rolling job may be answered through a table at all: its layer is viscous, and
+/// it keeps the default rule (a job that names its own rule is studying that rule's strip
+/// sums).
+fn tabulable(kappa: f64, options: &SolveOptions) -> bool {
+    kappa > 0.0 && options.quadrature == Quadrature::default()
 }
 
 /// A table under its key: κ (its bits) and the strip rule.
