@@ -137,7 +137,7 @@ pub trait ResultCache: Send + Sync {
 /// The cache of one process, bounded in bytes and in time.
 #[derive(Clone)]
 pub struct MemoryCache {
-    cache: Cache<String, Arc<Solved>>,
+    cache: Cache<String, Arc<Solved>, super::KeyHasher>,
 }
 
 impl MemoryCache {
@@ -156,7 +156,7 @@ impl MemoryCache {
                 .max_capacity(max_bytes)
                 .weigher(|_, solved: &Arc<Solved>| budget::weight(solved.weight()))
                 .time_to_live(ttl)
-                .build(),
+                .build_with_hasher(super::KeyHasher::default()),
         }
     }
 }

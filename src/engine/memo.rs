@@ -11,7 +11,7 @@ use crate::job::{Kept, Memo};
 
 /// Solved points by key, bounded in bytes and in time.
 pub struct PointMemo {
-    points: Cache<String, (Kept, u32)>,
+    points: Cache<String, (Kept, u32), super::KeyHasher>,
 }
 
 impl std::fmt::Debug for PointMemo {
@@ -32,7 +32,7 @@ impl PointMemo {
                     budget::weight(key.len() as u64 + u64::from(*bytes))
                 })
                 .time_to_live(ttl)
-                .build(),
+                .build_with_hasher(super::KeyHasher::default()),
         }
     }
 }

@@ -207,7 +207,7 @@ pub struct Engine {
     coalescer: Coalescer,
     /// The text of valid inputs (their kind and compact JSON with sorted keys) → their
     /// cache key, so that a repeated request is answered without being validated again.
-    input_keys: moka::future::Cache<String, String>,
+    input_keys: moka::future::Cache<String, String, super::KeyHasher>,
     /// Solved points of sweeps, for a retry after a deadline.
     pub(super) points: Arc<PointMemo>,
     /// Work jobs leave for later (tables to build); `None` if its thread could not start.
@@ -263,7 +263,7 @@ impl Engine {
                     budget::weight((input.len() + key.len()) as u64)
                 })
                 .time_to_live(config.cache_ttl)
-                .build(),
+                .build_with_hasher(super::KeyHasher::default()),
             points: Arc::new(PointMemo::new(
                 Budget::split(config.memory_budget).points,
                 config.cache_ttl,

@@ -2,6 +2,10 @@
 //! and the papers behind the numbers.
 
 use serde::{Deserialize, Serialize, Serializer};
+use std::collections::HashMap;
+use std::sync::{Mutex, OnceLock};
+
+use serde_json::value::RawValue;
 use serde_json::Value;
 use sha2::{Digest, Sha256};
 use utoipa::ToSchema;
@@ -108,6 +112,7 @@ pub struct Meta {
     #[schema(value_type = Object)]
     pub input: Value,
     /// The papers behind the numbers.
+    #[serde(serialize_with = "references_json")]
     #[schema(value_type = Vec<Reference>)]
     pub references: &'static [Reference],
     /// Values of the input that are valid but implausible as sent.
@@ -122,11 +127,50 @@ pub struct Meta {
 /// The groups of units as one object (groups may share entries, as the two kinds of sweep
 /// points do).
 fn units_map<S: Serializer>(units: &Units, s: S) -> Result<S::Ok, S::Error> {
-    let map: std::collections::BTreeMap<_, _> = units
-        .iter()
-        .flat_map(|group| group.iter().copied())
-        .collect();
-    s.collect_map(map)
+    static_json((units.as_ptr() as usize, units.len()), s, || {
+        let map: std::collections::BTreeMap<_, _> = units
+            .iter()
+            .flat_map(|group| group.iter().copied())
+            .collect();
+        serde_json::value::to_raw_value(&map)
+    })
+}
+
+fn references_json<S: Serializer>(references: &&[Reference], s: S) -> Result<S::Ok, S::Error> {
+    let key = (references.as_ptr() as usize, references.len());
+    static_json(key, s, || serde_json::value::to_raw_value(references))
+}
+
+/// Writes a static part of an answer (its references, its units), rendered as JSON once per
+/// process and then copied: they are the same for every answer of a kind, and building and
+/// escaping them again made up a sixth of rendering an answer. `key` tells the static parts
+/// apart (their address and length); there are a handful, so the rendered texts are kept for
+/// good.
+fn static_json<S: Serializer>(
+    key: (usize, usize),
+    s: S,
+    render: impl FnOnce() -> serde_json::Result<Box<RawValue>>,
+) -> Result<S::Ok, S::Error> {
+    type Rendered = Mutex<HashMap<(usize, usize), &'static RawValue>>;
+    static RENDERED: OnceLock<Rendered> = OnceLock::new();
+    let rendered = RENDERED.get_or_init(Rendered::default);
+    let known = rendered
+        .lock()
+        .unwrap_or_else(|poisoned| poisoned.into_inner())
+        .get(&key)
+        .copied();
+    let json = match known {
+        Some(json) => json,
+        None => {
+            let json: &'static RawValue = Box::leak(render().map_err(serde::ser::Error::custom)?);
+            rendered
+                .lock()
+                .unwrap_or_else(|poisoned| poisoned.into_inner())
+                .insert(key, json);
+            json
+        }
+    };
+    json.serialize(s)
 }
 
 impl Meta {
@@ -185,4 +229,26 @@ pub fn input_hash(kind: &str, canonical: &Value, warnings: &[InputWarning]) -> S
         .iter()
         .map(|b| format!("{b:02x}"))
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[derive(Serialize)]
+    struct Refs(#[serde(serialize_with = "references_json")] &'static [Reference]);
+
+    /// The rolling references are the first three of all five, at the same address: the
+    /// texts rendered once must still tell them apart, and match a direct rendering.
+    #[test]
+    fn static_parts_rendered_once_match_a_direct_rendering_and_tell_prefixes_apart() {
+        for _ in 0..2 {
+            for references in [ROLLING_REFERENCES, &REFERENCES[..]] {
+                assert_eq!(
+                    serde_json::to_string(&Refs(references)).unwrap(),
+                    serde_json::to_string(references).unwrap()
+                );
+            }
+        }
+    }
 }

@@ -828,41 +828,51 @@ impl Section {
     }
 
     /// `n` boundary points spread evenly in θ ∈ [−π/2, π/2], y = r sin θ, in metres.
-    /// Each exit root starts from `roots` if given, else from the previous strip's.
+    /// Each exit root starts from `roots` if given, else from the previous strip's. The
+    /// contact is symmetric in y, so the points at θ > 0 are those at −θ reflected.
     fn boundary(
         &self,
         n: usize,
         scale: f64,
         roots: Option<&RootGuide>,
     ) -> Result<Vec<BoundaryPoint>, ModelError> {
+        let mut points: Vec<BoundaryPoint> = Vec::with_capacity(n);
         let mut previous = None;
-        (0..n)
-            .map(|j| {
-                let theta = if n == 1 {
-                    0.0
-                } else {
-                    -FRAC_PI_2 + PI * j as f64 / (n - 1) as f64
-                };
-                let (y, exit, entry) = if j == 0 || j + 1 == n && n > 1 {
-                    (theta.sin() * self.half_width, 0.0, 0.0)
-                } else {
-                    let strip = self.strip(theta.cos());
-                    let guess = roots.map(|r| r.guess(self.beta(strip.entry)));
-                    let rho = strip.exit_root(guess.or(previous))?.rho;
-                    previous = Some(rho);
-                    (
-                        theta.sin() * self.half_width,
-                        (rho - 1.0) * strip.entry,
-                        strip.entry,
-                    )
-                };
-                Ok(BoundaryPoint {
-                    y: y * scale,
-                    exit: exit * scale,
-                    entry: entry * scale,
-                })
-            })
-            .collect()
+        for j in 0..n {
+            let mirror = n - 1 - j;
+            if mirror < j {
+                let reflected = points[mirror];
+                points.push(BoundaryPoint {
+                    y: -reflected.y,
+                    ..reflected
+                });
+                continue;
+            }
+            let theta = if n == 1 {
+                0.0
+            } else {
+                -FRAC_PI_2 + PI * j as f64 / (n - 1) as f64
+            };
+            let (y, exit, entry) = if j == 0 && n > 1 {
+                (-self.half_width, 0.0, 0.0)
+            } else {
+                let strip = self.strip(theta.cos());
+                let guess = roots.map(|r| r.guess(self.beta(strip.entry)));
+                let rho = strip.exit_root(guess.or(previous))?.rho;
+                previous = Some(rho);
+                (
+                    theta.sin() * self.half_width,
+                    (rho - 1.0) * strip.entry,
+                    strip.entry,
+                )
+            };
+            points.push(BoundaryPoint {
+                y: y * scale,
+                exit: exit * scale,
+                entry: entry * scale,
+            });
+        }
+        Ok(points)
     }
 
     /// p(x, y) on an n × n grid over [−r, r]², in Pa. `scale` is r₀ (m) and `k_over_r` is k/R.
@@ -962,6 +972,34 @@ mod tests {
                         "ξ = {xi}, κ = {kappa}, cos θ = {c}: {guess} vs {exact}"
                     );
                 }
+            }
+        }
+    }
+
+    /// The points at θ > 0 are reflections, so they are checked here against their own
+    /// strips' exit roots.
+    #[test]
+    fn the_reflected_half_of_the_boundary_is_that_of_its_own_strips() {
+        let rolling = Rolling::default();
+        let solution = solve(&rolling, &SolveOptions::default()).unwrap();
+        let n = solution.boundary.len();
+        let r0 = solution.static_contact.half_width;
+        let r = solution.half_width / r0;
+        let xi = rolling.velocity * rolling.layer.relaxation_time / r0;
+        let section = Section::new(r, xi, rolling.layer.kappa());
+        for (j, point) in solution.boundary.iter().enumerate().skip(n / 2 + 1) {
+            let theta = -FRAC_PI_2 + PI * j as f64 / (n - 1) as f64;
+            let strip = section.strip(theta.cos());
+            let rho = strip.exit_root(None).unwrap().rho;
+            let exit = (rho - 1.0) * strip.entry * r0;
+            assert!((point.y / (theta.sin() * r * r0) - 1.0).abs() < 1e-13);
+            if j + 1 < n {
+                assert!(
+                    (point.exit / exit - 1.0).abs() < 1e-12,
+                    "{} vs {exit}",
+                    point.exit
+                );
+                assert!((point.entry / (strip.entry * r0) - 1.0).abs() < 1e-13);
             }
         }
     }

@@ -117,11 +117,14 @@ trait Render: fmt::Debug + Send + Sync {
 
 impl<T: Output> Render for T {
     fn json(&self, pretty: bool) -> serde_json::Result<Vec<u8>> {
+        // Most answers fit: one allocation instead of a doubling series.
+        let mut json = Vec::with_capacity(8 * 1024);
         if pretty {
-            serde_json::to_vec_pretty(self)
+            serde_json::to_writer_pretty(&mut json, self)?;
         } else {
-            serde_json::to_vec(self)
+            serde_json::to_writer(&mut json, self)?;
         }
+        Ok(json)
     }
 
     fn table(&self) -> Table {
@@ -259,6 +262,11 @@ fn non_finite() -> RenderError {
 /// Whether JSON text holds a `null` value. Outside strings the letter `n` can only start
 /// `null` (`true`, `false` and numbers have none), so one pass that skips strings finds it.
 fn has_null(json: &[u8]) -> bool {
+    // Nearly every answer has no `null` anywhere, in a string or not: one vectorised search
+    // settles it (a byte-by-byte scan of a 5 kB answer cost a third of its rendering).
+    if memchr::memmem::find(json, b"null").is_none() {
+        return false;
+    }
     let (mut in_string, mut escaped) = (false, false);
     for &b in json {
         if in_string {
