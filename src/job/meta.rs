@@ -224,11 +224,14 @@ pub fn input_hash(kind: &str, canonical: &Value, warnings: &[InputWarning]) -> S
         hasher.update(b"\n");
         hasher.update(warning.message.as_bytes());
     }
-    hasher
-        .finalize()
-        .iter()
-        .map(|b| format!("{b:02x}"))
-        .collect()
+    // Hex by table: one allocation rather than one per byte (this runs on every request).
+    const HEX: &[u8; 16] = b"0123456789abcdef";
+    let mut hex = String::with_capacity(64);
+    for byte in hasher.finalize() {
+        hex.push(char::from(HEX[usize::from(byte >> 4)]));
+        hex.push(char::from(HEX[usize::from(byte & 15)]));
+    }
+    hex
 }
 
 #[cfg(test)]

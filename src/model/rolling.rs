@@ -490,7 +490,10 @@ impl Shape {
         const NESTED_FROM: usize = 16;
         let rule = StripRule::shared(quadrature)?;
         let companion = quadrature.companion();
-        if companion.size() >= rule.len() || rule.len() < NESTED_FROM {
+        // An elastic contact (at rest, or no viscosity) has its root at t = 0, found in one
+        // pass: nothing to start.
+        let elastic = xi == 0.0 || kappa == 0.0;
+        if elastic || companion.size() >= rule.len() || rule.len() < NESTED_FROM {
             let cold = Start::cold(rule.len());
             return Ok((Shape::solve(xi, kappa, rule, cold)?, None));
         }
