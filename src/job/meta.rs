@@ -141,7 +141,14 @@ fn references_json<S: Serializer>(references: &&[Reference], s: S) -> Result<S::
     static_json(key, s, || serde_json::value::to_raw_value(references))
 }
 
-/// Writes a static part of an answer (its references, its units), rendered as JSON once per
+/// A long fixed text of an answer (an assumption in words, its rule), escaped once.
+pub(crate) fn static_text<S: Serializer>(text: &&'static str, s: S) -> Result<S::Ok, S::Error> {
+    static_json((text.as_ptr() as usize, text.len()), s, || {
+        serde_json::value::to_raw_value(text)
+    })
+}
+
+/// Writes a static part of an answer (its references, its units, its fixed texts), rendered as JSON once per
 /// process and then copied: they are the same for every answer of a kind, and building and
 /// escaping them again made up a sixth of rendering an answer. `key` tells the static parts
 /// apart (their address and length); there are a handful, so the rendered texts are kept for

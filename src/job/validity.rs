@@ -34,6 +34,7 @@ pub struct AssumptionOutput {
     /// `surfaces_apart`, `asperity_gap` or `particles_in_contact`.
     pub name: &'static str,
     /// The assumption in words.
+    #[serde(serialize_with = "super::meta::static_text")]
     pub assumption: &'static str,
     /// What the ratio measures, e.g. `penetration / thickness`.
     pub ratio: &'static str,
@@ -44,6 +45,7 @@ pub struct AssumptionOutput {
     /// The worse of the two.
     pub status: ValidityStatus,
     /// When the ratio warns and when it refuses the answer.
+    #[serde(serialize_with = "super::meta::static_text")]
     pub rule: &'static str,
     /// Why it warns, in words (with `warn` only).
     #[serde(skip_serializing_if = "Option::is_none")]
