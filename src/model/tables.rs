@@ -2,7 +2,7 @@
 //! once from the exact strip solver, shared by every answer that uses that layer, and
 //! bounded in number.
 //!
-//! Building a table costs about 7 ms for κ ≤ 100, as much as some 200 exact solves at a given
+//! Building a table costs about 5 ms for κ ≤ 100, as much as some 220 exact solves at a given
 //! load (BENCHMARKS.md), so who builds when is the caller's choice ([`Use`]): a sweep or a
 //! figure builds at once, a single rolling answer uses a table only if one is built and
 //! otherwise solves exactly (and may have one built in the background, [`wanted`]).
@@ -69,7 +69,7 @@ pub enum Use {
 }
 
 impl Use {
-    /// Solves from which a job builds its layer's table. A table costs about 200 exact
+    /// Solves from which a job builds its layer's table. A table costs about 220 exact
     /// solves to build, but it is kept for every later job on the layer (a sweep is rarely
     /// alone), so jobs smaller than that build it too.
     const TABLE_COST: usize = 64;
