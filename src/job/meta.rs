@@ -148,11 +148,12 @@ pub(crate) fn static_text<S: Serializer>(text: &&'static str, s: S) -> Result<S:
     })
 }
 
-/// Writes a static part of an answer (its references, its units, its fixed texts), rendered as JSON once per
-/// process and then copied: they are the same for every answer of a kind, and building and
-/// escaping them again made up a sixth of rendering an answer. `key` tells the static parts
-/// apart (their address and length); there are a handful, so the rendered texts are kept for
-/// good.
+/// Writes a static part of an answer (its references, its units, its fixed texts), rendered
+/// as JSON once per process and then copied: they are the same for every answer of a kind,
+/// and building and escaping them again made up about a quarter of rendering an answer.
+/// `key` tells the static parts apart (their address and length); there are a few dozen, so
+/// the rendered texts are kept for good (two threads meeting a new one at once may both
+/// render it; one copy then goes unused, once).
 fn static_json<S: Serializer>(
     key: (usize, usize),
     s: S,

@@ -236,9 +236,10 @@ pub struct VerificationOutput {
     pub quadrature_error_estimate: f64,
     /// Nodes (or strips) of the y-quadrature (count).
     pub quadrature_nodes: usize,
-    /// Iterations of the load equation (count).
+    /// Iterations of the load equation: strip-sum passes under every rule of the solve,
+    /// coarsest first, or look-ups in the similarity table (count).
     pub iterations: u32,
-    /// Newton steps of all exit-edge roots (count).
+    /// Newton steps of all exit-edge roots, under every rule (count).
     pub exit_root_iterations: u32,
     /// Whether every root finder converged.
     pub converged: bool,

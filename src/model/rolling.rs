@@ -154,9 +154,10 @@ pub struct Verification {
     pub quadrature_error_estimate: f64,
     /// Strips (quadrature nodes) in the half-width.
     pub quadrature_nodes: usize,
-    /// Iterations of the load equation P(δ) = P.
+    /// Iterations of the load equation P(δ) = P: strip-sum passes under every rule of the
+    /// nested solve (coarsest first), or table look-ups.
     pub iterations: u32,
-    /// Newton steps of all exit-edge roots together.
+    /// Newton steps of all exit-edge roots together (every rule's).
     pub exit_root_iterations: u32,
     /// Whether every root converged (a solution is only returned when it did).
     pub converged: bool,
