@@ -19,13 +19,13 @@ pub mod store;
 pub use service::{CacheStatus, Engine, EngineConfig, EngineError, Storage};
 
 use crate::job::{Control, Job, JobError};
+use crate::render::Answer;
 
 /// The hasher of the engine's in-process maps (answers, input keys, sweep points). Their keys
 /// churn at the request rate and moka rehashes its table as entries come and go: with
 /// SipHash that was a tenth of an uncached request's CPU. foldhash is seeded per process, so
 /// keys cannot be chosen to collide without knowing the seed.
 type KeyHasher = foldhash::fast::RandomState;
-use crate::render::Answer;
 
 /// Runs `job` to its answer, or until `control` stops it.
 pub fn run(job: &Job, control: &Control) -> Result<Answer, JobError> {

@@ -247,7 +247,7 @@ pub(super) fn solve_with(
         rolling_resistance_coefficient: pressure_centre_shift / rolling.radius,
         friction_coefficient: layer.interfacial_shear_strength() * contact_area / rolling.load,
         static_contact: reference,
-        boundary: section.boundary(options.boundary_points, r0, contact.roots.as_ref())?,
+        boundary: section.boundary(options.boundary_points, r0, contact.solved.as_ref())?,
         pressure: match options.pressure_grid {
             Some(n) => Some(section.pressure_grid(n, r0, layer.stiffness() / rolling.radius)?),
             None => None,
@@ -368,8 +368,9 @@ struct Contact {
     /// x_p/r₀.
     pressure_centre: f64,
     verification: Verification,
-    /// The exit roots of the strips solved, if any, for starting others.
-    roots: Option<RootGuide>,
+    /// The rule solved and its strips' exit roots, if solved by strip sums: a guide for the
+    /// boundary's roots.
+    solved: Option<(Arc<StripRule>, Vec<f64>)>,
 }
 
 impl Contact {
@@ -400,7 +401,7 @@ impl Contact {
                 converged: true,
                 table_error: None,
             },
-            roots: Some(RootGuide::new(&section, &shape.rule, &shape.exit_roots)),
+            solved: Some((shape.rule, shape.exit_roots)),
         })
     }
 
@@ -437,7 +438,7 @@ impl Contact {
                 converged: true,
                 table_error: Some(table.error()),
             },
-            roots: None,
+            solved: None,
         })
     }
 }
@@ -832,14 +833,19 @@ impl Section {
     }
 
     /// `n` boundary points spread evenly in θ ∈ [−π/2, π/2], y = r sin θ, in metres.
-    /// Each exit root starts from `roots` if given, else from the previous strip's. The
-    /// contact is symmetric in y, so the points at θ > 0 are those at −θ reflected.
+    /// Each exit root starts from the roots of `solved` (a rule and its strips' roots) if
+    /// given ([`RootGuide`]), else from the previous strip's. The contact is symmetric in y,
+    /// so the points at θ > 0 are those at −θ reflected.
     fn boundary(
         &self,
         n: usize,
         scale: f64,
-        roots: Option<&RootGuide>,
+        solved: Option<&(Arc<StripRule>, Vec<f64>)>,
     ) -> Result<Vec<BoundaryPoint>, ModelError> {
+        // Only points strictly inside (−π/2, π/2) need a root (n = 2 is the two tips).
+        let roots = solved
+            .filter(|_| n == 1 || n > 2)
+            .map(|(rule, rho)| RootGuide::new(self, rule, rho));
         let mut points: Vec<BoundaryPoint> = Vec::with_capacity(n);
         let mut previous = None;
         for j in 0..n {
@@ -861,7 +867,7 @@ impl Section {
                 (-self.half_width, 0.0, 0.0)
             } else {
                 let strip = self.strip(theta.cos());
-                let guess = roots.map(|r| r.guess(self.beta(strip.entry)));
+                let guess = roots.as_ref().map(|r| r.guess(self.beta(strip.entry)));
                 let rho = strip.exit_root(guess.or(previous))?.rho;
                 previous = Some(rho);
                 (

@@ -117,14 +117,11 @@ trait Render: fmt::Debug + Send + Sync {
 
 impl<T: Output> Render for T {
     fn json(&self, pretty: bool) -> serde_json::Result<Vec<u8>> {
-        // Most answers fit: one allocation instead of a doubling series.
-        let mut json = Vec::with_capacity(8 * 1024);
         if pretty {
-            serde_json::to_writer_pretty(&mut json, self)?;
+            serde_json::to_vec_pretty(self)
         } else {
-            serde_json::to_writer(&mut json, self)?;
+            serde_json::to_vec(self)
         }
-        Ok(json)
     }
 
     fn table(&self) -> Table {
