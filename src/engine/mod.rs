@@ -9,6 +9,7 @@ mod background;
 mod budget;
 pub mod cache;
 mod coalesce;
+mod doorkeeper;
 pub mod fleet;
 mod memo;
 pub mod metrics;

@@ -19,6 +19,7 @@ use super::background::Background;
 use super::budget::{self, Budget};
 use super::cache::{Claim, MemoryCache, ResultCache, Solved};
 use super::coalesce::Coalescer;
+use super::doorkeeper::Doorkeeper;
 use super::fleet::Shared;
 use super::memo::PointMemo;
 use super::metrics::{self as names, Metrics};
@@ -208,6 +209,8 @@ pub struct Engine {
     /// The text of valid inputs (their kind and compact JSON with sorted keys) → their
     /// cache key, so that a repeated request is answered without being validated again.
     input_keys: moka::future::Cache<String, String, super::KeyHasher>,
+    /// Which inputs were seen once: the memo takes an input on its second sighting.
+    doorkeeper: Doorkeeper,
     /// Solved points of sweeps, for a retry after a deadline.
     pub(super) points: Arc<PointMemo>,
     /// Work jobs leave for later (tables to build); `None` if its thread could not start.
@@ -264,6 +267,9 @@ impl Engine {
                 })
                 .time_to_live(config.cache_ttl)
                 .build_with_hasher(super::KeyHasher::default()),
+            doorkeeper: Doorkeeper::new(
+                Budget::split(config.memory_budget).inputs / budget::ENTRY_OVERHEAD,
+            ),
             points: Arc::new(PointMemo::new(
                 Budget::split(config.memory_budget).points,
                 config.cache_ttl,
@@ -318,9 +324,11 @@ impl Engine {
     }
 
     /// Remembers that the input `text` (as for [`Engine::cached_input`]) is a valid job
-    /// with cache key `key`.
+    /// with cache key `key`, if it was seen before ([`Doorkeeper`]).
     pub async fn remember_input(&self, text: String, key: String) {
-        self.input_keys.insert(text, key).await;
+        if self.doorkeeper.seen_before(&text) {
+            self.input_keys.insert(text, key).await;
+        }
     }
 
     /// Solves `job`, whose [`Meta`] is `meta` (computed once by the caller: it holds the
@@ -731,5 +739,30 @@ impl Engine {
             Err(JobError::Cancelled) => live.stopped(),
             Err(e) => JobState::Failed(e),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[tokio::test]
+    async fn the_input_memo_takes_an_input_on_its_second_sighting() {
+        let config = EngineConfig {
+            pool_size: 1,
+            solve_deadline: Duration::from_secs(1),
+            job_deadline: Duration::from_secs(1),
+            max_queued_jobs: 1,
+            memory_budget: 1 << 20,
+            max_jobs: 1,
+            cache_ttl: Duration::from_secs(60),
+            job_retention: Duration::from_secs(60),
+        };
+        let engine = Engine::new(config, Metrics::noop());
+        let input = "rolling\n{\"load\":1e-9}";
+        engine.remember_input(input.into(), "key".into()).await;
+        assert_eq!(engine.input_keys.get(input).await, None);
+        engine.remember_input(input.into(), "key".into()).await;
+        assert_eq!(engine.input_keys.get(input).await.as_deref(), Some("key"));
     }
 }
