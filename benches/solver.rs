@@ -1,7 +1,7 @@
 //! Speed of the physics core: one rolling solve at 1e-9 relative accuracy (target: < 100 µs
 //! median), the data of all of the paper's Figures 3–9 (target: < 50 ms), a `kelvin_layer`
 //! three-body job with a given total load (target: < 20 ms median); and the work the HTTP
-//! service adds to a solve.
+//! service adds to a solve; a fit of three parameters to 30 points (target: ≤ 50 ms).
 //! Results and method: BENCHMARKS.md. Run with `cargo bench --bench solver`.
 
 use std::hint::black_box;
@@ -188,5 +188,19 @@ fn service(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, rolling, sweep, figures, three_body, service);
+/// A fit of three parameters (T_σ, T_ε, E_L) to the 30 noisy points of `examples/fit.json`,
+/// on one thread (target: ≤ 50 ms).
+fn fit(c: &mut Criterion) {
+    let text = std::fs::read(concat!(env!("CARGO_MANIFEST_DIR"), "/examples/fit.json")).unwrap();
+    let job = Job::from_json(&text, &Limits::default()).unwrap();
+    let control = Control::new(None, 1);
+    let mut group = c.benchmark_group("fit");
+    group.sample_size(20);
+    group.bench_function("three_parameters_30_points", |b| {
+        b.iter(|| black_box(engine::run(black_box(&job), &control).unwrap()))
+    });
+    group.finish();
+}
+
+criterion_group!(benches, rolling, sweep, figures, three_body, service, fit);
 criterion_main!(benches);

@@ -53,6 +53,20 @@ fn every_example_job_solves() {
     assert!((load / 1e-3 - 1.0).abs() < 1e-10);
     let mu = &three_body["friction_coefficient"];
     assert!(mu["rolling"].as_f64().unwrap() < mu["static"].as_f64().unwrap());
+
+    // README's worked example: the data were drawn from T_σ = 80 ms, T_ε = 600 ms,
+    // E_L = 2.5 GPa, and each 95 % interval holds its true value.
+    let fit = json(&thirdbody(&["solve", "examples/fit.json"], None));
+    for (name, truth) in [
+        ("relaxation_time", 0.08),
+        ("retardation_time", 0.6),
+        ("elastic_modulus", 2.5e9),
+    ] {
+        let interval = &fit["parameters"][name]["interval_95"];
+        let (lo, hi) = (interval[0].as_f64().unwrap(), interval[1].as_f64().unwrap());
+        assert!(lo < truth && truth < hi, "{name}: [{lo}, {hi}]");
+    }
+    assert_eq!(fit["identifiability"]["identifiable"], true);
 }
 
 #[test]

@@ -141,6 +141,41 @@ fn a_three_body_system_shades_the_particles_in_contact_and_splits_the_area() {
 }
 
 #[test]
+fn a_fit_draws_each_series_measured_and_fitted_with_its_residuals() {
+    let text = include_str!("../examples/fit.json");
+    let (answer, svg) = solve(serde_json::from_str(text).unwrap());
+    let (series, legend) = parts(&svg);
+    assert_eq!(
+        legend,
+        [
+            "R = 25 nm, P = 800 pN, measured",
+            "R = 25 nm, P = 800 pN, fitted",
+            "R = 25 nm, P = 1.2 nN, measured",
+            "R = 25 nm, P = 1.2 nN, fitted"
+        ]
+    );
+    // Per series: its markers, its curve, one residual segment per point.
+    assert_eq!(series.len(), 2 * 2 + 30);
+    let chart = pictures::fit(&answer).unwrap();
+    let Layer::Line { points, .. } = &chart.layers[1] else {
+        panic!("the fitted curve")
+    };
+    let curve = answer["curves"][0]["points"].as_array().unwrap();
+    assert_eq!(points.len(), curve.len());
+    assert_eq!(
+        points[0].1,
+        curve[0]["friction_coefficient"].as_f64().unwrap()
+    );
+    let Layer::Line { points, dashed, .. } = &chart.layers[2] else {
+        panic!("a residual")
+    };
+    let first = &answer["residuals"][0]["friction_coefficient"];
+    assert!(*dashed);
+    assert_eq!(points[0].1, first["measured"].as_f64().unwrap());
+    assert_eq!(points[1].1, first["fitted"].as_f64().unwrap());
+}
+
+#[test]
 fn each_figure_draws_every_series_of_its_answer() {
     for number in 3..=9 {
         let (answer, svg) = solve(json!({"kind": "figure", "input": {"number": number}}));

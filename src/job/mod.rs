@@ -2,7 +2,7 @@
 //! the cache key derived from it; and what each kind of job computes.
 //!
 //! A job kind is one module behind one trait ([`Kind`]): [`rolling`], [`three_body`],
-//! [`sweep`], [`figure`], registered by name in [`registry`]. The pieces their inputs share
+//! [`sweep`], [`figure`], [`fit`], registered by name in [`registry`]. The pieces their inputs share
 //! (quantities with units, the layer, the quadrature, the field checker) are in [`input`].
 //! The same types serve `thirdbody solve` and the HTTP API. Every input field is optional
 //! and defaults to docs/model.md §5; validation reports every bad field at once, each with its
@@ -11,6 +11,7 @@
 mod control;
 mod error;
 pub mod figure;
+pub mod fit;
 pub mod input;
 mod kind;
 pub mod meta;
@@ -26,6 +27,7 @@ mod wire;
 pub use control::{Control, Kept, Later, Memo};
 pub use error::{FieldError, JobError};
 pub use figure::FigureJob;
+pub use fit::FitJob;
 pub use input::Quantity;
 pub use kind::{Job, Kind, Validated, Work};
 pub use meta::{InputWarning, Meta, Reference, Software, REFERENCES, ROLLING_REFERENCES, SOFTWARE};

@@ -426,3 +426,114 @@ fn common_prefix(labels: &[&str]) -> usize {
     }
     end
 }
+
+/// A fit: each series' measured points, the fitted curve through them, and each residual as
+/// a dashed segment from the point to the curve; all in one colour per series. Series of the
+/// other quantity than the first series' are left out, and a note says so.
+pub fn fit(answer: &Value) -> Result<Chart, PictureError> {
+    let curves = list(&answer["curves"], "curves")?;
+    let residuals = list(&answer["residuals"], "residuals")?;
+    let first = curves.first().ok_or("the fit has no curve")?;
+    let quantity = first["quantity"]
+        .as_str()
+        .ok_or("the curve has no quantity")?;
+    let along = first["along"].as_str().ok_or("the curve has no `along`")?;
+    let mut layers = Vec::new();
+    let mut left_out = 0;
+    let mut all_x = Vec::new();
+    for curve in curves {
+        if curve["quantity"] != first["quantity"] {
+            left_out += 1;
+            continue;
+        }
+        let series = number(&curve["series"], "curves[].series")?;
+        // Named by the conditions the curve holds: `R = 25 nm, P = 1 nN`.
+        let held = list(&curve["points"], "curves[].points")?.first().map(|p| {
+            [
+                ("R", "radius", "m"),
+                ("P", "load", "N"),
+                ("V", "velocity", "m/s"),
+            ]
+            .iter()
+            .filter(|c| c.1 != along)
+            .filter_map(|(symbol, name, unit)| {
+                Some(format!("{symbol} = {}", shown(p[*name].as_f64()?, unit)))
+            })
+            .collect::<Vec<_>>()
+            .join(", ")
+        });
+        let group = held.unwrap_or_else(|| format!("series {series}"));
+        let xy = |p: &Value, y: &Value| {
+            Ok::<_, PictureError>((number(&p[along], along)?, number(y, quantity)?))
+        };
+        let line = list(&curve["points"], "curves[].points")?
+            .iter()
+            .map(|p| xy(p, &p[quantity]))
+            .collect::<Result<Vec<_>, _>>()?;
+        let mine: Vec<&Value> = residuals
+            .iter()
+            .filter(|r| r["series"].as_f64() == Some(series))
+            .collect();
+        let mut measured = Vec::new();
+        let mut segments = Vec::new();
+        for r in mine {
+            let (x, y) = xy(r, &r[quantity]["measured"])?;
+            let (_, fitted) = xy(r, &r[quantity]["fitted"])?;
+            measured.push((x, y));
+            segments.push(Layer::Line {
+                name: String::new(),
+                group: group.clone(),
+                points: vec![(x, y), (x, fitted)],
+                dashed: true,
+            });
+        }
+        all_x.extend(measured.iter().map(|p| p.0));
+        // Markers first: they take the colour the series' lines then share.
+        layers.push(Layer::Markers {
+            name: format!("{group}, measured"),
+            points: measured,
+            hollow: false,
+        });
+        layers.push(Layer::Line {
+            name: format!("{group}, fitted"),
+            group: group.clone(),
+            points: line,
+            dashed: false,
+        });
+        layers.extend(segments);
+    }
+    let unit = if quantity == "contact_area" {
+        "m^2"
+    } else {
+        ""
+    };
+    let x_unit = match along {
+        "velocity" => "m/s",
+        "load" => "N",
+        _ => "m",
+    };
+    let (lo, hi) = all_x.iter().fold((f64::INFINITY, 0.0_f64), |(lo, hi), &x| {
+        (lo.min(x), hi.max(x))
+    });
+    let mut x = Axis::new(along, x_unit);
+    if lo > 0.0 && hi / lo > 20.0 {
+        x = x.log();
+    }
+    let chi = number(&answer["chi_squared"], "chi_squared")?;
+    let dof = number(&answer["dof"], "dof")?;
+    let mut notes = vec![
+        format!("χ² = {} for {dof} dof", shown(chi, "")),
+        "dashed: residuals".to_string(),
+    ];
+    if left_out > 0 {
+        notes.push(format!("{left_out} series of the other quantity not drawn"));
+    }
+    Ok(Chart {
+        title: format!("Fit: {} against {along}", quantity.replace('_', " ")),
+        x,
+        y: Axis::new(&quantity.replace('_', " "), unit),
+        layers,
+        equal_aspect: false,
+        notes,
+    })
+}

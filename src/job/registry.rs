@@ -11,6 +11,7 @@ use utoipa::openapi::{Ref, RefOr};
 use utoipa::{PartialSchema, ToSchema};
 
 use super::figure::FigureJob;
+use super::fit::FitJob;
 use super::kind::{Job, Kind};
 use super::rolling::RollingJob;
 use super::sweep::SweepJob;
@@ -75,6 +76,7 @@ const LIST: &[Registered] = &[
     Registered::of::<ThreeBodyJob>(),
     Registered::of::<SweepJob>(),
     Registered::of::<FigureJob>(),
+    Registered::of::<FitJob>(),
 ];
 
 static KINDS: &[Registered] = LIST;

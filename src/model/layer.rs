@@ -125,6 +125,14 @@ pub enum Parameter {
     TotalLoad,
     /// Mean load per particle in contact.
     ParticleLoad,
+    /// κ = T_ε/T_σ − 1, as a fit gives it.
+    Kappa,
+    /// k = E_L/H, as a fit gives it.
+    Stiffness,
+    /// μ, as measured.
+    FrictionCoefficient,
+    /// A, as measured.
+    ContactArea,
 }
 
 impl Parameter {
@@ -142,7 +150,9 @@ impl Parameter {
             PoissonRatio | UpperPoissonRatio | ParticlePoissonRatio => "",
             RetardationTime | RelaxationTime => "s",
             ArealDensity | AsperityDensity => "m^-2",
-            NominalArea => "m^2",
+            NominalArea | ContactArea => "m^2",
+            Kappa | FrictionCoefficient => "",
+            Stiffness => "Pa/m",
         }
     }
 
@@ -166,9 +176,9 @@ impl Parameter {
         if self.is_poisson_ratio() {
             "0 ≤ ν < 0.5".to_string()
         } else if self.may_be_zero() {
-            format!("finite and ≥ 0 {unit}")
+            format!("finite and ≥ 0 {unit}").trim_end().to_string()
         } else {
-            format!("finite and > 0 {unit}")
+            format!("finite and > 0 {unit}").trim_end().to_string()
         }
     }
 
@@ -224,6 +234,10 @@ impl fmt::Display for Parameter {
             Parameter::Separation => "separation",
             Parameter::TotalLoad => "total load",
             Parameter::ParticleLoad => "mean particle load",
+            Parameter::Kappa => "κ",
+            Parameter::Stiffness => "stiffness",
+            Parameter::FrictionCoefficient => "friction coefficient",
+            Parameter::ContactArea => "contact area",
         })
     }
 }

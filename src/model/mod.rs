@@ -4,6 +4,7 @@
 
 mod error;
 pub mod figures;
+pub mod fit;
 mod layer;
 pub mod limits;
 pub mod quadrature;

@@ -3,6 +3,7 @@
 
 mod checks;
 mod errors;
+mod fits;
 mod forms;
 mod helpers;
 mod in_process;

@@ -5,6 +5,7 @@
 
 pub mod checks;
 pub mod figures;
+pub mod fits;
 pub mod jobs;
 pub mod ops;
 pub mod rolling;
@@ -54,6 +55,7 @@ pub fn router() -> OpenApiRouter<AppState> {
         .routes(routes!(rolling::solve))
         .routes(routes!(three_body::solve))
         .routes(routes!(sweeps::solve))
+        .routes(routes!(fits::solve))
         .routes(routes!(checks::run))
         .routes(routes!(jobs::submit))
         .routes(routes!(jobs::status, jobs::delete))

@@ -68,6 +68,22 @@ impl Checker {
         result
     }
 
+    /// [`Checker::nested`] for item `index` of the list `list` (its fields' paths under
+    /// `list[index]`).
+    pub fn item<T, R>(
+        &mut self,
+        list: &str,
+        index: usize,
+        item: &T,
+        read: impl FnOnce(&mut Checker, &T) -> R,
+    ) -> R {
+        let inner = self.path(&format!("{list}[{index}]"));
+        let outer = std::mem::replace(&mut self.prefix, inner);
+        let result = read(self, item);
+        self.prefix = outer;
+        result
+    }
+
     fn remember(&mut self, source: Source, path: &str) {
         if !self.paths.iter().any(|(s, _)| *s == source) {
             self.paths.push((source, path.to_string()));
@@ -304,7 +320,9 @@ fn implausible(parameter: Parameter, x: f64) -> Option<String> {
         }
         RetardationTime | RelaxationTime => (0.0, 1e6, Some("ms")),
         PoissonRatio | UpperPoissonRatio | ParticlePoissonRatio | ArealDensity | NominalArea
-        | AsperityDensity | TotalLoad => return None,
+        | AsperityDensity | TotalLoad | Kappa | Stiffness | FrictionCoefficient | ContactArea => {
+            return None
+        }
     };
     if !(x.is_finite() && x > 0.0) || (limit_low..=limit_high).contains(&x) {
         return None;

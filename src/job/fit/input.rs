@@ -1,0 +1,452 @@
+//! The fit's input on the wire: the layer's fixed values, the measured series and the
+//! parameters to fit with their starts and bounds; read into a [`Problem`] of the model.
+
+use serde::{Deserialize, Serialize};
+use serde_json::{json, Value};
+use utoipa::ToSchema;
+
+use crate::job::input::{field, Checker, Field, LayerInput, Quantity};
+use crate::model::fit::{Bounds, Datum, FitParameter, Measured, Parameterization, Point, Problem};
+use crate::model::{Layer, Parameter, Rolling};
+
+/// Input of a fit: measured points of one or more series, and the layer's parameters to
+/// fit to them (the others fixed at `layer`'s values).
+#[derive(Clone, Debug, Default, PartialEq, Deserialize, Serialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+#[schema(example = json!({
+    "layer": {"elastic_modulus": "3 GPa", "thickness": "100 nm", "poisson_ratio": 0.35},
+    "series": [{"radius": "25 nm", "load": "1 nN", "quantity": "friction_coefficient",
+                "points": [{"velocity": "1 nm/s", "value": 0.1051, "uncertainty": 0.001},
+                           {"velocity": "4 nm/s", "value": 0.0947, "uncertainty": 0.001},
+                           {"velocity": "10 nm/s", "value": 0.0761, "uncertainty": 0.001}]}],
+    "parameters": {"relaxation_time": {"start": "50 ms", "min": "1 ms", "max": "10 s"},
+                   "retardation_time": {"start": "200 ms"}}}))]
+pub struct FitInput {
+    /// The layer's values that are not fitted, and the base of those that are (default:
+    /// docs/model.md §5).
+    pub layer: Option<LayerInput>,
+    /// The measured series (at least one).
+    pub series: Option<Vec<SeriesInput>>,
+    /// The parameters to fit (at least one).
+    pub parameters: Option<ParametersInput>,
+}
+
+/// Points measured on one particle size and load (each point may override them).
+#[derive(Clone, Debug, Default, PartialEq, Deserialize, Serialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct SeriesInput {
+    /// R (m; default 25 nm).
+    pub radius: Option<Quantity>,
+    /// P (N; default 1 nN).
+    pub load: Option<Quantity>,
+    /// V (m/s; default 4 nm/s).
+    pub velocity: Option<Quantity>,
+    /// What was measured (default `friction_coefficient`).
+    pub quantity: Option<MeasuredQuantity>,
+    /// The points (at least one).
+    pub points: Option<Vec<PointInput>>,
+}
+
+/// A measured quantity.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize, Serialize, ToSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum MeasuredQuantity {
+    /// μ (eq. 12), a plain number.
+    #[default]
+    FrictionCoefficient,
+    /// A (m²).
+    ContactArea,
+}
+
+impl MeasuredQuantity {
+    pub fn model(self) -> Measured {
+        match self {
+            MeasuredQuantity::FrictionCoefficient => Measured::FrictionCoefficient,
+            MeasuredQuantity::ContactArea => Measured::ContactArea,
+        }
+    }
+
+    pub fn of(measured: Measured) -> MeasuredQuantity {
+        match measured {
+            Measured::FrictionCoefficient => MeasuredQuantity::FrictionCoefficient,
+            Measured::ContactArea => MeasuredQuantity::ContactArea,
+        }
+    }
+
+    fn parameter(self) -> Parameter {
+        match self {
+            MeasuredQuantity::FrictionCoefficient => Parameter::FrictionCoefficient,
+            MeasuredQuantity::ContactArea => Parameter::ContactArea,
+        }
+    }
+}
+
+/// One measured point.
+#[derive(Clone, Debug, Default, PartialEq, Deserialize, Serialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct PointInput {
+    /// R (m; default: the series').
+    pub radius: Option<Quantity>,
+    /// P (N; default: the series').
+    pub load: Option<Quantity>,
+    /// V (m/s; default: the series').
+    pub velocity: Option<Quantity>,
+    /// The measured value (μ: a plain number; A: m²). Required.
+    pub value: Option<Quantity>,
+    /// Its standard uncertainty, in the value's unit: given for every point or for none
+    /// (then the scatter of the residuals sets it).
+    pub uncertainty: Option<Quantity>,
+}
+
+/// The parameters to fit; at most one of `retardation_time` and `kappa`, and of `thickness`
+/// and `k`.
+#[derive(Clone, Debug, Default, PartialEq, Deserialize, Serialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct ParametersInput {
+    /// T_σ (s).
+    pub relaxation_time: Option<BoundsInput>,
+    /// T_ε (s), ≥ T_σ.
+    pub retardation_time: Option<BoundsInput>,
+    /// κ = T_ε/T_σ − 1 (T_ε then follows T_σ).
+    pub kappa: Option<BoundsInput>,
+    /// E_L (Pa).
+    pub elastic_modulus: Option<BoundsInput>,
+    /// H (m).
+    pub thickness: Option<BoundsInput>,
+    /// k = E_L/H (Pa/m; H then follows E_L).
+    pub k: Option<BoundsInput>,
+}
+
+/// Where a parameter starts and the bounds it stays within.
+#[derive(Clone, Debug, Default, PartialEq, Deserialize, Serialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct BoundsInput {
+    /// Default: the layer's value (κ: 4 if the layer is elastic).
+    pub start: Option<Quantity>,
+    /// Default: start / 1000.
+    pub min: Option<Quantity>,
+    /// Default: start × 1000.
+    pub max: Option<Quantity>,
+}
+
+/// How far the default bounds reach either side of the start.
+const DEFAULT_SPAN: f64 = 1e3;
+
+impl ParametersInput {
+    /// Each parameter given, in the order of [`FitParameter::ALL`].
+    fn given(&self) -> Vec<(FitParameter, Field<'_, BoundsInput>)> {
+        let input = self;
+        let fields = [
+            field!(input.relaxation_time),
+            field!(input.retardation_time),
+            field!(input.kappa),
+            field!(input.elastic_modulus),
+            field!(input.thickness),
+            field!(input.k),
+        ];
+        FitParameter::ALL
+            .into_iter()
+            .zip(fields)
+            .filter(|(_, f)| f.value.is_some())
+            .collect()
+    }
+
+    fn of(problem: &Problem) -> ParametersInput {
+        let mut input = ParametersInput::default();
+        for (&parameter, b) in problem.parameterization.free.iter().zip(&problem.bounds) {
+            let bounds = Some(BoundsInput {
+                start: Quantity::si(b.start),
+                min: Quantity::si(b.min),
+                max: Quantity::si(b.max),
+            });
+            match parameter {
+                FitParameter::RelaxationTime => input.relaxation_time = bounds,
+                FitParameter::RetardationTime => input.retardation_time = bounds,
+                FitParameter::Kappa => input.kappa = bounds,
+                FitParameter::ElasticModulus => input.elastic_modulus = bounds,
+                FitParameter::Thickness => input.thickness = bounds,
+                FitParameter::Stiffness => input.k = bounds,
+            }
+        }
+        input
+    }
+}
+
+/// The model's parameter a fit parameter's values are checked as.
+fn checked_as(parameter: FitParameter) -> Parameter {
+    match parameter {
+        FitParameter::RelaxationTime => Parameter::RelaxationTime,
+        FitParameter::RetardationTime => Parameter::RetardationTime,
+        FitParameter::Kappa => Parameter::Kappa,
+        FitParameter::ElasticModulus => Parameter::ElasticModulus,
+        FitParameter::Thickness => Parameter::Thickness,
+        FitParameter::Stiffness => Parameter::Stiffness,
+    }
+}
+
+impl FitInput {
+    /// Reads the fit under `checker`; `max_points` bounds the number of points.
+    pub fn read(&self, checker: &mut Checker, max_points: usize) -> Problem {
+        let input = self;
+        let base = checker.nested(field!(input.layer), |c, layer| layer.read(c));
+        checker.parameters(base.violations());
+        let (free, bounds) = checker.nested(field!(input.parameters), |c, p| {
+            read_parameters(p, &base, c)
+        });
+        if free.is_empty() {
+            let sent = if input.parameters.is_some() {
+                json!({})
+            } else {
+                Value::Null
+            };
+            checker.invalid("parameters", sent, "at least one parameter to fit");
+        }
+        let data = read_series(input.series.as_deref(), max_points, checker);
+        let problem = Problem {
+            parameterization: Parameterization { base, free },
+            bounds,
+            data,
+        };
+        check_counts(&problem, input, checker);
+        problem
+    }
+
+    /// The input that gives `problem`, whose series have `sizes` points: every point
+    /// explicit, in SI.
+    pub fn of(problem: &Problem, sizes: &[usize]) -> FitInput {
+        let mut data = problem.data.iter();
+        let series = sizes
+            .iter()
+            .map(|&n| {
+                let points: Vec<&Datum> = data.by_ref().take(n).collect();
+                SeriesInput {
+                    quantity: points
+                        .first()
+                        .map(|d| MeasuredQuantity::of(d.point.measured)),
+                    points: Some(
+                        points
+                            .into_iter()
+                            .map(|d| PointInput {
+                                radius: Quantity::si(d.point.radius),
+                                load: Quantity::si(d.point.load),
+                                velocity: Quantity::si(d.point.velocity),
+                                value: Quantity::si(d.value),
+                                uncertainty: d.uncertainty.and_then(Quantity::si),
+                            })
+                            .collect(),
+                    ),
+                    ..SeriesInput::default()
+                }
+            })
+            .collect();
+        FitInput {
+            layer: Some(LayerInput::of(&problem.parameterization.base)),
+            series: Some(series),
+            parameters: Some(ParametersInput::of(problem)),
+        }
+    }
+}
+
+fn read_parameters(
+    input: &ParametersInput,
+    base: &Layer,
+    checker: &mut Checker,
+) -> (Vec<FitParameter>, Vec<Bounds>) {
+    let given = input.given();
+    let named = |p: FitParameter| given.iter().any(|(q, _)| *q == p);
+    for (a, b) in [
+        (FitParameter::RetardationTime, FitParameter::Kappa),
+        (FitParameter::Thickness, FitParameter::Stiffness),
+    ] {
+        if named(a) && named(b) {
+            let allowed = format!("at most one of {} and {}", a.name(), b.name());
+            checker.invalid(b.name(), json!({}), &allowed);
+        }
+    }
+    let mut free = Vec::new();
+    let mut all = Vec::new();
+    for (parameter, field) in given {
+        let model = checked_as(parameter);
+        let layer_value = match parameter.of(base) {
+            k if parameter == FitParameter::Kappa && k <= 0.0 => 4.0,
+            x => x,
+        };
+        let b = checker.nested(field, |c, bounds| {
+            let start = c.quantity(field!(bounds.start), model, layer_value);
+            let min = c.quantity(field!(bounds.min), model, start / DEFAULT_SPAN);
+            let max = c.quantity(field!(bounds.max), model, start * DEFAULT_SPAN);
+            for (name, value) in [("start", start), ("min", min), ("max", max)] {
+                if let Err(e) = model.check(value) {
+                    c.out_of_range(name, value, model.unit(), &e.allowed);
+                }
+            }
+            if min > max {
+                c.out_of_range(
+                    "min",
+                    min,
+                    model.unit(),
+                    &format!("≤ max = {max:e} {}", model.unit()),
+                );
+            } else if !(min..=max).contains(&start) {
+                let allowed = format!("within [min, max] = [{min:e}, {max:e}] {}", model.unit());
+                c.out_of_range("start", start, model.unit(), &allowed);
+            }
+            Bounds { start, min, max }
+        });
+        free.push(parameter);
+        all.push(b);
+    }
+    // The starts must make a valid layer (T_ε ≥ T_σ above all).
+    let starts: Vec<f64> = all.iter().map(|b| b.start).collect();
+    let parameterization = Parameterization {
+        base: *base,
+        free: free.clone(),
+    };
+    if starts.iter().all(|x| x.is_finite()) && base.violations().is_empty() {
+        for e in parameterization.layer(&starts).violations() {
+            let allowed = format!("starts that make a valid layer, but at them {e}");
+            checker.invalid("", json!(starts), &allowed);
+        }
+    }
+    (free, all)
+}
+
+fn read_series(
+    series: Option<&[SeriesInput]>,
+    max_points: usize,
+    checker: &mut Checker,
+) -> Vec<Datum> {
+    let Some(series) = series else {
+        checker.invalid("series", Value::Null, "a list of measured series: required");
+        return Vec::new();
+    };
+    if series.is_empty() {
+        checker.invalid("series", json!([]), "a list of at least one series");
+    }
+    let total: usize = series
+        .iter()
+        .map(|s| s.points.as_ref().map_or(0, Vec::len))
+        .sum();
+    if total > max_points {
+        let allowed = format!("at most {max_points} points over all series");
+        checker.invalid("series", json!(total), &allowed);
+        return Vec::new();
+    }
+    let d = Rolling::default();
+    let mut data = Vec::new();
+    for (i, s) in series.iter().enumerate() {
+        checker.item("series", i, s, |c, s| {
+            let radius = c.quantity(field!(s.radius), Parameter::Radius, d.radius);
+            let load = c.quantity(field!(s.load), Parameter::Load, d.load);
+            let velocity = c.quantity(field!(s.velocity), Parameter::Velocity, d.velocity);
+            let given = [field!(s.radius), field!(s.load), field!(s.velocity)];
+            let series_point = Point {
+                radius,
+                load,
+                velocity,
+                measured: Measured::FrictionCoefficient,
+            };
+            check_conditions(c, &given, &series_point);
+            let quantity = s.quantity.unwrap_or_default();
+            let points = s.points.as_deref().unwrap_or_default();
+            if points.is_empty() {
+                c.invalid(
+                    "points",
+                    json!(points),
+                    "a list of at least one measured point",
+                );
+            }
+            for (j, p) in points.iter().enumerate() {
+                data.push(c.item("points", j, p, |c, p| {
+                    let point = Point {
+                        radius: c.quantity(field!(p.radius), Parameter::Radius, radius),
+                        load: c.quantity(field!(p.load), Parameter::Load, load),
+                        velocity: c.quantity(field!(p.velocity), Parameter::Velocity, velocity),
+                        measured: quantity.model(),
+                    };
+                    let why = "the measured value at this point";
+                    let value = c.required(field!(p.value), quantity.parameter(), why);
+                    let uncertainty = c.optional(field!(p.uncertainty), quantity.parameter());
+                    let checks = [("value", Some(value)), ("uncertainty", uncertainty)];
+                    for (name, x) in checks.into_iter().filter_map(|(n, x)| Some((n, x?))) {
+                        if let Err(e) = quantity.parameter().check(x) {
+                            c.out_of_range(name, x, quantity.parameter().unit(), &e.allowed);
+                        }
+                    }
+                    let overrides = [field!(p.radius), field!(p.load), field!(p.velocity)];
+                    check_conditions(c, &overrides, &point);
+                    Datum {
+                        point,
+                        value,
+                        uncertainty,
+                    }
+                }));
+            }
+        });
+    }
+    data
+}
+
+/// Checks the conditions of `point` that were given (`fields`: radius, load, velocity).
+fn check_conditions(checker: &mut Checker, fields: &[Field<Quantity>; 3], point: &Point) {
+    let conditions = [
+        (Parameter::Radius, point.radius),
+        (Parameter::Load, point.load),
+        (Parameter::Velocity, point.velocity),
+    ];
+    for (field, (parameter, x)) in fields.iter().zip(conditions) {
+        if let (Some(_), Err(e)) = (field.value, parameter.check(x)) {
+            checker.out_of_range(field.name, x, parameter.unit(), &e.allowed);
+        }
+    }
+}
+
+/// Enough data for the parameters, and uncertainties for all points or none.
+fn check_counts(problem: &Problem, input: &FitInput, checker: &mut Checker) {
+    let with = problem
+        .data
+        .iter()
+        .filter(|d| d.uncertainty.is_some())
+        .count();
+    if with > 0 && with < problem.data.len() {
+        let allowed = format!(
+            "an uncertainty for every point or for none ({with} of {} have one)",
+            problem.data.len()
+        );
+        checker.invalid("series", json!(with), &allowed);
+    }
+    let m = problem.parameterization.free.len();
+    let mut conditions: Vec<[u64; 4]> = problem
+        .data
+        .iter()
+        .map(|d| {
+            let p = &d.point;
+            [
+                p.radius.to_bits(),
+                p.load.to_bits(),
+                p.velocity.to_bits(),
+                p.measured as u64,
+            ]
+        })
+        .collect();
+    conditions.sort_unstable();
+    conditions.dedup();
+    if input.series.as_ref().is_some_and(|s| !s.is_empty()) && m > 0 {
+        // Without uncertainties the scatter needs one point more than the parameters.
+        let needed = if with == 0 { m + 1 } else { m };
+        if problem.data.len() < needed {
+            let allowed = format!(
+                "at least {needed} points to fit {m} parameters{}",
+                if with == 0 {
+                    " without uncertainties"
+                } else {
+                    ""
+                }
+            );
+            checker.invalid("series", json!(problem.data.len()), &allowed);
+        } else if conditions.len() < m {
+            let allowed = format!("points at {m} distinct conditions (radius, load, velocity, quantity) at least, to fit {m} parameters; all points are at {}", conditions.len());
+            checker.invalid("series", json!(conditions.len()), &allowed);
+        }
+    }
+}

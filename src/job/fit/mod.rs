@@ -1,0 +1,412 @@
+//! The fit job: the layer's relaxation time, retardation time (or κ), modulus and thickness
+//! (or stiffness) that best explain measured friction coefficients or contact areas, with
+//! their uncertainty and what the data leave undetermined ([`crate::model::fit`]).
+//!
+//! A fit cannot tell its size in advance: it counts solves as its work, checks its control
+//! before each one (a solve takes tens of microseconds, so a cancel stops it at once), and
+//! reports `Work::Unknown`.
+
+mod input;
+mod output;
+
+use std::collections::BTreeMap;
+
+use serde_json::{json, Value};
+
+pub use input::{
+    BoundsInput, FitInput, MeasuredQuantity, ParametersInput, PointInput, SeriesInput,
+};
+pub use output::{
+    Compared, Comparison, Curve, CurvePoint, Estimate, FitOutput, Identifiability, Modelled,
+    Residual, Search, UncertaintySource, Undetermined,
+};
+
+use super::input as wire;
+use super::meta::ROLLING_REFERENCES;
+use super::pictures::PictureError;
+use super::{Control, FieldError, JobError, Kind, Limits, Meta, Reference, Validated, Work};
+use crate::model::fit::stats::Analysis;
+use crate::model::fit::{self, Datum, FitError, Fitted, Point, Problem};
+use crate::model::Layer;
+use crate::render::svg::Chart;
+
+/// A validated fit.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FitJob {
+    pub problem: Problem,
+    /// The number of points of each series, in order (the data are the series' points).
+    pub series: Vec<usize>,
+}
+
+impl Kind for FitJob {
+    const NAME: &'static str = "fit";
+    type Output = FitOutput;
+
+    fn validate(value: Value, limits: &Limits) -> Result<Validated<Self>, JobError> {
+        let max = limits.max_sweep_points;
+        wire::validate(value, |input: &FitInput, checker| {
+            let problem = input.read(checker, max);
+            let series = input
+                .series
+                .iter()
+                .flatten()
+                .map(|s| s.points.as_ref().map_or(0, Vec::len))
+                .collect();
+            FitJob { problem, series }
+        })
+    }
+
+    /// Every point explicit, in SI, in its series.
+    fn canonical(&self) -> Value {
+        wire::canonical(&FitInput::of(&self.problem, &self.series))
+    }
+
+    fn references(&self) -> &'static [Reference] {
+        ROLLING_REFERENCES
+    }
+
+    fn work(&self) -> Work {
+        Work::Unknown
+    }
+
+    fn run(&self, meta: Meta, control: &Control) -> Result<FitOutput, JobError> {
+        let check = |solves: usize| {
+            control.check()?;
+            control.advance(solves);
+            Ok(())
+        };
+        let fitted = fit::fit(&self.problem, &check).map_err(|e| self.refused(e))?;
+        let layer = self.problem.parameterization.layer(&fitted.values);
+        let mut curves = Vec::new();
+        for (index, points) in self.series_data().enumerate() {
+            curves.push(curve(index, points, &layer, control)?);
+        }
+        Ok(FitOutput {
+            parameter_names: self.names(),
+            parameters: self.estimates(&fitted),
+            correlation: fitted
+                .analysis
+                .correlation
+                .row_iter()
+                .map(|r| r.iter().copied().collect())
+                .collect(),
+            chi_squared: fitted.chi_squared,
+            dof: fitted.dof,
+            uncertainties: if self.scaled() {
+                UncertaintySource::FromScatter
+            } else {
+                UncertaintySource::Given
+            },
+            residuals: self.residuals(&fitted),
+            curves,
+            identifiability: self.identifiability(&fitted),
+            search: Search {
+                candidates: fitted.candidates,
+                starts: fitted.starts,
+                steps: fitted.steps,
+                converged: fitted.converged,
+            },
+            meta,
+        })
+    }
+
+    fn picture(answer: &Value) -> Result<Chart, PictureError> {
+        super::pictures::fit(answer)
+    }
+}
+
+impl FitJob {
+    fn names(&self) -> Vec<&'static str> {
+        let free = &self.problem.parameterization.free;
+        free.iter().map(|p| p.name()).collect()
+    }
+
+    /// No point has an uncertainty: the scatter sets them.
+    fn scaled(&self) -> bool {
+        self.problem.data.iter().all(|d| d.uncertainty.is_none())
+    }
+
+    /// The data of each series.
+    fn series_data(&self) -> impl Iterator<Item = &[Datum]> {
+        let mut rest = &self.problem.data[..];
+        self.series.iter().map(move |&n| {
+            let (this, next) = rest.split_at(n.min(rest.len()));
+            rest = next;
+            this
+        })
+    }
+
+    /// Why the fit has no answer, as a job error.
+    fn refused(&self, e: FitError<JobError>) -> JobError {
+        match e {
+            FitError::Stopped(e) => e,
+            FitError::Model(e) => e.into(),
+            FitError::NoEffect(indices) => JobError::Invalid(
+                indices
+                    .into_iter()
+                    .map(|i| {
+                        let name = self.problem.parameterization.free[i].name();
+                        let field = format!("parameters.{name}");
+                        let allowed = "a parameter some measured point depends on".to_string();
+                        let hint = if name.ends_with("_time") || name == "kappa" {
+                            " (a time has no effect when every point is at rest, V = 0)"
+                        } else {
+                            ""
+                        };
+                        let message = format!(
+                            "{field}: no measured point depends on {name}{hint}: it cannot \
+                             be fitted; give its value in `layer` instead"
+                        );
+                        FieldError {
+                            field,
+                            value: json!({}),
+                            allowed,
+                            message,
+                        }
+                    })
+                    .collect(),
+            ),
+        }
+    }
+
+    fn estimates(&self, fitted: &Fitted) -> BTreeMap<&'static str, Estimate> {
+        let a = &fitted.analysis;
+        let free = &self.problem.parameterization.free;
+        free.iter()
+            .zip(&self.problem.bounds)
+            .enumerate()
+            .map(|(j, (parameter, bounds))| {
+                let value = fitted.values[j];
+                let se = standard_error(a, j);
+                let half = se.map(|se| a.coverage_factor * se);
+                let on = |bound: f64| (value / bound).ln().abs() < 1e-9;
+                let estimate = Estimate {
+                    value,
+                    standard_error: se.map(|se| se * value),
+                    interval_95: half.map(|h| [value * (-h).exp(), value * h.exp()]),
+                    determined: se.is_some(),
+                    bounds: [bounds.min, bounds.max],
+                    at_bound: on(bounds.min) || on(bounds.max),
+                };
+                (parameter.name(), estimate)
+            })
+            .collect()
+    }
+
+    fn residuals(&self, fitted: &Fitted) -> Vec<Residual> {
+        // Without uncertainties, residuals are normalised by the scatter √(χ²/dof).
+        let scatter = (fitted.chi_squared / fitted.dof.max(1) as f64).sqrt();
+        let mut rows = Vec::new();
+        let mut i = 0;
+        for (series, data) in self.series_data().enumerate() {
+            for (point, d) in data.iter().enumerate() {
+                let fit = fitted.fitted[i];
+                i += 1;
+                let residual = fit - d.value;
+                let sigma = d.uncertainty.unwrap_or(scatter);
+                let comparison = Comparison {
+                    measured: d.value,
+                    fitted: fit,
+                    residual,
+                    uncertainty: d.uncertainty,
+                };
+                rows.push(Residual {
+                    series,
+                    point,
+                    radius: d.point.radius,
+                    load: d.point.load,
+                    velocity: d.point.velocity,
+                    compared: Compared::new(MeasuredQuantity::of(d.point.measured), comparison),
+                    normalized_residual: if residual == 0.0 {
+                        0.0
+                    } else {
+                        residual / sigma
+                    },
+                });
+            }
+        }
+        rows
+    }
+
+    fn identifiability(&self, fitted: &Fitted) -> Identifiability {
+        let names = self.names();
+        let a = &fitted.analysis;
+        let determined: Vec<&str> = (0..names.len())
+            .filter(|&j| standard_error(a, j).is_some())
+            .map(|j| names[j])
+            .collect();
+        let undetermined: Vec<Undetermined> = a
+            .null_directions
+            .iter()
+            .map(|v| undetermined(&names, v.as_slice()))
+            .collect();
+        let identifiable = determined.len() == names.len();
+        let message = if identifiable {
+            format!(
+                "The data determine every fitted parameter: {}.",
+                names.join(", ")
+            )
+        } else {
+            let alone = if determined.is_empty() {
+                "no parameter alone".to_string()
+            } else {
+                determined.join(", ") + " alone"
+            };
+            let mut sentences: Vec<String> =
+                undetermined.iter().map(|u| u.message.clone()).collect();
+            let weak: Vec<&str> = names
+                .iter()
+                .filter(|n| !determined.contains(n))
+                .filter(|n| !undetermined.iter().any(|u| u.parameters.contains(n)))
+                .copied()
+                .collect();
+            if !weak.is_empty() {
+                sentences.push(format!(
+                    "{} is determined so weakly that no interval can be given.",
+                    weak.join(" and ")
+                ));
+            }
+            format!("The data determine {alone}. {}", sentences.join(" "))
+        };
+        Identifiability {
+            identifiable,
+            determined,
+            undetermined,
+            message,
+        }
+    }
+}
+
+/// The largest half-width of an interval in ln value: e^300 is near the end of double
+/// precision.
+const MAX_LN_HALF_WIDTH: f64 = 300.0;
+
+/// The standard error of ln p_j, if the data determine p_j: alone, and within an interval
+/// double precision can hold.
+fn standard_error(a: &Analysis, j: usize) -> Option<f64> {
+    a.standard_errors[j].filter(|&se| a.coverage_factor * se < MAX_LN_HALF_WIDTH)
+}
+
+/// A component below this in a null direction does not involve its parameter.
+const INVOLVED: f64 = 1e-3;
+
+/// The combination of `names` that the null direction `v` (in their logarithms) leaves free.
+fn undetermined(names: &[&'static str], v: &[f64]) -> Undetermined {
+    let largest = v.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+    let involved: Vec<usize> = (0..v.len())
+        .filter(|&j| v[j].abs() > INVOLVED * largest)
+        .collect();
+    let round = |x: f64| (x / largest * 1e4).round() / 1e4;
+    let direction: BTreeMap<&'static str, f64> =
+        involved.iter().map(|&j| (names[j], round(v[j]))).collect();
+    let parameters: Vec<&'static str> = involved.iter().map(|&j| names[j]).collect();
+    let moves: Vec<String> = involved
+        .iter()
+        .map(|&j| format!("ln {} by {:+}", names[j], round(v[j])))
+        .collect();
+    let mut message = format!(
+        "The data do not determine {} apart: changing {} together leaves every fitted value \
+         unchanged, so the values given are one of many that fit equally.",
+        parameters.join(" and "),
+        moves.join(", ")
+    );
+    if let [a, b] = involved[..] {
+        // The product a^x b^y with (x, y) ⟂ (v_a, v_b) is what the data fix.
+        let (x, y) = (v[b], -v[a]);
+        let scale = if x.abs() >= y.abs() { x } else { y };
+        let term = |name: &str, e: f64| {
+            let e = (e * 1e4).round() / 1e4;
+            if e == 1.0 {
+                name.to_string()
+            } else {
+                format!("{name}^{e}")
+            }
+        };
+        message += &format!(
+            " Only {} · {} is determined.",
+            term(names[a], x / scale),
+            term(names[b], y / scale)
+        );
+    }
+    Undetermined {
+        parameters,
+        direction,
+        message,
+    }
+}
+
+/// A condition of a point: its name, how to read it, how to set it.
+type Condition = (&'static str, fn(&Point) -> f64, fn(&mut Point, f64));
+
+/// Points along a curve.
+const CURVE_POINTS: usize = 41;
+
+/// The fitted model along the series `points`: dense over the one condition they vary,
+/// through the points themselves when they vary several or none.
+fn curve(
+    series: usize,
+    points: &[Datum],
+    layer: &Layer,
+    control: &Control,
+) -> Result<Curve, JobError> {
+    let first = points.first().map_or_else(
+        || Err(JobError::Internal("a series without points".to_string())),
+        |d| Ok(d.point),
+    )?;
+    let conditions: [Condition; 3] = [
+        ("velocity", |p| p.velocity, |p, x| p.velocity = x),
+        ("load", |p| p.load, |p, x| p.load = x),
+        ("radius", |p| p.radius, |p, x| p.radius = x),
+    ];
+    let varied: Vec<&Condition> = conditions
+        .iter()
+        .filter(|(_, of, _)| points.iter().any(|d| of(&d.point) != of(&first)))
+        .collect();
+    let along = varied.first().map_or("velocity", |c| c.0);
+    let mut grid: Vec<Point> = points.iter().map(|d| d.point).collect();
+    if let [(_, of, set)] = varied[..] {
+        let (lo, hi) = grid
+            .iter()
+            .map(of)
+            .fold((f64::INFINITY, 0.0_f64), |(lo, hi), x| {
+                (lo.min(x), hi.max(x))
+            });
+        let logarithmic = lo > 0.0 && hi / lo > 20.0;
+        grid = (0..CURVE_POINTS)
+            .map(|i| {
+                let f = i as f64 / (CURVE_POINTS - 1) as f64;
+                let mut p = first;
+                set(
+                    &mut p,
+                    if logarithmic {
+                        lo * (hi / lo).powf(f)
+                    } else {
+                        lo + f * (hi - lo)
+                    },
+                );
+                p
+            })
+            .collect();
+    } else if let Some((_, of, _)) = varied.first() {
+        grid.sort_by(|a, b| of(a).total_cmp(&of(b)));
+    }
+    let mut curve_points = Vec::with_capacity(grid.len());
+    for p in grid {
+        let y = control.solve(|| p.value(layer))?;
+        curve_points.push(CurvePoint {
+            radius: p.radius,
+            load: p.load,
+            velocity: p.velocity,
+            value: match p.measured {
+                fit::Measured::FrictionCoefficient => Modelled::FrictionCoefficient(y),
+                fit::Measured::ContactArea => Modelled::ContactArea(y),
+            },
+        });
+    }
+    Ok(Curve {
+        series,
+        quantity: MeasuredQuantity::of(first.measured),
+        along,
+        points: curve_points,
+    })
+}

@@ -1,0 +1,467 @@
+//! The inverse problem: the layer's parameters that best explain measured friction
+//! coefficients or contact areas of rolling particles. [`forward`] gives the model's value at
+//! one measured point and its sensitivities to the parameters; [`lm`] is the bounded
+//! Levenberg–Marquardt minimiser; [`stats`] turns the minimum into standard errors,
+//! intervals and an identifiability verdict.
+//!
+//! Parameters are fitted in logarithms: every one is positive, they span decades, and the
+//! model's own structure is multiplicative in them (MODEL.md §3: A = A₀(k, R, P) · α(ξ, κ)).
+
+pub mod forward;
+pub mod lm;
+pub mod stats;
+
+pub use forward::{Measured, Point, Sensitivity};
+
+use nalgebra::{DMatrix, DVector};
+
+use super::{Layer, ModelError};
+use lm::{Evaluation, LeastSquares};
+use stats::Analysis;
+
+/// A parameter a fit can determine. `Kappa` stands in for `RetardationTime`, and `Stiffness`
+/// for `Thickness`: a fit takes at most one of each pair.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum FitParameter {
+    /// T_σ (s).
+    RelaxationTime,
+    /// T_ε (s), ≥ T_σ.
+    RetardationTime,
+    /// κ = T_ε/T_σ − 1.
+    Kappa,
+    /// E_L (Pa).
+    ElasticModulus,
+    /// H (m).
+    Thickness,
+    /// k = E_L/H (Pa/m).
+    Stiffness,
+}
+
+impl FitParameter {
+    /// Every parameter, in the order of the wire's names.
+    pub const ALL: [FitParameter; 6] = [
+        FitParameter::RelaxationTime,
+        FitParameter::RetardationTime,
+        FitParameter::Kappa,
+        FitParameter::ElasticModulus,
+        FitParameter::Thickness,
+        FitParameter::Stiffness,
+    ];
+
+    /// The name on the wire.
+    pub fn name(self) -> &'static str {
+        match self {
+            FitParameter::RelaxationTime => "relaxation_time",
+            FitParameter::RetardationTime => "retardation_time",
+            FitParameter::Kappa => "kappa",
+            FitParameter::ElasticModulus => "elastic_modulus",
+            FitParameter::Thickness => "thickness",
+            FitParameter::Stiffness => "k",
+        }
+    }
+
+    /// The SI unit ("" for κ).
+    pub fn unit(self) -> &'static str {
+        match self {
+            FitParameter::RelaxationTime | FitParameter::RetardationTime => "s",
+            FitParameter::Kappa => "",
+            FitParameter::ElasticModulus => "Pa",
+            FitParameter::Thickness => "m",
+            FitParameter::Stiffness => "Pa/m",
+        }
+    }
+
+    /// The parameter's value in `layer`.
+    pub fn of(self, layer: &Layer) -> f64 {
+        match self {
+            FitParameter::RelaxationTime => layer.relaxation_time,
+            FitParameter::RetardationTime => layer.retardation_time,
+            FitParameter::Kappa => layer.kappa(),
+            FitParameter::ElasticModulus => layer.elastic_modulus,
+            FitParameter::Thickness => layer.thickness,
+            FitParameter::Stiffness => layer.stiffness(),
+        }
+    }
+}
+
+/// Which parameters a fit varies, over a layer that gives the others.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Parameterization {
+    pub base: Layer,
+    pub free: Vec<FitParameter>,
+}
+
+impl Parameterization {
+    /// Whether κ is held (or fitted) rather than T_ε: then T_ε follows T_σ.
+    fn kappa_mode(&self) -> bool {
+        self.free.contains(&FitParameter::Kappa)
+    }
+
+    /// Whether k is fitted rather than H: then H follows E_L.
+    fn stiffness_mode(&self) -> bool {
+        self.free.contains(&FitParameter::Stiffness)
+    }
+
+    /// The layer at the free parameters' `values` (SI, in the order of `free`).
+    pub fn layer(&self, values: &[f64]) -> Layer {
+        let mut layer = self.base;
+        let (mut kappa, mut stiffness) = (self.base.kappa(), self.base.stiffness());
+        for (&parameter, &value) in self.free.iter().zip(values) {
+            match parameter {
+                FitParameter::RelaxationTime => layer.relaxation_time = value,
+                FitParameter::RetardationTime => layer.retardation_time = value,
+                FitParameter::Kappa => kappa = value,
+                FitParameter::ElasticModulus => layer.elastic_modulus = value,
+                FitParameter::Thickness => layer.thickness = value,
+                FitParameter::Stiffness => stiffness = value,
+            }
+        }
+        if self.kappa_mode() {
+            layer.retardation_time = layer.relaxation_time * (1.0 + kappa);
+        }
+        if self.stiffness_mode() {
+            layer.thickness = layer.elastic_modulus / stiffness;
+        }
+        layer
+    }
+
+    /// ∂ ln y / ∂ ln p for each free parameter p, from the sensitivities of a point at
+    /// fixed (T_σ, κ, E_L, H) and the layer's κ (the chain rule of each parameterization).
+    pub fn log_derivatives(&self, s: &Sensitivity, kappa: f64) -> Vec<f64> {
+        self.free
+            .iter()
+            .map(|&parameter| match parameter {
+                FitParameter::RelaxationTime if self.kappa_mode() => s.relaxation_time,
+                // T_ε held: κ = T_ε/T_σ − 1 falls as T_σ rises.
+                FitParameter::RelaxationTime => s.relaxation_time - s.kappa * (1.0 + kappa),
+                FitParameter::RetardationTime => s.kappa * (1.0 + kappa),
+                FitParameter::Kappa => s.kappa * kappa,
+                // k held: H = E_L/k rises with E_L.
+                FitParameter::ElasticModulus if self.stiffness_mode() => {
+                    s.elastic_modulus + s.thickness
+                }
+                FitParameter::ElasticModulus => s.elastic_modulus,
+                FitParameter::Thickness => s.thickness,
+                FitParameter::Stiffness => -s.thickness,
+            })
+            .collect()
+    }
+}
+
+/// A measured value at a point, with its standard uncertainty if known.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Datum {
+    pub point: Point,
+    pub value: f64,
+    pub uncertainty: Option<f64>,
+}
+
+/// Where a free parameter starts and the box it stays in (SI, all positive).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Bounds {
+    pub start: f64,
+    pub min: f64,
+    pub max: f64,
+}
+
+/// A fit: the data, the parameters free and their bounds (in the order of `free`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Problem {
+    pub parameterization: Parameterization,
+    pub bounds: Vec<Bounds>,
+    /// Every datum has an uncertainty, or none has.
+    pub data: Vec<Datum>,
+}
+
+impl Problem {
+    /// Why the model fails at the start (no minimisation could begin there).
+    fn failure_at_start(&self) -> ModelError {
+        let start: Vec<f64> = self.bounds.iter().map(|b| b.start).collect();
+        let layer = self.parameterization.layer(&start);
+        if let Some(e) = layer.violations().into_iter().next() {
+            return ModelError::InvalidParameter(e);
+        }
+        self.data
+            .iter()
+            .find_map(|d| d.point.value_and_sensitivity(&layer, true).err())
+            .unwrap_or_else(|| {
+                ModelError::OutOfModel(
+                    "the weighted residuals overflow at every start: a measured value or an \
+                     uncertainty is beyond the scale of double precision"
+                        .to_string(),
+                )
+            })
+    }
+}
+
+/// The best fit.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Fitted {
+    /// The free parameters' values (SI).
+    pub values: Vec<f64>,
+    /// Uncertainty of their logarithms.
+    pub analysis: Analysis,
+    pub chi_squared: f64,
+    pub dof: usize,
+    /// The model's value at each datum.
+    pub fitted: Vec<f64>,
+    /// Points tried as starts, and the minimisations run from the best of them.
+    pub candidates: usize,
+    pub starts: usize,
+    /// Levenberg–Marquardt steps over all starts.
+    pub steps: usize,
+    /// Whether the best minimisation stopped by its tolerances.
+    pub converged: bool,
+}
+
+/// Why a fit has no answer.
+#[derive(Debug, PartialEq)]
+pub enum FitError<E> {
+    /// The caller's check stopped it (cancelled, past its deadline).
+    Stopped(E),
+    /// The model failed at the start.
+    Model(ModelError),
+    /// The free parameters (indices into `free`) change no residual at the best fit.
+    NoEffect(Vec<usize>),
+}
+
+/// Minimisations run: from the given start and from the best other candidate.
+const STARTS: usize = 2;
+
+/// Fits `problem`. `check` is called before each solve with the solves done since its last
+/// call; an error from it stops the fit.
+pub fn fit<E>(
+    problem: &Problem,
+    check: &(dyn Fn(usize) -> Result<(), E> + Sync),
+) -> Result<Fitted, FitError<E>> {
+    let ln = |f: fn(&Bounds) -> f64| {
+        DVector::from_iterator(
+            problem.bounds.len(),
+            problem.bounds.iter().map(|b| f(b).ln()),
+        )
+    };
+    let (start, lower, upper) = (ln(|b| b.start), ln(|b| b.min), ln(|b| b.max));
+    let mut residuals = Residuals { problem, check };
+    // Screen the start and the corners of the box's middle half by their cost alone.
+    let mut candidates = vec![start.clone()];
+    for corner in 0..1usize << start.len() {
+        candidates.push(DVector::from_fn(start.len(), |i, _| {
+            let quarter = if corner >> i & 1 == 0 { 0.25 } else { 0.75 };
+            lower[i] + quarter * (upper[i] - lower[i])
+        }));
+    }
+    let mut costs = Vec::new();
+    for (i, x) in candidates.iter().enumerate() {
+        if let Some(cost) = residuals.cost(x).map_err(FitError::Stopped)? {
+            costs.push((cost, i));
+        }
+    }
+    costs.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let mut starts = vec![0];
+    starts.extend(
+        costs
+            .iter()
+            .map(|&(_, i)| i)
+            .filter(|&i| i != 0)
+            .take(STARTS - 1),
+    );
+    let mut best: Option<lm::Minimum> = None;
+    let mut steps = 0;
+    for &i in &starts {
+        let found = lm::minimize(&mut residuals, &candidates[i], &lower, &upper)
+            .map_err(FitError::Stopped)?;
+        if let Some(m) = found {
+            steps += m.steps;
+            if best.as_ref().map_or(true, |b| m.cost < b.cost) {
+                best = Some(m);
+            }
+        }
+    }
+    let Some(best) = best else {
+        return Err(FitError::Model(problem.failure_at_start()));
+    };
+    let n = problem.data.len();
+    let dof = n.saturating_sub(start.len());
+    let scaled = problem.data.iter().all(|d| d.uncertainty.is_none());
+    let analysis = stats::analyse(&best.jacobian, best.cost, dof, scaled);
+    if !analysis.no_effect.is_empty() {
+        return Err(FitError::NoEffect(analysis.no_effect));
+    }
+    let fitted = problem
+        .data
+        .iter()
+        .zip(best.residuals.iter())
+        .map(|(d, r)| d.value + r * d.uncertainty.unwrap_or(1.0))
+        .collect();
+    Ok(Fitted {
+        values: best.x.iter().map(|x| x.exp()).collect(),
+        analysis,
+        chi_squared: best.cost,
+        dof,
+        fitted,
+        candidates: candidates.len(),
+        starts: starts.len(),
+        steps,
+        converged: best.converged,
+    })
+}
+
+/// The weighted residuals of a problem in the logarithms of its free parameters.
+struct Residuals<'a, E> {
+    problem: &'a Problem,
+    check: &'a (dyn Fn(usize) -> Result<(), E> + Sync),
+}
+
+impl<E> Residuals<'_, E> {
+    /// The layer at `x`, if inside the model's ranges (T_ε ≥ T_σ among them).
+    fn layer(&self, x: &DVector<f64>) -> Option<Layer> {
+        let values: Vec<f64> = x.iter().map(|x| x.exp()).collect();
+        let layer = self.problem.parameterization.layer(&values);
+        layer.violations().is_empty().then_some(layer)
+    }
+
+    /// Σ r² at `x`, without the Jacobian; `None` outside the model's domain.
+    fn cost(&mut self, x: &DVector<f64>) -> Result<Option<f64>, E> {
+        let Some(layer) = self.layer(x) else {
+            return Ok(None);
+        };
+        let mut cost = 0.0;
+        for d in &self.problem.data {
+            (self.check)(1)?;
+            let Ok(y) = d.point.value(&layer) else {
+                return Ok(None);
+            };
+            cost += ((y - d.value) / d.uncertainty.unwrap_or(1.0)).powi(2);
+        }
+        Ok(cost.is_finite().then_some(cost))
+    }
+}
+
+impl<E> LeastSquares for Residuals<'_, E> {
+    type Error = E;
+
+    fn evaluate(&mut self, x: &DVector<f64>) -> Result<Option<Evaluation>, E> {
+        let Some(layer) = self.layer(x) else {
+            return Ok(None);
+        };
+        let (n, m) = (self.problem.data.len(), x.len());
+        let mut residuals = DVector::zeros(n);
+        let mut jacobian = DMatrix::zeros(n, m);
+        for (i, d) in self.problem.data.iter().enumerate() {
+            (self.check)(1)?;
+            let Ok((y, Some(s))) = d.point.value_and_sensitivity(&layer, true) else {
+                return Ok(None);
+            };
+            let weight = 1.0 / d.uncertainty.unwrap_or(1.0);
+            residuals[i] = (y - d.value) * weight;
+            let derivatives = self
+                .problem
+                .parameterization
+                .log_derivatives(&s, layer.kappa());
+            for (j, dj) in derivatives.into_iter().enumerate() {
+                jacobian[(i, j)] = y * dj * weight;
+            }
+        }
+        // Values beyond double precision (a modulus at 1e300) count as outside the domain.
+        let finite = residuals.norm_squared().is_finite() && jacobian.iter().all(|x| x.is_finite());
+        Ok(finite.then_some(Evaluation {
+            residuals,
+            jacobian,
+        }))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn each_parameterization_gives_the_layer_it_names() {
+        let base = Layer::default();
+        let p = Parameterization {
+            base,
+            free: vec![FitParameter::RelaxationTime, FitParameter::Kappa],
+        };
+        let layer = p.layer(&[0.2, 3.0]);
+        assert_eq!(layer.relaxation_time, 0.2);
+        assert!((layer.retardation_time - 0.8).abs() < 1e-15);
+        let p = Parameterization {
+            base,
+            free: vec![FitParameter::ElasticModulus, FitParameter::Stiffness],
+        };
+        let layer = p.layer(&[6e9, 3e16]);
+        assert!((layer.thickness - 2e-7).abs() < 1e-22);
+        for parameter in FitParameter::ALL {
+            let p = Parameterization {
+                base,
+                free: vec![parameter],
+            };
+            let value = parameter.of(&base) * 1.5;
+            let layer = p.layer(&[value]);
+            assert!(
+                (parameter.of(&layer) / value - 1.0).abs() < 1e-15,
+                "{parameter:?}"
+            );
+        }
+    }
+
+    fn friction_at(speeds_nm_s: &[f64], layer: &Layer) -> Vec<Datum> {
+        speeds_nm_s
+            .iter()
+            .map(|&v| {
+                let point = Point {
+                    radius: 25e-9,
+                    load: 1e-9,
+                    velocity: v * 1e-9,
+                    measured: Measured::FrictionCoefficient,
+                };
+                Datum {
+                    point,
+                    value: point.value(layer).unwrap(),
+                    uncertainty: Some(1e-3),
+                }
+            })
+            .collect()
+    }
+
+    #[test]
+    fn noiseless_data_give_back_the_layer_they_came_from() {
+        let truth = Layer::default();
+        let problem = Problem {
+            parameterization: Parameterization {
+                base: Layer {
+                    relaxation_time: 0.05,
+                    retardation_time: 0.2,
+                    ..truth
+                },
+                free: vec![FitParameter::RelaxationTime, FitParameter::RetardationTime],
+            },
+            bounds: vec![
+                Bounds {
+                    start: 0.05,
+                    min: 1e-3,
+                    max: 10.0,
+                },
+                Bounds {
+                    start: 0.2,
+                    min: 1e-3,
+                    max: 100.0,
+                },
+            ],
+            data: friction_at(&[0.0, 1.0, 2.0, 4.0, 8.0, 16.0, 32.0], &truth),
+        };
+        let fitted = fit(&problem, &|_| Ok::<(), ()>(())).unwrap();
+        assert!(
+            (fitted.values[0] / 0.1 - 1.0).abs() < 1e-6,
+            "{:?}",
+            fitted.values
+        );
+        assert!(
+            (fitted.values[1] / 0.5 - 1.0).abs() < 1e-6,
+            "{:?}",
+            fitted.values
+        );
+        assert!(fitted.chi_squared < 1e-12);
+        assert!(fitted.analysis.null_directions.is_empty());
+    }
+}
