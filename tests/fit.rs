@@ -10,7 +10,8 @@ use std::time::{Duration, Instant};
 
 use serde_json::{json, Value};
 use thirdbody::job::{Control, Job, JobError, Limits};
-use thirdbody::model::fit::{Measured, Point};
+use thirdbody::model::fit::{Measured, Point, Setting};
+use thirdbody::model::three_body::{OperatingPoint, ThreeBody, ThreeBodyOptions};
 use thirdbody::model::Layer;
 use thirdbody::render::Format;
 
@@ -24,8 +25,10 @@ fn fit(input: Value) -> Result<Value, JobError> {
 /// The model's value on `layer` at R = `radius` nm, P = `load` nN, V = `speed` nm/s.
 fn model(layer: &Layer, measured: Measured, radius: f64, load: f64, speed: f64) -> f64 {
     let point = Point {
-        radius: radius * 1e-9,
-        load: load * 1e-9,
+        setting: Setting::Particle {
+            radius: radius * 1e-9,
+            load: load * 1e-9,
+        },
         velocity: speed * 1e-9,
         measured,
     };
@@ -238,6 +241,69 @@ fn all_four_from_friction_at_one_load_leave_one_direction_free() {
         (d("relaxation_time") * sign + 0.5).abs() < 1e-3,
         "{combination}"
     );
+}
+
+/// The system friction coefficient of the default three-body system on `layer` at total
+/// load W = `total_load` mN and V = `speed` nm/s.
+fn system_friction(layer: &Layer, total_load: f64, speed: f64) -> f64 {
+    let w = total_load * 1e-3;
+    let point = Point {
+        setting: Setting::System {
+            system: ThreeBody::with_defaults(OperatingPoint::TotalLoad(w)),
+            options: ThreeBodyOptions::default(),
+            total_load: w,
+        },
+        velocity: speed * 1e-9,
+        measured: Measured::FrictionCoefficient,
+    };
+    point.value(layer).unwrap()
+}
+
+#[test]
+fn a_three_body_series_gives_back_the_layer_its_friction_came_from() {
+    // The system's friction coefficient against speed at two total loads (docs/model.md §4
+    // defaults: 50 ± 5 nm particles, 1e12 m⁻², 1 mm², steel above).
+    let truth = Layer::default();
+    let series: Vec<Value> = [0.5, 1.0]
+        .iter()
+        .map(|&w| {
+            let points: Vec<Value> = [0.0, 1.0, 2.0, 4.0, 8.0, 16.0]
+                .iter()
+                .map(|&v| json!({"velocity": format!("{v} nm/s"), "value": system_friction(&truth, w, v)}))
+                .collect();
+            json!({"system": {}, "total_load": format!("{w} mN"), "points": points})
+        })
+        .collect();
+    let answer = fit(
+        json!({"series": series, "layer": {"relaxation_time": "40 ms", "retardation_time": "1 s"},
+        "parameters": {"relaxation_time": {}, "retardation_time": {}}}),
+    )
+    .unwrap();
+    for (name, expected) in [("relaxation_time", 0.1), ("retardation_time", 0.5)] {
+        let got = value(&answer, name);
+        assert!((got / expected - 1.0).abs() < 1e-6, "{name}: {got}");
+    }
+    let residual = &answer["residuals"][7];
+    assert_eq!(residual["total_load"], 1e-3);
+    assert!(residual.get("radius").is_none() && residual.get("load").is_none());
+    assert_eq!(answer["curves"][0]["along"], "velocity");
+    assert_eq!(answer["curves"][0]["points"][0]["total_load"], 5e-4);
+    // A system's series may not give what the fit sets, nor one particle's conditions.
+    let errors = refused(
+        json!({"series": [{"system": {"layer": {}, "operating": {"total_load": "1 mN"}},
+        "radius": "25 nm", "quantity": "contact_area", "points": [{"velocity": 0, "value": 0.1}]}],
+        "parameters": {"elastic_modulus": {}}}),
+    );
+    let fields: Vec<&str> = errors.iter().map(|e| e.0.as_str()).collect();
+    for field in [
+        "series[0].system.layer",
+        "series[0].system.operating",
+        "series[0].radius",
+        "series[0].quantity",
+        "series[0].points[0].total_load",
+    ] {
+        assert!(fields.contains(&field), "{field} not in {errors:?}");
+    }
 }
 
 #[test]

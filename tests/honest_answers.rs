@@ -217,6 +217,10 @@ fn every_numeric_field_of_every_answer_has_a_unit() {
             {"load": "1 nN", "value": "90 nm^2"}, {"load": "1.4 nN", "value": "101 nm^2"},
             {"load": "1.2 nN", "value": "95 nm^2"}]}],
             "parameters": {"elastic_modulus": {}, "thickness": {}}}}),
+        json!({"kind": "fit", "input": {"series": [{"system": {}, "total_load": "1 mN", "points": [
+            {"velocity": 0, "value": 0.023}, {"velocity": "4 nm/s", "value": 0.021},
+            {"velocity": "8 nm/s", "value": 0.019}]}],
+            "parameters": {"relaxation_time": {}}}}),
     ] {
         let answer = answer(job.clone()).unwrap();
         let units = answer["meta"]["units"].as_object().unwrap();

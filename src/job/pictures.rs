@@ -452,6 +452,7 @@ pub fn fit(answer: &Value) -> Result<Chart, PictureError> {
             [
                 ("R", "radius", "m"),
                 ("P", "load", "N"),
+                ("W", "total_load", "N"),
                 ("V", "velocity", "m/s"),
             ]
             .iter()
@@ -509,7 +510,7 @@ pub fn fit(answer: &Value) -> Result<Chart, PictureError> {
     };
     let x_unit = match along {
         "velocity" => "m/s",
-        "load" => "N",
+        "load" | "total_load" => "N",
         _ => "m",
     };
     let (lo, hi) = all_x.iter().fold((f64::INFINITY, 0.0_f64), |(lo, hi), &x| {

@@ -174,7 +174,7 @@ impl Answer {
                 let table = self.0.table();
                 let finite = table.rows.iter().flatten().all(|cell| match cell {
                     Cell::Number(x) => x.is_finite(),
-                    Cell::Count(_) | Cell::Text(_) => true,
+                    Cell::Count(_) | Cell::Text(_) | Cell::Empty => true,
                 });
                 if !finite {
                     return Err(non_finite());

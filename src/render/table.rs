@@ -13,11 +13,14 @@ pub enum Cell {
     Count(usize),
     /// Free text, such as a legend (quoted in CSV).
     Text(String),
+    /// Nothing: a column that does not apply to this row.
+    Empty,
 }
 
 /// How a column reads its cell off a row.
 enum Read<R> {
     Number(fn(&R) -> f64),
+    Optional(fn(&R) -> Option<f64>),
     Count(fn(&R) -> usize),
     Text(fn(&R) -> String),
 }
@@ -37,6 +40,19 @@ impl<R> Column<R> {
             name,
             unit,
             read: Read::Number(read),
+        }
+    }
+
+    /// A column of quantities that some rows do not have (their cell is empty).
+    pub const fn optional(
+        name: &'static str,
+        unit: &'static str,
+        read: fn(&R) -> Option<f64>,
+    ) -> Self {
+        Column {
+            name,
+            unit,
+            read: Read::Optional(read),
         }
     }
 
@@ -62,6 +78,7 @@ impl<R> Column<R> {
     pub fn cell(&self, row: &R) -> Cell {
         match self.read {
             Read::Number(read) => Cell::Number(read(row)),
+            Read::Optional(read) => read(row).map_or(Cell::Empty, Cell::Number),
             Read::Count(read) => Cell::Count(read(row)),
             Read::Text(read) => Cell::Text(read(row)),
         }
@@ -141,6 +158,7 @@ fn csv_cell(cell: &Cell) -> String {
         Cell::Number(x) => format_number(*x),
         Cell::Count(n) => n.to_string(),
         Cell::Text(text) => format!("\"{}\"", text.replace('"', "\"\"")),
+        Cell::Empty => String::new(),
     }
 }
 

@@ -6,7 +6,11 @@ use serde_json::{json, Value};
 use utoipa::ToSchema;
 
 use crate::job::input::{field, Checker, Field, LayerInput, Quantity};
-use crate::model::fit::{Bounds, Datum, FitParameter, Measured, Parameterization, Point, Problem};
+use crate::job::three_body::{OperatingInput, ThreeBodyInput, ThreeBodyJob};
+use crate::model::fit::{
+    Bounds, Datum, FitParameter, Measured, Parameterization, Point, Problem, Setting,
+};
+use crate::model::three_body::{OperatingPoint, ThreeBody, ThreeBodyOptions};
 use crate::model::{Layer, Parameter, Rolling};
 
 /// Input of a fit: measured points of one or more series, and the layer's parameters to
@@ -31,16 +35,23 @@ pub struct FitInput {
     pub parameters: Option<ParametersInput>,
 }
 
-/// Points measured on one particle size and load (each point may override them).
+/// Points measured on one particle size and load (each point may override them), or on one
+/// three-body system at total loads.
 #[derive(Clone, Debug, Default, PartialEq, Deserialize, Serialize, ToSchema)]
 #[serde(deny_unknown_fields)]
 pub struct SeriesInput {
-    /// R (m; default 25 nm).
+    /// R (m; default 25 nm); not with `system`.
     pub radius: Option<Quantity>,
-    /// P (N; default 1 nN).
+    /// P (N; default 1 nN); not with `system`.
     pub load: Option<Quantity>,
     /// V (m/s; default 4 nm/s).
     pub velocity: Option<Quantity>,
+    /// A three-body system (a `ThreeBodyInput` without `layer`, `velocity` and `operating`,
+    /// which the fit sets): the series then measures the system's friction coefficient at
+    /// the points' total loads.
+    pub system: Option<ThreeBodyInput>,
+    /// W (N), the total load on a `system`, for points that do not give theirs.
+    pub total_load: Option<Quantity>,
     /// What was measured (default `friction_coefficient`).
     pub quantity: Option<MeasuredQuantity>,
     /// The points (at least one).
@@ -91,6 +102,8 @@ pub struct PointInput {
     pub load: Option<Quantity>,
     /// V (m/s; default: the series').
     pub velocity: Option<Quantity>,
+    /// W (N) on the series' `system` (default: the series').
+    pub total_load: Option<Quantity>,
     /// The measured value (μ: a plain number; A: m²). Required.
     pub value: Option<Quantity>,
     /// Its standard uncertainty, in the value's unit: given for every point or for none
@@ -219,22 +232,11 @@ impl FitInput {
             .iter()
             .map(|&n| {
                 let points: Vec<&Datum> = data.by_ref().take(n).collect();
+                let first = points.first().map(|d| d.point);
                 SeriesInput {
-                    quantity: points
-                        .first()
-                        .map(|d| MeasuredQuantity::of(d.point.measured)),
-                    points: Some(
-                        points
-                            .into_iter()
-                            .map(|d| PointInput {
-                                radius: Quantity::si(d.point.radius),
-                                load: Quantity::si(d.point.load),
-                                velocity: Quantity::si(d.point.velocity),
-                                value: Quantity::si(d.value),
-                                uncertainty: d.uncertainty.and_then(Quantity::si),
-                            })
-                            .collect(),
-                    ),
+                    quantity: first.map(|p| MeasuredQuantity::of(p.measured)),
+                    system: first.and_then(|p| system_input(&p.setting)),
+                    points: Some(points.into_iter().map(PointInput::of).collect()),
                     ..SeriesInput::default()
                 }
             })
@@ -245,6 +247,42 @@ impl FitInput {
             parameters: Some(ParametersInput::of(problem)),
         }
     }
+}
+
+impl PointInput {
+    /// The point of `datum`, every field explicit.
+    fn of(datum: &Datum) -> PointInput {
+        let p = &datum.point;
+        let mut input = PointInput {
+            velocity: Quantity::si(p.velocity),
+            value: Quantity::si(datum.value),
+            uncertainty: datum.uncertainty.and_then(Quantity::si),
+            ..PointInput::default()
+        };
+        match p.setting {
+            Setting::Particle { radius, load } => {
+                input.radius = Quantity::si(radius);
+                input.load = Quantity::si(load);
+            }
+            Setting::System { total_load, .. } => input.total_load = Quantity::si(total_load),
+        }
+        input
+    }
+}
+
+/// The system of a three-body setting as a series gives it: without what the fit sets.
+fn system_input(setting: &Setting) -> Option<ThreeBodyInput> {
+    let Setting::System {
+        system, options, ..
+    } = *setting
+    else {
+        return None;
+    };
+    let mut input = ThreeBodyJob { system, options }.input();
+    input.layer = None;
+    input.velocity = None;
+    input.operating = None;
+    Some(input)
 }
 
 fn read_parameters(
@@ -332,72 +370,174 @@ fn read_series(
         checker.invalid("series", json!(total), &allowed);
         return Vec::new();
     }
-    let d = Rolling::default();
     let mut data = Vec::new();
     for (i, s) in series.iter().enumerate() {
-        checker.item("series", i, s, |c, s| {
-            let radius = c.quantity(field!(s.radius), Parameter::Radius, d.radius);
-            let load = c.quantity(field!(s.load), Parameter::Load, d.load);
-            let velocity = c.quantity(field!(s.velocity), Parameter::Velocity, d.velocity);
-            let given = [field!(s.radius), field!(s.load), field!(s.velocity)];
-            let series_point = Point {
-                radius,
-                load,
-                velocity,
-                measured: Measured::FrictionCoefficient,
-            };
-            check_conditions(c, &given, &series_point);
-            let quantity = s.quantity.unwrap_or_default();
-            let points = s.points.as_deref().unwrap_or_default();
-            if points.is_empty() {
-                c.invalid(
-                    "points",
-                    json!(points),
-                    "a list of at least one measured point",
-                );
-            }
-            for (j, p) in points.iter().enumerate() {
-                data.push(c.item("points", j, p, |c, p| {
-                    let point = Point {
-                        radius: c.quantity(field!(p.radius), Parameter::Radius, radius),
-                        load: c.quantity(field!(p.load), Parameter::Load, load),
-                        velocity: c.quantity(field!(p.velocity), Parameter::Velocity, velocity),
-                        measured: quantity.model(),
-                    };
-                    let why = "the measured value at this point";
-                    let value = c.required(field!(p.value), quantity.parameter(), why);
-                    let uncertainty = c.optional(field!(p.uncertainty), quantity.parameter());
-                    let checks = [("value", Some(value)), ("uncertainty", uncertainty)];
-                    for (name, x) in checks.into_iter().filter_map(|(n, x)| Some((n, x?))) {
-                        if let Err(e) = quantity.parameter().check(x) {
-                            c.out_of_range(name, x, quantity.parameter().unit(), &e.allowed);
-                        }
-                    }
-                    let overrides = [field!(p.radius), field!(p.load), field!(p.velocity)];
-                    check_conditions(c, &overrides, &point);
-                    Datum {
-                        point,
-                        value,
-                        uncertainty,
-                    }
-                }));
-            }
-        });
+        checker.item("series", i, s, |c, s| read_one(s, c, &mut data));
     }
     data
 }
 
-/// Checks the conditions of `point` that were given (`fields`: radius, load, velocity).
-fn check_conditions(checker: &mut Checker, fields: &[Field<Quantity>; 3], point: &Point) {
-    let conditions = [
-        (Parameter::Radius, point.radius),
-        (Parameter::Load, point.load),
-        (Parameter::Velocity, point.velocity),
-    ];
-    for (field, (parameter, x)) in fields.iter().zip(conditions) {
-        if let (Some(_), Err(e)) = (field.value, parameter.check(x)) {
-            checker.out_of_range(field.name, x, parameter.unit(), &e.allowed);
+/// Reads one series into `data`.
+fn read_one(s: &SeriesInput, c: &mut Checker, data: &mut Vec<Datum>) {
+    let d = Rolling::default();
+    let quantity = s.quantity.unwrap_or_default();
+    let velocity = condition(c, field!(s.velocity), Parameter::Velocity, d.velocity);
+    let series = match &s.system {
+        Some(system) => {
+            for field in [field!(s.radius), field!(s.load)] {
+                refuse(c, field, "absent: a three-body series gives `total_load`");
+            }
+            if quantity != MeasuredQuantity::FrictionCoefficient {
+                let allowed = "friction_coefficient: a three-body series measures the system's";
+                c.invalid("quantity", json!(quantity), allowed);
+            }
+            let (system, options) = read_system(system, c);
+            let total_load = c.optional(field!(s.total_load), Parameter::TotalLoad);
+            check_range(c, field!(s.total_load), Parameter::TotalLoad, total_load);
+            Series::System(system, options, total_load)
         }
+        None => {
+            refuse(
+                c,
+                field!(s.total_load),
+                "absent: only a series with a `system` has one",
+            );
+            Series::Particle {
+                radius: condition(c, field!(s.radius), Parameter::Radius, d.radius),
+                load: condition(c, field!(s.load), Parameter::Load, d.load),
+            }
+        }
+    };
+    let points = s.points.as_deref().unwrap_or_default();
+    if points.is_empty() {
+        let allowed = "a list of at least one measured point";
+        c.invalid("points", json!(points), allowed);
+    }
+    for (j, p) in points.iter().enumerate() {
+        data.push(c.item("points", j, p, |c, p| {
+            let point = Point {
+                setting: series.of_point(p, c),
+                velocity: condition(c, field!(p.velocity), Parameter::Velocity, velocity),
+                measured: quantity.model(),
+            };
+            let why = "the measured value at this point";
+            let value = c.required(field!(p.value), quantity.parameter(), why);
+            check_range(c, field!(p.value), quantity.parameter(), Some(value));
+            let uncertainty = c.optional(field!(p.uncertainty), quantity.parameter());
+            check_range(c, field!(p.uncertainty), quantity.parameter(), uncertainty);
+            Datum {
+                point,
+                value,
+                uncertainty,
+            }
+        }));
+    }
+}
+
+/// What a series fixes for its points (one per series: its size does not matter).
+#[allow(clippy::large_enum_variant)]
+enum Series {
+    Particle { radius: f64, load: f64 },
+    System(ThreeBody, ThreeBodyOptions, Option<f64>),
+}
+
+impl Series {
+    /// The setting of the point `p` of the series.
+    fn of_point(&self, p: &PointInput, c: &mut Checker) -> Setting {
+        match *self {
+            Series::Particle { radius, load } => {
+                refuse(
+                    c,
+                    field!(p.total_load),
+                    "absent: only a series with a `system` has one",
+                );
+                Setting::Particle {
+                    radius: condition(c, field!(p.radius), Parameter::Radius, radius),
+                    load: condition(c, field!(p.load), Parameter::Load, load),
+                }
+            }
+            Series::System(system, options, total_load) => {
+                for field in [field!(p.radius), field!(p.load)] {
+                    refuse(c, field, "absent: a three-body series gives `total_load`");
+                }
+                let why = "for each point of a three-body series, or for the series";
+                let total_load = match total_load {
+                    Some(w) => c.quantity(field!(p.total_load), Parameter::TotalLoad, w),
+                    None => c.required(field!(p.total_load), Parameter::TotalLoad, why),
+                };
+                check_range(
+                    c,
+                    field!(p.total_load),
+                    Parameter::TotalLoad,
+                    Some(total_load),
+                );
+                Setting::System {
+                    system,
+                    options,
+                    total_load,
+                }
+            }
+        }
+    }
+}
+
+/// The system of a three-body series; what the fit sets refused if given.
+fn read_system(input: &ThreeBodyInput, c: &mut Checker) -> (ThreeBody, ThreeBodyOptions) {
+    let set = [
+        (
+            "layer",
+            input.layer.is_some(),
+            "absent: the fit's `layer` is the system's",
+        ),
+        (
+            "velocity",
+            input.velocity.is_some(),
+            "absent: each point gives its `velocity`",
+        ),
+        (
+            "operating",
+            input.operating.is_some(),
+            "absent: each point gives its `total_load`",
+        ),
+    ];
+    for (name, given, allowed) in set {
+        if given {
+            c.invalid(&format!("system.{name}"), json!({}), allowed);
+        }
+    }
+    let mut input = input.clone();
+    input.layer = None;
+    input.velocity = None;
+    // A placeholder: each point solves at its own total load.
+    input.operating = Some(OperatingInput::of(OperatingPoint::TotalLoad(1e-3)));
+    let field = Field {
+        name: "system",
+        value: Some(&input),
+    };
+    let job = c.nested(field, |c, s| ThreeBodyJob::read(s, c));
+    (job.system, job.options)
+}
+
+/// The quantity `field` as `parameter`, its range checked if given; `default` if absent.
+fn condition(c: &mut Checker, field: Field<Quantity>, parameter: Parameter, default: f64) -> f64 {
+    let x = c.quantity(field, parameter, default);
+    check_range(c, field, parameter, Some(x));
+    x
+}
+
+/// Checks `value`, read from `field` as `parameter`, against its range if the field was given.
+fn check_range(c: &mut Checker, field: Field<Quantity>, parameter: Parameter, value: Option<f64>) {
+    if let (Some(_), Some(x)) = (field.value, value) {
+        if let Err(e) = parameter.check(x) {
+            c.out_of_range(field.name, x, parameter.unit(), &e.allowed);
+        }
+    }
+}
+
+/// Refuses `field` if given: `allowed` says why it may not be.
+fn refuse(c: &mut Checker, field: Field<Quantity>, allowed: &str) {
+    if let Some(q) = field.value {
+        c.invalid(field.name, json!(q), allowed);
     }
 }
 
@@ -416,18 +556,10 @@ fn check_counts(problem: &Problem, input: &FitInput, checker: &mut Checker) {
         checker.invalid("series", json!(with), &allowed);
     }
     let m = problem.parameterization.free.len();
-    let mut conditions: Vec<[u64; 4]> = problem
+    let mut conditions: Vec<String> = problem
         .data
         .iter()
-        .map(|d| {
-            let p = &d.point;
-            [
-                p.radius.to_bits(),
-                p.load.to_bits(),
-                p.velocity.to_bits(),
-                p.measured as u64,
-            ]
-        })
+        .map(|d| format!("{:?}", d.point))
         .collect();
     conditions.sort_unstable();
     conditions.dedup();

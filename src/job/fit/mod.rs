@@ -17,7 +17,7 @@ pub use input::{
     BoundsInput, FitInput, MeasuredQuantity, ParametersInput, PointInput, SeriesInput,
 };
 pub use output::{
-    Compared, Comparison, Curve, CurvePoint, Estimate, FitOutput, Identifiability, Modelled,
+    At, Compared, Comparison, Curve, CurvePoint, Estimate, FitOutput, Identifiability, Modelled,
     Residual, Search, UncertaintySource, Undetermined,
 };
 
@@ -26,7 +26,7 @@ use super::meta::ROLLING_REFERENCES;
 use super::pictures::PictureError;
 use super::{Control, FieldError, JobError, Kind, Limits, Meta, Reference, Validated, Work};
 use crate::model::fit::stats::Analysis;
-use crate::model::fit::{self, Datum, FitError, Fitted, Point, Problem};
+use crate::model::fit::{self, Datum, FitError, Fitted, Point, Problem, Setting};
 use crate::model::Layer;
 use crate::render::svg::Chart;
 
@@ -213,8 +213,7 @@ impl FitJob {
                 rows.push(Residual {
                     series,
                     point,
-                    radius: d.point.radius,
-                    load: d.point.load,
+                    at: at(&d.point),
                     velocity: d.point.velocity,
                     compared: Compared::new(MeasuredQuantity::of(d.point.measured), comparison),
                     normalized_residual: if residual == 0.0 {
@@ -335,8 +334,17 @@ fn undetermined(names: &[&'static str], v: &[f64]) -> Undetermined {
     }
 }
 
-/// A condition of a point: its name, how to read it, how to set it.
-type Condition = (&'static str, fn(&Point) -> f64, fn(&mut Point, f64));
+/// A condition of a point: its name, how to read it (`None`: the point has none), how to
+/// set it.
+type Condition = (&'static str, fn(&Point) -> Option<f64>, fn(&mut Point, f64));
+
+/// Where `point` was measured, as the answer says it.
+fn at(point: &Point) -> At {
+    match point.setting {
+        Setting::Particle { radius, load } => At::Particle { radius, load },
+        Setting::System { total_load, .. } => At::System { total_load },
+    }
+}
 
 /// Points along a curve.
 const CURVE_POINTS: usize = 41;
@@ -353,10 +361,44 @@ fn curve(
         || Err(JobError::Internal("a series without points".to_string())),
         |d| Ok(d.point),
     )?;
-    let conditions: [Condition; 3] = [
-        ("velocity", |p| p.velocity, |p, x| p.velocity = x),
-        ("load", |p| p.load, |p, x| p.load = x),
-        ("radius", |p| p.radius, |p, x| p.radius = x),
+    let conditions: [Condition; 4] = [
+        ("velocity", |p| Some(p.velocity), |p, x| p.velocity = x),
+        (
+            "load",
+            |p| match p.setting {
+                Setting::Particle { load, .. } => Some(load),
+                Setting::System { .. } => None,
+            },
+            |p, x| {
+                if let Setting::Particle { load, .. } = &mut p.setting {
+                    *load = x;
+                }
+            },
+        ),
+        (
+            "radius",
+            |p| match p.setting {
+                Setting::Particle { radius, .. } => Some(radius),
+                Setting::System { .. } => None,
+            },
+            |p, x| {
+                if let Setting::Particle { radius, .. } = &mut p.setting {
+                    *radius = x;
+                }
+            },
+        ),
+        (
+            "total_load",
+            |p| match p.setting {
+                Setting::Particle { .. } => None,
+                Setting::System { total_load, .. } => Some(total_load),
+            },
+            |p, x| {
+                if let Setting::System { total_load, .. } = &mut p.setting {
+                    *total_load = x;
+                }
+            },
+        ),
     ];
     let varied: Vec<&Condition> = conditions
         .iter()
@@ -367,7 +409,7 @@ fn curve(
     if let [(_, of, set)] = varied[..] {
         let (lo, hi) = grid
             .iter()
-            .map(of)
+            .filter_map(of)
             .fold((f64::INFINITY, 0.0_f64), |(lo, hi), x| {
                 (lo.min(x), hi.max(x))
             });
@@ -388,14 +430,17 @@ fn curve(
             })
             .collect();
     } else if let Some((_, of, _)) = varied.first() {
-        grid.sort_by(|a, b| of(a).total_cmp(&of(b)));
+        grid.sort_by(|a, b| {
+            of(a)
+                .partial_cmp(&of(b))
+                .unwrap_or(std::cmp::Ordering::Equal)
+        });
     }
     let mut curve_points = Vec::with_capacity(grid.len());
     for p in grid {
         let y = control.solve(|| p.value(layer))?;
         curve_points.push(CurvePoint {
-            radius: p.radius,
-            load: p.load,
+            at: at(&p),
             velocity: p.velocity,
             value: match p.measured {
                 fit::Measured::FrictionCoefficient => Modelled::FrictionCoefficient(y),

@@ -73,10 +73,9 @@ pub struct Residual {
     /// Index of the series, and of the point in it.
     pub series: usize,
     pub point: usize,
-    /// R (m).
-    pub radius: f64,
-    /// P (N).
-    pub load: f64,
+    /// Where: R and P of one particle, or W on a three-body system.
+    #[serde(flatten)]
+    pub at: At,
     /// V (m/s).
     pub velocity: f64,
     /// The measured and fitted values, under the name of the quantity measured.
@@ -129,18 +128,51 @@ impl Compared {
 pub struct Curve {
     pub series: usize,
     pub quantity: MeasuredQuantity,
-    /// The condition along the curve: `velocity`, `load` or `radius`.
+    /// The condition along the curve: `velocity`, `load`, `radius` or `total_load`.
     pub along: &'static str,
     pub points: Vec<CurvePoint>,
+}
+
+/// Where a point was measured: on one particle, or on a three-body system.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, ToSchema)]
+#[serde(untagged)]
+pub enum At {
+    Particle {
+        /// R (m).
+        radius: f64,
+        /// P (N).
+        load: f64,
+    },
+    System {
+        /// W (N).
+        total_load: f64,
+    },
+}
+
+impl At {
+    /// R and P, on one particle.
+    pub fn particle(&self) -> Option<(f64, f64)> {
+        match *self {
+            At::Particle { radius, load } => Some((radius, load)),
+            At::System { .. } => None,
+        }
+    }
+
+    /// W, on a three-body system.
+    pub fn total_load(&self) -> Option<f64> {
+        match *self {
+            At::Particle { .. } => None,
+            At::System { total_load } => Some(total_load),
+        }
+    }
 }
 
 /// A point of a fitted curve.
 #[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
 pub struct CurvePoint {
-    /// R (m).
-    pub radius: f64,
-    /// P (N).
-    pub load: f64,
+    /// Where: R and P of one particle, or W on a three-body system.
+    #[serde(flatten)]
+    pub at: At,
     /// V (m/s).
     pub velocity: f64,
     /// The model's value, under the name of the quantity.
@@ -194,6 +226,7 @@ pub struct Search {
 }
 
 impl Output for FitOutput {
+    /// `radius` and `load` for a particle's points, `total_load` for a system's.
     const UNITS: Units = &[&[
         ("parameters.relaxation_time.value", "s"),
         ("parameters.relaxation_time.standard_error", "s"),
@@ -226,6 +259,7 @@ impl Output for FitOutput {
         ("residuals[].point", ""),
         ("residuals[].radius", "m"),
         ("residuals[].load", "N"),
+        ("residuals[].total_load", "N"),
         ("residuals[].velocity", "m/s"),
         ("residuals[].friction_coefficient.measured", ""),
         ("residuals[].friction_coefficient.fitted", ""),
@@ -239,6 +273,7 @@ impl Output for FitOutput {
         ("curves[].series", ""),
         ("curves[].points[].radius", "m"),
         ("curves[].points[].load", "N"),
+        ("curves[].points[].total_load", "N"),
         ("curves[].points[].velocity", "m/s"),
         ("curves[].points[].friction_coefficient", ""),
         ("curves[].points[].contact_area", "m^2"),
@@ -265,11 +300,12 @@ impl Output for FitOutput {
     /// One row per measured point: measured, fitted and residual in the unit of `quantity`
     /// (`m^2` for contact_area, a plain number for friction_coefficient).
     fn table(&self) -> Table {
-        const COLUMNS: [Column<Residual>; 11] = [
+        const COLUMNS: [Column<Residual>; 12] = [
             Column::count("series", |r| r.series),
             Column::count("point", |r| r.point),
-            Column::number("radius", "m", |r| r.radius),
-            Column::number("load", "N", |r| r.load),
+            Column::optional("radius", "m", |r| r.at.particle().map(|(radius, _)| radius)),
+            Column::optional("load", "N", |r| r.at.particle().map(|(_, load)| load)),
+            Column::optional("total_load", "N", |r| r.at.total_load()),
             Column::number("velocity", "m/s", |r| r.velocity),
             Column::text("quantity", |r| r.compared.parts().0.to_string()),
             Column::number("measured", "", |r| r.compared.parts().2.measured),

@@ -1,12 +1,18 @@
 //! The model's value at one measured point, and its sensitivities to the layer.
 //!
-//! MODEL.md §3 gives the structure: A = A₀ · α(ξ, κ) with A₀ = 2√(πRP H/E_L),
-//! ξ = V T_σ / r₀ and r₀ ∝ (H/E_L)^{1/4}; μ = τ_a A / P with τ_a = E_L/(2000(1 + ν)). So
-//! every sensitivity in logarithms follows from two: g = ∂ ln α/∂ ln ξ (one solve at a
-//! slightly higher speed) and ∂ ln α/∂κ (one solve at a slightly larger κ). A point costs at
-//! most three solves, whatever the number of parameters; a point at rest costs one.
+//! For one particle, MODEL.md §3 gives the structure: A = A₀ · α(ξ, κ) with
+//! A₀ = 2√(πRP H/E_L), ξ = V T_σ / r₀ and r₀ ∝ (H/E_L)^{1/4}; μ = τ_a A / P with
+//! τ_a = E_L/(2000(1 + ν)). So every sensitivity in logarithms follows from two:
+//! g = ∂ ln α/∂ ln ξ (one solve at a slightly higher speed) and ∂ ln α/∂κ (one solve at a
+//! slightly larger κ). Such a point costs at most three solves, whatever the number of
+//! parameters; a point at rest costs one.
+//!
+//! A three-body system (MODEL.md §4) mixes particles of every size and the upper surface's
+//! contacts, so it has no such structure: its sensitivities are forward differences in T_σ
+//! (at fixed κ), κ, E_L and H, four more solves (two at rest, where the times have no effect).
 
 use super::super::tables::{self, Use};
+use super::super::three_body::{self, OperatingPoint, ThreeBody, ThreeBodyOptions};
 use super::super::{Layer, ModelError, Quadrature, Rolling, SolveOptions};
 
 /// What was measured at a point.
@@ -18,13 +24,27 @@ pub enum Measured {
     ContactArea,
 }
 
+/// Where the measured particles roll.
+// A system is some 260 bytes, a particle 16: a fit holds at most `max_sweep_points` points,
+// so the waste is bounded (≤ 3 MB), and points stay `Copy`.
+#[allow(clippy::large_enum_variant)]
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Setting {
+    /// One particle of radius R (m) under load P (N).
+    Particle { radius: f64, load: f64 },
+    /// A three-body system at total load W (N); its layer, speed and operating point are the
+    /// fit's. Only its friction coefficient is measured.
+    System {
+        system: ThreeBody,
+        options: ThreeBodyOptions,
+        total_load: f64,
+    },
+}
+
 /// The operating condition of a measured point.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Point {
-    /// R (m).
-    pub radius: f64,
-    /// P (N).
-    pub load: f64,
+    pub setting: Setting,
     /// V (m/s).
     pub velocity: f64,
     pub measured: Measured,
@@ -49,58 +69,112 @@ impl Point {
         self.solve(layer, self.velocity)
     }
 
-    /// The value and, if `sensitive`, its sensitivities.
-    pub fn value_and_sensitivity(
-        &self,
-        layer: &Layer,
-        sensitive: bool,
-    ) -> Result<(f64, Option<Sensitivity>), ModelError> {
+    /// The value and its sensitivities.
+    pub fn value_and_sensitivity(&self, layer: &Layer) -> Result<(f64, Sensitivity), ModelError> {
         let y = self.value(layer)?;
-        if !sensitive {
-            return Ok((y, None));
-        }
+        let sensitivity = match self.setting {
+            Setting::Particle { .. } => self.structured(layer, y)?,
+            Setting::System { .. } => self.differenced(layer, y)?,
+        };
+        Ok((y, sensitivity))
+    }
+
+    /// The sensitivities of a particle, through the similarity structure.
+    fn structured(&self, layer: &Layer, y: f64) -> Result<Sensitivity, ModelError> {
         // At rest α = 1 whatever ξ and κ: only A₀ and τ_a depend on the layer.
         let (g, dk) = if self.velocity == 0.0 {
             (0.0, 0.0)
         } else {
             let faster = self.solve(layer, self.velocity * (1.0 + STEP))?;
             let g = (faster / y).ln() / (1.0 + STEP).ln();
-            let kappa = layer.kappa();
-            let dkappa = STEP * kappa.max(1e-3);
-            let stiffer = Layer {
-                retardation_time: layer.relaxation_time * (1.0 + kappa + dkappa),
-                ..*layer
-            };
-            let dk = (self.solve(&stiffer, self.velocity)? / y).ln() / dkappa;
-            (g, dk)
+            (g, self.kappa_sensitivity(layer, y)?)
         };
         // ln A = ln A₀ + ln α: ln A₀ has −½ ln E_L + ½ ln H, ln ξ has ¼ ln E_L − ¼ ln H.
         let tau = match self.measured {
             Measured::FrictionCoefficient => 1.0,
             Measured::ContactArea => 0.0,
         };
-        let sensitivity = Sensitivity {
+        Ok(Sensitivity {
             relaxation_time: g,
             kappa: dk,
             elastic_modulus: -0.5 + 0.25 * g + tau,
             thickness: 0.5 - 0.25 * g,
+        })
+    }
+
+    /// The sensitivities by forward differences in each of T_σ (κ fixed), κ, E_L and H.
+    fn differenced(&self, layer: &Layer, y: f64) -> Result<Sensitivity, ModelError> {
+        let log_step = (1.0 + STEP).ln();
+        let along = |changed: Layer| -> Result<f64, ModelError> {
+            Ok((self.solve(&changed, self.velocity)? / y).ln() / log_step)
         };
-        Ok((y, Some(sensitivity)))
+        let (relaxation_time, kappa) = if self.velocity == 0.0 {
+            (0.0, 0.0)
+        } else {
+            let slower = Layer {
+                relaxation_time: layer.relaxation_time * (1.0 + STEP),
+                retardation_time: layer.retardation_time * (1.0 + STEP),
+                ..*layer
+            };
+            (along(slower)?, self.kappa_sensitivity(layer, y)?)
+        };
+        Ok(Sensitivity {
+            relaxation_time,
+            kappa,
+            elastic_modulus: along(Layer {
+                elastic_modulus: layer.elastic_modulus * (1.0 + STEP),
+                ..*layer
+            })?,
+            thickness: along(Layer {
+                thickness: layer.thickness * (1.0 + STEP),
+                ..*layer
+            })?,
+        })
+    }
+
+    /// ∂ ln y/∂κ at fixed T_σ, by a forward difference.
+    fn kappa_sensitivity(&self, layer: &Layer, y: f64) -> Result<f64, ModelError> {
+        let kappa = layer.kappa();
+        let dkappa = STEP * kappa.max(1e-3);
+        let stiffer = Layer {
+            retardation_time: layer.relaxation_time * (1.0 + kappa + dkappa),
+            ..*layer
+        };
+        Ok((self.solve(&stiffer, self.velocity)? / y).ln() / dkappa)
     }
 
     fn solve(&self, layer: &Layer, velocity: f64) -> Result<f64, ModelError> {
-        let rolling = Rolling {
-            radius: self.radius,
-            load: self.load,
-            velocity,
-            layer: *layer,
-        };
-        let options = SolveOptions::integrals_only(Quadrature::default());
-        let solution = tables::solve(&rolling, &options, Use::Exact)?;
-        Ok(match self.measured {
-            Measured::FrictionCoefficient => solution.friction_coefficient,
-            Measured::ContactArea => solution.contact_area,
-        })
+        match self.setting {
+            Setting::Particle { radius, load } => {
+                let rolling = Rolling {
+                    radius,
+                    load,
+                    velocity,
+                    layer: *layer,
+                };
+                let options = SolveOptions::integrals_only(Quadrature::default());
+                let solution = tables::solve(&rolling, &options, Use::Exact)?;
+                Ok(match self.measured {
+                    Measured::FrictionCoefficient => solution.friction_coefficient,
+                    Measured::ContactArea => solution.contact_area,
+                })
+            }
+            Setting::System {
+                system,
+                options,
+                total_load,
+            } => {
+                let system = ThreeBody {
+                    layer: *layer,
+                    velocity,
+                    operating: OperatingPoint::TotalLoad(total_load),
+                    ..system
+                };
+                Ok(three_body::solve(&system, &options)?
+                    .rolling
+                    .friction_coefficient)
+            }
+        }
     }
 }
 
@@ -114,15 +188,26 @@ mod tests {
     #[test]
     fn sensitivities_match_finite_differences_in_every_parameter() {
         let base = Layer::default();
-        for measured in [Measured::FrictionCoefficient, Measured::ContactArea] {
+        let particle = Setting::Particle {
+            radius: 25e-9,
+            load: 1e-9,
+        };
+        let system = Setting::System {
+            system: ThreeBody::with_defaults(OperatingPoint::TotalLoad(1e-3)),
+            options: ThreeBodyOptions::default(),
+            total_load: 1e-3,
+        };
+        for (setting, measured) in [
+            (particle, Measured::FrictionCoefficient),
+            (particle, Measured::ContactArea),
+            (system, Measured::FrictionCoefficient),
+        ] {
             let point = Point {
-                radius: 25e-9,
-                load: 1e-9,
+                setting,
                 velocity: 6e-9,
                 measured,
             };
-            let (y, s) = point.value_and_sensitivity(&base, true).unwrap();
-            let s = s.unwrap();
+            let (y, s) = point.value_and_sensitivity(&base).unwrap();
             for parameter in FitParameter::ALL {
                 let p = Parameterization {
                     base,
@@ -136,7 +221,7 @@ mod tests {
                 let analytic = p.log_derivatives(&s, base.kappa())[0];
                 assert!(
                     (analytic - numeric).abs() < 1e-4 * numeric.abs().max(0.1),
-                    "{measured:?} {parameter:?}: {analytic} vs {numeric} (y = {y})"
+                    "{setting:?} {measured:?} {parameter:?}: {analytic} vs {numeric} (y = {y})"
                 );
             }
         }

@@ -11,7 +11,7 @@ pub mod forward;
 pub mod lm;
 pub mod stats;
 
-pub use forward::{Measured, Point, Sensitivity};
+pub use forward::{Measured, Point, Sensitivity, Setting};
 
 use nalgebra::{DMatrix, DVector};
 
@@ -183,7 +183,7 @@ impl Problem {
         }
         self.data
             .iter()
-            .find_map(|d| d.point.value_and_sensitivity(&layer, true).err())
+            .find_map(|d| d.point.value_and_sensitivity(&layer).err())
             .unwrap_or_else(|| {
                 ModelError::OutOfModel(
                     "the weighted residuals overflow at every start: a measured value or an \
@@ -349,7 +349,7 @@ impl<E> LeastSquares for Residuals<'_, E> {
         let mut jacobian = DMatrix::zeros(n, m);
         for (i, d) in self.problem.data.iter().enumerate() {
             (self.check)(1)?;
-            let Ok((y, Some(s))) = d.point.value_and_sensitivity(&layer, true) else {
+            let Ok((y, s)) = d.point.value_and_sensitivity(&layer) else {
                 return Ok(None);
             };
             let weight = 1.0 / d.uncertainty.unwrap_or(1.0);
@@ -410,8 +410,10 @@ mod tests {
             .iter()
             .map(|&v| {
                 let point = Point {
-                    radius: 25e-9,
-                    load: 1e-9,
+                    setting: Setting::Particle {
+                        radius: 25e-9,
+                        load: 1e-9,
+                    },
                     velocity: v * 1e-9,
                     measured: Measured::FrictionCoefficient,
                 };
