@@ -38,12 +38,12 @@ const DROPPED: &str = "the result was dropped to stay within the memory budget (
 /// How often a progress stream looks at a running job's count of solves.
 const PROGRESS_INTERVAL: Duration = Duration::from_millis(100);
 
-/// Solves done out of the job's total.
+/// Work done out of the job's total.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, ToSchema)]
 pub struct Progress {
-    /// Rolling solves done (count).
+    /// Units of work done (count): rolling solves, or for a fit the points evaluated.
     pub done: usize,
-    /// Rolling solves the job takes (count; 0 for a job that cannot tell in advance).
+    /// Units of work the job takes (count; 0 for a job that cannot tell in advance, a fit).
     pub total: usize,
 }
 

@@ -2,9 +2,9 @@
 //! (or stiffness) that best explain measured friction coefficients or contact areas, with
 //! their uncertainty and what the data leave undetermined ([`crate::model::fit`]).
 //!
-//! A fit cannot tell its size in advance: it counts solves as its work, checks its control
-//! before each one (a solve takes tens of microseconds, so a cancel stops it at once), and
-//! reports `Work::Unknown`.
+//! A fit cannot tell its size in advance: it counts the points it evaluates as its work,
+//! checks its control before each one (a particle's point takes tens of microseconds, a
+//! system's a few milliseconds, so a cancel stops it at once), and reports `Work::Unknown`.
 
 mod input;
 mod output;
@@ -70,9 +70,9 @@ impl Kind for FitJob {
     }
 
     fn run(&self, meta: Meta, control: &Control) -> Result<FitOutput, JobError> {
-        let check = |solves: usize| {
+        let check = || {
             control.check()?;
-            control.advance(solves);
+            control.advance(1);
             Ok(())
         };
         let fitted = fit::fit(&self.problem, &check).map_err(|e| self.refused(e))?;

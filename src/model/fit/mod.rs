@@ -228,11 +228,11 @@ pub enum FitError<E> {
 /// Minimisations run: from the given start and from the best other candidate.
 const STARTS: usize = 2;
 
-/// Fits `problem`. `check` is called before each solve with the solves done since its last
-/// call; an error from it stops the fit.
+/// Fits `problem`. `check` is called before each point is evaluated (one to five solves);
+/// an error from it stops the fit.
 pub fn fit<E>(
     problem: &Problem,
-    check: &(dyn Fn(usize) -> Result<(), E> + Sync),
+    check: &(dyn Fn() -> Result<(), E> + Sync),
 ) -> Result<Fitted, FitError<E>> {
     let ln = |f: fn(&Bounds) -> f64| {
         DVector::from_iterator(
@@ -309,7 +309,7 @@ pub fn fit<E>(
 /// The weighted residuals of a problem in the logarithms of its free parameters.
 struct Residuals<'a, E> {
     problem: &'a Problem,
-    check: &'a (dyn Fn(usize) -> Result<(), E> + Sync),
+    check: &'a (dyn Fn() -> Result<(), E> + Sync),
 }
 
 impl<E> Residuals<'_, E> {
@@ -327,7 +327,7 @@ impl<E> Residuals<'_, E> {
         };
         let mut cost = 0.0;
         for d in &self.problem.data {
-            (self.check)(1)?;
+            (self.check)()?;
             let Ok(y) = d.point.value(&layer) else {
                 return Ok(None);
             };
@@ -348,7 +348,7 @@ impl<E> LeastSquares for Residuals<'_, E> {
         let mut residuals = DVector::zeros(n);
         let mut jacobian = DMatrix::zeros(n, m);
         for (i, d) in self.problem.data.iter().enumerate() {
-            (self.check)(1)?;
+            (self.check)()?;
             let Ok((y, s)) = d.point.value_and_sensitivity(&layer) else {
                 return Ok(None);
             };
@@ -452,7 +452,7 @@ mod tests {
             ],
             data: friction_at(&[0.0, 1.0, 2.0, 4.0, 8.0, 16.0, 32.0], &truth),
         };
-        let fitted = fit(&problem, &|_| Ok::<(), ()>(())).unwrap();
+        let fitted = fit(&problem, &|| Ok::<(), ()>(())).unwrap();
         assert!(
             (fitted.values[0] / 0.1 - 1.0).abs() < 1e-6,
             "{:?}",
