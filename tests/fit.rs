@@ -321,6 +321,18 @@ fn bounds_hold() {
     assert_eq!(t["bounds"], json!([0.01, 0.06]));
     let r = value(&answer, "retardation_time");
     assert!((0.3..=2.0).contains(&r), "{r}");
+    // Without a start, bounds that exclude the layer's value start from their middle.
+    let job = Job::from_value(
+        json!({"kind": "fit", "input": {"series": [friction_series(&truth, 1.0, 0.001, &mut noise, true)],
+            "parameters": {"retardation_time": {"min": "1 s", "max": "100 s"}}}}),
+        &Limits::default(),
+    )
+    .unwrap();
+    let start = &job.canonical()["parameters"]["retardation_time"]["start"];
+    assert!(
+        (start.as_f64().unwrap() / 10.0 - 1.0).abs() < 1e-12,
+        "{start}"
+    );
 }
 
 /// The field errors of a fit refused as invalid.

@@ -134,7 +134,8 @@ pub struct ParametersInput {
 #[derive(Clone, Debug, Default, PartialEq, Deserialize, Serialize, ToSchema)]
 #[serde(deny_unknown_fields)]
 pub struct BoundsInput {
-    /// Default: the layer's value (κ: 4 if the layer is elastic).
+    /// Default: the layer's value (κ: 4 if the layer is elastic), or, if `min` and `max`
+    /// do not hold it, their geometric mean (the bound given, if only one is).
     pub start: Option<Quantity>,
     /// Default: start / 1000.
     pub min: Option<Quantity>,
@@ -310,9 +311,19 @@ fn read_parameters(
             x => x,
         };
         let b = checker.nested(field, |c, bounds| {
-            let start = c.quantity(field!(bounds.start), model, layer_value);
-            let min = c.quantity(field!(bounds.min), model, start / DEFAULT_SPAN);
-            let max = c.quantity(field!(bounds.max), model, start * DEFAULT_SPAN);
+            let given_min = c.optional(field!(bounds.min), model);
+            let given_max = c.optional(field!(bounds.max), model);
+            // Without a start, the layer's value if the bounds given hold it; their middle
+            // (in logarithm) if both are given; the nearer one otherwise.
+            let default = match (given_min, given_max) {
+                (Some(lo), Some(hi)) if !(lo..=hi).contains(&layer_value) => (lo * hi).sqrt(),
+                (lo, hi) => layer_value
+                    .max(lo.unwrap_or(f64::NEG_INFINITY))
+                    .min(hi.unwrap_or(f64::INFINITY)),
+            };
+            let start = c.quantity(field!(bounds.start), model, default);
+            let min = given_min.unwrap_or(start / DEFAULT_SPAN);
+            let max = given_max.unwrap_or(start * DEFAULT_SPAN);
             for (name, value) in [("start", start), ("min", min), ("max", max)] {
                 if let Err(e) = model.check(value) {
                     c.out_of_range(name, value, model.unit(), &e.allowed);
