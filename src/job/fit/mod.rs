@@ -17,8 +17,8 @@ pub use input::{
     BoundsInput, FitInput, MeasuredQuantity, ParametersInput, PointInput, SeriesInput,
 };
 pub use output::{
-    At, Compared, Comparison, Curve, CurvePoint, Estimate, FitOutput, Identifiability, Modelled,
-    Residual, Search, UncertaintySource, Undetermined,
+    Comparison, Curve, CurvePoint, Estimate, FitOutput, Identifiability, Residual, Search,
+    UncertaintySource, Undetermined,
 };
 
 use super::input as wire;
@@ -210,12 +210,18 @@ impl FitJob {
                     residual,
                     uncertainty: d.uncertainty,
                 };
+                let (radius, load, total_load) = where_measured(&d.point);
+                let (friction_coefficient, contact_area) =
+                    by_quantity(d.point.measured, comparison);
                 rows.push(Residual {
                     series,
                     point,
-                    at: at(&d.point),
+                    radius,
+                    load,
+                    total_load,
                     velocity: d.point.velocity,
-                    compared: Compared::new(MeasuredQuantity::of(d.point.measured), comparison),
+                    friction_coefficient,
+                    contact_area,
                     normalized_residual: if residual == 0.0 {
                         0.0
                     } else {
@@ -338,11 +344,19 @@ fn undetermined(names: &[&'static str], v: &[f64]) -> Undetermined {
 /// set it.
 type Condition = (&'static str, fn(&Point) -> Option<f64>, fn(&mut Point, f64));
 
-/// Where `point` was measured, as the answer says it.
-fn at(point: &Point) -> At {
+/// R, P and W of `point`: the first two on one particle, the last on a three-body system.
+fn where_measured(point: &Point) -> (Option<f64>, Option<f64>, Option<f64>) {
     match point.setting {
-        Setting::Particle { radius, load } => At::Particle { radius, load },
-        Setting::System { total_load, .. } => At::System { total_load },
+        Setting::Particle { radius, load } => (Some(radius), Some(load), None),
+        Setting::System { total_load, .. } => (None, None, Some(total_load)),
+    }
+}
+
+/// `x` as the friction coefficient or as the contact area, as `measured` says.
+fn by_quantity<T>(measured: fit::Measured, x: T) -> (Option<T>, Option<T>) {
+    match measured {
+        fit::Measured::FrictionCoefficient => (Some(x), None),
+        fit::Measured::ContactArea => (None, Some(x)),
     }
 }
 
@@ -365,10 +379,7 @@ fn curve(
         ("velocity", |p| Some(p.velocity), |p, x| p.velocity = x),
         (
             "load",
-            |p| match p.setting {
-                Setting::Particle { load, .. } => Some(load),
-                Setting::System { .. } => None,
-            },
+            |p| where_measured(p).1,
             |p, x| {
                 if let Setting::Particle { load, .. } = &mut p.setting {
                     *load = x;
@@ -377,10 +388,7 @@ fn curve(
         ),
         (
             "radius",
-            |p| match p.setting {
-                Setting::Particle { radius, .. } => Some(radius),
-                Setting::System { .. } => None,
-            },
+            |p| where_measured(p).0,
             |p, x| {
                 if let Setting::Particle { radius, .. } = &mut p.setting {
                     *radius = x;
@@ -389,10 +397,7 @@ fn curve(
         ),
         (
             "total_load",
-            |p| match p.setting {
-                Setting::Particle { .. } => None,
-                Setting::System { total_load, .. } => Some(total_load),
-            },
+            |p| where_measured(p).2,
             |p, x| {
                 if let Setting::System { total_load, .. } = &mut p.setting {
                     *total_load = x;
@@ -439,13 +444,15 @@ fn curve(
     let mut curve_points = Vec::with_capacity(grid.len());
     for p in grid {
         let y = control.solve(|| p.value(layer))?;
+        let (radius, load, total_load) = where_measured(&p);
+        let (friction_coefficient, contact_area) = by_quantity(p.measured, y);
         curve_points.push(CurvePoint {
-            at: at(&p),
+            radius,
+            load,
+            total_load,
             velocity: p.velocity,
-            value: match p.measured {
-                fit::Measured::FrictionCoefficient => Modelled::FrictionCoefficient(y),
-                fit::Measured::ContactArea => Modelled::ContactArea(y),
-            },
+            friction_coefficient,
+            contact_area,
         });
     }
     Ok(Curve {

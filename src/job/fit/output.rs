@@ -67,22 +67,42 @@ pub struct Estimate {
     pub at_bound: bool,
 }
 
-/// The model against one measured point.
+/// The model against one measured point: `radius` and `load` on one particle, `total_load`
+/// on a three-body system; the comparison under the name of the quantity measured.
 #[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
 pub struct Residual {
     /// Index of the series, and of the point in it.
     pub series: usize,
     pub point: usize,
-    /// Where: R and P of one particle, or W on a three-body system.
-    #[serde(flatten)]
-    pub at: At,
+    /// R (m), on one particle.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub radius: Option<f64>,
+    /// P (N), on one particle.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub load: Option<f64>,
+    /// W (N), on a three-body system.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub total_load: Option<f64>,
     /// V (m/s).
     pub velocity: f64,
-    /// The measured and fitted values, under the name of the quantity measured.
-    #[serde(flatten)]
-    pub compared: Compared,
+    /// μ measured and fitted, if μ was measured.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub friction_coefficient: Option<Comparison>,
+    /// A (m²) measured and fitted, if A was measured.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub contact_area: Option<Comparison>,
     /// (fitted − measured)/uncertainty; from the scatter when no uncertainty was given.
     pub normalized_residual: f64,
+}
+
+impl Residual {
+    /// The comparison with the name and unit of its quantity.
+    fn compared(&self) -> Option<(&'static str, &'static str, &Comparison)> {
+        let mu = self.friction_coefficient.as_ref();
+        let area = self.contact_area.as_ref();
+        mu.map(|c| ("friction_coefficient", "", c))
+            .or(area.map(|c| ("contact_area", "m^2", c)))
+    }
 }
 
 /// A measured value beside the model's.
@@ -97,31 +117,6 @@ pub struct Comparison {
     pub uncertainty: Option<f64>,
 }
 
-/// A comparison under the name of its quantity: `friction_coefficient` or `contact_area`
-/// (m²).
-#[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
-#[serde(rename_all = "snake_case")]
-pub enum Compared {
-    FrictionCoefficient(Comparison),
-    ContactArea(Comparison),
-}
-
-impl Compared {
-    pub fn new(quantity: MeasuredQuantity, comparison: Comparison) -> Compared {
-        match quantity {
-            MeasuredQuantity::FrictionCoefficient => Compared::FrictionCoefficient(comparison),
-            MeasuredQuantity::ContactArea => Compared::ContactArea(comparison),
-        }
-    }
-
-    fn parts(&self) -> (&'static str, &'static str, &Comparison) {
-        match self {
-            Compared::FrictionCoefficient(c) => ("friction_coefficient", "", c),
-            Compared::ContactArea(c) => ("contact_area", "m^2", c),
-        }
-    }
-}
-
 /// The fitted model along a series: over the range of the condition its points vary (dense),
 /// or through its points when they vary more than one.
 #[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
@@ -133,60 +128,27 @@ pub struct Curve {
     pub points: Vec<CurvePoint>,
 }
 
-/// Where a point was measured: on one particle, or on a three-body system.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, ToSchema)]
-#[serde(untagged)]
-pub enum At {
-    Particle {
-        /// R (m).
-        radius: f64,
-        /// P (N).
-        load: f64,
-    },
-    System {
-        /// W (N).
-        total_load: f64,
-    },
-}
-
-impl At {
-    /// R and P, on one particle.
-    pub fn particle(&self) -> Option<(f64, f64)> {
-        match *self {
-            At::Particle { radius, load } => Some((radius, load)),
-            At::System { .. } => None,
-        }
-    }
-
-    /// W, on a three-body system.
-    pub fn total_load(&self) -> Option<f64> {
-        match *self {
-            At::Particle { .. } => None,
-            At::System { total_load } => Some(total_load),
-        }
-    }
-}
-
-/// A point of a fitted curve.
+/// A point of a fitted curve: its conditions as a residual gives them, and the model's value
+/// under the name of the quantity.
 #[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
 pub struct CurvePoint {
-    /// Where: R and P of one particle, or W on a three-body system.
-    #[serde(flatten)]
-    pub at: At,
+    /// R (m), on one particle.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub radius: Option<f64>,
+    /// P (N), on one particle.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub load: Option<f64>,
+    /// W (N), on a three-body system.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub total_load: Option<f64>,
     /// V (m/s).
     pub velocity: f64,
-    /// The model's value, under the name of the quantity.
-    #[serde(flatten)]
-    pub value: Modelled,
-}
-
-/// The model's value under the name of its quantity: `friction_coefficient` or
-/// `contact_area` (m²).
-#[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
-#[serde(rename_all = "snake_case")]
-pub enum Modelled {
-    FrictionCoefficient(f64),
-    ContactArea(f64),
+    /// μ, if the series measured μ.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub friction_coefficient: Option<f64>,
+    /// A (m²), if the series measured A.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub contact_area: Option<f64>,
 }
 
 /// What the data determine.
@@ -303,15 +265,15 @@ impl Output for FitOutput {
         const COLUMNS: [Column<Residual>; 12] = [
             Column::count("series", |r| r.series),
             Column::count("point", |r| r.point),
-            Column::optional("radius", "m", |r| r.at.particle().map(|(radius, _)| radius)),
-            Column::optional("load", "N", |r| r.at.particle().map(|(_, load)| load)),
-            Column::optional("total_load", "N", |r| r.at.total_load()),
+            Column::optional("radius", "m", |r| r.radius),
+            Column::optional("load", "N", |r| r.load),
+            Column::optional("total_load", "N", |r| r.total_load),
             Column::number("velocity", "m/s", |r| r.velocity),
-            Column::text("quantity", |r| r.compared.parts().0.to_string()),
-            Column::number("measured", "", |r| r.compared.parts().2.measured),
-            Column::number("fitted", "", |r| r.compared.parts().2.fitted),
-            Column::number("residual", "", |r| r.compared.parts().2.residual),
-            Column::text("unit", |r| r.compared.parts().1.to_string()),
+            Column::text("quantity", |r| r.compared().map_or("", |c| c.0).to_string()),
+            Column::optional("measured", "", |r| r.compared().map(|c| c.2.measured)),
+            Column::optional("fitted", "", |r| r.compared().map(|c| c.2.fitted)),
+            Column::optional("residual", "", |r| r.compared().map(|c| c.2.residual)),
+            Column::text("unit", |r| r.compared().map_or("", |c| c.1).to_string()),
             Column::number("normalized_residual", "", |r| r.normalized_residual),
         ];
         Table::new(&COLUMNS, &self.residuals)
