@@ -17,8 +17,8 @@ pub use input::{
     BoundsInput, FitInput, MeasuredQuantity, ParametersInput, PointInput, SeriesInput,
 };
 pub use output::{
-    Comparison, Curve, CurvePoint, Estimate, FitOutput, Identifiability, Residual, Search,
-    UncertaintySource, Undetermined,
+    Comparison, Conditions, Curve, CurvePoint, Estimate, FitOutput, Identifiability, Residual,
+    Search, UncertaintySource, Undetermined,
 };
 
 use super::input as wire;
@@ -210,16 +210,12 @@ impl FitJob {
                     residual,
                     uncertainty: d.uncertainty,
                 };
-                let (radius, load, total_load) = where_measured(&d.point);
                 let (friction_coefficient, contact_area) =
                     by_quantity(d.point.measured, comparison);
                 rows.push(Residual {
                     series,
                     point,
-                    radius,
-                    load,
-                    total_load,
-                    velocity: d.point.velocity,
+                    at: where_measured(&d.point),
                     friction_coefficient,
                     contact_area,
                     normalized_residual: if residual == 0.0 {
@@ -344,11 +340,17 @@ fn undetermined(names: &[&'static str], v: &[f64]) -> Undetermined {
 /// set it.
 type Condition = (&'static str, fn(&Point) -> Option<f64>, fn(&mut Point, f64));
 
-/// R, P and W of `point`: the first two on one particle, the last on a three-body system.
-fn where_measured(point: &Point) -> (Option<f64>, Option<f64>, Option<f64>) {
-    match point.setting {
+/// Where `point` was measured, as the answer says it.
+fn where_measured(point: &Point) -> Conditions {
+    let (radius, load, total_load) = match point.setting {
         Setting::Particle { radius, load } => (Some(radius), Some(load), None),
         Setting::System { total_load, .. } => (None, None, Some(total_load)),
+    };
+    Conditions {
+        radius,
+        load,
+        total_load,
+        velocity: point.velocity,
     }
 }
 
@@ -379,7 +381,7 @@ fn curve(
         ("velocity", |p| Some(p.velocity), |p, x| p.velocity = x),
         (
             "load",
-            |p| where_measured(p).1,
+            |p| where_measured(p).load,
             |p, x| {
                 if let Setting::Particle { load, .. } = &mut p.setting {
                     *load = x;
@@ -388,7 +390,7 @@ fn curve(
         ),
         (
             "radius",
-            |p| where_measured(p).0,
+            |p| where_measured(p).radius,
             |p, x| {
                 if let Setting::Particle { radius, .. } = &mut p.setting {
                     *radius = x;
@@ -397,7 +399,7 @@ fn curve(
         ),
         (
             "total_load",
-            |p| where_measured(p).2,
+            |p| where_measured(p).total_load,
             |p, x| {
                 if let Setting::System { total_load, .. } = &mut p.setting {
                     *total_load = x;
@@ -444,13 +446,9 @@ fn curve(
     let mut curve_points = Vec::with_capacity(grid.len());
     for p in grid {
         let y = control.solve(|| p.value(layer))?;
-        let (radius, load, total_load) = where_measured(&p);
         let (friction_coefficient, contact_area) = by_quantity(p.measured, y);
         curve_points.push(CurvePoint {
-            radius,
-            load,
-            total_load,
-            velocity: p.velocity,
+            at: where_measured(&p),
             friction_coefficient,
             contact_area,
         });

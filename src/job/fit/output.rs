@@ -74,17 +74,8 @@ pub struct Residual {
     /// Index of the series, and of the point in it.
     pub series: usize,
     pub point: usize,
-    /// R (m), on one particle.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub radius: Option<f64>,
-    /// P (N), on one particle.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub load: Option<f64>,
-    /// W (N), on a three-body system.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub total_load: Option<f64>,
-    /// V (m/s).
-    pub velocity: f64,
+    #[serde(flatten)]
+    pub at: Conditions,
     /// μ measured and fitted, if μ was measured.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub friction_coefficient: Option<Comparison>,
@@ -103,6 +94,23 @@ impl Residual {
         mu.map(|c| ("friction_coefficient", "", c))
             .or(area.map(|c| ("contact_area", "m^2", c)))
     }
+}
+
+/// Where a point was measured: `radius` and `load` on one particle, `total_load` on a
+/// three-body system; `velocity` always.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, ToSchema)]
+pub struct Conditions {
+    /// R (m), on one particle.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub radius: Option<f64>,
+    /// P (N), on one particle.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub load: Option<f64>,
+    /// W (N), on a three-body system.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub total_load: Option<f64>,
+    /// V (m/s).
+    pub velocity: f64,
 }
 
 /// A measured value beside the model's.
@@ -132,17 +140,8 @@ pub struct Curve {
 /// under the name of the quantity.
 #[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
 pub struct CurvePoint {
-    /// R (m), on one particle.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub radius: Option<f64>,
-    /// P (N), on one particle.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub load: Option<f64>,
-    /// W (N), on a three-body system.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub total_load: Option<f64>,
-    /// V (m/s).
-    pub velocity: f64,
+    #[serde(flatten)]
+    pub at: Conditions,
     /// μ, if the series measured μ.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub friction_coefficient: Option<f64>,
@@ -265,10 +264,10 @@ impl Output for FitOutput {
         const COLUMNS: [Column<Residual>; 12] = [
             Column::count("series", |r| r.series),
             Column::count("point", |r| r.point),
-            Column::optional("radius", "m", |r| r.radius),
-            Column::optional("load", "N", |r| r.load),
-            Column::optional("total_load", "N", |r| r.total_load),
-            Column::number("velocity", "m/s", |r| r.velocity),
+            Column::optional("radius", "m", |r| r.at.radius),
+            Column::optional("load", "N", |r| r.at.load),
+            Column::optional("total_load", "N", |r| r.at.total_load),
+            Column::number("velocity", "m/s", |r| r.at.velocity),
             Column::text("quantity", |r| r.compared().map_or("", |c| c.0).to_string()),
             Column::optional("measured", "", |r| r.compared().map(|c| c.2.measured)),
             Column::optional("fitted", "", |r| r.compared().map(|c| c.2.fitted)),
