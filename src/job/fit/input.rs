@@ -186,18 +186,6 @@ impl ParametersInput {
     }
 }
 
-/// The model's parameter a fit parameter's values are checked as.
-fn checked_as(parameter: FitParameter) -> Parameter {
-    match parameter {
-        FitParameter::RelaxationTime => Parameter::RelaxationTime,
-        FitParameter::RetardationTime => Parameter::RetardationTime,
-        FitParameter::Kappa => Parameter::Kappa,
-        FitParameter::ElasticModulus => Parameter::ElasticModulus,
-        FitParameter::Thickness => Parameter::Thickness,
-        FitParameter::Stiffness => Parameter::Stiffness,
-    }
-}
-
 impl FitInput {
     /// Reads the fit under `checker`; `max_points` bounds the number of points.
     pub fn read(&self, checker: &mut Checker, max_points: usize) -> Problem {
@@ -305,7 +293,7 @@ fn read_parameters(
     let mut free = Vec::new();
     let mut all = Vec::new();
     for (parameter, field) in given {
-        let model = checked_as(parameter);
+        let model = parameter.parameter();
         let layer_value = match parameter.of(base) {
             k if parameter == FitParameter::Kappa && k <= 0.0 => 4.0,
             x => x,

@@ -11,6 +11,7 @@ mod output;
 
 use std::collections::BTreeMap;
 
+use nalgebra::DVector;
 use serde_json::{json, Value};
 
 pub use input::{
@@ -25,7 +26,7 @@ use super::input as wire;
 use super::meta::ROLLING_REFERENCES;
 use super::pictures::PictureError;
 use super::{Control, FieldError, JobError, Kind, Limits, Meta, Reference, Validated, Work};
-use crate::model::fit::stats::Analysis;
+use crate::model::fit::stats;
 use crate::model::fit::{self, Datum, FitError, Fitted, Point, Problem, Setting};
 use crate::model::Layer;
 use crate::render::svg::Chart;
@@ -92,7 +93,7 @@ impl Kind for FitJob {
                 .collect(),
             chi_squared: fitted.chi_squared,
             dof: fitted.dof,
-            uncertainties: if self.scaled() {
+            uncertainties: if fitted.scaled {
                 UncertaintySource::FromScatter
             } else {
                 UncertaintySource::Given
@@ -121,11 +122,6 @@ impl FitJob {
         free.iter().map(|p| p.name()).collect()
     }
 
-    /// No point has an uncertainty: the scatter sets them.
-    fn scaled(&self) -> bool {
-        self.problem.data.iter().all(|d| d.uncertainty.is_none())
-    }
-
     /// The data of each series.
     fn series_data(&self) -> impl Iterator<Item = &[Datum]> {
         let mut rest = &self.problem.data[..];
@@ -145,10 +141,11 @@ impl FitJob {
                 indices
                     .into_iter()
                     .map(|i| {
-                        let name = self.problem.parameterization.free[i].name();
+                        let parameter = self.problem.parameterization.free[i];
+                        let name = parameter.name();
                         let field = format!("parameters.{name}");
                         let allowed = "a parameter some measured point depends on".to_string();
-                        let hint = if name.ends_with("_time") || name == "kappa" {
+                        let hint = if parameter.is_time_scale() {
                             " (a time has no effect when every point is at rest, V = 0)"
                         } else {
                             ""
@@ -177,7 +174,7 @@ impl FitJob {
             .enumerate()
             .map(|(j, (parameter, bounds))| {
                 let value = fitted.values[j];
-                let se = standard_error(a, j);
+                let se = a.standard_errors[j];
                 let half = se.map(|se| a.coverage_factor * se);
                 let on = |bound: f64| (value / bound).ln().abs() < 1e-9;
                 let estimate = Estimate {
@@ -233,13 +230,13 @@ impl FitJob {
         let names = self.names();
         let a = &fitted.analysis;
         let determined: Vec<&str> = (0..names.len())
-            .filter(|&j| standard_error(a, j).is_some())
+            .filter(|&j| a.standard_errors[j].is_some())
             .map(|j| names[j])
             .collect();
         let undetermined: Vec<Undetermined> = a
             .null_directions
             .iter()
-            .map(|v| undetermined(&names, v.as_slice()))
+            .map(|v| undetermined(&names, v))
             .collect();
         let identifiable = determined.len() == names.len();
         let message = if identifiable {
@@ -278,25 +275,10 @@ impl FitJob {
     }
 }
 
-/// The largest half-width of an interval in ln value: e^300 is near the end of double
-/// precision.
-const MAX_LN_HALF_WIDTH: f64 = 300.0;
-
-/// The standard error of ln p_j, if the data determine p_j: alone, and within an interval
-/// double precision can hold.
-fn standard_error(a: &Analysis, j: usize) -> Option<f64> {
-    a.standard_errors[j].filter(|&se| a.coverage_factor * se < MAX_LN_HALF_WIDTH)
-}
-
-/// A component below this in a null direction does not involve its parameter.
-const INVOLVED: f64 = 1e-3;
-
 /// The combination of `names` that the null direction `v` (in their logarithms) leaves free.
-fn undetermined(names: &[&'static str], v: &[f64]) -> Undetermined {
-    let largest = v.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
-    let involved: Vec<usize> = (0..v.len())
-        .filter(|&j| v[j].abs() > INVOLVED * largest)
-        .collect();
+fn undetermined(names: &[&'static str], v: &DVector<f64>) -> Undetermined {
+    let largest = v.amax();
+    let involved = stats::involved(v);
     let round = |x: f64| (x / largest * 1e4).round() / 1e4;
     let direction: BTreeMap<&'static str, f64> =
         involved.iter().map(|&j| (names[j], round(v[j]))).collect();

@@ -15,7 +15,7 @@ pub use forward::{Measured, Point, Sensitivity, Setting};
 
 use nalgebra::{DMatrix, DVector};
 
-use super::{Layer, ModelError};
+use super::{Layer, ModelError, Parameter};
 use lm::{Evaluation, LeastSquares};
 use stats::Analysis;
 
@@ -60,15 +60,24 @@ impl FitParameter {
         }
     }
 
-    /// The SI unit ("" for κ).
-    pub fn unit(self) -> &'static str {
+    /// The model's parameter its values are read and checked as (its unit, its range).
+    pub fn parameter(self) -> Parameter {
         match self {
-            FitParameter::RelaxationTime | FitParameter::RetardationTime => "s",
-            FitParameter::Kappa => "",
-            FitParameter::ElasticModulus => "Pa",
-            FitParameter::Thickness => "m",
-            FitParameter::Stiffness => "Pa/m",
+            FitParameter::RelaxationTime => Parameter::RelaxationTime,
+            FitParameter::RetardationTime => Parameter::RetardationTime,
+            FitParameter::Kappa => Parameter::Kappa,
+            FitParameter::ElasticModulus => Parameter::ElasticModulus,
+            FitParameter::Thickness => Parameter::Thickness,
+            FitParameter::Stiffness => Parameter::Stiffness,
         }
+    }
+
+    /// Whether it sets a time scale of the layer, which points at rest cannot show.
+    pub fn is_time_scale(self) -> bool {
+        matches!(
+            self,
+            FitParameter::RelaxationTime | FitParameter::RetardationTime | FitParameter::Kappa
+        )
     }
 
     /// The parameter's value in `layer`.
@@ -156,6 +165,14 @@ pub struct Datum {
     pub uncertainty: Option<f64>,
 }
 
+impl Datum {
+    /// The residual's scale: the uncertainty, or 1 when none is known (the scatter of the
+    /// residuals then sets the scale, [`stats::analyse`]).
+    fn sigma(&self) -> f64 {
+        self.uncertainty.unwrap_or(1.0)
+    }
+}
+
 /// Where a free parameter starts and the box it stays in (SI, all positive).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Bounds {
@@ -203,6 +220,8 @@ pub struct Fitted {
     pub analysis: Analysis,
     pub chi_squared: f64,
     pub dof: usize,
+    /// No datum had an uncertainty: the covariance was scaled by χ²/dof.
+    pub scaled: bool,
     /// The model's value at each datum.
     pub fitted: Vec<f64>,
     /// Points tried as starts, and the minimisations run from the best of them.
@@ -291,13 +310,14 @@ pub fn fit<E>(
         .data
         .iter()
         .zip(best.residuals.iter())
-        .map(|(d, r)| d.value + r * d.uncertainty.unwrap_or(1.0))
+        .map(|(d, r)| d.value + r * d.sigma())
         .collect();
     Ok(Fitted {
         values: best.x.iter().map(|x| x.exp()).collect(),
         analysis,
         chi_squared: best.cost,
         dof,
+        scaled,
         fitted,
         candidates: candidates.len(),
         starts: starts.len(),
@@ -331,7 +351,7 @@ impl<E> Residuals<'_, E> {
             let Ok(y) = d.point.value(&layer) else {
                 return Ok(None);
             };
-            cost += ((y - d.value) / d.uncertainty.unwrap_or(1.0)).powi(2);
+            cost += ((y - d.value) / d.sigma()).powi(2);
         }
         Ok(cost.is_finite().then_some(cost))
     }
@@ -352,7 +372,7 @@ impl<E> LeastSquares for Residuals<'_, E> {
             let Ok((y, s)) = d.point.value_and_sensitivity(&layer) else {
                 return Ok(None);
             };
-            let weight = 1.0 / d.uncertainty.unwrap_or(1.0);
+            let weight = 1.0 / d.sigma();
             residuals[i] = (y - d.value) * weight;
             let derivatives = self
                 .problem

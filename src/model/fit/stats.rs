@@ -11,13 +11,18 @@ use nalgebra::{DMatrix, DVector};
 const NULL: f64 = 1e-5;
 /// A parameter whose Jacobian column is below this fraction of the largest has no effect.
 const NO_EFFECT: f64 = 1e-9;
-/// A parameter with a component above this in a null direction is not determined alone.
+/// A parameter with a component above this in a (unit) null direction is not determined
+/// alone.
 const INVOLVED: f64 = 1e-3;
+/// The largest half-width of an interval in ln value: e^300 is near the end of double
+/// precision, so a parameter known less well than that is not determined either.
+const MAX_LN_HALF_WIDTH: f64 = 300.0;
 
 /// The uncertainty of the parameters at a minimum (in the coordinates of the Jacobian).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Analysis {
-    /// Standard errors; `None` for a parameter the data do not determine alone.
+    /// Standard errors; `None` for a parameter the data do not determine alone, or so weakly
+    /// that its interval would overflow.
     pub standard_errors: Vec<Option<f64>>,
     /// Correlations of the determined part (1 on the diagonal).
     pub correlation: DMatrix<f64>,
@@ -63,9 +68,17 @@ pub fn analyse(jacobian: &DMatrix<f64>, chi_squared: f64, dof: usize, scaled: bo
         1.0
     };
     covariance *= scale;
-    let determined = |j: usize| null_directions.iter().all(|v| v[j].abs() <= INVOLVED);
+    let coverage_factor = if scaled {
+        t_quantile_975(dof.max(1))
+    } else {
+        Z_975
+    };
+    let in_null_space = |j: usize| null_directions.iter().any(|v| involved(v).contains(&j));
     let standard_errors = (0..m)
-        .map(|j| determined(j).then(|| covariance[(j, j)].max(0.0).sqrt()))
+        .map(|j| {
+            let se = covariance[(j, j)].max(0.0).sqrt();
+            (!in_null_space(j) && coverage_factor * se < MAX_LN_HALF_WIDTH).then_some(se)
+        })
         .collect();
     let correlation = DMatrix::from_fn(m, m, |i, j| {
         let d = (covariance[(i, i)] * covariance[(j, j)]).sqrt();
@@ -82,12 +95,15 @@ pub fn analyse(jacobian: &DMatrix<f64>, chi_squared: f64, dof: usize, scaled: bo
         correlation,
         null_directions,
         no_effect,
-        coverage_factor: if scaled {
-            t_quantile_975(dof.max(1))
-        } else {
-            Z_975
-        },
+        coverage_factor,
     }
+}
+
+/// The parameters a null direction moves (the indices of its components above [`INVOLVED`]).
+pub fn involved(direction: &DVector<f64>) -> Vec<usize> {
+    (0..direction.len())
+        .filter(|&j| direction[j].abs() > INVOLVED)
+        .collect()
 }
 
 /// The directions orthogonal to the rows of `v_t` (a thin SVD of a wide matrix).
