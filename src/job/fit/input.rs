@@ -384,10 +384,14 @@ fn read_one(s: &SeriesInput, c: &mut Checker, data: &mut Vec<Datum>) {
     let series = match &s.system {
         Some(system) => {
             for field in [field!(s.radius), field!(s.load)] {
-                refuse(c, field, "absent: a three-body series gives `total_load`");
+                refuse(
+                    c,
+                    field,
+                    "none: a three-body series gives `total_load` instead",
+                );
             }
             if quantity != MeasuredQuantity::FrictionCoefficient {
-                let allowed = "friction_coefficient: a three-body series measures the system's";
+                let allowed = "friction_coefficient: a three-body series measures the system's friction coefficient";
                 c.invalid("quantity", json!(quantity), allowed);
             }
             let (system, options) = read_system(system, c);
@@ -399,7 +403,7 @@ fn read_one(s: &SeriesInput, c: &mut Checker, data: &mut Vec<Datum>) {
             refuse(
                 c,
                 field!(s.total_load),
-                "absent: only a series with a `system` has one",
+                "none: only a three-body series (one with a `system`) has a total load",
             );
             Series::Particle {
                 radius: condition(c, field!(s.radius), Parameter::Radius, d.radius),
@@ -448,7 +452,7 @@ impl Series {
                 refuse(
                     c,
                     field!(p.total_load),
-                    "absent: only a series with a `system` has one",
+                    "none: only a three-body series (one with a `system`) has a total load",
                 );
                 Setting::Particle {
                     radius: condition(c, field!(p.radius), Parameter::Radius, radius),
@@ -457,7 +461,11 @@ impl Series {
             }
             Series::System(system, options, total_load) => {
                 for field in [field!(p.radius), field!(p.load)] {
-                    refuse(c, field, "absent: a three-body series gives `total_load`");
+                    refuse(
+                        c,
+                        field,
+                        "none: a three-body series gives `total_load` instead",
+                    );
                 }
                 let why = "for each point of a three-body series, or for the series";
                 let total_load = match total_load {
@@ -486,17 +494,17 @@ fn read_system(input: &ThreeBodyInput, c: &mut Checker) -> (ThreeBody, ThreeBody
         (
             "layer",
             input.layer.is_some(),
-            "absent: the fit's `layer` is the system's",
+            "none: the fit's own `layer` is the system's layer",
         ),
         (
             "velocity",
             input.velocity.is_some(),
-            "absent: each point gives its `velocity`",
+            "none: each point gives its own `velocity`",
         ),
         (
             "operating",
             input.operating.is_some(),
-            "absent: each point gives its `total_load`",
+            "none: each point gives its own `total_load`",
         ),
     ];
     for (name, given, allowed) in set {
@@ -566,17 +574,23 @@ fn check_counts(problem: &Problem, input: &FitInput, checker: &mut Checker) {
         // Without uncertainties the scatter needs one point more than the parameters.
         let needed = if with == 0 { m + 1 } else { m };
         if problem.data.len() < needed {
+            let without = if with == 0 {
+                " without uncertainties"
+            } else {
+                ""
+            };
             let allowed = format!(
-                "at least {needed} points to fit {m} parameters{}",
-                if with == 0 {
-                    " without uncertainties"
-                } else {
-                    ""
-                }
+                "at least {needed} points to fit {m} parameter{}{without}, but {} given",
+                if m == 1 { "" } else { "s" },
+                problem.data.len()
             );
             checker.invalid("series", json!(problem.data.len()), &allowed);
         } else if conditions.len() < m {
-            let allowed = format!("points at {m} distinct conditions (radius, load, velocity, quantity) at least, to fit {m} parameters; all points are at {}", conditions.len());
+            let allowed = format!(
+                "points at {m} or more distinct conditions (radius, load or total load, \
+                 velocity, quantity) to fit {m} parameters, but all are at {}",
+                conditions.len()
+            );
             checker.invalid("series", json!(conditions.len()), &allowed);
         }
     }
