@@ -116,7 +116,7 @@ fn a_kind_of_unknown_size_runs_and_stops_on_cancel_and_deadline() {
     let answer = engine::run(&job, &Control::new(None, 1)).unwrap();
     let out: CountdownOutput = answer.downcast().unwrap();
     assert_eq!(out.steps, 5);
-    assert_eq!(out.meta.input, json!({"steps": 5}));
+    assert_eq!(out.meta.input.get(), json!({"steps": 5}).to_string());
 
     let long = Job::new(Countdown { steps: 1_000_000 });
     let late = Control::new(Some(Instant::now() + Duration::from_millis(20)), 1);

@@ -30,12 +30,13 @@ impl Budget {
 }
 
 /// Bytes an entry of a map costs beyond its key and value: the map's own bookkeeping, the
-/// allocations' headers, the eviction policy's records (measured for moka at ~200 bytes).
+/// allocations' headers, the eviction policy's records (measured for moka at ~200 bytes, and
+/// kept as an upper bound for the maps of [`super::bounded`]).
 pub const ENTRY_OVERHEAD: u64 = 256;
 
-/// A weight for moka (u32), saturating.
-pub fn weight(bytes: u64) -> u32 {
-    u32::try_from(bytes.saturating_add(ENTRY_OVERHEAD)).unwrap_or(u32::MAX)
+/// The weight of an entry holding `bytes`: with its overhead.
+pub fn weight(bytes: u64) -> u64 {
+    bytes.saturating_add(ENTRY_OVERHEAD)
 }
 
 #[cfg(test)]

@@ -5,14 +5,13 @@
 use std::sync::{Arc, OnceLock};
 use std::time::{Duration, Instant};
 
-use async_trait::async_trait;
-use bytes::Bytes;
-use moka::future::Cache;
-
+use super::bounded::Bounded;
 use super::budget;
 use crate::job::registry;
 use crate::job::JobError;
 use crate::render::{draw_svg, Answer, Format, RenderError};
+use async_trait::async_trait;
+use bytes::Bytes;
 
 /// A solved job as it is kept and sent: its JSON rendered once (a cache hit then costs no
 /// serialization: measured in BENCHMARKS.md, rendering a rolling answer costs more than a
@@ -137,7 +136,7 @@ pub trait ResultCache: Send + Sync {
 /// The cache of one process, bounded in bytes and in time.
 #[derive(Clone)]
 pub struct MemoryCache {
-    cache: Cache<String, Arc<Solved>, super::KeyHasher>,
+    cache: Arc<Bounded<Arc<Solved>>>,
 }
 
 impl MemoryCache {
@@ -151,12 +150,10 @@ impl MemoryCache {
 
     /// Holds at most about `max_bytes` of answers, each for at most `ttl`.
     pub fn new(max_bytes: u64, ttl: Duration) -> Self {
+        // A rolling answer, the commonest, weighs about 16 kB.
+        let weigh = |solved: &Arc<Solved>| solved.weight();
         MemoryCache {
-            cache: Cache::builder()
-                .max_capacity(max_bytes)
-                .weigher(|_, solved: &Arc<Solved>| budget::weight(solved.weight()))
-                .time_to_live(ttl)
-                .build_with_hasher(super::KeyHasher::default()),
+            cache: Arc::new(Bounded::new(max_bytes, ttl, 16 << 10, weigh)),
         }
     }
 }
@@ -164,10 +161,10 @@ impl MemoryCache {
 #[async_trait]
 impl ResultCache for MemoryCache {
     async fn get(&self, key: &str) -> Option<Arc<Solved>> {
-        self.cache.get(key).await
+        self.cache.get(key)
     }
 
     async fn insert(&self, solved: Arc<Solved>) {
-        self.cache.insert(solved.key.clone(), solved).await;
+        self.cache.insert(solved.key.clone(), solved);
     }
 }

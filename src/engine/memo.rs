@@ -4,20 +4,18 @@
 
 use std::time::Duration;
 
-use moka::sync::Cache;
-
-use super::budget;
+use super::bounded::Bounded;
 use crate::job::{Kept, Memo};
 
 /// Solved points by key, bounded in bytes and in time.
 pub struct PointMemo {
-    points: Cache<String, (Kept, u32), super::KeyHasher>,
+    points: Bounded<(Kept, u32)>,
 }
 
 impl std::fmt::Debug for PointMemo {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("PointMemo")
-            .field("entries", &self.points.entry_count())
+            .field("entries", &self.points.len())
             .finish()
     }
 }
@@ -25,14 +23,10 @@ impl std::fmt::Debug for PointMemo {
 impl PointMemo {
     /// Holds about `max_bytes` of points, each for at most `ttl`.
     pub fn new(max_bytes: u64, ttl: Duration) -> Self {
+        // A point of a rolling sweep, the commonest, weighs about 1 kB.
+        let weigh = |(_, bytes): &(Kept, u32)| u64::from(*bytes);
         PointMemo {
-            points: Cache::builder()
-                .max_capacity(max_bytes)
-                .weigher(|key: &String, (_, bytes): &(Kept, u32)| {
-                    budget::weight(key.len() as u64 + u64::from(*bytes))
-                })
-                .time_to_live(ttl)
-                .build_with_hasher(super::KeyHasher::default()),
+            points: Bounded::new(max_bytes, ttl, 1 << 10, weigh),
         }
     }
 }

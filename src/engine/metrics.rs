@@ -89,6 +89,20 @@ impl Metrics {
         self.recorder
             .register_histogram(&key(name, labels), &METADATA)
     }
+
+    /// [`Metrics::histogram`] for labels whose values are fixed texts, which are then not
+    /// copied: the solve histogram is looked up on every solve.
+    pub fn fixed_histogram(
+        &self,
+        name: &'static str,
+        labels: &[(&'static str, &'static str)],
+    ) -> Histogram {
+        let labels = labels.iter().map(|&(k, v)| Label::from_static_parts(k, v));
+        self.recorder.register_histogram(
+            &Key::from_parts(name, labels.collect::<Vec<_>>()),
+            &METADATA,
+        )
+    }
 }
 
 fn key(name: &'static str, labels: &[(&'static str, &str)]) -> Key {

@@ -6,6 +6,7 @@
 //! the place of the in-process ones.
 
 mod background;
+mod bounded;
 mod budget;
 pub mod cache;
 mod coalesce;
@@ -22,10 +23,11 @@ pub use service::{CacheStatus, Engine, EngineConfig, EngineError, Storage};
 use crate::job::{Control, Job, JobError};
 use crate::render::Answer;
 
-/// The hasher of the engine's in-process maps (answers, input keys, sweep points). Their keys
-/// churn at the request rate and moka rehashes its table as entries come and go: with
-/// SipHash that was a tenth of an uncached request's CPU. foldhash is seeded per process, so
-/// keys cannot be chosen to collide without knowing the seed.
+/// The hasher of the engine's in-process maps (answers, input keys, sweep points) and of the
+/// doorkeeper. Their keys churn at the request rate: with SipHash, hashing was a tenth of an
+/// uncached request's CPU (under moka, which rehashed its table as entries came and went).
+/// foldhash is seeded per process, so keys cannot be chosen to collide without knowing the
+/// seed.
 type KeyHasher = foldhash::fast::RandomState;
 
 /// Runs `job` to its answer, or until `control` stops it.

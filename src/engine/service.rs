@@ -16,6 +16,7 @@ use tracing::Instrument;
 use uuid::Uuid;
 
 use super::background::Background;
+use super::bounded::Bounded;
 use super::budget::{self, Budget};
 use super::cache::{Claim, MemoryCache, ResultCache, Solved};
 use super::coalesce::Coalescer;
@@ -208,7 +209,7 @@ pub struct Engine {
     coalescer: Coalescer,
     /// The text of valid inputs (their kind and compact JSON with sorted keys) → their
     /// cache key, so that a repeated request is answered without being validated again.
-    input_keys: moka::future::Cache<String, String, super::KeyHasher>,
+    input_keys: Bounded<Arc<str>>,
     /// Which inputs were seen once: the memo takes an input on its second sighting.
     doorkeeper: Doorkeeper,
     /// Solved points of sweeps, for a retry after a deadline.
@@ -260,13 +261,13 @@ impl Engine {
             pool: Pool::new(config.pool_size),
             cache: storage.cache,
             coalescer: Coalescer::default(),
-            input_keys: moka::future::Cache::builder()
-                .max_capacity(Budget::split(config.memory_budget).inputs)
-                .weigher(|input: &String, key: &String| {
-                    budget::weight((input.len() + key.len()) as u64)
-                })
-                .time_to_live(config.cache_ttl)
-                .build_with_hasher(super::KeyHasher::default()),
+            // An input and its key weigh about 100 bytes, and the entry's overhead more.
+            input_keys: Bounded::new(
+                Budget::split(config.memory_budget).inputs,
+                config.cache_ttl,
+                budget::ENTRY_OVERHEAD,
+                |key: &Arc<str>| key.len() as u64,
+            ),
             doorkeeper: Doorkeeper::new(
                 Budget::split(config.memory_budget).inputs / budget::ENTRY_OVERHEAD,
             ),
@@ -313,7 +314,7 @@ impl Engine {
     /// Refused while draining, like every other call for an answer.
     pub async fn cached_input(&self, text: &str) -> Result<Option<Arc<Solved>>, EngineError> {
         self.admit()?;
-        let Some(key) = self.input_keys.get(text).await else {
+        let Some(key) = self.input_keys.get(text) else {
             return Ok(None);
         };
         let solved = self.cache.get(&key).await;
@@ -325,9 +326,9 @@ impl Engine {
 
     /// Remembers that the input `text` (as for [`Engine::cached_input`]) is a valid job
     /// with cache key `key`, if it was seen before ([`Doorkeeper`]).
-    pub async fn remember_input(&self, text: String, key: String) {
+    pub fn remember_input(&self, text: String, key: String) {
         if self.doorkeeper.seen_before(&text) {
-            self.input_keys.insert(text, key).await;
+            self.input_keys.insert(text, key.into());
         }
     }
 
@@ -697,7 +698,7 @@ impl Engine {
             Err(_) => "failed",
         };
         self.metrics
-            .histogram(
+            .fixed_histogram(
                 names::SOLVE_DURATION,
                 &[("kind", kind), ("outcome", outcome)],
             )
@@ -760,9 +761,9 @@ mod tests {
         };
         let engine = Engine::new(config, Metrics::noop());
         let input = "rolling\n{\"load\":1e-9}";
-        engine.remember_input(input.into(), "key".into()).await;
-        assert_eq!(engine.input_keys.get(input).await, None);
-        engine.remember_input(input.into(), "key".into()).await;
-        assert_eq!(engine.input_keys.get(input).await.as_deref(), Some("key"));
+        engine.remember_input(input.into(), "key".into());
+        assert_eq!(engine.input_keys.get(input), None);
+        engine.remember_input(input.into(), "key".into());
+        assert_eq!(engine.input_keys.get(input).as_deref(), Some("key"));
     }
 }

@@ -110,7 +110,7 @@ pub struct Meta {
     pub input_hash: String,
     /// The input as understood: defaults filled in, SI numbers.
     #[schema(value_type = Object)]
-    pub input: Value,
+    pub input: Canonical,
     /// The papers behind the numbers.
     #[serde(serialize_with = "references_json")]
     #[schema(value_type = Vec<Reference>)]
@@ -122,6 +122,34 @@ pub struct Meta {
     #[serde(serialize_with = "units_map")]
     #[schema(value_type = std::collections::BTreeMap<String, String>)]
     pub units: Units,
+}
+
+/// A canonical input as its JSON text (keys sorted, no `null`), the text its hash is taken
+/// of. Kept as text rather than as a [`Value`]: an answer then writes its input by copying,
+/// and a cached answer holds one string rather than a tree of maps and keys, which cost more
+/// to free when the answer is pushed out than the rest of the answer (BENCHMARKS.md,
+/// issue 12).
+#[derive(Clone, Debug, Serialize)]
+#[serde(transparent)]
+pub struct Canonical(Box<RawValue>);
+
+impl Canonical {
+    /// The canonical text of `input`.
+    pub fn new(input: &Value) -> Canonical {
+        Canonical(serde_json::value::to_raw_value(input).expect("a JSON value writes as JSON"))
+    }
+
+    /// The JSON text.
+    pub fn get(&self) -> &str {
+        self.0.get()
+    }
+}
+
+/// Equal texts, equal inputs: the form is canonical.
+impl PartialEq for Canonical {
+    fn eq(&self, other: &Canonical) -> bool {
+        self.get() == other.get()
+    }
 }
 
 /// The groups of units as one object (groups may share entries, as the two kinds of sweep
@@ -191,11 +219,12 @@ impl Meta {
         warnings: Vec<InputWarning>,
         units: Units,
     ) -> Self {
+        let input = Canonical::new(&canonical);
         Meta {
             model_version: MODEL_VERSION,
             software: SOFTWARE,
-            input_hash: input_hash(kind, &canonical, &warnings),
-            input: canonical,
+            input_hash: input_hash(kind, input.get(), &warnings),
+            input,
             references,
             warnings,
             units,
@@ -221,13 +250,13 @@ pub fn provenance(input_hash: &str) -> String {
 /// Hex SHA-256 of `model version \n kind \n canonical JSON` (keys sorted, shortest floats),
 /// followed by the input's warnings if it raised any: an answer that carries warnings is
 /// another answer than the same input's without them.
-pub fn input_hash(kind: &str, canonical: &Value, warnings: &[InputWarning]) -> String {
+pub fn input_hash(kind: &str, canonical: &str, warnings: &[InputWarning]) -> String {
     let mut hasher = Sha256::new();
     hasher.update(MODEL_VERSION.as_bytes());
     hasher.update(b"\n");
     hasher.update(kind.as_bytes());
     hasher.update(b"\n");
-    hasher.update(canonical.to_string().as_bytes());
+    hasher.update(canonical.as_bytes());
     for warning in warnings {
         hasher.update(b"\n");
         hasher.update(warning.message.as_bytes());

@@ -9,6 +9,7 @@ pub mod svg;
 mod table;
 
 use std::any::Any;
+use std::cell::RefCell;
 use std::fmt;
 
 use serde::{Serialize, Serializer};
@@ -120,7 +121,7 @@ impl<T: Output> Render for T {
         if pretty {
             serde_json::to_vec_pretty(self)
         } else {
-            serde_json::to_vec(self)
+            scratch(|buffer| serde_json::to_writer(buffer, self))
         }
     }
 
@@ -139,6 +140,37 @@ impl<T: Output> Render for T {
     fn same(&self, other: &dyn Any) -> bool {
         other.downcast_ref::<T>() == Some(self)
     }
+}
+
+thread_local! {
+    /// A buffer each thread writes answers into, kept between answers.
+    static SCRATCH: RefCell<Vec<u8>> = const { RefCell::new(Vec::new()) };
+}
+
+/// Buffers larger than this are not kept for the next answer.
+const SCRATCH_KEPT: usize = 64 << 10;
+
+/// What `write` writes, copied out of this thread's scratch buffer into a vector of its exact
+/// size. Written into a fresh vector, a 7 kB rolling answer grew through seven reallocations
+/// and their copies, and the large ones made the allocator consolidate its free lists: on an
+/// uncached request's path (BENCHMARKS.md, issue 12). An answer written while another is
+/// (one holding the other) gets a fresh vector.
+fn scratch(
+    write: impl FnOnce(&mut Vec<u8>) -> serde_json::Result<()>,
+) -> serde_json::Result<Vec<u8>> {
+    SCRATCH.with(|cell| {
+        let Ok(mut buffer) = cell.try_borrow_mut() else {
+            let mut fresh = Vec::new();
+            write(&mut fresh)?;
+            return Ok(fresh);
+        };
+        buffer.clear();
+        let written = write(&mut buffer).map(|()| buffer.to_vec());
+        if buffer.capacity() > SCRATCH_KEPT {
+            *buffer = Vec::new();
+        }
+        written
+    })
 }
 
 /// Draws an answer from its JSON (each job kind has its own).
@@ -324,5 +356,44 @@ mod tests {
         assert!(bad.render(Format::Json).is_err());
         assert!(bad.render(Format::Csv).is_err());
         assert!(bad.to_pretty_json().is_err());
+    }
+
+    /// An answer holding another.
+    #[derive(Debug, PartialEq, Serialize)]
+    struct Holder {
+        inner: Answer,
+        points: Vec<f64>,
+    }
+
+    impl Output for Holder {
+        const UNITS: Units = &[];
+
+        fn table(&self) -> Table {
+            const COLUMNS: [Column<f64>; 1] = [Column::number("x", "m", |x| *x)];
+            Table::new(&COLUMNS, &self.points)
+        }
+    }
+
+    #[test]
+    fn an_answer_written_while_another_is_and_one_larger_than_the_scratch_kept_render_whole() {
+        let holder = Answer::new(Holder {
+            inner: Answer::new(Point { x: 0.5 }),
+            points: vec![0.25; 2],
+        });
+        let json = holder.render(Format::Json).unwrap();
+        assert_eq!(json, br#"{"inner":{"x":0.5},"points":[0.25,0.25]}"#);
+        assert_eq!(json.capacity(), json.len());
+        let large = Answer::new(Holder {
+            inner: Answer::new(Point { x: 1.0 }),
+            points: vec![0.125; 20_000],
+        });
+        let json = large.render(Format::Json).unwrap();
+        assert!(json.len() > SCRATCH_KEPT);
+        assert!(json.ends_with(b",0.125]}"));
+        SCRATCH.with_borrow(|buffer| assert!(buffer.capacity() <= SCRATCH_KEPT));
+        assert_eq!(
+            holder.render(Format::Json).unwrap(),
+            br#"{"inner":{"x":0.5},"points":[0.25,0.25]}"#
+        );
     }
 }

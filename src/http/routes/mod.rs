@@ -263,7 +263,7 @@ impl SolveRequest {
             Ok((job, meta))
         })
         .await?;
-        engine.remember_input(text, meta.input_hash.clone()).await;
+        engine.remember_input(text, meta.input_hash.clone());
         self.answering.solve(state, job, meta).await
     }
 }

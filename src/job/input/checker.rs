@@ -2,6 +2,7 @@
 //! against its range, every bad field recorded with its path and its value as sent.
 
 use std::collections::{HashMap, HashSet};
+use std::rc::Rc;
 
 use serde_json::{json, Value};
 
@@ -18,18 +19,51 @@ enum Source {
     Option(SolveOption),
 }
 
+/// Where a field was read: the object holding it, its name, and its item if it is a list.
+/// Its path as text is built only for a report: building one for every field read was a
+/// tenth of an uncached request's allocations (BENCHMARKS.md, issue 12).
+#[derive(Clone, Debug)]
+struct Location {
+    object: Rc<str>,
+    field: &'static str,
+    item: Option<usize>,
+}
+
+impl Location {
+    /// The field's path (`layer.thickness`, `radius[2]`).
+    fn path(&self) -> String {
+        let mut path = join(&self.object, self.field);
+        if let Some(i) = self.item {
+            path.push_str(&format!("[{i}]"));
+        }
+        path
+    }
+}
+
+/// The path of `field` in the object at `object` (`""`: the object itself).
+fn join(object: &str, field: &str) -> String {
+    if object.is_empty() {
+        field.to_string()
+    } else if field.is_empty() {
+        object.to_string()
+    } else {
+        format!("{object}.{field}")
+    }
+}
+
 /// Collects the errors of one input while its fields are read.
 #[derive(Debug, Default)]
 pub struct Checker {
     /// Path of the object being read (`""` at the top, `layer`, `base.layer`...).
-    prefix: String,
+    prefix: Rc<str>,
     errors: Vec<FieldError>,
-    /// Each quantity read, by path: the value as sent.
+    /// The quantities read whose value as sent is not their SI number (text with units),
+    /// by path.
     sent: HashMap<String, Value>,
     /// The paths of the fields reported (a field reported once is not reported again).
     reported: HashSet<String>,
     /// Where each model parameter and option was read (the first place).
-    paths: Vec<(Source, String)>,
+    paths: Vec<(Source, Location)>,
     warnings: Vec<InputWarning>,
     /// Errors found past [`MAX_ERRORS`].
     omitted: usize,
@@ -45,12 +79,15 @@ impl Checker {
 
     /// The full path of `field` in the object being read (`""`: the object itself).
     pub fn path(&self, field: &str) -> String {
-        if self.prefix.is_empty() {
-            field.to_string()
-        } else if field.is_empty() {
-            self.prefix.clone()
-        } else {
-            format!("{}.{field}", self.prefix)
+        join(&self.prefix, field)
+    }
+
+    /// Where `field` of the object being read is.
+    fn at(&self, field: &'static str) -> Location {
+        Location {
+            object: self.prefix.clone(),
+            field,
+            item: None,
         }
     }
 
@@ -60,7 +97,7 @@ impl Checker {
         field: Field<'a, T>,
         read: impl FnOnce(&mut Checker, &T) -> R,
     ) -> R {
-        let inner = self.path(field.name);
+        let inner = self.path(field.name).into();
         let outer = std::mem::replace(&mut self.prefix, inner);
         let object = field.value.cloned().unwrap_or_default();
         let result = read(self, &object);
@@ -77,16 +114,16 @@ impl Checker {
         item: &T,
         read: impl FnOnce(&mut Checker, &T) -> R,
     ) -> R {
-        let inner = self.path(&format!("{list}[{index}]"));
+        let inner = self.path(&format!("{list}[{index}]")).into();
         let outer = std::mem::replace(&mut self.prefix, inner);
         let result = read(self, item);
         self.prefix = outer;
         result
     }
 
-    fn remember(&mut self, source: Source, path: &str) {
+    fn remember(&mut self, source: Source, at: &Location) {
         if !self.paths.iter().any(|(s, _)| *s == source) {
-            self.paths.push((source, path.to_string()));
+            self.paths.push((source, at.clone()));
         }
     }
 
@@ -98,9 +135,9 @@ impl Checker {
 
     /// [`Checker::quantity`] for a field that may be absent.
     pub fn optional(&mut self, field: Field<Quantity>, parameter: Parameter) -> Option<f64> {
-        let path = self.path(field.name);
-        self.remember(Source::Parameter(parameter), &path);
-        Some(self.read(path, field.value?, parameter))
+        let at = self.at(field.name);
+        self.remember(Source::Parameter(parameter), &at);
+        Some(self.read(&at, field.value?, parameter))
     }
 
     /// [`Checker::optional`] for a field the object needs (`why` says when).
@@ -116,8 +153,7 @@ impl Checker {
     /// A count such as a number of nodes, the solver `option` (its range is the model's to
     /// check, see [`Checker::options`]).
     pub fn count(&mut self, field: Field<usize>, option: SolveOption) -> Option<usize> {
-        let path = self.path(field.name);
-        self.remember(Source::Option(option), &path);
+        self.remember(Source::Option(option), &self.at(field.name));
         field.value.copied()
     }
 
@@ -141,42 +177,54 @@ impl Checker {
             self.invalid(field.name, json!(values.len()), &allowed);
             return Vec::new();
         }
-        let path = self.path(field.name);
+        let list = self.at(field.name);
         values
             .iter()
             .enumerate()
             .map(|(i, q)| {
-                let item = format!("{path}[{i}]");
-                let x = self.read(item.clone(), q, parameter);
+                let at = Location {
+                    item: Some(i),
+                    ..list.clone()
+                };
+                let x = self.read(&at, q, parameter);
                 if let Err(e) = parameter.check(x) {
-                    self.out_of_range_at(item, x, parameter.unit(), &e.allowed);
+                    self.out_of_range_at(at.path(), x, parameter.unit(), &e.allowed);
                 }
                 x
             })
             .collect()
     }
 
-    /// Reads one quantity at `path`.
-    fn read(&mut self, path: String, quantity: &Quantity, parameter: Parameter) -> f64 {
-        self.sent.insert(path.clone(), quantity.sent());
-        let dimension = dimension(parameter);
+    /// Reads one quantity at `at`.
+    fn read(&mut self, at: &Location, quantity: &Quantity, parameter: Parameter) -> f64 {
         let parsed = match quantity {
             Quantity::Number(x) => {
                 if let Some(message) = implausible(parameter, *x) {
+                    let path = at.path();
                     let message = format!("{path}: {message}");
                     self.warnings.push(InputWarning {
-                        field: path.clone(),
+                        field: path,
                         value: quantity.sent(),
                         message,
                     });
                 }
                 Ok(*x)
             }
-            Quantity::Text(text) => parse_quantity(text, dimension),
+            Quantity::Text(text) => parse_quantity(text, dimension(parameter)),
         };
         // -0 is 0: one value, one canonical form, one cache key.
-        parsed.map(super::si).unwrap_or_else(|e| {
-            self.unreadable(path, quantity.sent(), dimension, &e);
+        let read = parsed.map(super::si);
+        // A report of a value out of range shows it as sent, or as its SI number when that
+        // is how it was sent.
+        let as_sent = match (quantity, &read) {
+            (Quantity::Number(x), Ok(si)) => x.to_bits() == si.to_bits(),
+            _ => false,
+        };
+        if !as_sent {
+            self.sent.insert(at.path(), quantity.sent());
+        }
+        read.unwrap_or_else(|e| {
+            self.unreadable(at.path(), quantity.sent(), dimension(parameter), &e);
             f64::NAN
         })
     }
@@ -247,7 +295,7 @@ impl Checker {
         self.paths
             .iter()
             .find(|(s, _)| *s == source)
-            .map_or_else(name, |(_, p)| p.clone())
+            .map_or_else(name, |(_, at)| at.path())
     }
 
     /// Records the model's range violations, each at the field its parameter was read from.
