@@ -2,6 +2,12 @@
 //! (`meta.software.commit`, the `X-Software-Commit` header, `thirdbody solve --provenance`).
 //! `THIRDBODY_GIT_COMMIT` overrides it (a container build has no `.git`); without either it
 //! is `unknown`.
+//!
+//! On Linux with glibc it also links the binary with packed relative relocations (DT_RELR,
+//! glibc ≥ 2.36, binutils ≥ 2.38; older linkers ignore the flag with a warning): the loader
+//! then applies the executable's 23,000 relocations from a bitmap instead of one 24-byte
+//! record each, which took a fifth of a `thirdbody solve` process's CPU (BENCHMARKS.md,
+//! issue 12). The executable stays position-independent, so ASLR is kept.
 
 use std::process::Command;
 
@@ -13,6 +19,10 @@ fn git(args: &[&str]) -> Option<String> {
 }
 
 fn main() {
+    let var = |name: &str| std::env::var(name).unwrap_or_default();
+    if var("CARGO_CFG_TARGET_OS") == "linux" && var("CARGO_CFG_TARGET_ENV") == "gnu" {
+        println!("cargo:rustc-link-arg-bins=-Wl,-z,pack-relative-relocs");
+    }
     println!("cargo:rerun-if-env-changed=THIRDBODY_GIT_COMMIT");
     let commit = std::env::var("THIRDBODY_GIT_COMMIT")
         .ok()
