@@ -18,7 +18,8 @@ use quick_cache::{OptionsBuilder, Weighter};
 
 use super::budget;
 
-/// Shards of a map, each with its own lock and an equal share of the bytes. An entry heavier
+/// Shards of a map, at most, each with its own lock and an equal share of the bytes (a small
+/// map has fewer: quick_cache gives a shard at least 32 typical entries). An entry heavier
 /// than most of a share is not kept: with 4 shards, one heavier than about a quarter of the
 /// whole bound (keeping it would push out most of the rest anyway).
 const SHARDS: usize = 4;

@@ -430,6 +430,49 @@ mod tests {
         }
     }
 
+    /// Out-of-range values in a list, each reported at its path with its value as sent: as
+    /// text, as a number, and -0 (which reads as 0).
+    #[test]
+    fn a_value_out_of_range_is_reported_at_its_path_as_sent() {
+        let mut checker = Checker::new();
+        let list = vec![
+            Quantity::Text("-5 nm".into()),
+            Quantity::Number(-2.0),
+            Quantity::Number(-0.0),
+            Quantity::Number(1e-8),
+        ];
+        let field = Field {
+            name: "radius",
+            value: Some(&list),
+        };
+        let read = checker.nested(
+            Field {
+                name: "base",
+                value: Some(&()),
+            },
+            |checker, _| checker.list(field, Parameter::Radius, 1e-8, 10),
+        );
+        assert_eq!(read[..2], [-5e-9, -2.0]);
+        let JobError::Invalid(errors) = checker.into_error() else {
+            panic!("not invalid");
+        };
+        let reported: Vec<_> = errors
+            .iter()
+            .map(|e| (e.field.as_str(), e.value.to_string()))
+            .collect();
+        assert_eq!(
+            reported,
+            [
+                ("base.radius[0]", "\"-5 nm\"".to_string()),
+                ("base.radius[1]", "-2.0".to_string()),
+                ("base.radius[2]", "-0.0".to_string()),
+            ]
+        );
+        assert!(errors[0]
+            .message
+            .starts_with("base.radius[0] = \"-5 nm\" (-5e-9 m)"));
+    }
+
     #[test]
     fn every_parameter_has_the_dimension_of_its_unit() {
         use Parameter::*;
