@@ -245,7 +245,13 @@ fn worker(args: ServeArgs) -> ExitCode {
     runtime.block_on(async {
         let timeout = config.shutdown_timeout;
         let pool_size = config.engine.pool_size;
-        let state = AppState::new(config);
+        let state = match AppState::new(config) {
+            Ok(state) => state,
+            Err(e) => {
+                eprintln!("thirdbody worker: {e}");
+                return ExitCode::FAILURE;
+            }
+        };
         let engine = state.engine();
         engine.start_workers(pool_size, false);
         tracing::info!(workers = pool_size, "taking work from Redis");
@@ -254,8 +260,8 @@ fn worker(args: ServeArgs) -> ExitCode {
         engine
             .finish_jobs(tokio::time::Instant::now() + timeout)
             .await;
-    });
-    ExitCode::SUCCESS
+        ExitCode::SUCCESS
+    })
 }
 
 /// `thirdbody serve`: validates the settings, then serves until SIGTERM or Ctrl-C.
@@ -272,7 +278,8 @@ fn serve(args: ServeArgs) -> ExitCode {
         // The address bound (the port the system chose, for `--bind 127.0.0.1:0`).
         let address = listener.local_addr().unwrap_or(bind);
         tracing::info!(%address, "listening; dashboard at /, API docs at /docs");
-        http::run(listener, AppState::new(config), shutdown_signal())
+        let state = AppState::new(config)?;
+        http::run(listener, state, shutdown_signal())
             .await
             .map_err(|e| format!("the server failed: {e}"))
     });

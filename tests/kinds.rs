@@ -104,8 +104,9 @@ fn engine() -> Arc<Engine> {
         max_jobs: 100,
         cache_ttl: Duration::from_secs(60),
         job_retention: Duration::from_secs(60),
+        spill: None,
     };
-    Engine::new(config, Metrics::noop())
+    Engine::new(config, Metrics::noop()).expect("an engine without a spill directory starts")
 }
 
 #[test]

@@ -148,7 +148,8 @@ fn particles_of_one_size_give_the_single_particle_friction_of_eq_12() {
             &SolveOptions::default(),
         )
         .unwrap();
-        assert!(rel(sol.rolling.mean_load(), load) < 1e-12);
+        let mean_load = sol.rolling.mean_load().expect("particles are in contact");
+        assert!(rel(mean_load, load) < 1e-12);
         assert!(
             rel(
                 sol.rolling.friction_coefficient,
@@ -282,6 +283,68 @@ fn asperities_carry_load_when_the_gap_is_small_and_none_in_the_gap_regime() {
     assert!(at(10e-9).loads.asperities < close.loads.asperities);
 }
 
+/// Asperities whose heights spread over tens of nanometres: they touch beyond the largest
+/// particle (x_max = 65 nm).
+fn tall_asperities() -> Value {
+    json!({"density": 1e11, "tip_radius": "1 um", "height_std": "30 nm", "hardness": "1 GPa"})
+}
+
+#[test]
+fn where_the_asperities_carry_the_load_alone_the_system_is_answered_with_a_warning() {
+    let out: ThreeBodyOutput = run(json!({"kind": "three_body", "input": {
+        "operating": {"separation": "70 nm"}, "asperities": tall_asperities()}}))
+    .unwrap()
+    .downcast()
+    .unwrap();
+    let text = serde_json::to_value(&out).unwrap();
+    assert_eq!(text["particles_in_contact"], 0.0);
+    assert_eq!(text["loads"]["particles"], 0.0);
+    let w = text["loads"]["total"].as_f64().unwrap();
+    assert!(w > 0.0 && w == text["loads"]["asperities"].as_f64().unwrap());
+    // No particle: no means per particle, rather than 0/0.
+    assert!(text.get("per_particle").is_none(), "{text}");
+    let mu = text["friction_coefficient"]["rolling"].as_f64().unwrap();
+    assert!(mu.is_finite() && mu > 0.0);
+    let warned: Vec<&str> = text["meta"]["validity"]["assumptions"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|a| a["status"] == "warn")
+        .map(|a| a["name"].as_str().unwrap())
+        .collect();
+    assert!(warned.contains(&"particles_in_contact") && warned.contains(&"asperity_gap"));
+    let csv = out.table().to_csv();
+    let row = csv.lines().nth(1).unwrap();
+    assert!(
+        row.contains(",,\"warn\""),
+        "the means are empty cells: {row}"
+    );
+}
+
+#[test]
+fn a_three_body_sweep_across_the_asperity_only_regime_answers_every_point() {
+    let out: SweepOutput = run(json!({"kind": "sweep", "input": {"kind": "three_body",
+        "base": {"asperities": tall_asperities()},
+        "vary": {"separation": ["40 nm", "60 nm", "70 nm", "80 nm"]}}}))
+    .unwrap()
+    .downcast()
+    .unwrap();
+    let SweepPoints::ThreeBody(points) = &out.points else {
+        panic!()
+    };
+    assert_eq!(points.len(), 4);
+    // 40 nm squeezes the largest particle beyond the model: that point alone is refused.
+    let reason = points[0].notes.note();
+    assert!(reason.contains("reaches the sphere's radius"), "{reason}");
+    assert!(points[0].result.is_none());
+    for p in &points[1..] {
+        assert!(p.result.is_some(), "{p:?}");
+    }
+    assert!(points[2].result.as_ref().unwrap().per_particle.is_none());
+    assert_eq!(out.meta.summary.counts.refused, 1);
+    assert_eq!(out.meta.summary.counts.warn, 3);
+}
+
 fn run(value: Value) -> Result<Answer, JobError> {
     let job = Job::from_value(value, &Limits::default())?;
     engine::run(&job, &Control::default())
@@ -382,7 +445,7 @@ fn bad_three_body_input_gets_clear_errors() {
         ),
         (
             json!({"operating": {"separation": "70 nm"}}),
-            "no particle is in contact",
+            "nothing is in contact",
         ),
         (
             json!({"operating": {"particle_load": "1 mN"}}),
@@ -415,7 +478,8 @@ fn three_body_sweeps_vary_the_operating_point_speed_and_mean_diameter() {
     single.velocity = 0.0;
     single.diameters = Diameters::with_default_bounds(40e-9, 5e-9);
     let direct = solve3(&single).unwrap();
-    assert_eq!(first.result.state.separation, direct.rolling.separation);
+    let result = first.result.as_ref().expect("the point is answered");
+    assert_eq!(result.state.separation, direct.rolling.separation);
     let csv = out.table().to_csv();
     assert!(csv.starts_with("total_load [N],velocity [m/s],mean_diameter [m],separation [m]"));
     assert_eq!(csv.lines().count(), 9);

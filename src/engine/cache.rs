@@ -23,6 +23,9 @@ pub struct Solved {
     pub key: String,
     /// The job's kind (which draws its picture).
     pub kind: &'static str,
+    /// Whether the answer is whole: a partial one (what a stopped job finished, marked so in
+    /// its `meta`) is never cached, and has no `ETag`.
+    pub complete: bool,
     json: Bytes,
     csv: OnceLock<Bytes>,
     /// The picture, drawn the first time a client asks for it.
@@ -39,6 +42,7 @@ impl Solved {
         Ok(Solved {
             key,
             kind,
+            complete: true,
             json: json.into(),
             csv: OnceLock::new(),
             svg: OnceLock::new(),
@@ -52,11 +56,34 @@ impl Solved {
         Solved {
             key,
             kind,
+            complete: true,
             json,
             csv: OnceLock::from(csv),
             svg: OnceLock::new(),
             answer: None,
         }
+    }
+
+    /// The partial answer of a stopped job (see [`Solved::complete`]).
+    pub fn partial(key: String, kind: &'static str, answer: Answer) -> Result<Solved, JobError> {
+        Ok(Solved {
+            complete: false,
+            ..Solved::new(key, kind, answer)?
+        })
+    }
+
+    /// The same answer as it is kept for a long time: its CSV rendered now and the typed
+    /// answer let go, so that it weighs its two texts and no more.
+    pub fn kept(&self) -> Result<Solved, RenderError> {
+        Ok(Solved {
+            key: self.key.clone(),
+            kind: self.kind,
+            complete: self.complete,
+            json: self.json.clone(),
+            csv: OnceLock::from(self.body(Format::Csv)?),
+            svg: OnceLock::new(),
+            answer: None,
+        })
     }
 
     /// The answer as compact JSON.
@@ -82,21 +109,29 @@ impl Solved {
                 if let Some(svg) = self.svg.get() {
                     return Ok(svg.clone());
                 }
-                let draw = registry::find(self.kind)
-                    .map_err(|e| RenderError::new(e.to_string()))?
-                    .picture();
-                let svg = Bytes::from(draw_svg(draw, &self.json)?);
+                let svg = picture(self.kind, &self.json)?;
                 Ok(self.svg.get_or_init(|| svg).clone())
             }
         }
     }
 
-    /// Bytes held in memory, roughly: the JSON text and the decoded answer (of about the
-    /// same size), the key, and the CSV once rendered (counted ahead: it is smaller than
-    /// the JSON).
+    /// Bytes held in memory, roughly: the JSON text, the CSV (counted ahead, at the JSON's
+    /// size, while it is still to render from the typed answer), the typed answer while it
+    /// is kept (about the JSON's size), and the key.
     pub fn weight(&self) -> u64 {
-        (3 * self.json.len() + self.key.len()) as u64
+        let json = self.json.len();
+        let csv = self.csv.get().map_or(json, Bytes::len);
+        let answer = if self.answer.is_some() { json } else { 0 };
+        (json + csv + answer + self.key.len()) as u64
     }
+}
+
+/// The picture of an answer of `kind` from its JSON.
+pub fn picture(kind: &str, json: &[u8]) -> Result<Bytes, RenderError> {
+    let draw = registry::find(kind)
+        .map_err(|e| RenderError::new(e.to_string()))?
+        .picture();
+    draw_svg(draw, json).map(Bytes::from)
 }
 
 fn internal(e: RenderError) -> JobError {

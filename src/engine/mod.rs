@@ -16,6 +16,7 @@ mod memo;
 pub mod metrics;
 pub mod pool;
 mod service;
+pub mod spill;
 pub mod store;
 
 pub use service::{CacheStatus, Engine, EngineConfig, EngineError, Storage};

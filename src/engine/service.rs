@@ -3,6 +3,7 @@
 //! cancel flag. Synchronous solves and asynchronous jobs both go through it.
 
 use std::collections::{HashMap, HashSet, VecDeque};
+use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex, MutexGuard};
 use std::time::{Duration, Instant};
@@ -25,8 +26,9 @@ use super::fleet::Shared;
 use super::memo::PointMemo;
 use super::metrics::{self as names, Metrics};
 use super::pool::Pool;
-use super::store::{JobRecord, JobState, JobStatus, JobStore, MemoryJobStore};
-use crate::job::{Control, Job, JobError, Meta, Work};
+use super::spill::{JobResult, SpillDir};
+use super::store::{JobRecord, JobState, JobStatus, JobStore, MemoryJobStore, Refusal};
+use crate::job::{Control, Job, JobError, Meta, Unfinished, Work};
 
 /// How long a cancel waits for the job to stop (it checks between units of work, which take
 /// microseconds to milliseconds).
@@ -52,6 +54,10 @@ pub struct EngineConfig {
     pub cache_ttl: Duration,
     /// How long a finished asynchronous job is kept.
     pub job_retention: Duration,
+    /// Where results too large for the memory budget are kept (a directory of this
+    /// process's is made there), and how many bytes of them at most; `None` or 0 bytes: in
+    /// memory only.
+    pub spill: Option<(PathBuf, u64)>,
 }
 
 /// Where an engine keeps answers and job records.
@@ -65,18 +71,24 @@ pub struct Storage {
 }
 
 impl Storage {
-    /// In this process's memory, within `config`'s bounds: the default.
-    pub fn in_process(config: &EngineConfig) -> Storage {
+    /// In this process's memory (and its spill directory), within `config`'s bounds: the
+    /// default. Fails if the spill directory cannot be made.
+    pub fn in_process(config: &EngineConfig) -> std::io::Result<Storage> {
         let budget = Budget::split(config.memory_budget);
-        Storage {
+        let spill = match &config.spill {
+            Some((parent, bytes)) if *bytes > 0 => Some(SpillDir::create(parent, *bytes)?),
+            _ => None,
+        };
+        Ok(Storage {
             cache: Arc::new(MemoryCache::for_engine(config)),
             jobs: Arc::new(MemoryJobStore::new(
                 config.job_retention,
                 config.max_jobs,
                 budget.job_results,
+                spill,
             )),
             fleet: None,
-        }
+        })
     }
 }
 
@@ -92,6 +104,20 @@ pub enum EngineError {
     /// The shared job store cannot be reached (why): asynchronous work is refused rather
     /// than accepted and possibly lost.
     Unavailable(String),
+    /// The job store cannot hold the job's result now (what is full, and when room is
+    /// next made): the job is refused before any work rather than its result dropped after.
+    ResultsFull { what: String, retry_after: Duration },
+    /// The job's result would not fit in the job store even if it were empty.
+    ResultTooLarge { needed: u64, limit: u64 },
+}
+
+impl From<Refusal> for EngineError {
+    fn from(refusal: Refusal) -> Self {
+        match refusal {
+            Refusal::Full { what, retry_after } => EngineError::ResultsFull { what, retry_after },
+            Refusal::TooLarge { needed, limit } => EngineError::ResultTooLarge { needed, limit },
+        }
+    }
 }
 
 impl From<JobError> for EngineError {
@@ -116,6 +142,22 @@ impl CacheStatus {
     }
 }
 
+/// A solve that did not answer: why, and the partial answer of a job that keeps what it
+/// finished ([`crate::job::Unfinished`]).
+struct Stopped {
+    error: JobError,
+    partial: Option<Arc<Solved>>,
+}
+
+impl From<JobError> for Stopped {
+    fn from(error: JobError) -> Self {
+        Stopped {
+            error,
+            partial: None,
+        }
+    }
+}
+
 /// The handles of an asynchronous job this process runs: what its record cannot hold.
 struct LiveJob {
     control: Arc<Control>,
@@ -136,11 +178,11 @@ impl LiveJob {
     }
 
     /// The state of a job that stopped on a cancel: interrupted if the shutdown asked.
-    fn stopped(&self) -> JobState {
+    fn stopped(&self, partial: Option<JobResult>) -> JobState {
         if self.interrupted.load(Ordering::SeqCst) {
             JobState::Interrupted
         } else {
-            JobState::Cancelled
+            JobState::Cancelled { partial }
         }
     }
 }
@@ -245,9 +287,9 @@ pub struct Engine {
 
 impl Engine {
     /// An engine that keeps everything in this process.
-    pub fn new(config: EngineConfig, metrics: Metrics) -> Arc<Engine> {
-        let storage = Storage::in_process(&config);
-        Engine::with_storage(config, metrics, storage)
+    pub fn new(config: EngineConfig, metrics: Metrics) -> std::io::Result<Arc<Engine>> {
+        let storage = Storage::in_process(&config)?;
+        Ok(Engine::with_storage(config, metrics, storage))
     }
 
     /// An engine that keeps answers and job records in `storage`.
@@ -381,13 +423,16 @@ impl Engine {
     ) -> Result<Arc<Solved>, EngineError> {
         let permit = self.pool.try_acquire().ok_or(EngineError::Overloaded)?;
         let control = Arc::new(self.control(deadline));
-        let solved = self.execute(permit, job, meta, control).await?;
+        let solved = self
+            .execute(permit, job, meta, control, false)
+            .await
+            .map_err(|stopped| stopped.error)?;
         self.cache.insert(solved.clone()).await;
         Ok(solved)
     }
 
     /// Queues `job` to run in the background; returns its record. Refused when the queue
-    /// is full or the service is draining.
+    /// is full, the service is draining, or there is no room to keep the job's result.
     pub async fn submit(self: &Arc<Self>, job: Job) -> Result<JobRecord, EngineError> {
         self.admit()?;
         self.store_reachable()?;
@@ -400,12 +445,14 @@ impl Engine {
                 Work::Known(total) => total,
                 Work::Unknown => 0,
             };
-            self.jobs.insert(record.clone()).await;
             self.jobs
-                .update(record.id, JobState::Succeeded(solved.clone()), done)
-                .await;
+                .insert(record.clone(), solved.weight())
+                .await
+                .map_err(|e| self.refused(e.into()))?;
+            let state = JobState::Succeeded(JobResult::Ready(solved));
+            self.jobs.update(record.id, state.clone(), done).await;
             self.uncollected().insert(record.id, self.config.max_jobs);
-            record.state = JobState::Succeeded(solved);
+            record.state = state;
             record.done = done;
             return Ok(record);
         }
@@ -422,10 +469,13 @@ impl Engine {
         {
             return Err(self.refused(EngineError::Overloaded));
         }
-        self.jobs_queued.increment(1.0);
         let record = JobRecord::queued(self.ids.next(), job.kind(), job.work());
         let id = record.id;
-        self.jobs.insert(record.clone()).await;
+        if let Err(refusal) = self.jobs.insert(record.clone(), job.result_bytes()).await {
+            self.queued.fetch_sub(1, Ordering::SeqCst);
+            return Err(self.refused(refusal.into()));
+        }
+        self.jobs_queued.increment(1.0);
         let deadline = Instant::now() + self.config.job_deadline;
         let live = Arc::new(LiveJob {
             control: Arc::new(self.control(deadline)),
@@ -507,12 +557,6 @@ impl Engine {
         if record.state.status().is_finished() {
             self.collected(id);
         }
-        if let JobState::Dropped { key } = &record.state {
-            // The store let the result go; the cache may still hold the answer.
-            if let Some(solved) = self.cache.get(key).await {
-                record.state = JobState::Succeeded(solved);
-            }
-        }
         if let Some(live) = self.live().get(&id) {
             if !record.state.status().is_finished() {
                 record.done = live.control.done();
@@ -538,7 +582,8 @@ impl Engine {
         let live = self.live().get(&id).cloned();
         if live.is_none() && self.jobs.shared() && !before.state.status().is_finished() {
             // Run by a worker of the fleet: it sees the cancel at its next heartbeat.
-            self.jobs.update(id, JobState::Cancelled, before.done).await;
+            let state = JobState::Cancelled { partial: None };
+            self.jobs.update(id, state, before.done).await;
         }
         if let Some(live) = live {
             live.cancel();
@@ -660,6 +705,7 @@ impl Engine {
             EngineError::Overloaded => "overloaded",
             EngineError::Draining => "draining",
             EngineError::Unavailable(_) => "unavailable",
+            EngineError::ResultsFull { .. } | EngineError::ResultTooLarge { .. } => "results_full",
             EngineError::Job(_) => return e,
         };
         self.metrics
@@ -669,20 +715,39 @@ impl Engine {
     }
 
     /// Solves `job` holding `permit` (on a blocking thread, or here if it is small), renders
-    /// its answer, and records the solve.
+    /// its answer, and records the solve. With `keep` (an asynchronous job's result, kept for
+    /// its retention) the answer is rendered in every form now ([`Solved::kept`]), and a job
+    /// stopped before its end keeps what it finished.
     async fn execute(
         &self,
         permit: OwnedSemaphorePermit,
         job: Job,
         meta: Meta,
         control: Arc<Control>,
-    ) -> Result<Arc<Solved>, JobError> {
+        keep: bool,
+    ) -> Result<Arc<Solved>, Stopped> {
         self.cache_misses.increment(1);
         let (kind, small) = (job.kind(), job.is_small());
         let start = Instant::now();
         let solve = move |control: &Control| {
             let key = meta.input_hash.clone();
-            Solved::new(key, job.kind(), job.run(meta, control)?).map(Arc::new)
+            let kept = |solved: Solved| match keep {
+                true => solved.kept().map_err(|e| JobError::Internal(e.to_string())),
+                false => Ok(solved),
+            };
+            Ok(match job.run_keeping(meta, control) {
+                Ok(answer) => Solved::new(key, job.kind(), answer)
+                    .and_then(kept)
+                    .map(Arc::new)
+                    .map_err(Stopped::from),
+                Err(Unfinished { error, partial }) => Err(Stopped {
+                    error,
+                    partial: partial
+                        .filter(|_| keep)
+                        .and_then(|a| Solved::partial(key, job.kind(), a).and_then(kept).ok())
+                        .map(Arc::new),
+                }),
+            })
         };
         let result = if small {
             // Tens of microseconds: less than the two thread hand-offs of `Pool::run`.
@@ -690,11 +755,18 @@ impl Engine {
             solve(&control)
         } else {
             Pool::run(permit, control, solve).await
-        };
+        }
+        .unwrap_or_else(|e| Err(Stopped::from(e)));
         let outcome = match &result {
             Ok(_) => "succeeded",
-            Err(JobError::Cancelled) => "cancelled",
-            Err(JobError::DeadlineExceeded) => "deadline_exceeded",
+            Err(Stopped {
+                error: JobError::Cancelled,
+                ..
+            }) => "cancelled",
+            Err(Stopped {
+                error: JobError::DeadlineExceeded,
+                ..
+            }) => "deadline_exceeded",
             Err(_) => "failed",
         };
         self.metrics
@@ -711,10 +783,10 @@ impl Engine {
         let permit = match self.cache.get(&meta.input_hash).await {
             Some(hit) => {
                 self.cache_hits.increment(1);
-                Err(JobState::Succeeded(hit))
+                Err(JobState::Succeeded(JobResult::Ready(hit)))
             }
             None => tokio::select! {
-                () = live.cancel.cancelled() => Err(live.stopped()),
+                () = live.cancel.cancelled() => Err(live.stopped(None)),
                 permits = async {
                     let slot = self.job_slots.clone().acquire_owned().await;
                     (slot, self.pool.acquire().await)
@@ -730,15 +802,22 @@ impl Engine {
         self.jobs.update(id, JobState::Running, 0).await;
         live.status.send_replace(JobStatus::Running);
         self.jobs_running.increment(1.0);
-        let result = self.execute(permit, job, meta, live.control.clone()).await;
+        let result = self
+            .execute(permit, job, meta, live.control.clone(), true)
+            .await;
         self.jobs_running.decrement(1.0);
         match result {
             Ok(solved) => {
                 self.cache.insert(solved.clone()).await;
-                JobState::Succeeded(solved)
+                JobState::Succeeded(JobResult::Ready(solved))
             }
-            Err(JobError::Cancelled) => live.stopped(),
-            Err(e) => JobState::Failed(e),
+            Err(Stopped { error, partial }) => {
+                let partial = partial.map(JobResult::Ready);
+                match error {
+                    JobError::Cancelled => live.stopped(partial),
+                    error => JobState::Failed { error, partial },
+                }
+            }
         }
     }
 }
@@ -758,8 +837,9 @@ mod tests {
             max_jobs: 1,
             cache_ttl: Duration::from_secs(60),
             job_retention: Duration::from_secs(60),
+            spill: None,
         };
-        let engine = Engine::new(config, Metrics::noop());
+        let engine = Engine::new(config, Metrics::noop()).unwrap();
         let input = "rolling\n{\"load\":1e-9}";
         engine.remember_input(input.into(), "key".into());
         assert_eq!(engine.input_keys.get(input), None);

@@ -12,7 +12,7 @@ use serde::Serialize;
 use utoipa::ToSchema;
 use uuid::Uuid;
 
-use super::cache::Solved;
+use super::spill::{JobResult, SpillDir};
 use crate::job::{JobError, Work};
 
 /// Where a job is in its life.
@@ -57,15 +57,18 @@ impl JobStatus {
 pub enum JobState {
     Queued,
     Running,
-    Succeeded(Arc<Solved>),
-    Failed(JobError),
-    Cancelled,
-    Interrupted,
-    /// Succeeded, but its result was dropped to keep within the memory budget: the answer
-    /// may still be in the cache under `key`.
-    Dropped {
-        key: String,
+    Succeeded(JobResult),
+    /// Failed; a job that keeps partial work (a sweep past its deadline) keeps what it
+    /// finished.
+    Failed {
+        error: JobError,
+        partial: Option<JobResult>,
     },
+    /// Cancelled; with what it finished, for a job that keeps partial work.
+    Cancelled {
+        partial: Option<JobResult>,
+    },
+    Interrupted,
 }
 
 impl JobState {
@@ -73,10 +76,42 @@ impl JobState {
         match self {
             JobState::Queued => JobStatus::Queued,
             JobState::Running => JobStatus::Running,
-            JobState::Succeeded(_) | JobState::Dropped { .. } => JobStatus::Succeeded,
-            JobState::Failed(_) => JobStatus::Failed,
-            JobState::Cancelled => JobStatus::Cancelled,
+            JobState::Succeeded(_) => JobStatus::Succeeded,
+            JobState::Failed { .. } => JobStatus::Failed,
+            JobState::Cancelled { .. } => JobStatus::Cancelled,
             JobState::Interrupted => JobStatus::Interrupted,
+        }
+    }
+
+    /// A failure that kept nothing.
+    pub fn failed(error: JobError) -> JobState {
+        JobState::Failed {
+            error,
+            partial: None,
+        }
+    }
+
+    /// The result, whole or partial, if the job has one.
+    pub fn result(&self) -> Option<&JobResult> {
+        match self {
+            JobState::Succeeded(result) => Some(result),
+            JobState::Failed { partial, .. } | JobState::Cancelled { partial } => partial.as_ref(),
+            _ => None,
+        }
+    }
+
+    /// The same state with its result replaced by `result`.
+    fn with_result(self, result: JobResult) -> JobState {
+        match self {
+            JobState::Succeeded(_) => JobState::Succeeded(result),
+            JobState::Failed { error, .. } => JobState::Failed {
+                error,
+                partial: Some(result),
+            },
+            JobState::Cancelled { .. } => JobState::Cancelled {
+                partial: Some(result),
+            },
+            other => other,
         }
     }
 }
@@ -116,10 +151,32 @@ impl JobRecord {
     }
 }
 
+/// Why a job store cannot take a job.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Refusal {
+    /// It holds as much as it may for jobs within their retention; room is made as they
+    /// expire (the first in `retry_after`) or are deleted.
+    Full {
+        /// What is full, in words, with the numbers.
+        what: String,
+        retry_after: Duration,
+    },
+    /// The job's result would not fit even in an empty store.
+    TooLarge {
+        /// Bytes the result may take.
+        needed: u64,
+        /// Bytes the store can hold for one result.
+        limit: u64,
+    },
+}
+
 /// Where the records of asynchronous jobs are kept.
 #[async_trait]
 pub trait JobStore: Send + Sync {
-    async fn insert(&self, record: JobRecord);
+    /// Records a job just accepted, whose result will take at most `result_bytes`: room is
+    /// made for it now, so that the result is kept for its retention once the work is done,
+    /// or the job is refused before any work.
+    async fn insert(&self, record: JobRecord, result_bytes: u64) -> Result<(), Refusal>;
     /// The job `id`, unless unknown or expired.
     async fn get(&self, id: Uuid) -> Option<JobRecord>;
     /// Moves the job `id` to `state` with `done` units of work done; a finished state
@@ -137,94 +194,213 @@ pub trait JobStore: Send + Sync {
     }
 }
 
-/// The records of one process's jobs, at most `max_jobs` of them (the oldest finished are
-/// forgotten first) holding at most `result_bytes` of results (the oldest results are dropped
-/// first: their records stay and say so).
+/// Where a job's result will be kept.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Place {
+    Memory,
+    Disk,
+}
+
+/// Room made for a result not in yet.
+#[derive(Clone, Copy, Debug)]
+struct Reservation {
+    bytes: u64,
+    place: Place,
+}
+
+/// The records of one process's jobs, at most `max_jobs` of them, with the results of those
+/// within their retention: in memory up to `result_bytes`, and beyond it on disk (up to the
+/// spill directory's limit). Room for a result is made when its job is accepted; a job for
+/// whose result there is no room is refused then, never after its work.
 #[derive(Debug)]
 pub struct MemoryJobStore {
     records: Mutex<Records>,
     retention: Duration,
     max_jobs: usize,
     result_bytes: u64,
+    spill: Option<Arc<SpillDir>>,
 }
 
 #[derive(Debug, Default)]
 struct Records {
     jobs: HashMap<Uuid, JobRecord>,
+    /// Room made for the results of jobs not finished yet.
+    reserved: HashMap<Uuid, Reservation>,
     /// Finished jobs, oldest first (ids may have been forgotten since).
     finished: VecDeque<Uuid>,
-    /// Bytes of the results held.
-    held: u64,
+    /// Bytes held and made room for, in memory and on disk.
+    memory: u64,
+    disk: u64,
 }
 
 impl Records {
-    fn result_weight(record: &JobRecord) -> u64 {
-        match &record.state {
-            JobState::Succeeded(solved) => solved.weight(),
-            _ => 0,
+    fn bytes(&mut self, place: Place) -> &mut u64 {
+        match place {
+            Place::Memory => &mut self.memory,
+            Place::Disk => &mut self.disk,
         }
     }
 
     fn forget(&mut self, id: &Uuid) {
         if let Some(record) = self.jobs.remove(id) {
-            self.held -= Records::result_weight(&record);
+            if let Some(result) = record.state.result() {
+                let held = self.bytes(place_of(result));
+                *held = held.saturating_sub(result.weight());
+            }
+        }
+        if let Some(r) = self.reserved.remove(id) {
+            let held = self.bytes(r.place);
+            *held = held.saturating_sub(r.bytes);
         }
     }
 
-    /// Forgets the oldest finished job; false if there is none.
-    fn forget_oldest(&mut self) -> bool {
-        while let Some(id) = self.finished.pop_front() {
-            if self.jobs.contains_key(&id) {
-                self.forget(&id);
-                return true;
-            }
+    /// Forgets the jobs past their retention.
+    fn purge(&mut self, retention: Duration, now: Instant) -> usize {
+        let expired: Vec<Uuid> = self
+            .jobs
+            .values()
+            .filter(|r| r.expired(retention, now))
+            .map(|r| r.id)
+            .collect();
+        for id in &expired {
+            self.forget(id);
         }
-        false
+        let Records { jobs, finished, .. } = self;
+        finished.retain(|id| jobs.contains_key(id));
+        expired.len()
     }
 
-    /// Drops the results of the oldest finished jobs until at most `limit` bytes are held.
-    fn drop_results(&mut self, limit: u64) {
-        let mut oldest = self.finished.iter();
-        while self.held > limit {
-            let Some(record) = oldest.next().and_then(|id| self.jobs.get_mut(id)) else {
-                if oldest.len() == 0 {
-                    break;
-                }
-                continue;
-            };
-            if let JobState::Succeeded(solved) = &record.state {
-                self.held -= solved.weight();
-                record.state = JobState::Dropped {
-                    key: solved.key.clone(),
-                };
-            }
-        }
+    /// How long until the oldest finished job expires (and makes room), at most
+    /// `retention`.
+    fn next_expiry(&self, retention: Duration, now: Instant) -> Duration {
+        self.finished
+            .iter()
+            .filter_map(|id| self.jobs.get(id)?.finished_at)
+            .map(|t| retention.saturating_sub(now.duration_since(t)))
+            .min()
+            .unwrap_or(retention)
     }
 }
 
 impl MemoryJobStore {
     /// A store that forgets a job `retention` after it finished, keeps at most `max_jobs`
-    /// records and `result_bytes` of their results.
-    pub fn new(retention: Duration, max_jobs: usize, result_bytes: u64) -> Self {
+    /// records and `result_bytes` of their results in memory, and spills results beyond
+    /// that to `spill`, if given.
+    pub fn new(
+        retention: Duration,
+        max_jobs: usize,
+        result_bytes: u64,
+        spill: Option<SpillDir>,
+    ) -> Self {
         MemoryJobStore {
             records: Mutex::default(),
             retention,
             max_jobs: max_jobs.max(1),
             result_bytes,
+            spill: spill.map(Arc::new),
         }
     }
 
     fn records(&self) -> MutexGuard<'_, Records> {
         self.records.lock().unwrap_or_else(|p| p.into_inner())
     }
+
+    fn spill_limit(&self) -> u64 {
+        self.spill.as_ref().map_or(0, |s| s.limit)
+    }
+
+    /// Room for a result of `bytes` in `records`: in memory if it fits there, else on disk.
+    fn room(&self, records: &Records, bytes: u64) -> Result<Place, Refusal> {
+        if records.memory.saturating_add(bytes) <= self.result_bytes {
+            return Ok(Place::Memory);
+        }
+        if records.disk.saturating_add(bytes) <= self.spill_limit() {
+            return Ok(Place::Disk);
+        }
+        let limit = self.result_bytes.max(self.spill_limit());
+        if bytes > limit {
+            return Err(Refusal::TooLarge {
+                needed: bytes,
+                limit,
+            });
+        }
+        Err(Refusal::Full {
+            what: format!(
+                "the results of finished jobs within their retention ({}) take {} of {} in                  memory and {} of {} on disk, and this job's result may take up to {}",
+                humantime::format_duration(self.retention),
+                megabytes(records.memory),
+                megabytes(self.result_bytes),
+                megabytes(records.disk),
+                megabytes(self.spill_limit()),
+                megabytes(bytes),
+            ),
+            retry_after: records.next_expiry(self.retention, Instant::now()),
+        })
+    }
+
+    /// Keeps `state`'s result where room was made for it (`place`): spilled to disk, written
+    /// off the async threads. A result that cannot be written stays in memory, over the
+    /// budget rather than lost.
+    async fn keep(&self, id: Uuid, state: JobState, place: Place) -> JobState {
+        let (Some(spill), Place::Disk, Some(JobResult::Ready(solved))) =
+            (&self.spill, place, state.result().cloned())
+        else {
+            return state;
+        };
+        let spill = spill.clone();
+        let written = tokio::task::spawn_blocking(move || spill.write(id, &solved))
+            .await
+            .unwrap_or_else(|e| Err(std::io::Error::other(e)));
+        match written {
+            Ok(spilled) => state.with_result(JobResult::Spilled(Arc::new(spilled))),
+            Err(e) => {
+                tracing::error!(error = %e, %id, "a result could not be spilled to disk");
+                state
+            }
+        }
+    }
+}
+
+/// Where a result is held.
+fn place_of(result: &JobResult) -> Place {
+    match result {
+        JobResult::Ready(_) => Place::Memory,
+        JobResult::Spilled(_) => Place::Disk,
+    }
+}
+
+/// `n` bytes in MB, for people.
+fn megabytes(n: u64) -> String {
+    format!("{:.1} MB", n as f64 / 1e6)
 }
 
 #[async_trait]
 impl JobStore for MemoryJobStore {
-    async fn insert(&self, record: JobRecord) {
+    async fn insert(&self, record: JobRecord, result_bytes: u64) -> Result<(), Refusal> {
+        let now = Instant::now();
         let mut records = self.records();
-        while records.jobs.len() >= self.max_jobs && records.forget_oldest() {}
+        records.purge(self.retention, now);
+        if records.jobs.len() >= self.max_jobs {
+            return Err(Refusal::Full {
+                what: format!(
+                    "it keeps {} jobs, the most it may, for their retention ({})",
+                    records.jobs.len(),
+                    humantime::format_duration(self.retention)
+                ),
+                retry_after: records.next_expiry(self.retention, now),
+            });
+        }
+        let place = self.room(&records, result_bytes)?;
+        *records.bytes(place) += result_bytes;
+        records.reserved.insert(
+            record.id,
+            Reservation {
+                bytes: result_bytes,
+                place,
+            },
+        );
         records.jobs.insert(record.id, record);
+        Ok(())
     }
 
     async fn get(&self, id: Uuid) -> Option<JobRecord> {
@@ -238,15 +414,35 @@ impl JobStore for MemoryJobStore {
     }
 
     async fn update(&self, id: Uuid, state: JobState, done: usize) {
-        let mut records = self.records();
-        let added = match &state {
-            JobState::Succeeded(solved) => solved.weight(),
-            _ => 0,
+        let finishing = state.status().is_finished();
+        // The room made for the result, taken once: by the update that finishes the job.
+        let reservation = if finishing {
+            self.records().reserved.remove(&id)
+        } else {
+            None
         };
+        let state = match reservation {
+            Some(r) => self.keep(id, state, r.place).await,
+            None => state,
+        };
+        let mut records = self.records();
+        if let Some(r) = reservation {
+            let held = records.bytes(r.place);
+            *held = held.saturating_sub(r.bytes);
+            if let Some(result) = state.result() {
+                *records.bytes(place_of(result)) += result.weight();
+                if result.weight() > r.bytes {
+                    tracing::warn!(
+                        %id, estimate = r.bytes, weight = result.weight(),
+                        "a result weighs more than the room made for it"
+                    );
+                }
+            }
+        }
         let Some(record) = records.jobs.get_mut(&id) else {
             return;
         };
-        let finished = state.status().is_finished() && record.finished_at.is_none();
+        let finished = finishing && record.finished_at.is_none();
         if finished {
             record.finished_at = Some(Instant::now());
         }
@@ -255,8 +451,6 @@ impl JobStore for MemoryJobStore {
         if finished {
             records.finished.push_back(id);
         }
-        records.held += added;
-        records.drop_results(self.result_bytes);
     }
 
     async fn remove(&self, id: Uuid) {
@@ -264,27 +458,15 @@ impl JobStore for MemoryJobStore {
     }
 
     async fn purge_expired(&self) -> usize {
-        let now = Instant::now();
-        let mut records = self.records();
-        let expired: Vec<Uuid> = records
-            .jobs
-            .values()
-            .filter(|r| r.expired(self.retention, now))
-            .map(|r| r.id)
-            .collect();
-        for id in &expired {
-            records.forget(id);
-        }
-        let Records { jobs, finished, .. } = &mut *records;
-        finished.retain(|id| jobs.contains_key(id));
-        expired.len()
+        self.records().purge(self.retention, Instant::now())
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::render::{Answer, Cell, Column, Output, Table, Units};
+    use crate::engine::cache::Solved;
+    use crate::render::{Answer, Column, Output, Table, Units};
     use serde::Serialize;
 
     #[derive(Debug, PartialEq, Serialize)]
@@ -299,57 +481,128 @@ mod tests {
         }
     }
 
-    fn solved(key: &str, bytes: usize) -> Arc<Solved> {
+    /// A result whose JSON and CSV take about `bytes` together, as a job keeps it.
+    fn kept(key: &str, bytes: usize) -> JobResult {
         let blob = Blob {
-            text: "x".repeat(bytes),
+            text: "x".repeat(bytes / 2),
         };
-        Arc::new(Solved::new(key.to_string(), "rolling", Answer::new(blob)).unwrap())
+        let solved = Solved::new(key.to_string(), "rolling", Answer::new(blob)).unwrap();
+        JobResult::Ready(Arc::new(solved.kept().unwrap()))
+    }
+
+    fn record() -> JobRecord {
+        JobRecord::queued(Uuid::new_v4(), "rolling", Work::Known(1))
+    }
+
+    /// Finishes job `id` with a result of `bytes`.
+    async fn succeed(store: &MemoryJobStore, id: Uuid, bytes: usize) {
+        store
+            .update(id, JobState::Succeeded(kept("k", bytes)), 1)
+            .await;
     }
 
     #[tokio::test]
-    async fn the_oldest_results_are_dropped_first_and_their_records_say_so() {
-        let one = solved("a", 1000).weight();
-        let store = MemoryJobStore::new(Duration::from_secs(60), 100, 2 * one + one / 2);
+    async fn a_result_is_kept_whole_for_its_retention_and_a_job_without_room_is_refused_before_its_work(
+    ) {
+        let store = MemoryJobStore::new(Duration::from_secs(60), 100, 10_000, None);
         let mut ids = Vec::new();
-        for key in ["a", "b", "c"] {
-            let record = JobRecord::queued(Uuid::new_v4(), "rolling", Work::Known(1));
-            ids.push(record.id);
-            store.insert(record).await;
-            store
-                .update(
-                    ids[ids.len() - 1],
-                    JobState::Succeeded(solved(key, 1000)),
-                    1,
-                )
-                .await;
+        for _ in 0..3 {
+            let r = record();
+            ids.push(r.id);
+            store.insert(r, 3_000).await.unwrap();
         }
-        let first = store.get(ids[0]).await.unwrap();
-        assert!(matches!(first.state, JobState::Dropped { ref key } if key == "a"));
-        assert_eq!(first.state.status(), JobStatus::Succeeded);
-        for id in &ids[1..] {
-            assert!(matches!(
-                store.get(*id).await.unwrap().state,
-                JobState::Succeeded(_)
-            ));
+        // Room for three results of 3 kB is made: a fourth does not fit, now.
+        match store.insert(record(), 3_000).await {
+            Err(Refusal::Full { what, retry_after }) => {
+                assert!(what.contains("0.0 MB of 0.0 MB on disk"), "{what}");
+                assert!(retry_after <= Duration::from_secs(60));
+            }
+            other => panic!("{other:?}"),
         }
+        // Too large for an empty store: said so, with both numbers.
+        assert_eq!(
+            store.insert(record(), 20_000).await,
+            Err(Refusal::TooLarge {
+                needed: 20_000,
+                limit: 10_000
+            })
+        );
+        for id in &ids {
+            succeed(&store, *id, 2_500).await;
+        }
+        // Every result is still there, whole.
+        for id in &ids {
+            let state = store.get(*id).await.unwrap().state;
+            assert!(matches!(state, JobState::Succeeded(JobResult::Ready(_))));
+        }
+        // A result that weighs less than its room gives the rest back: one more 1 kB job fits.
+        store.insert(record(), 1_000).await.unwrap();
+        // Forgetting a job makes room.
+        store.remove(ids[0]).await;
+        store.insert(record(), 3_000).await.unwrap();
     }
 
     #[tokio::test]
-    async fn at_most_max_jobs_records_are_kept_the_oldest_finished_forgotten() {
-        let store = MemoryJobStore::new(Duration::from_secs(60), 3, 1 << 20);
+    async fn results_beyond_the_memory_budget_are_spilled_to_disk_and_deleted_with_their_record() {
+        let parent = std::env::temp_dir();
+        let spill = SpillDir::create(&parent, 1 << 20).unwrap();
+        let store = MemoryJobStore::new(Duration::from_secs(60), 100, 4_000, Some(spill));
+        let (small, large) = (record(), record());
+        let (small_id, large_id) = (small.id, large.id);
+        store.insert(small, 3_000).await.unwrap();
+        store.insert(large, 100_000).await.unwrap();
+        succeed(&store, small_id, 2_000).await;
+        succeed(&store, large_id, 90_000).await;
+        assert!(matches!(
+            store.get(small_id).await.unwrap().state,
+            JobState::Succeeded(JobResult::Ready(_))
+        ));
+        let JobState::Succeeded(JobResult::Spilled(spilled)) =
+            store.get(large_id).await.unwrap().state
+        else {
+            panic!("the large result is not on disk");
+        };
+        let json = spilled.json().await.unwrap();
+        assert!(json.len() > 40_000 && json.starts_with(b"{\"text\":\"xxx"));
+        let file = spilled.file(crate::render::Format::Csv).to_path_buf();
+        assert!(file.exists());
+        drop(spilled);
+        store.remove(large_id).await;
+        assert!(!file.exists(), "the spilled result outlived its record");
+    }
+
+    #[tokio::test]
+    async fn at_most_max_jobs_records_are_kept_and_more_are_refused_until_one_is_forgotten() {
+        let store = MemoryJobStore::new(Duration::from_secs(60), 3, 1 << 20, None);
         let mut ids = Vec::new();
-        for _ in 0..5 {
-            let record = JobRecord::queued(Uuid::new_v4(), "rolling", Work::Known(1));
-            ids.push(record.id);
-            store.insert(record).await;
-            store
-                .update(ids[ids.len() - 1], JobState::Cancelled, 0)
-                .await;
+        for _ in 0..3 {
+            let r = record();
+            ids.push(r.id);
+            store.insert(r, 100).await.unwrap();
+            let cancelled = JobState::Cancelled { partial: None };
+            store.update(ids[ids.len() - 1], cancelled, 0).await;
         }
-        assert!(store.get(ids[0]).await.is_none() && store.get(ids[1]).await.is_none());
-        for id in &ids[2..] {
+        assert!(matches!(
+            store.insert(record(), 100).await,
+            Err(Refusal::Full { .. })
+        ));
+        for id in &ids {
             assert!(store.get(*id).await.is_some());
         }
-        let _ = Cell::Count(0);
+        store.remove(ids[0]).await;
+        store.insert(record(), 100).await.unwrap();
+    }
+
+    #[tokio::test]
+    async fn expired_jobs_make_room() {
+        let store = MemoryJobStore::new(Duration::from_millis(20), 1, 1 << 20, None);
+        let first = record();
+        let id = first.id;
+        store.insert(first, 100).await.unwrap();
+        succeed(&store, id, 50).await;
+        assert!(store.insert(record(), 100).await.is_err());
+        tokio::time::sleep(Duration::from_millis(30)).await;
+        store.insert(record(), 100).await.unwrap();
+        assert!(store.get(id).await.is_none());
     }
 }

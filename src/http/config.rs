@@ -4,6 +4,7 @@
 
 use std::fmt;
 use std::net::SocketAddr;
+use std::path::PathBuf;
 use std::time::Duration;
 
 use axum::http::HeaderValue;
@@ -65,6 +66,17 @@ pub struct ServeArgs {
     /// How long a finished asynchronous job is kept for its client to collect.
     #[arg(long, env = "THIRDBODY_JOB_RETENTION", default_value = "15m", value_parser = duration)]
     pub job_retention: Duration,
+
+    /// Where the results of finished jobs that do not fit in the memory budget are kept: a
+    /// directory of this process's is made there, and removed when it stops. Default: the
+    /// system's temporary directory.
+    #[arg(long, env = "THIRDBODY_SPILL_DIR")]
+    pub spill_dir: Option<PathBuf>,
+
+    /// Bytes of results that may be kept there (0: none; results are then kept in memory
+    /// only, and a job whose result does not fit is refused when it is submitted).
+    #[arg(long, env = "THIRDBODY_SPILL_BYTES", default_value_t = 1 << 30)]
+    pub spill_bytes: u64,
 
     /// Connections open at once; more wait in the kernel's backlog (keep it below the
     /// process's limit on open files).
@@ -271,6 +283,20 @@ impl ServeArgs {
                 humantime::format_duration(self.request_timeout)
             ));
         }
+        let spill = match self.spill_bytes {
+            0 => None,
+            bytes => {
+                let dir = self.spill_dir.unwrap_or_else(std::env::temp_dir);
+                if !dir.is_dir() {
+                    return fail(format!(
+                        "--spill-dir {}: not a directory (results beyond the memory budget are \
+                         kept there; --spill-bytes 0 keeps them in memory only)",
+                        dir.display()
+                    ));
+                }
+                Some((dir, bytes))
+            }
+        };
         Ok(Config {
             bind: self.bind,
             fleet: self.fleet.validate()?,
@@ -287,6 +313,7 @@ impl ServeArgs {
                 max_jobs: self.max_jobs,
                 cache_ttl: self.cache_ttl,
                 job_retention: self.job_retention,
+                spill,
             },
             limits: Limits {
                 max_sweep_points: self.max_sweep_points,

@@ -33,6 +33,8 @@ pub struct Problem {
     /// before the job finished), `not-ready` (409: the job has no result yet), `cancelled`
     /// (409), `overloaded` (429),
     /// `draining` (503), `unavailable` (503: the shared job store cannot be reached),
+    /// `results-full` (503: no room to keep the job's result now; retry after `Retry-After`),
+    /// `result-too-large` (422: the job's result would not fit even in an empty store),
     /// `deadline-exceeded` (504), `internal` (500); or `about:blank` for a
     /// status with no more to say than its title.
     #[serde(rename = "type")]
@@ -66,6 +68,8 @@ enum Kind {
     Overloaded,
     Draining,
     Unavailable,
+    ResultsFull,
+    ResultTooLarge,
     DeadlineExceeded,
     Internal,
     /// `about:blank`: the status says it all.
@@ -76,7 +80,7 @@ impl Kind {
     fn status(self) -> StatusCode {
         match self {
             Kind::MalformedJson => StatusCode::BAD_REQUEST,
-            Kind::InvalidInput | Kind::SolveFailed | Kind::OutOfDomain => {
+            Kind::InvalidInput | Kind::SolveFailed | Kind::OutOfDomain | Kind::ResultTooLarge => {
                 StatusCode::UNPROCESSABLE_ENTITY
             }
             Kind::UnsupportedMediaType => StatusCode::UNSUPPORTED_MEDIA_TYPE,
@@ -86,7 +90,9 @@ impl Kind {
             Kind::Interrupted => StatusCode::GONE,
             Kind::Cancelled | Kind::NotReady => StatusCode::CONFLICT,
             Kind::Overloaded => StatusCode::TOO_MANY_REQUESTS,
-            Kind::Draining | Kind::Unavailable => StatusCode::SERVICE_UNAVAILABLE,
+            Kind::Draining | Kind::Unavailable | Kind::ResultsFull => {
+                StatusCode::SERVICE_UNAVAILABLE
+            }
             Kind::DeadlineExceeded => StatusCode::GATEWAY_TIMEOUT,
             Kind::Internal => StatusCode::INTERNAL_SERVER_ERROR,
             Kind::Blank(status) => status,
@@ -110,6 +116,8 @@ impl Kind {
             Kind::Overloaded => ("overloaded", "Every solver thread is busy"),
             Kind::Draining => ("draining", "The service is shutting down"),
             Kind::Unavailable => ("unavailable", "The shared job store cannot be reached"),
+            Kind::ResultsFull => ("results-full", "No room to keep the job's result now"),
+            Kind::ResultTooLarge => ("result-too-large", "The job's result is too large to keep"),
             Kind::DeadlineExceeded => ("deadline-exceeded", "The solve ran past its deadline"),
             Kind::Internal => ("internal", "Internal error"),
             Kind::Blank(_) => return None,
@@ -136,6 +144,8 @@ pub struct ApiError {
     kind: Kind,
     detail: String,
     errors: Vec<FieldError>,
+    /// Seconds to wait before trying again, when this case knows better than its kind.
+    retry_after: Option<u32>,
 }
 
 impl ApiError {
@@ -144,6 +154,7 @@ impl ApiError {
             kind,
             detail: detail.into(),
             errors: Vec::new(),
+            retry_after: None,
         }
     }
 
@@ -214,19 +225,17 @@ impl From<JobError> for ApiError {
         match e {
             JobError::Syntax(_) => ApiError::new(Kind::MalformedJson, detail),
             JobError::Schema { field, .. } => ApiError {
-                kind: Kind::InvalidInput,
                 errors: vec![FieldError {
                     field,
                     value: Value::Null,
                     allowed: "the shape given by the input's schema in /openapi.json".to_string(),
                     message: detail.clone(),
                 }],
-                detail,
+                ..ApiError::new(Kind::InvalidInput, detail)
             },
             JobError::Invalid(errors) => ApiError {
-                kind: Kind::InvalidInput,
-                detail,
                 errors,
+                ..ApiError::new(Kind::InvalidInput, detail)
             },
             // Deterministic, so retrying cannot help and the service is not at fault: the
             // client must change the input.
@@ -259,6 +268,32 @@ impl From<EngineError> for ApiError {
                      accepted, so that none is lost; synchronous solves still work"
                 ),
             ),
+            EngineError::ResultsFull { what, retry_after } => {
+                // Rounded up, and at least a second: room is made no sooner.
+                let seconds = retry_after.as_secs_f64().ceil().max(1.0);
+                ApiError {
+                    retry_after: Some(seconds.min(f64::from(u32::MAX)) as u32),
+                    ..ApiError::new(
+                        Kind::ResultsFull,
+                        format!(
+                            "the job was not accepted, so that its result is not lost after \
+                             the work: {what}. Room is made as finished jobs expire (the next \
+                             in {seconds} s) or are deleted (DELETE /v1/jobs/{{id}}); a \
+                             smaller job may fit now"
+                        ),
+                    )
+                }
+            }
+            EngineError::ResultTooLarge { needed, limit } => ApiError::new(
+                Kind::ResultTooLarge,
+                format!(
+                    "the job's result may take up to {:.1} MB, more than the {:.1} MB this \
+                     service keeps for one result (--memory-budget, --spill-bytes): split the \
+                     job, or ask for fewer points",
+                    needed as f64 / 1e6,
+                    limit as f64 / 1e6
+                ),
+            ),
         }
     }
 }
@@ -281,7 +316,7 @@ impl IntoResponse for ApiError {
         }
         let body = serde_json::to_vec(&self.problem()).unwrap_or_default();
         let mut response = (status, [(header::CONTENT_TYPE, PROBLEM_JSON)], body).into_response();
-        if let Some(seconds) = self.kind.retry_after() {
+        if let Some(seconds) = self.retry_after.or(self.kind.retry_after()) {
             response
                 .headers_mut()
                 .insert(header::RETRY_AFTER, HeaderValue::from(seconds));

@@ -1,6 +1,6 @@
 //! What a running job shares with whoever watches it: a cancel flag, a deadline and a count
 //! of work done. A job kind polls it between units of work ([`Control::check`], or the
-//! helpers that do it for it: [`Control::solve`], [`Control::map`], [`Control::map_kept`]).
+//! helpers that do it for it: [`Control::solve`], [`Control::map`], [`Control::map_each`], [`Control::kept`]).
 
 use std::any::Any;
 use std::fmt;
@@ -8,6 +8,9 @@ use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex};
 use std::thread;
 use std::time::Instant;
+
+use serde::{Deserialize, Serialize};
+use utoipa::ToSchema;
 
 use super::JobError;
 use crate::model::ModelError;
@@ -31,6 +34,42 @@ pub trait Later: fmt::Debug + Send + Sync {
     /// Runs `work` some time later, once per `key` while it is pending, or not at all if
     /// too much is pending already.
     fn offer(&self, key: String, work: Box<dyn FnOnce() + Send>);
+}
+
+/// What a job that maps over items does with an item the model refuses.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize, Serialize, ToSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum OnRefusal {
+    /// Go on with the other items: the refused one is answered with the reason (default).
+    #[default]
+    Continue,
+    /// Stop at the first refusal: the job fails with it.
+    Fail,
+}
+
+/// What became of the items of a [`Control::map_each`].
+#[derive(Debug)]
+pub struct Swept<R, E> {
+    /// Each item's solution or refusal, in order; `None` for an item the map did not reach
+    /// because it stopped.
+    pub outcomes: Vec<Option<Result<R, E>>>,
+    /// Why the map stopped before reaching every item (a cancel, the deadline); `None`
+    /// also when it stopped at a refusal ([`OnRefusal::Fail`]), which is in `outcomes`.
+    pub stopped: Option<JobError>,
+}
+
+impl<R, E> Swept<R, E> {
+    /// Takes the first refusal out, with its index.
+    pub fn take_first_refusal(&mut self) -> Option<(usize, E)> {
+        let i = self
+            .outcomes
+            .iter()
+            .position(|o| matches!(o, Some(Err(_))))?;
+        match self.outcomes[i].take() {
+            Some(Err(e)) => Some((i, e)),
+            _ => None,
+        }
+    }
 }
 
 /// Shared between a running job and whoever watches it: progress, cancellation, deadline.
@@ -64,7 +103,7 @@ impl Control {
         }
     }
 
-    /// The same control, keeping solved units in `memo` ([`Control::map_kept`]).
+    /// The same control, keeping solved units in `memo` ([`Control::kept`]).
     pub fn with_memo(mut self, memo: Arc<dyn Memo>) -> Self {
         self.memo = Some(memo);
         self
@@ -119,21 +158,20 @@ impl Control {
         Ok(solution)
     }
 
-    /// [`Control::map`] for units worth keeping: an item whose `key` is in the control's
-    /// memo is recalled rather than solved, and every item solved is kept there at once, so
-    /// that what a run solved before its deadline is not lost to its retry. `bytes` is what
-    /// one solution holds in memory. Without a memo it is [`Control::map`].
-    pub fn map_kept<T: Sync, R: Clone + Send + Sync + 'static>(
-        &self,
-        items: &[T],
-        key: impl Fn(&T) -> String + Sync,
-        bytes: impl Fn(&R) -> usize + Sync,
-        solve: impl Fn(&T) -> Result<R, ModelError> + Sync,
-    ) -> Result<Vec<R>, JobError> {
-        let Some(memo) = &self.memo else {
-            return self.map(items, solve);
-        };
-        self.map(items, |item| {
+    /// `solve` for units worth keeping: an item whose `key` is in the control's memo is
+    /// recalled rather than solved, and every item solved is kept there at once, so that
+    /// what a run solved before its deadline is not lost to its retry. `bytes` is what one
+    /// solution holds in memory. Without a memo it is `solve` itself.
+    pub fn kept<'a, T, R: Clone + Send + Sync + 'static, E>(
+        &'a self,
+        key: impl Fn(&T) -> String + Sync + 'a,
+        bytes: impl Fn(&R) -> usize + Sync + 'a,
+        solve: impl Fn(&T) -> Result<R, E> + Sync + 'a,
+    ) -> impl Fn(&T) -> Result<R, E> + Sync + 'a {
+        move |item| {
+            let Some(memo) = &self.memo else {
+                return solve(item);
+            };
             let key = key(item);
             if let Some(kept) = memo.recall(&key).and_then(|k| k.downcast::<R>().ok()) {
                 return Ok((*kept).clone());
@@ -142,7 +180,7 @@ impl Control {
             let size = bytes(&solution);
             memo.keep(key, Arc::new(solution.clone()), size);
             Ok(solution)
-        })
+        }
     }
 
     /// Applies `solve` to every item, in parallel over the control's threads, results in
@@ -153,29 +191,60 @@ impl Control {
         items: &[T],
         solve: impl Fn(&T) -> Result<R, ModelError> + Sync,
     ) -> Result<Vec<R>, JobError> {
+        let swept = self.map_each(items, OnRefusal::Fail, solve);
+        if let Some(e) = swept.stopped {
+            return Err(e);
+        }
+        swept
+            .outcomes
+            .into_iter()
+            .map(|outcome| match outcome {
+                Some(Ok(solution)) => Ok(solution),
+                Some(Err(e)) => Err(e.into()),
+                None => Err(JobError::Internal(
+                    "a solver thread stopped unexpectedly".to_string(),
+                )),
+            })
+            .collect()
+    }
+
+    /// Applies `solve` to every item, in parallel over the control's threads, outcomes in
+    /// order; one unit of work per item, refused or not. An item `solve` refuses does not
+    /// stop the others, unless `on_refusal` says so (the items not reached after it are
+    /// then `None`). A cancel or the deadline stops the map (`stopped`): the items it did
+    /// not reach are `None`, the others kept, so that a stopped job keeps what it finished.
+    pub fn map_each<T: Sync, R: Send, E: Send>(
+        &self,
+        items: &[T],
+        on_refusal: OnRefusal,
+        solve: impl Fn(&T) -> Result<R, E> + Sync,
+    ) -> Swept<R, E> {
         let next = AtomicUsize::new(0);
-        let failure: Mutex<Option<JobError>> = Mutex::new(None);
-        let failed = AtomicBool::new(false);
+        let stop: Mutex<Option<JobError>> = Mutex::new(None);
+        let halted = AtomicBool::new(false);
         let worker = || {
             let mut solved = Vec::new();
-            while !failed.load(Ordering::Relaxed) {
+            while !halted.load(Ordering::Relaxed) {
                 let i = next.fetch_add(1, Ordering::Relaxed);
                 let Some(item) = items.get(i) else { break };
-                match self.solve(|| solve(item)) {
-                    Ok(solution) => solved.push((i, solution)),
-                    Err(e) => {
-                        failed.store(true, Ordering::Relaxed);
-                        failure
-                            .lock()
-                            .unwrap_or_else(|p| p.into_inner())
-                            .get_or_insert(e);
-                    }
+                if let Err(e) = self.check() {
+                    halted.store(true, Ordering::Relaxed);
+                    stop.lock()
+                        .unwrap_or_else(|p| p.into_inner())
+                        .get_or_insert(e);
+                    break;
                 }
+                let outcome = solve(item);
+                self.advance(1);
+                if outcome.is_err() && on_refusal == OnRefusal::Fail {
+                    halted.store(true, Ordering::Relaxed);
+                }
+                solved.push((i, outcome));
             }
             solved
         };
         let threads = self.threads.min(items.len()).max(1);
-        let mut solved: Vec<(usize, R)> = if threads == 1 {
+        let solved: Vec<(usize, Result<R, E>)> = if threads == 1 {
             worker()
         } else {
             thread::scope(|s| {
@@ -186,15 +255,17 @@ impl Control {
                     .collect()
             })
         };
-        if let Some(e) = failure.into_inner().unwrap_or_else(|p| p.into_inner()) {
-            return Err(e);
+        let mut outcomes: Vec<Option<Result<R, E>>> = items.iter().map(|_| None).collect();
+        for (i, outcome) in solved {
+            outcomes[i] = Some(outcome);
         }
-        if solved.len() != items.len() {
-            return Err(JobError::Internal(
+        let mut stopped = stop.into_inner().unwrap_or_else(|p| p.into_inner());
+        let refused = || outcomes.iter().any(|o| matches!(o, Some(Err(_))));
+        if stopped.is_none() && outcomes.iter().any(Option::is_none) && !refused() {
+            stopped = Some(JobError::Internal(
                 "a solver thread stopped unexpectedly".to_string(),
             ));
         }
-        solved.sort_by_key(|(i, _)| *i);
-        Ok(solved.into_iter().map(|(_, s)| s).collect())
+        Swept { outcomes, stopped }
     }
 }

@@ -7,6 +7,7 @@ use serde_json::{json, Value};
 use utoipa::ToSchema;
 
 use super::input::{self, Checker};
+use super::kind::SMALL_ANSWER;
 use super::meta::ROLLING_REFERENCES;
 use super::{Control, JobError, Kind, Limits, Meta, Reference, Validated, Work};
 use crate::model::figures::{Axis, Figure, Plan, FIGURES};
@@ -71,6 +72,11 @@ impl Kind for FigureJob {
 
     fn work(&self) -> Work {
         Work::Known(self.plan.contacts.len())
+    }
+
+    /// A plotted point is at most two numbers and its legend in JSON, a row in CSV.
+    fn result_bytes(&self) -> u64 {
+        SMALL_ANSWER + self.plan.contacts.len() as u64 * 512
     }
 
     fn run(&self, meta: Meta, control: &Control) -> Result<FigureOutput, JobError> {

@@ -86,6 +86,22 @@ pub trait Kind: fmt::Debug + PartialEq + Send + Sync + Sized + 'static {
         false
     }
 
+    /// Bytes the answer's JSON and CSV take together, at most: an asynchronous job's store
+    /// makes room for its result before accepting it ([`crate::engine::store::JobStore`]).
+    /// An answer of a few kilobytes by default; kinds whose answer grows with their input
+    /// say how.
+    fn result_bytes(&self) -> u64 {
+        SMALL_ANSWER
+    }
+
+    /// Why an answer of this kind is unfinished, if it is: a job that keeps partial work (a
+    /// sweep, a fit) answers with what it finished when it is cancelled or runs out of time,
+    /// and says so here. `None` by default: an answer is whole.
+    fn unfinished(output: &Self::Output) -> Option<JobError> {
+        let _ = output;
+        None
+    }
+
     /// The answer with the rows of points `range` only (for a job that splits: see
     /// [`Kind::points`]).
     fn run_points(
@@ -99,6 +115,38 @@ pub trait Kind: fmt::Debug + PartialEq + Send + Sync + Sized + 'static {
     }
 }
 
+/// A job that stopped before its end: why, and the answer with what it finished, for a kind
+/// that keeps partial work ([`Kind::unfinished`]).
+#[derive(Debug)]
+pub struct Unfinished {
+    pub error: JobError,
+    pub partial: Option<Answer>,
+}
+
+impl From<JobError> for Unfinished {
+    fn from(error: JobError) -> Self {
+        Unfinished {
+            error,
+            partial: None,
+        }
+    }
+}
+
+/// The answer of `output`, or the partial answer of an unfinished run.
+fn answer<K: Kind>(output: K::Output) -> Result<Answer, Unfinished> {
+    match K::unfinished(&output) {
+        None => Ok(Answer::new(output).drawn_by(K::picture)),
+        Some(error) => Err(Unfinished {
+            error,
+            partial: Some(Answer::new(output).drawn_by(K::picture)),
+        }),
+    }
+}
+
+/// Bytes an answer of fixed size (a rolling contact with its default boundary, a three-body
+/// system) takes at most in JSON and CSV, with its `meta` (measured: 6 to 7 kB).
+pub const SMALL_ANSWER: u64 = 24 << 10;
+
 /// What [`Job`] needs of a kind, object-safe.
 trait Dispatch: fmt::Debug + Send + Sync {
     fn name(&self) -> &'static str;
@@ -106,14 +154,15 @@ trait Dispatch: fmt::Debug + Send + Sync {
     fn references(&self) -> &'static [Reference];
     fn work(&self) -> Work;
     fn small(&self) -> bool;
-    fn run(&self, meta: Meta, control: &Control) -> Result<Answer, JobError>;
+    fn result_bytes(&self) -> u64;
+    fn run(&self, meta: Meta, control: &Control) -> Result<Answer, Unfinished>;
     fn points(&self) -> Option<usize>;
     fn run_points(
         &self,
         meta: Meta,
         range: Range<usize>,
         control: &Control,
-    ) -> Result<Answer, JobError>;
+    ) -> Result<Answer, Unfinished>;
     fn units(&self) -> crate::render::Units;
     fn as_any(&self) -> &dyn Any;
     fn same(&self, other: &dyn Any) -> bool;
@@ -140,8 +189,12 @@ impl<K: Kind> Dispatch for K {
         Kind::small(self)
     }
 
-    fn run(&self, meta: Meta, control: &Control) -> Result<Answer, JobError> {
-        Kind::run(self, meta, control).map(|o| Answer::new(o).drawn_by(K::picture))
+    fn result_bytes(&self) -> u64 {
+        Kind::result_bytes(self)
+    }
+
+    fn run(&self, meta: Meta, control: &Control) -> Result<Answer, Unfinished> {
+        answer::<K>(Kind::run(self, meta, control)?)
     }
 
     fn points(&self) -> Option<usize> {
@@ -153,8 +206,8 @@ impl<K: Kind> Dispatch for K {
         meta: Meta,
         range: Range<usize>,
         control: &Control,
-    ) -> Result<Answer, JobError> {
-        Kind::run_points(self, meta, range, control).map(|o| Answer::new(o).drawn_by(K::picture))
+    ) -> Result<Answer, Unfinished> {
+        answer::<K>(Kind::run_points(self, meta, range, control)?)
     }
 
     fn units(&self) -> crate::render::Units {
@@ -230,13 +283,25 @@ impl Job {
         self.kind.work()
     }
 
+    /// Bytes its answer takes at most, in JSON and CSV ([`Kind::result_bytes`]).
+    pub fn result_bytes(&self) -> u64 {
+        self.kind.result_bytes()
+    }
+
     /// Whether the job is small enough to run on the caller's thread ([`Kind::small`]).
     pub fn is_small(&self) -> bool {
         self.kind.small()
     }
 
-    /// Runs the job to its answer, whose `meta` is `meta` (see [`Job::meta`]).
+    /// Runs the job to its answer, whose `meta` is `meta` (see [`Job::meta`]); a run
+    /// stopped before its end is its error.
     pub fn run(&self, meta: Meta, control: &Control) -> Result<Answer, JobError> {
+        self.kind.run(meta, control).map_err(|u| u.error)
+    }
+
+    /// Runs the job as [`Job::run`] does, keeping the partial answer of a run stopped before
+    /// its end (a cancel, the deadline) for a kind that keeps partial work.
+    pub fn run_keeping(&self, meta: Meta, control: &Control) -> Result<Answer, Unfinished> {
         self.kind.run(meta, control)
     }
 
@@ -252,7 +317,9 @@ impl Job {
         range: Range<usize>,
         control: &Control,
     ) -> Result<Answer, JobError> {
-        self.kind.run_points(meta, range, control)
+        self.kind
+            .run_points(meta, range, control)
+            .map_err(|u| u.error)
     }
 
     /// The same job, with `warnings` as its input's (a job read back from its wire form,

@@ -9,16 +9,21 @@ use std::ops::Range;
 use serde::{Deserialize, Serialize};
 use serde_json::value::RawValue;
 
+use super::points::SweepSummary;
+use super::sweep::SweepMeta;
 use super::{JobError, Meta};
 use crate::render::{Answer, Format};
 
-/// A part solved and rendered: its rows as JSON and as CSV.
-#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+/// A part solved and rendered: its rows as JSON and as CSV, and what the sweep's `meta`
+/// says of them.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct RenderedPart {
     /// The rows as JSON values separated by commas (the inside of the `points` list).
     pub json: String,
     /// The rows as CSV, with the header line.
     pub csv: String,
+    /// The counts, worst errors and validity of the part's rows, merged into the whole's.
+    pub summary: SweepSummary,
 }
 
 /// The answer to a whole job, rendered.
@@ -42,6 +47,7 @@ pub fn render(answer: &Answer) -> Result<RenderedPart, JobError> {
     struct Rows<'a> {
         #[serde(borrow)]
         points: &'a RawValue,
+        meta: SweepSummary,
     }
     let internal = |e: String| JobError::Internal(format!("cannot render a part: {e}"));
     let json = answer
@@ -59,13 +65,23 @@ pub fn render(answer: &Answer) -> Result<RenderedPart, JobError> {
     Ok(RenderedPart {
         json: inside.to_string(),
         csv: String::from_utf8(csv).map_err(|e| internal(e.to_string()))?,
+        summary: rows.meta,
     })
 }
 
 /// The whole answer from its parts, in order, and its `meta`: the bytes
 /// `Answer::render` gives for the job solved whole.
 pub fn assemble(meta: &Meta, parts: &[RenderedPart]) -> Result<Assembled, JobError> {
-    let meta = serde_json::to_string(meta)
+    let summary = parts
+        .iter()
+        .map(|p| p.summary.clone())
+        .reduce(SweepSummary::merge)
+        .ok_or_else(|| JobError::Internal("a job of no part".to_string()))?;
+    let meta = SweepMeta {
+        meta: meta.clone(),
+        summary,
+    };
+    let meta = serde_json::to_string(&meta)
         .map_err(|e| JobError::Internal(format!("cannot render meta: {e}")))?;
     let rows: Vec<&str> = parts
         .iter()
@@ -143,12 +159,36 @@ mod tests {
     }
 
     #[test]
-    fn a_point_out_of_the_domain_is_named_by_its_index_in_the_whole_sweep() {
+    fn a_point_out_of_the_domain_is_a_refused_row_or_with_on_refusal_fail_named_by_its_index() {
         let sweep = r#"{"kind": "sweep", "input": {"vary": {"load": ["1 nN", "1 mN"]}}}"#;
         let job = Job::from_json(sweep.as_bytes(), &Limits::default()).unwrap();
+        let part = render(
+            &job.run_points(job.meta(), 1..2, &Control::default())
+                .unwrap(),
+        )
+        .unwrap();
+        assert!(
+            part.json
+                .contains(r#""status":"refused","reason":"the penetration"#),
+            "{}",
+            part.json
+        );
+        assert_eq!(part.summary.counts.refused, 1);
+        let failing = r#"{"kind": "sweep", "input": {"on_refusal": "fail",
+            "vary": {"load": ["1 nN", "1 mN"]}}}"#;
+        let job = Job::from_json(failing.as_bytes(), &Limits::default()).unwrap();
         let error = job
             .run_points(job.meta(), 1..2, &Control::default())
             .unwrap_err();
         assert!(error.to_string().starts_with("points[1]: "), "{error}");
+    }
+
+    #[test]
+    fn a_sweep_with_refused_points_in_parts_is_the_sweep_whole() {
+        let sweep = r#"{"kind": "sweep", "input": {"vary": {
+            "load": ["1 nN", "1 mN", "2 nN"], "velocity": ["0 nm/s", "4 nm/s"]}}}"#;
+        for per_part in [1, 2, 5] {
+            assembled_equals_whole(sweep, per_part);
+        }
     }
 }

@@ -141,9 +141,7 @@ fn field<'a>(point: &'a Value, path: &str) -> &'a Value {
 pub fn sweep(answer: &Value) -> Result<Chart, PictureError> {
     let points = list(&answer["points"], "points")?;
     let first = points.first().ok_or("the sweep has no point")?;
-    let three_body = first
-        .get("friction_coefficient")
-        .is_some_and(Value::is_object);
+    let three_body = first.get("operating").is_some();
     let varied: Vec<_> = VARIED
         .iter()
         .filter(|(_, _, path)| field(first, path).is_number())
@@ -175,9 +173,15 @@ pub fn sweep(answer: &Value) -> Result<Chart, PictureError> {
             number(&p["friction_coefficient"], "friction_coefficient")
         }
     };
-    // Curves by the values of the other varied lists, in order of first appearance.
+    // Curves by the values of the other varied lists, in order of first appearance; points
+    // without numbers (refused, or not solved) are counted in a note.
     let mut curves: Vec<Curve> = Vec::new();
+    let mut unanswered = 0;
     for point in points {
+        if matches!(point["status"].as_str(), Some("refused" | "missing")) {
+            unanswered += 1;
+            continue;
+        }
         let label: Vec<String> = varied
             .iter()
             .filter(|v| v.2 != along.2)
@@ -229,13 +233,20 @@ pub fn sweep(answer: &Value) -> Result<Chart, PictureError> {
     } else {
         "friction coefficient"
     };
+    let notes = match unanswered {
+        0 => Vec::new(),
+        n => vec![format!(
+            "{n} of {} points not drawn: refused by the model, or not solved (see their status)",
+            points.len()
+        )],
+    };
     Ok(Chart {
         title: format!("Sweep: {y_name} against {}", along.0.replace('_', " ")),
         x: Axis::new(along.0, along.1),
         y: Axis::new(y_name, ""),
         layers,
         equal_aspect: false,
-        notes: Vec::new(),
+        notes,
     })
 }
 

@@ -7,8 +7,10 @@ use serde_json::Value;
 use utoipa::ToSchema;
 
 use super::input::{self, field, Checker, LayerInput, QuadratureKind, Quantity};
+use super::kind::SMALL_ANSWER;
 use super::meta::ROLLING_REFERENCES;
-use super::validity::{self, validity_units, Subject, ValidityOutput};
+use super::points::{PointNotes, PointNotesFields, PointStatus, Row, SweepVerification};
+use super::validity::{self, validity_units, PointValidity, Subject, ValidityOutput};
 use super::{Control, JobError, Kind, Limits, Meta, Reference, Validated, Work};
 use crate::model::rolling::{BoundaryPoint, PressureGrid, Verification};
 use crate::model::tables::{self, Use};
@@ -144,6 +146,17 @@ impl Kind for RollingJob {
             && self.options.boundary_points <= SMALL_BOUNDARY
     }
 
+    /// A boundary point is three numbers (at most 96 bytes of JSON with their keys), a
+    /// pressure grid value one (at most 26 bytes).
+    fn result_bytes(&self) -> u64 {
+        let boundary = self.options.boundary_points as u64 * 96;
+        let grid = self.options.pressure_grid.map_or(0, |n| {
+            let n = n as u64;
+            (n * n + 2 * n) * 26
+        });
+        SMALL_ANSWER + boundary + grid
+    }
+
     fn run(&self, meta: Meta, control: &Control) -> Result<RollingOutput, JobError> {
         let solution =
             control.solve(|| tables::solve(&self.rolling, &self.options, Use::IfBuilt))?;
@@ -227,7 +240,7 @@ pub struct StaticOutput {
 }
 
 /// How far the answer can be trusted.
-#[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, ToSchema)]
 pub struct VerificationOutput {
     /// |P(δ) − P|/P at the returned δ (dimensionless).
     pub relative_load_residual: f64,
@@ -247,8 +260,30 @@ pub struct VerificationOutput {
     /// (built once per layer from the exact strip solver, then ≈ 1 µs per answer): a bound
     /// on the relative difference of every integral quantity from the exact solve
     /// (dimensionless). Absent for an exact solve.
-    #[serde(skip_serializing_if = "Option::is_none")]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub table_error: Option<f64>,
+}
+
+impl VerificationOutput {
+    /// The worse of two answers' errors, field by field (a sweep's, over its points).
+    pub fn worst(&self, other: &VerificationOutput) -> VerificationOutput {
+        VerificationOutput {
+            relative_load_residual: self
+                .relative_load_residual
+                .max(other.relative_load_residual),
+            quadrature_error_estimate: self
+                .quadrature_error_estimate
+                .max(other.quadrature_error_estimate),
+            quadrature_nodes: self.quadrature_nodes.min(other.quadrature_nodes),
+            iterations: self.iterations.max(other.iterations),
+            exit_root_iterations: self.exit_root_iterations.max(other.exit_root_iterations),
+            converged: self.converged && other.converged,
+            table_error: match (self.table_error, other.table_error) {
+                (Some(a), Some(b)) => Some(a.max(b)),
+                (a, b) => a.or(b),
+            },
+        }
+    }
 }
 
 impl From<&Verification> for VerificationOutput {
@@ -284,7 +319,8 @@ impl From<&RollingSolution> for ContactOutput {
     }
 }
 
-/// One row of a rolling sweep.
+/// One row of a rolling sweep: the point's conditions, its status, and (answered) its numbers
+/// and the ratios of the model's assumptions, or (refused) the reason.
 // Also the CSV row of a rolling answer: one declaration of the columns of rolling contacts.
 #[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
 pub struct SweepPoint {
@@ -294,63 +330,120 @@ pub struct SweepPoint {
     pub load: f64,
     /// V (m/s).
     pub velocity: f64,
+    pub status: PointStatus,
+    /// The contact, when answered.
     #[serde(flatten)]
-    pub contact: ContactOutput,
-    pub verification: VerificationOutput,
-    /// The model's assumptions at this point (docs/model.md §7).
-    pub validity: ValidityOutput,
-}
-
-/// The validity of a rolling contact; a violated assumption is the job's error.
-fn validity(rolling: &Rolling, solution: &RollingSolution) -> Result<ValidityOutput, JobError> {
-    validity::assess(
-        &model::validity::rolling(rolling, solution),
-        Subject::Particle,
-    )
+    pub contact: Option<ContactOutput>,
+    #[serde(flatten)]
+    #[schema(inline, value_type = PointNotesFields)]
+    pub notes: PointNotes,
+    /// The numerical error of an answered point (in the sweep's `meta.verification`, the
+    /// worst over its points).
+    #[serde(skip)]
+    pub verification: Option<VerificationOutput>,
 }
 
 impl SweepPoint {
-    /// The point of `rolling`, solved as `solution`, unless the model's domain excludes it.
+    /// The row of `rolling`, solved as `solution`, unless the model's domain excludes it.
     pub fn new(rolling: &Rolling, solution: &RollingSolution) -> Result<Self, JobError> {
-        Ok(SweepPoint {
+        let validity = PointValidity::assess(
+            model::validity::rolling(rolling, solution),
+            Subject::Particle,
+        )?;
+        Ok(SweepPoint::answered(
+            rolling,
+            solution.into(),
+            (&solution.verification).into(),
+            validity,
+        ))
+    }
+
+    fn answered(
+        rolling: &Rolling,
+        contact: ContactOutput,
+        verification: VerificationOutput,
+        validity: PointValidity,
+    ) -> SweepPoint {
+        let notes = PointNotes::Answered(validity);
+        SweepPoint {
             radius: rolling.radius,
             load: rolling.load,
             velocity: rolling.velocity,
-            contact: solution.into(),
-            verification: (&solution.verification).into(),
-            validity: validity(rolling, solution)?,
-        })
+            status: notes.status(),
+            contact: Some(contact),
+            notes,
+            verification: Some(verification),
+        }
+    }
+
+    /// The row of `rolling` without numbers.
+    fn unanswered(rolling: &Rolling, notes: PointNotes) -> SweepPoint {
+        SweepPoint {
+            radius: rolling.radius,
+            load: rolling.load,
+            velocity: rolling.velocity,
+            status: notes.status(),
+            contact: None,
+            notes,
+            verification: None,
+        }
+    }
+
+    /// A number of the contact, for a column.
+    fn number(&self, read: fn(&ContactOutput) -> f64) -> Option<f64> {
+        self.contact.as_ref().map(read)
     }
 
     /// The CSV columns of rolling contacts.
-    pub const COLUMNS: [Column<SweepPoint>; 14] = [
+    pub const COLUMNS: [Column<SweepPoint>; 15] = [
         Column::number("radius", "m", |p| p.radius),
         Column::number("load", "N", |p| p.load),
         Column::number("velocity", "m/s", |p| p.velocity),
-        Column::number("penetration", "m", |p| p.contact.penetration),
-        Column::number("contact_area", "m²", |p| p.contact.contact_area),
-        Column::number("half_width", "m", |p| p.contact.half_width),
-        Column::number("centroid_shift", "m", |p| p.contact.centroid_shift),
-        Column::number("pressure_centre_shift", "m", |p| {
-            p.contact.pressure_centre_shift
+        Column::optional("penetration", "m", |p| p.number(|c| c.penetration)),
+        Column::optional("contact_area", "m²", |p| p.number(|c| c.contact_area)),
+        Column::optional("half_width", "m", |p| p.number(|c| c.half_width)),
+        Column::optional("centroid_shift", "m", |p| p.number(|c| c.centroid_shift)),
+        Column::optional("pressure_centre_shift", "m", |p| {
+            p.number(|c| c.pressure_centre_shift)
         }),
-        Column::number("rolling_resistance_coefficient", "", |p| {
-            p.contact.rolling_resistance_coefficient
+        Column::optional("rolling_resistance_coefficient", "", |p| {
+            p.number(|c| c.rolling_resistance_coefficient)
         }),
-        Column::number("friction_coefficient", "", |p| {
-            p.contact.friction_coefficient
+        Column::optional("friction_coefficient", "", |p| {
+            p.number(|c| c.friction_coefficient)
         }),
-        Column::number("static_penetration", "m", |p| {
-            p.contact.static_contact.penetration
+        Column::optional("static_penetration", "m", |p| {
+            p.number(|c| c.static_contact.penetration)
         }),
-        Column::number("static_contact_area", "m²", |p| {
-            p.contact.static_contact.contact_area
+        Column::optional("static_contact_area", "m²", |p| {
+            p.number(|c| c.static_contact.contact_area)
         }),
-        Column::number("static_friction_coefficient", "", |p| {
-            p.contact.static_contact.friction_coefficient
+        Column::optional("static_friction_coefficient", "", |p| {
+            p.number(|c| c.static_contact.friction_coefficient)
         }),
-        Column::text("validity", |p| validity::summary(&p.validity)),
+        Column::text("status", |p| p.status.as_str().to_string()),
+        Column::text("note", |p| p.notes.note()),
     ];
+}
+
+impl Row for SweepPoint {
+    type Point = Rolling;
+
+    fn refused(point: &Rolling, reason: String) -> Self {
+        SweepPoint::unanswered(point, PointNotes::Refused(reason))
+    }
+
+    fn missing(point: &Rolling) -> Self {
+        SweepPoint::unanswered(point, PointNotes::Missing)
+    }
+
+    fn notes(&self) -> &PointNotes {
+        &self.notes
+    }
+
+    fn verification(&self) -> Option<SweepVerification> {
+        self.verification.clone().map(SweepVerification::Rolling)
+    }
 }
 
 /// A point of the contact boundary (m).
@@ -422,6 +515,9 @@ pub struct RollingOutput {
     /// them).
     #[serde(skip)]
     rolling: Rolling,
+    /// The validity's checks, for the CSV row.
+    #[serde(skip)]
+    checks: PointValidity,
 }
 
 impl RollingOutput {
@@ -432,6 +528,7 @@ impl RollingOutput {
         solution: &RollingSolution,
         meta: Meta,
     ) -> Result<Self, JobError> {
+        let checks = model::validity::rolling(rolling, solution);
         Ok(RollingOutput {
             contact: solution.into(),
             boundary: solution.boundary.iter().map(Into::into).collect(),
@@ -439,9 +536,10 @@ impl RollingOutput {
             meta: RollingMeta {
                 meta,
                 verification: (&solution.verification).into(),
-                validity: validity(rolling, solution)?,
+                validity: validity::assess(&checks, Subject::Particle)?,
             },
             rolling: *rolling,
+            checks: PointValidity::assess(checks, Subject::Particle)?,
         })
     }
 }
@@ -463,14 +561,12 @@ impl Output for RollingOutput {
 
     /// One row: the contact's conditions and integrals, as a sweep's row.
     fn table(&self) -> Table {
-        let point = SweepPoint {
-            radius: self.rolling.radius,
-            load: self.rolling.load,
-            velocity: self.rolling.velocity,
-            contact: self.contact.clone(),
-            verification: self.meta.verification.clone(),
-            validity: self.meta.validity.clone(),
-        };
+        let point = SweepPoint::answered(
+            &self.rolling,
+            self.contact.clone(),
+            self.meta.verification.clone(),
+            self.checks.clone(),
+        );
         Table::new(&SweepPoint::COLUMNS, [&point])
     }
 }

@@ -11,13 +11,15 @@ use serde_json::{json, Value};
 use utoipa::ToSchema;
 
 use super::input::{self, field, Checker, Field, Quantity};
+use super::kind::SMALL_ANSWER;
 use super::meta::{REFERENCES, ROLLING_REFERENCES};
+use super::points::{self, SweepSummary};
 use super::rolling::{contact_units, verification_units, RollingInput, RollingJob};
 use super::three_body::{
     result_units, three_body_verification_units, ThreeBodyInput, ThreeBodyJob,
 };
-use super::validity::validity_units;
-use super::{Control, JobError, Kind, Limits, Meta, Reference, Validated, Work};
+use super::validity::Subject;
+use super::{Control, JobError, Kind, Limits, Meta, OnRefusal, Reference, Swept, Validated, Work};
 use crate::model::tables::{self, Use};
 use crate::model::three_body::{self, Diameters, OperatingPoint, ThreeBody, ThreeBodySolution};
 use crate::model::{Parameter, Rolling, RollingSolution, SolveOptions, MODEL_VERSION};
@@ -42,6 +44,9 @@ pub struct SweepInput {
     /// `ThreeBodyVary`. An absent list keeps the base value.
     #[schema(value_type = Option<Object>)]
     pub vary: Option<Value>,
+    /// What a point the model refuses does: `continue` (default: its row says why, and the
+    /// other points are answered) or `fail` (the sweep fails with it).
+    pub on_refusal: Option<OnRefusal>,
 }
 
 /// The kind of job a sweep repeats.
@@ -83,7 +88,14 @@ pub struct ThreeBodyVary {
 
 /// A validated sweep.
 #[derive(Clone, Debug, PartialEq)]
-pub enum SweepJob {
+pub struct SweepJob {
+    pub points: SweepOfPoints,
+    pub on_refusal: OnRefusal,
+}
+
+/// The points of a validated sweep, by kind.
+#[derive(Clone, Debug, PartialEq)]
+pub enum SweepOfPoints {
     Rolling(RollingSweep),
     ThreeBody(ThreeBodySweep),
 }
@@ -114,9 +126,11 @@ pub struct ThreeBodySweep {
 impl SweepJob {
     /// Number of points: the product of the list lengths; `None` past `usize`.
     pub fn size(&self) -> Option<usize> {
-        let lengths = match self {
-            SweepJob::Rolling(s) => [s.radius.len(), s.load.len(), s.velocity.len()],
-            SweepJob::ThreeBody(s) => [s.operating.len(), s.velocity.len(), s.mean_diameter.len()],
+        let lengths = match &self.points {
+            SweepOfPoints::Rolling(s) => [s.radius.len(), s.load.len(), s.velocity.len()],
+            SweepOfPoints::ThreeBody(s) => {
+                [s.operating.len(), s.velocity.len(), s.mean_diameter.len()]
+            }
         };
         lengths.into_iter().try_fold(1_usize, usize::checked_mul)
     }
@@ -130,13 +144,17 @@ impl Kind for SweepJob {
         let input: SweepInput = input::deserialize(value, "")?;
         let mut checker = Checker::new();
         let (base, vary) = (field!(input.base), field!(input.vary));
-        let job = match input.kind.unwrap_or_default() {
+        let points = match input.kind.unwrap_or_default() {
             SweepOf::Rolling => {
-                SweepJob::Rolling(RollingSweep::read(base, vary, limits, &mut checker)?)
+                SweepOfPoints::Rolling(RollingSweep::read(base, vary, limits, &mut checker)?)
             }
             SweepOf::ThreeBody => {
-                SweepJob::ThreeBody(ThreeBodySweep::read(base, vary, limits, &mut checker)?)
+                SweepOfPoints::ThreeBody(ThreeBodySweep::read(base, vary, limits, &mut checker)?)
             }
+        };
+        let job = SweepJob {
+            points,
+            on_refusal: input.on_refusal.unwrap_or_default(),
         };
         let max = limits.max_sweep_points;
         if job.size().map_or(true, |n| n > max) {
@@ -151,21 +169,22 @@ impl Kind for SweepJob {
 
     /// A valid sweep input itself: the base in canonical form and every list explicit.
     fn canonical(&self) -> Value {
-        let (kind, base, vary) = match self {
-            SweepJob::Rolling(s) => (SweepOf::Rolling, s.base.canonical(), s.vary()),
-            SweepJob::ThreeBody(s) => (SweepOf::ThreeBody, s.base_input(), s.vary()),
+        let (kind, base, vary) = match &self.points {
+            SweepOfPoints::Rolling(s) => (SweepOf::Rolling, s.base.canonical(), s.vary()),
+            SweepOfPoints::ThreeBody(s) => (SweepOf::ThreeBody, s.base_input(), s.vary()),
         };
         input::canonical(&SweepInput {
             kind: Some(kind),
             base: Some(base),
             vary: Some(vary),
+            on_refusal: Some(self.on_refusal),
         })
     }
 
     fn references(&self) -> &'static [Reference] {
-        match self {
-            SweepJob::Rolling(_) => ROLLING_REFERENCES,
-            SweepJob::ThreeBody(_) => &REFERENCES,
+        match self.points {
+            SweepOfPoints::Rolling(_) => ROLLING_REFERENCES,
+            SweepOfPoints::ThreeBody(_) => &REFERENCES,
         }
     }
 
@@ -186,6 +205,17 @@ impl Kind for SweepJob {
         self.size()
     }
 
+    /// A row's numbers are at most 26 bytes each in JSON (with its key) and CSV; a refused
+    /// row carries its reason (a few hundred bytes) in both instead.
+    fn result_bytes(&self) -> u64 {
+        let per_point: u64 = match self.points {
+            SweepOfPoints::Rolling(_) => 1536,
+            SweepOfPoints::ThreeBody(_) => 3072,
+        };
+        let points = self.size().unwrap_or(usize::MAX) as u64;
+        SMALL_ANSWER.saturating_add(points.saturating_mul(per_point))
+    }
+
     fn run_points(
         &self,
         meta: Meta,
@@ -193,52 +223,72 @@ impl Kind for SweepJob {
         control: &Control,
     ) -> Result<SweepOutput, JobError> {
         let first = range.start;
-        let points = match self {
-            SweepJob::Rolling(s) => {
+        let on_refusal = self.on_refusal;
+        let (points, summary, stop) = match &self.points {
+            SweepOfPoints::Rolling(s) => {
                 let all = s.points();
                 let options = &s.base.options;
                 let method = Use::for_solves(all.len(), options.quadrature);
                 let contacts = part(all, range)?;
                 let solve = |p: &Rolling| tables::solve(p, options, method);
-                let solutions = if method == Use::Build {
+                let swept = if method == Use::Build {
                     // A point costs a microsecond: cheaper to solve again than to keep.
-                    control.map(&contacts, solve)?
+                    control.map_each(&contacts, on_refusal, |p| SweepPoint::new(p, &solve(p)?))
                 } else {
-                    control.map_kept(
-                        &contacts,
+                    let kept = control.kept(
                         |p| format!("{MODEL_VERSION} rolling {p:?} {options:?}"),
                         |_| std::mem::size_of::<RollingSolution>(),
                         solve,
-                    )?
+                    );
+                    control.map_each(&contacts, on_refusal, |p| SweepPoint::new(p, &kept(p)?))
                 };
-                let rows = contacts.iter().zip(&solutions).enumerate();
-                SweepPoints::Rolling(
-                    rows.map(|(i, (p, s))| {
-                        SweepPoint::new(p, s).map_err(|e| at_point(first + i, e))
-                    })
-                    .collect::<Result<_, _>>()?,
-                )
+                let swept = refused_at(swept, first, on_refusal)?;
+                let stop = swept.stopped.clone();
+                let (rows, summary) = points::rows(&contacts, swept, first, Subject::Particle);
+                (SweepPoints::Rolling(rows), summary, stop)
             }
-            SweepJob::ThreeBody(s) => {
+            SweepOfPoints::ThreeBody(s) => {
                 let systems = part(s.points(), range)?;
                 let options = &s.base.options;
-                let solutions = control.map_kept(
-                    &systems,
+                let kept = control.kept(
                     |p| format!("{MODEL_VERSION} three_body {p:?} {options:?}"),
                     |_| std::mem::size_of::<ThreeBodySolution>(),
                     |p| three_body::solve(p, options),
-                )?;
-                let rows = systems.iter().zip(&solutions).enumerate();
-                SweepPoints::ThreeBody(
-                    rows.map(|(i, (p, s))| {
-                        ThreeBodySweepPoint::new(p, s).map_err(|e| at_point(first + i, e))
-                    })
-                    .collect::<Result<_, _>>()?,
-                )
+                );
+                let swept = control.map_each(&systems, on_refusal, |p| {
+                    ThreeBodySweepPoint::new(p, &kept(p)?)
+                });
+                let swept = refused_at(swept, first, on_refusal)?;
+                let stop = swept.stopped.clone();
+                let (rows, summary) = points::rows(&systems, swept, first, Subject::System);
+                (SweepPoints::ThreeBody(rows), summary, stop)
             }
         };
-        Ok(SweepOutput { points, meta })
+        Ok(SweepOutput {
+            points,
+            meta: SweepMeta { meta, summary },
+            stop,
+        })
     }
+
+    fn unfinished(output: &SweepOutput) -> Option<JobError> {
+        output.stop.clone()
+    }
+}
+
+/// A sweep that stopped at a refusal (`on_refusal: fail`) fails with it, the point named by
+/// its index in the whole sweep; otherwise what became of its points.
+fn refused_at<R>(
+    mut swept: Swept<R, JobError>,
+    first: usize,
+    on_refusal: OnRefusal,
+) -> Result<Swept<R, JobError>, JobError> {
+    if on_refusal == OnRefusal::Fail && swept.stopped.is_none() {
+        if let Some((i, e)) = swept.take_first_refusal() {
+            return Err(at_point(first + i, e));
+        }
+    }
+    Ok(swept)
 }
 
 /// The points `range` of `points`.
@@ -257,6 +307,7 @@ fn part<T>(mut points: Vec<T>, range: Range<usize>) -> Result<Vec<T>, JobError> 
 fn at_point(index: usize, e: JobError) -> JobError {
     match e {
         JobError::OutOfDomain(m) => JobError::OutOfDomain(format!("points[{index}]: {m}")),
+        JobError::Unsolvable(m) => JobError::Unsolvable(format!("points[{index}]: {m}")),
         other => other,
     }
 }
@@ -521,7 +572,19 @@ pub struct SweepOutput {
     /// One row per point; rolling: radius outermost, then load, then speed; three-body:
     /// operating point, then speed, then mean diameter.
     pub points: SweepPoints,
+    pub meta: SweepMeta,
+    /// Why the sweep stopped before its end, if it did (`meta.stopped` in words).
+    #[serde(skip)]
+    pub stop: Option<JobError>,
+}
+
+/// The `meta` block of a sweep: the job's, and what it says of the rows.
+#[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
+pub struct SweepMeta {
+    #[serde(flatten)]
     pub meta: Meta,
+    #[serde(flatten)]
+    pub summary: SweepSummary,
 }
 
 impl Output for SweepOutput {
@@ -537,10 +600,25 @@ impl Output for SweepOutput {
             ("points[].operating.particle_load", "N"),
         ],
         contact_units!("points[]."),
-        verification_units!("points[].verification."),
         result_units!("points[]."),
-        three_body_verification_units!("points[].verification."),
-        validity_units!("points[].validity."),
+        &[
+            ("points[].validity.inside_layer", ""),
+            ("points[].validity.parabolic_sphere", ""),
+            ("points[].validity.local_layer", ""),
+            ("points[].validity.adhesive_friction", ""),
+            ("points[].validity.surfaces_apart", ""),
+            ("points[].validity.asperity_gap", ""),
+            ("points[].validity.particles_in_contact", ""),
+            ("meta.counts.total", ""),
+            ("meta.counts.ok", ""),
+            ("meta.counts.warn", ""),
+            ("meta.counts.refused", ""),
+            ("meta.counts.missing", ""),
+            ("meta.validity.assumptions[].warned", ""),
+            ("meta.validity.assumptions[].first_warned", ""),
+        ],
+        verification_units!("meta.verification."),
+        three_body_verification_units!("meta.verification."),
     ];
 
     /// One row per point.

@@ -9,7 +9,8 @@ use utoipa::ToSchema;
 
 use super::input::{self, field, Checker, LayerInput, QuadratureKind, Quantity};
 use super::meta::REFERENCES;
-use super::validity::{self, validity_units, Subject, ValidityOutput};
+use super::points::{PointNotes, PointNotesFields, PointStatus, Row, SweepVerification};
+use super::validity::{self, validity_units, PointValidity, Subject, ValidityOutput};
 use super::{Control, JobError, Kind, Limits, Meta, Reference, Validated, Work};
 use crate::model::three_body::{
     self, Asperities, ContactState, Diameters, LayerContact, OperatingPoint, Particle, ThreeBody,
@@ -572,7 +573,7 @@ pub struct PerParticleOutput {
 }
 
 /// How far the answer can be trusted.
-#[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, ToSchema)]
 pub struct ThreeBodyVerificationOutput {
     pub diameter_nodes: usize,
     pub separation_iterations: u32,
@@ -581,9 +582,30 @@ pub struct ThreeBodyVerificationOutput {
     /// Largest relative change of areas and loads with half the diameter nodes.
     pub quadrature_error_estimate: f64,
     /// Relative error of the kelvin_layer table against direct solves (when used).
-    #[serde(skip_serializing_if = "Option::is_none")]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub layer_table_error: Option<f64>,
     pub converged: bool,
+}
+
+impl ThreeBodyVerificationOutput {
+    /// The worse of two answers' errors, field by field (a sweep's, over its points).
+    pub fn worst(&self, other: &ThreeBodyVerificationOutput) -> ThreeBodyVerificationOutput {
+        ThreeBodyVerificationOutput {
+            diameter_nodes: self.diameter_nodes.min(other.diameter_nodes),
+            separation_iterations: self.separation_iterations.max(other.separation_iterations),
+            relative_load_residual: self
+                .relative_load_residual
+                .max(other.relative_load_residual),
+            quadrature_error_estimate: self
+                .quadrature_error_estimate
+                .max(other.quadrature_error_estimate),
+            layer_table_error: match (self.layer_table_error, other.layer_table_error) {
+                (Some(a), Some(b)) => Some(a.max(b)),
+                (a, b) => a.or(b),
+            },
+            converged: self.converged && other.converged,
+        }
+    }
 }
 
 /// The results of a three-body solve, shared by answers and sweep points.
@@ -592,7 +614,10 @@ pub struct ThreeBodyResult {
     #[serde(flatten)]
     pub state: StateOutput,
     pub friction_coefficient: FrictionOutput,
-    pub per_particle: PerParticleOutput,
+    /// Means per particle in contact; absent when no particle is in contact (the
+    /// asperities carry the load alone).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub per_particle: Option<PerParticleOutput>,
     /// The same system at V = 0.
     pub static_operating_point: StateOutput,
 }
@@ -605,10 +630,12 @@ impl From<&ThreeBodySolution> for ThreeBodyResult {
                 static_: s.static_state.friction_coefficient,
                 rolling: s.rolling.friction_coefficient,
             },
-            per_particle: PerParticleOutput {
-                mean_area: s.rolling.mean_area(),
-                mean_load: s.rolling.mean_load(),
-            },
+            per_particle: s.rolling.mean_area().zip(s.rolling.mean_load()).map(
+                |(mean_area, mean_load)| PerParticleOutput {
+                    mean_area,
+                    mean_load,
+                },
+            ),
             static_operating_point: (&s.static_state).into(),
         }
     }
@@ -638,12 +665,6 @@ pub struct ThreeBodyMeta {
     pub validity: ValidityOutput,
 }
 
-/// The validity of a three-body system; a violated assumption is the job's error.
-fn validity(system: &ThreeBody, solution: &ThreeBodySolution) -> Result<ValidityOutput, JobError> {
-    let checks = crate::model::validity::three_body(system, solution);
-    validity::assess(&checks, Subject::System)
-}
-
 /// The answer to a three-body job.
 #[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
 pub struct ThreeBodyOutput {
@@ -654,6 +675,9 @@ pub struct ThreeBodyOutput {
     /// on the wire; the CSV row needs them).
     #[serde(skip)]
     system: ThreeBody,
+    /// The validity's checks, for the CSV row.
+    #[serde(skip)]
+    checks: PointValidity,
 }
 
 impl ThreeBodyOutput {
@@ -664,14 +688,16 @@ impl ThreeBodyOutput {
         solution: &ThreeBodySolution,
         meta: Meta,
     ) -> Result<Self, JobError> {
+        let checks = crate::model::validity::three_body(system, solution);
         Ok(ThreeBodyOutput {
             result: solution.into(),
             meta: ThreeBodyMeta {
                 meta,
                 verification: solution.into(),
-                validity: validity(system, solution)?,
+                validity: validity::assess(&checks, Subject::System)?,
             },
             system: *system,
+            checks: PointValidity::assess(checks, Subject::System)?,
         })
     }
 }
@@ -686,20 +712,18 @@ impl Output for ThreeBodyOutput {
     /// One row: the system's operating point, speed and mean diameter and its results, as a
     /// sweep's row.
     fn table(&self) -> Table {
-        let point = ThreeBodySweepPoint {
-            operating: operating_canonical(self.system.operating),
-            velocity: self.system.velocity,
-            mean_diameter: self.system.diameters.mean,
-            result: self.result.clone(),
-            verification: self.meta.verification.clone(),
-            validity: self.meta.validity.clone(),
-            operating_point: self.system.operating,
-        };
+        let point = ThreeBodySweepPoint::answered(
+            &self.system,
+            self.result.clone(),
+            self.meta.verification.clone(),
+            self.checks.clone(),
+        );
         ThreeBodySweepPoint::table(&[point])
     }
 }
 
-/// One row of a three-body sweep.
+/// One row of a three-body sweep: the point's conditions, its status, and (answered) its
+/// results and the ratios of the model's assumptions, or (refused) the reason.
 // Also the CSV row of a three-body answer: one declaration of the columns of systems.
 #[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
 pub struct ThreeBodySweepPoint {
@@ -711,28 +735,72 @@ pub struct ThreeBodySweepPoint {
     pub velocity: f64,
     /// x_a (m).
     pub mean_diameter: f64,
+    pub status: PointStatus,
+    /// The system's results, when answered.
     #[serde(flatten)]
-    pub result: ThreeBodyResult,
-    pub verification: ThreeBodyVerificationOutput,
-    /// The model's assumptions at this point (docs/model.md §7).
-    pub validity: ValidityOutput,
+    pub result: Option<ThreeBodyResult>,
+    #[serde(flatten)]
+    #[schema(inline, value_type = PointNotesFields)]
+    pub notes: PointNotes,
+    /// The numerical error of an answered point (in the sweep's `meta.verification`, the
+    /// worst over its points).
+    #[serde(skip)]
+    pub verification: Option<ThreeBodyVerificationOutput>,
     /// `operating`, typed (for the CSV).
     #[serde(skip)]
     operating_point: OperatingPoint,
 }
 
 impl ThreeBodySweepPoint {
-    /// The point of `system`, solved as `solution`, unless the model's domain excludes it.
+    /// The row of `system`, solved as `solution`, unless the model's domain excludes it.
     pub fn new(system: &ThreeBody, solution: &ThreeBodySolution) -> Result<Self, JobError> {
-        Ok(ThreeBodySweepPoint {
+        let checks = crate::model::validity::three_body(system, solution);
+        let validity = PointValidity::assess(checks, Subject::System)?;
+        Ok(ThreeBodySweepPoint::answered(
+            system,
+            solution.into(),
+            solution.into(),
+            validity,
+        ))
+    }
+
+    fn answered(
+        system: &ThreeBody,
+        result: ThreeBodyResult,
+        verification: ThreeBodyVerificationOutput,
+        validity: PointValidity,
+    ) -> ThreeBodySweepPoint {
+        let mut row = ThreeBodySweepPoint::unanswered(system, PointNotes::Answered(validity));
+        row.result = Some(result);
+        row.verification = Some(verification);
+        row
+    }
+
+    /// The row of `system` without results.
+    fn unanswered(system: &ThreeBody, notes: PointNotes) -> ThreeBodySweepPoint {
+        ThreeBodySweepPoint {
             operating: operating_canonical(system.operating),
             velocity: system.velocity,
             mean_diameter: system.diameters.mean,
-            result: solution.into(),
-            verification: solution.into(),
-            validity: validity(system, solution)?,
+            status: notes.status(),
+            result: None,
+            notes,
+            verification: None,
             operating_point: system.operating,
-        })
+        }
+    }
+
+    /// A result, for a column.
+    fn number(&self, read: fn(&ThreeBodyResult) -> f64) -> Option<f64> {
+        self.result.as_ref().map(read)
+    }
+
+    /// A mean per particle, for a column.
+    fn mean(&self, read: fn(&PerParticleOutput) -> f64) -> Option<f64> {
+        self.result
+            .as_ref()
+            .and_then(|r| r.per_particle.as_ref())
+            .map(read)
     }
 
     /// The model parameter the operating point gives.
@@ -757,35 +825,60 @@ impl ThreeBodySweepPoint {
     }
 
     /// The CSV columns of three-body systems.
-    const COLUMNS: [Column<ThreeBodySweepPoint>; 17] = [
+    const COLUMNS: [Column<ThreeBodySweepPoint>; 18] = [
         Column::number("operating", "", |p| p.operating_point.value()),
         Column::number("velocity", "m/s", |p| p.velocity),
         Column::number("mean_diameter", "m", |p| p.mean_diameter),
-        Column::number("separation", "m", |p| p.result.state.separation),
-        Column::number("particles_in_contact", "", |p| {
-            p.result.state.particles_in_contact
+        Column::optional("separation", "m", |p| p.number(|r| r.state.separation)),
+        Column::optional("particles_in_contact", "", |p| {
+            p.number(|r| r.state.particles_in_contact)
         }),
-        Column::number("area_surface_surface", "m²", |p| {
-            p.result.state.areas.surface_surface
+        Column::optional("area_surface_surface", "m²", |p| {
+            p.number(|r| r.state.areas.surface_surface)
         }),
-        Column::number("area_particle_upper", "m²", |p| {
-            p.result.state.areas.particle_upper
+        Column::optional("area_particle_upper", "m²", |p| {
+            p.number(|r| r.state.areas.particle_upper)
         }),
-        Column::number("area_particle_layer", "m²", |p| {
-            p.result.state.areas.particle_layer
+        Column::optional("area_particle_layer", "m²", |p| {
+            p.number(|r| r.state.areas.particle_layer)
         }),
-        Column::number("area_total", "m²", |p| p.result.state.areas.total),
-        Column::number("load_asperities", "N", |p| p.result.state.loads.asperities),
-        Column::number("load_particles", "N", |p| p.result.state.loads.particles),
-        Column::number("load_total", "N", |p| p.result.state.loads.total),
-        Column::number("friction_static", "", |p| {
-            p.result.friction_coefficient.static_
+        Column::optional("area_total", "m²", |p| p.number(|r| r.state.areas.total)),
+        Column::optional("load_asperities", "N", |p| {
+            p.number(|r| r.state.loads.asperities)
         }),
-        Column::number("friction_rolling", "", |p| {
-            p.result.friction_coefficient.rolling
+        Column::optional("load_particles", "N", |p| {
+            p.number(|r| r.state.loads.particles)
         }),
-        Column::number("mean_area", "m²", |p| p.result.per_particle.mean_area),
-        Column::number("mean_load", "N", |p| p.result.per_particle.mean_load),
-        Column::text("validity", |p| validity::summary(&p.validity)),
+        Column::optional("load_total", "N", |p| p.number(|r| r.state.loads.total)),
+        Column::optional("friction_static", "", |p| {
+            p.number(|r| r.friction_coefficient.static_)
+        }),
+        Column::optional("friction_rolling", "", |p| {
+            p.number(|r| r.friction_coefficient.rolling)
+        }),
+        Column::optional("mean_area", "m²", |p| p.mean(|m| m.mean_area)),
+        Column::optional("mean_load", "N", |p| p.mean(|m| m.mean_load)),
+        Column::text("status", |p| p.status.as_str().to_string()),
+        Column::text("note", |p| p.notes.note()),
     ];
+}
+
+impl Row for ThreeBodySweepPoint {
+    type Point = ThreeBody;
+
+    fn refused(point: &ThreeBody, reason: String) -> Self {
+        ThreeBodySweepPoint::unanswered(point, PointNotes::Refused(reason))
+    }
+
+    fn missing(point: &ThreeBody) -> Self {
+        ThreeBodySweepPoint::unanswered(point, PointNotes::Missing)
+    }
+
+    fn notes(&self) -> &PointNotes {
+        &self.notes
+    }
+
+    fn verification(&self) -> Option<SweepVerification> {
+        self.verification.clone().map(SweepVerification::ThreeBody)
+    }
 }

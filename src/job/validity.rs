@@ -2,7 +2,7 @@
 //! ratio and status, in `meta.validity` (and per sweep point); a violated assumption refuses
 //! the answer with a message naming the cause and the numbers.
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
 use super::JobError;
@@ -20,9 +20,12 @@ macro_rules! validity_units {
 pub(crate) use validity_units;
 
 /// `ok`, or `warn`: the answer is given, and a note says why it may be off.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Serialize, ToSchema)]
+#[derive(
+    Clone, Copy, Debug, Default, PartialEq, Eq, PartialOrd, Ord, Serialize, Deserialize, ToSchema,
+)]
 #[serde(rename_all = "lowercase")]
 pub enum ValidityStatus {
+    #[default]
     Ok,
     Warn,
 }
@@ -99,6 +102,234 @@ pub fn summary(validity: &ValidityOutput) -> String {
         "ok".to_string()
     } else {
         format!("warn: {}", warned.join(" "))
+    }
+}
+
+/// A compact validity of one point of a sweep: each assumption's ratio at the point's speed,
+/// by name (`validity`), and the names of those that warn, at the point's speed or at rest
+/// (`warn`). The words, rules and notes are in the sweep's `meta.validity`, once
+/// ([`ValidityTally`]): written on every point they were two thirds of a sweep's bytes.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PointValidity {
+    checks: Vec<Check>,
+}
+
+impl PointValidity {
+    /// The validity of a point measured by `checks`, or the reason it is refused (the first
+    /// violated assumption, in words).
+    pub fn assess(checks: Vec<Check>, subject: Subject) -> Result<PointValidity, JobError> {
+        if let Some(check) = checks.iter().find(|c| c.status() == Status::Violated) {
+            return Err(JobError::OutOfDomain(violation(check, subject)));
+        }
+        Ok(PointValidity { checks })
+    }
+
+    /// The worst status of the assumptions.
+    pub fn status(&self) -> ValidityStatus {
+        if self.warned().next().is_some() {
+            ValidityStatus::Warn
+        } else {
+            ValidityStatus::Ok
+        }
+    }
+
+    /// The names of the assumptions that warn.
+    pub fn warned(&self) -> impl Iterator<Item = &'static str> + '_ {
+        self.checks
+            .iter()
+            .filter(|c| c.status() != Status::Ok)
+            .map(|c| names(c.assumption).0)
+    }
+
+    /// The names of the assumptions that warn, as a CSV cell: space-separated.
+    pub fn warned_text(&self) -> String {
+        self.warned().collect::<Vec<_>>().join(" ")
+    }
+
+    /// The checks measured.
+    pub fn checks(&self) -> &[Check] {
+        &self.checks
+    }
+}
+
+/// `{"inside_layer": 0.0062, ...}`: each ratio at the point's speed.
+impl Serialize for PointValidity {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        use serde::ser::SerializeMap;
+        let mut map = s.serialize_map(Some(self.checks.len()))?;
+        for check in &self.checks {
+            map.serialize_entry(names(check.assumption).0, &check.ratio())?;
+        }
+        map.end()
+    }
+}
+
+/// How the points of a sweep stand against each assumption, for its `meta.validity`: the
+/// assumption in words once, how many answered points it warns on, and the note of the
+/// first of them. Tallies of consecutive ranges of points merge into the tally of the
+/// whole ([`ValidityTally::merge`]), so that a sweep solved in parts says the same as one
+/// solved whole.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ValidityTally {
+    assumptions: Vec<Tally>,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+struct Tally {
+    assumption: Assumption,
+    warned: usize,
+    /// The first point that warns: its index in the sweep and the note.
+    first: Option<(usize, String)>,
+}
+
+impl Tally {
+    /// Point `index` warns: its note is kept if it comes before the first one seen.
+    fn offer(&mut self, index: usize, note: impl FnOnce() -> String) {
+        if self.first.as_ref().map_or(true, |(i, _)| index < *i) {
+            self.first = Some((index, note()));
+        }
+    }
+}
+
+impl ValidityTally {
+    /// Counts point `index`, measured as `validity`.
+    pub fn count(&mut self, index: usize, validity: &PointValidity, subject: Subject) {
+        for check in &validity.checks {
+            let tally = self.tally(check.assumption);
+            if check.status() != Status::Ok {
+                tally.warned += 1;
+                tally.offer(index, || note(check, subject));
+            }
+        }
+    }
+
+    fn tally(&mut self, assumption: Assumption) -> &mut Tally {
+        let at = match self
+            .assumptions
+            .iter()
+            .position(|t| t.assumption == assumption)
+        {
+            Some(at) => at,
+            None => {
+                self.assumptions.push(Tally {
+                    assumption,
+                    warned: 0,
+                    first: None,
+                });
+                self.assumptions.len() - 1
+            }
+        };
+        &mut self.assumptions[at]
+    }
+
+    /// Adds the tally of other points.
+    pub fn merge(&mut self, other: ValidityTally) {
+        for theirs in other.assumptions {
+            let ours = self.tally(theirs.assumption);
+            ours.warned += theirs.warned;
+            if let Some((index, note)) = theirs.first {
+                ours.offer(index, || note);
+            }
+        }
+    }
+
+    /// `warn` if any point warns.
+    pub fn status(&self) -> ValidityStatus {
+        if self.assumptions.iter().any(|t| t.warned > 0) {
+            ValidityStatus::Warn
+        } else {
+            ValidityStatus::Ok
+        }
+    }
+}
+
+/// One assumption of a sweep's `meta.validity`.
+#[derive(Serialize, Deserialize, ToSchema)]
+pub struct AssumptionTallyOutput {
+    /// As in a rolling answer's `meta.validity`: `inside_layer`, `local_layer`, ...
+    name: String,
+    /// The assumption in words.
+    #[serde(skip_deserializing, serialize_with = "super::meta::static_text")]
+    assumption: &'static str,
+    /// What the ratio of each point's `validity` measures.
+    #[serde(skip_deserializing)]
+    ratio: &'static str,
+    /// When the ratio warns and when it refuses a point.
+    #[serde(skip_deserializing, serialize_with = "super::meta::static_text")]
+    rule: &'static str,
+    /// Answered points on which it warns (count).
+    warned: usize,
+    /// The index of the first of them.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    first_warned: Option<usize>,
+    /// Why it warns there, in words.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    note: Option<String>,
+}
+
+/// The model's assumptions over the answered points of a sweep (docs/model.md §7): each in
+/// words once, how many points it warns on, and why it warns on the first of them.
+#[derive(Serialize, Deserialize, ToSchema)]
+pub struct SweepValidityOutput {
+    /// `warn` if any answered point warns, or the model refused a point.
+    #[serde(skip_deserializing)]
+    status: ValidityStatus,
+    assumptions: Vec<AssumptionTallyOutput>,
+}
+
+impl ValidityTally {
+    /// The tally as written; `refused` says whether the model refused points of the sweep,
+    /// which makes its status `warn` too.
+    pub fn output(&self, refused: bool) -> SweepValidityOutput {
+        let status = if refused {
+            ValidityStatus::Warn
+        } else {
+            self.status()
+        };
+        SweepValidityOutput {
+            status,
+            assumptions: self
+                .assumptions
+                .iter()
+                .map(|t| {
+                    let (name, assumption, ratio, rule) = names(t.assumption);
+                    AssumptionTallyOutput {
+                        name: name.to_string(),
+                        assumption,
+                        ratio,
+                        rule,
+                        warned: t.warned,
+                        first_warned: t.first.as_ref().map(|(i, _)| *i),
+                        note: t.first.as_ref().map(|(_, note)| note.clone()),
+                    }
+                })
+                .collect(),
+        }
+    }
+}
+
+/// Reads back what [`ValidityTally`] wrote (a part of a sweep solved in another process).
+impl<'de> Deserialize<'de> for ValidityTally {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let written = SweepValidityOutput::deserialize(d)?;
+        let assumptions = written
+            .assumptions
+            .into_iter()
+            .map(|t| {
+                let assumption = Assumption::ALL
+                    .into_iter()
+                    .find(|a| names(*a).0 == t.name)
+                    .ok_or_else(|| {
+                        serde::de::Error::custom(format!("no assumption is named {}", t.name))
+                    })?;
+                Ok(Tally {
+                    assumption,
+                    warned: t.warned,
+                    first: t.first_warned.zip(t.note),
+                })
+            })
+            .collect::<Result<_, D::Error>>()?;
+        Ok(ValidityTally { assumptions })
     }
 }
 

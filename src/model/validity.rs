@@ -40,6 +40,17 @@ pub enum Assumption {
 }
 
 impl Assumption {
+    /// Every assumption.
+    pub const ALL: [Assumption; 7] = [
+        Assumption::InsideLayer,
+        Assumption::Parabolic,
+        Assumption::LocalLayer,
+        Assumption::AdhesiveFriction,
+        Assumption::SurfacesApart,
+        Assumption::AsperityGap,
+        Assumption::ParticlesInContact,
+    ];
+
     /// The status of `ratio`.
     pub fn status(self, ratio: f64) -> Status {
         use Assumption::*;

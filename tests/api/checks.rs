@@ -101,9 +101,17 @@ async fn every_answer_says_where_it_comes_from_and_a_job_result_comes_as_csv() {
     let running = app.submit(&crate::helpers::long_sweep(21)).await;
     let not_ready = problem(app.get(&format!("{running}/result")).await, 409).await;
     assert_eq!(not_ready["type"], problem_type("not-ready"));
+    app.wait_for_job(&running, |j| j["status"] == "running")
+        .await;
     app.cancel(&running).await;
-    let cancelled = problem(app.get(&format!("{running}/result")).await, 409).await;
-    assert_eq!(cancelled["type"], problem_type("cancelled"));
+    // A cancelled sweep keeps what it finished: its answer is partial, and says so.
+    let partial = app.get(&format!("{running}/result")).await;
+    assert_eq!(partial.status(), 200);
+    assert!(partial.headers().get("etag").is_none());
+    let partial: Value = partial.json().await.unwrap();
+    assert_eq!(partial["meta"]["complete"], false);
+    assert_eq!(partial["meta"]["stopped"], "the job was cancelled");
+    assert!(partial["meta"]["counts"]["missing"].as_u64().unwrap() > 0);
 }
 
 #[tokio::test]

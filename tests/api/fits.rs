@@ -99,5 +99,5 @@ async fn a_fit_job_reports_progress_and_stops_on_cancel() {
         .await;
     assert_eq!(done["status"], "succeeded", "{done}");
     assert!(done["progress"]["done"].as_u64().unwrap() > 30);
-    assert_eq!(done["result"]["dof"], 27);
+    assert_eq!(app.result(&done).await["dof"], 27);
 }

@@ -33,7 +33,7 @@ pub fn config(flags: &[&str]) -> Config {
 
 /// The service `thirdbody serve` would be with these flags.
 pub fn state(flags: &[&str]) -> AppState {
-    AppState::new(config(flags))
+    AppState::new(config(flags)).expect("the service starts")
 }
 
 /// Serves on 127.0.0.1, port 0, with `flags`.
@@ -139,6 +139,16 @@ impl TestApp {
             .await
     }
 
+    /// The answer of a job (as its view gives it), fetched from its `result_url`: a job's
+    /// view never carries its answer.
+    pub async fn result(&self, job: &Value) -> Value {
+        assert!(job.get("result").is_none(), "{job}");
+        let url = job["result_url"].as_str().expect("the job has a result");
+        let response = self.get(url).await;
+        assert_eq!(response.status(), StatusCode::OK);
+        response.json().await.unwrap()
+    }
+
     /// Submits an asynchronous job; returns its URL.
     pub async fn submit(&self, job: &Value) -> String {
         let response = self.post("/v1/jobs", job).await;
@@ -170,15 +180,17 @@ pub async fn within<T>(future: impl Future<Output = T>) -> T {
         .expect("the test hung")
 }
 
-/// A sweep of `n`³ points, long enough to hold a solver thread for the length of a test.
+/// A sweep long enough to hold a solver thread for the length of a test, as long as `n`³
+/// points of ≈ 0.05 ms would be: (`n`/2)³ points of the finest rule (1024 Gauss nodes,
+/// ≈ 0.4 ms each, exact strip solves rather than table look-ups), so that what a stopped
+/// sweep keeps (a row per point) stays small. Each `n` is another job.
 pub fn long_sweep(n: usize) -> Value {
-    let radii: Vec<String> = (0..n).map(|i| format!("{} nm", 25 + i)).collect();
-    let loads: Vec<String> = (0..n).map(|i| format!("{} pN", 1000 + i)).collect();
-    let speeds: Vec<String> = (0..n).map(|i| format!("{} nm/s", 1 + i)).collect();
-    // A rule of its own keeps every point an exact strip solve (≈ 0.1 ms), not a table
-    // look-up (≈ 1 µs): the job stays long.
+    let m = n.div_ceil(2);
+    let radii: Vec<String> = (0..m).map(|i| format!("{} nm", 25 + i)).collect();
+    let loads: Vec<String> = (0..m).map(|i| format!("{} pN", 1000 + n + i)).collect();
+    let speeds: Vec<String> = (0..m).map(|i| format!("{} nm/s", 1 + i)).collect();
     serde_json::json!({"kind": "sweep", "input": {
-        "base": {"options": {"strips": 128}},
+        "base": {"options": {"strips": 1024}},
         "vary": {"radius": radii, "load": loads, "velocity": speeds}}})
 }
 

@@ -10,7 +10,7 @@ use crate::helpers::{config, serve};
 #[tokio::test]
 async fn services_sharing_a_storage_share_answers_and_jobs() {
     let config = config(&[]);
-    let storage = Storage::in_process(&config.engine);
+    let storage = Storage::in_process(&config.engine).expect("the spill directory is made");
     let a = serve(AppState::with_storage(config.clone(), storage.clone())).await;
     let b = serve(AppState::with_storage(config, storage)).await;
 
@@ -27,5 +27,5 @@ async fn services_sharing_a_storage_share_answers_and_jobs() {
         .wait_for_job(&location, |j| j["status"] == "succeeded")
         .await;
     assert_eq!(job["progress"], json!({"done": 2, "total": 2}));
-    assert_eq!(job["result"]["points"].as_array().unwrap().len(), 2);
+    assert_eq!(b.result(&job).await["points"].as_array().unwrap().len(), 2);
 }

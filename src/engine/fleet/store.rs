@@ -16,10 +16,10 @@ use uuid::Uuid;
 use super::cache::millis;
 use super::{keys, Failure, Fleet};
 use crate::engine::cache::Solved;
-use crate::engine::store::{JobRecord, JobState, JobStatus, JobStore};
+use crate::engine::spill::JobResult;
+use crate::engine::store::{JobRecord, JobState, JobStatus, JobStore, Refusal};
 use crate::job::parts::RenderedPart;
 use crate::job::{registry, JobError, Work};
-use crate::render::Format;
 use std::sync::Arc;
 
 /// Moves a job to a new state unless it has finished; a finished state keeps the result,
@@ -238,19 +238,18 @@ impl RedisJobStore {
         done: Option<usize>,
     ) -> Result<(), Failure> {
         let job = keys::job(id);
-        let (error, json, csv) = match state {
-            JobState::Failed(e) => (
-                serde_json::to_vec(e).expect("a job error is JSON"),
-                Bytes::new(),
-                Bytes::new(),
-            ),
-            JobState::Succeeded(solved) => {
-                let csv = solved
-                    .body(Format::Csv)
-                    .map_err(|e| Failure(format!("cannot render the result: {e}")))?;
-                (Vec::new(), solved.json().clone(), csv)
+        let error = match state {
+            JobState::Failed { error, .. } => {
+                serde_json::to_vec(error).expect("a job error is JSON")
             }
-            _ => (Vec::new(), Bytes::new(), Bytes::new()),
+            _ => Vec::new(),
+        };
+        let (json, csv) = match state.result() {
+            Some(result) => result
+                .bodies()
+                .await
+                .map_err(|e| Failure(format!("cannot render the result: {e}")))?,
+            None => (Bytes::new(), Bytes::new()),
         };
         let status = state.status().as_str();
         let done = done.map(|n| n.to_string()).unwrap_or_default();
@@ -299,25 +298,37 @@ impl RedisJobStore {
             .map(|k| k.name())
             .map_err(|e| Failure(format!("a stored job is unreadable: {e}")))?;
         let work = text("work").parse().map_or(Work::Unknown, Work::Known);
+        // A result of a cancelled or failed job is what it finished before it stopped.
+        let result = |complete: bool| match (&json, &csv) {
+            (Some(json), Some(csv)) => {
+                let mut solved = Solved::rendered(
+                    text("key"),
+                    kind,
+                    Bytes::from(json.clone()),
+                    Bytes::from(csv.clone()),
+                );
+                solved.complete = complete;
+                Some(JobResult::Ready(Arc::new(solved)))
+            }
+            _ => None,
+        };
         let state = match parse_status(&text("status")) {
             JobStatus::Queued => JobState::Queued,
             JobStatus::Running => JobState::Running,
-            JobStatus::Cancelled => JobState::Cancelled,
+            JobStatus::Cancelled => JobState::Cancelled {
+                partial: result(false),
+            },
             JobStatus::Interrupted => JobState::Interrupted,
-            JobStatus::Failed => JobState::Failed(
-                serde_json::from_slice(fields.get("error").map_or(&[][..], Vec::as_slice))
+            JobStatus::Failed => JobState::Failed {
+                error: serde_json::from_slice(fields.get("error").map_or(&[][..], Vec::as_slice))
                     .unwrap_or_else(|e| {
                         JobError::Internal(format!("the job's error is unreadable: {e}"))
                     }),
-            ),
-            JobStatus::Succeeded => match (json, csv) {
-                (Some(json), Some(csv)) => JobState::Succeeded(Arc::new(Solved::rendered(
-                    text("key"),
-                    kind,
-                    Bytes::from(json),
-                    Bytes::from(csv),
-                ))),
-                _ => JobState::Failed(JobError::Internal(
+                partial: result(false),
+            },
+            JobStatus::Succeeded => match result(true) {
+                Some(result) => JobState::Succeeded(result),
+                None => JobState::failed(JobError::Internal(
                     "the job's result was lost from the job store".to_string(),
                 )),
             },
@@ -336,7 +347,9 @@ impl RedisJobStore {
 
 #[async_trait]
 impl JobStore for RedisJobStore {
-    async fn insert(&self, record: JobRecord) {
+    /// The results are kept in Redis, whose memory bounds them (its `maxmemory`): no room
+    /// is made here.
+    async fn insert(&self, record: JobRecord, _result_bytes: u64) -> Result<(), Refusal> {
         let cmd = redis::cmd("HSET")
             .arg(keys::job(record.id).record)
             .arg("kind")
@@ -355,6 +368,7 @@ impl JobStore for RedisJobStore {
         if let Err(e) = self.fleet.jobs.query::<()>(&cmd).await {
             tracing::warn!(error = %e, id = %record.id, "a job record was not stored");
         }
+        Ok(())
     }
 
     async fn get(&self, id: Uuid) -> Option<JobRecord> {

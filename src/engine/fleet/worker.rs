@@ -20,10 +20,11 @@ use super::{keys, Failure, Fleet};
 use crate::engine::cache::Solved;
 use crate::engine::metrics as names;
 use crate::engine::pool::Pool;
+use crate::engine::spill::JobResult;
 use crate::engine::store::JobState;
 use crate::engine::Engine;
 use crate::job::parts::{self, RenderedPart};
-use crate::job::{Control, Job, JobError, Work};
+use crate::job::{Control, Job, JobError, Unfinished, Work};
 
 /// How long an idle worker waits before looking at the stream again.
 const IDLE: Duration = Duration::from_millis(20);
@@ -107,6 +108,8 @@ impl Entry {
 /// What a solver thread gives back.
 enum Outcome {
     Whole(Arc<Solved>),
+    /// A job solved whole that stopped before its end, and what it finished.
+    Stopped(JobError, Arc<Solved>),
     Part(RenderedPart),
 }
 
@@ -177,12 +180,12 @@ impl Engine {
                 entry.part_name(),
             ));
             return self
-                .finish(shared, &entry, JobState::Failed(error), None)
+                .finish(shared, &entry, JobState::failed(error), None)
                 .await;
         }
         let job = match Job::from_wire(&runnable.wire) {
             Ok(job) => job,
-            Err(e) => return self.finish(shared, &entry, JobState::Failed(e), None).await,
+            Err(e) => return self.finish(shared, &entry, JobState::failed(e), None).await,
         };
         let meta = job.meta();
         if meta.input_hash != runnable.key {
@@ -190,7 +193,7 @@ impl Engine {
                 "the job read back from the job store is not the job accepted".to_string(),
             );
             return self
-                .finish(shared, &entry, JobState::Failed(error), None)
+                .finish(shared, &entry, JobState::failed(error), None)
                 .await;
         }
         let control = Arc::new(self.control(runnable.deadline));
@@ -211,11 +214,22 @@ impl Engine {
         let part = entry.part.clone();
         let solving = job.clone();
         let result = Pool::run(permit, control.clone(), move |control| match part {
-            None => Ok(Outcome::Whole(Arc::new(Solved::new(
-                key,
-                solving.kind(),
-                solving.run(meta, control)?,
-            )?))),
+            None => match solving.run_keeping(meta, control) {
+                Ok(answer) => Ok(Outcome::Whole(Arc::new(Solved::new(
+                    key,
+                    solving.kind(),
+                    answer,
+                )?))),
+                // What a job past its deadline finished is kept with its failure.
+                Err(Unfinished {
+                    error: error @ JobError::DeadlineExceeded,
+                    partial: Some(answer),
+                }) => Ok(Outcome::Stopped(
+                    error,
+                    Arc::new(Solved::partial(key, solving.kind(), answer)?),
+                )),
+                Err(unfinished) => Err(unfinished.error),
+            },
             Some((_, range)) => Ok(Outcome::Part(parts::render(
                 &solving.run_points(meta, range, control)?,
             )?)),
@@ -239,7 +253,15 @@ impl Engine {
                     Work::Known(total) => total,
                     Work::Unknown => control.done(),
                 };
-                self.finish(shared, &entry, JobState::Succeeded(solved), Some(total))
+                let state = JobState::Succeeded(JobResult::Ready(solved));
+                self.finish(shared, &entry, state, Some(total)).await;
+            }
+            Ok(Outcome::Stopped(error, partial)) => {
+                let state = JobState::Failed {
+                    error,
+                    partial: Some(JobResult::Ready(partial)),
+                };
+                self.finish(shared, &entry, state, Some(control.done()))
                     .await;
             }
             Ok(Outcome::Part(rendered)) => {
@@ -258,7 +280,7 @@ impl Engine {
             Err(JobError::Cancelled) if self.is_draining() => {}
             Err(JobError::Cancelled) => acknowledge(&shared.fleet, &entry).await,
             Err(e) => {
-                self.finish(shared, &entry, JobState::Failed(e), Some(control.done()))
+                self.finish(shared, &entry, JobState::failed(e), Some(control.done()))
                     .await;
             }
         }
@@ -282,9 +304,9 @@ impl Engine {
                     Bytes::from(assembled.csv),
                 ));
                 self.cache.insert(solved.clone()).await;
-                JobState::Succeeded(solved)
+                JobState::Succeeded(JobResult::Ready(solved))
             }
-            Err(e) => JobState::Failed(e),
+            Err(e) => JobState::failed(e),
         };
         let done = match (&state, job.work()) {
             (JobState::Succeeded(_), Work::Known(n)) => Some(n),

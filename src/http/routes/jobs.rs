@@ -11,14 +11,12 @@ use axum::response::sse::{Event, KeepAlive, Sse};
 use axum::response::{IntoResponse, Response};
 use axum::Json;
 use futures_util::stream::{self, Stream};
-use serde::{Deserialize, Serialize, Serializer};
-use serde_json::value::RawValue;
+use serde::{Deserialize, Serialize};
 use tokio::sync::watch;
 use utoipa::{IntoParams, ToSchema};
 use uuid::Uuid;
 
 use super::{Answering, FormatQuery};
-use crate::engine::cache::Solved;
 use crate::engine::store::{JobRecord, JobState, JobStatus};
 use crate::engine::Engine;
 use crate::http::accept::{Accept, AcceptsJson};
@@ -30,10 +28,6 @@ use crate::http::responses::{
 use crate::http::AppState;
 use crate::job::registry::{AnyOutput, Envelope, KindName};
 use crate::job::{Job, JobError, Work};
-
-/// What a job whose result was let go says.
-const DROPPED: &str = "the result was dropped to stay within the memory budget (the oldest \
-                       results go first): submit the job again";
 
 /// How often a progress stream looks at a running job's count of solves.
 const PROGRESS_INTERVAL: Duration = Duration::from_millis(100);
@@ -47,7 +41,8 @@ pub struct Progress {
     pub total: usize,
 }
 
-/// An asynchronous job as clients see it.
+/// An asynchronous job as clients see it: small, whatever the size of its answer, which is
+/// at `result_url`.
 #[derive(Debug, Serialize, ToSchema)]
 pub struct JobView {
     /// The job's id (a UUID); its URL is `/v1/jobs/{id}`.
@@ -55,37 +50,24 @@ pub struct JobView {
     pub kind: KindName,
     pub status: JobStatus,
     pub progress: Progress,
-    /// The answer, once `succeeded`: the output of the job's kind.
-    #[serde(skip_serializing_if = "Option::is_none", serialize_with = "rendered")]
-    #[schema(value_type = Option<AnyOutput>)]
-    pub result: Option<Arc<Solved>>,
+    /// Where the job's answer is, once it has one: `/v1/jobs/{id}/result` (JSON, CSV or its
+    /// picture). A succeeded job's answer is whole; a cancelled or failed sweep's holds the
+    /// points it finished (see `partial`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub result_url: Option<String>,
+    /// Whether the answer at `result_url` is partial: what a cancelled or failed job
+    /// finished, its unsolved points `missing` (present only when true).
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub partial: bool,
     /// Why it failed, once `failed`.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub problem: Option<Problem>,
-    /// Why a `succeeded` job has no `result` (it was dropped to stay within the memory
-    /// budget).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub note: Option<&'static str>,
-}
-
-/// Writes a result as the JSON it was rendered to once, not serialized again.
-fn rendered<S: Serializer>(solved: &Option<Arc<Solved>>, s: S) -> Result<S::Ok, S::Error> {
-    let raw: Option<&RawValue> = solved
-        .as_ref()
-        .map(|solved| serde_json::from_slice(solved.json()))
-        .transpose()
-        .map_err(serde::ser::Error::custom)?;
-    raw.serialize(s)
 }
 
 impl JobView {
-    /// The job as recorded; with `full`, its result too once it has one.
-    fn of(record: &JobRecord, full: bool) -> JobView {
-        let (result, problem) = match &record.state {
-            JobState::Succeeded(solved) if full => (Some(solved.clone()), None),
-            JobState::Failed(e) => (None, Some(ApiError::from(e.clone()).problem())),
-            _ => (None, None),
-        };
+    /// The job as recorded.
+    fn of(record: &JobRecord) -> JobView {
+        let result = record.state.result();
         JobView {
             id: record.id,
             kind: KindName::of(record.kind),
@@ -97,9 +79,12 @@ impl JobView {
                     Work::Unknown => 0,
                 },
             },
-            result,
-            problem,
-            note: matches!(record.state, JobState::Dropped { .. }).then_some(DROPPED),
+            result_url: result.map(|_| format!("/v1/jobs/{}/result", record.id)),
+            partial: result.is_some_and(|r| !r.complete()),
+            problem: match &record.state {
+                JobState::Failed { error, .. } => Some(ApiError::from(error.clone()).problem()),
+                _ => None,
+            },
         }
     }
 }
@@ -175,7 +160,7 @@ pub async fn submit(
         .await?;
     let record = state.engine().submit(job).await?;
     let location = format!("/v1/jobs/{}", record.id);
-    let view = JobView::of(&record, true);
+    let view = JobView::of(&record);
     let headers = [
         (header::LOCATION, location),
         (header::RETRY_AFTER, "1".into()),
@@ -193,7 +178,7 @@ pub async fn submit(
     responses((status = 200, description = "The job", body = JobView), NotFound, Gone, NotAcceptable)
 )]
 pub async fn status(_: AcceptsJson, FoundJob(record): FoundJob) -> Json<JobView> {
-    Json(JobView::of(&record, true))
+    Json(JobView::of(&record))
 }
 
 /// Cancel a job.
@@ -216,7 +201,7 @@ pub async fn cancel(
     FoundJob(record): FoundJob,
 ) -> Json<JobView> {
     let record = state.engine().cancel(record.id).await.unwrap_or(record);
-    Json(JobView::of(&record, true))
+    Json(JobView::of(&record))
 }
 
 /// Delete a job.
@@ -238,7 +223,7 @@ pub async fn delete(
     FoundJob(record): FoundJob,
 ) -> Json<JobView> {
     let record = state.engine().delete(record.id).await.unwrap_or(record);
-    Json(JobView::of(&record, true))
+    Json(JobView::of(&record))
 }
 
 /// A finished job's answer.
@@ -264,20 +249,23 @@ pub async fn result(
     answering: Answering,
     FoundJob(record): FoundJob,
 ) -> Result<Response, ApiError> {
+    if let Some(result) = record.state.result() {
+        return answering.respond_result(result).await;
+    }
     match record.state {
-        JobState::Succeeded(solved) => answering.respond(&solved, None),
-        JobState::Failed(e) => Err(e.into()),
-        JobState::Cancelled => Err(JobError::Cancelled.into()),
-        JobState::Dropped { .. } => Err(ApiError::not_found(DROPPED)),
+        JobState::Failed { error, .. } => Err(error.into()),
+        JobState::Cancelled { .. } => Err(JobError::Cancelled.into()),
         JobState::Interrupted => Err(ApiError::interrupted(format!(
             "job {} was interrupted: the service stopped before it finished. Submit it again",
             record.id
         ))),
-        JobState::Queued | JobState::Running => Err(ApiError::not_ready(format!(
-            "job {} is {}: poll /v1/jobs/{0}, or follow /v1/jobs/{0}/events",
-            record.id,
-            record.state.status().as_str()
-        ))),
+        JobState::Succeeded(_) | JobState::Queued | JobState::Running => {
+            Err(ApiError::not_ready(format!(
+                "job {} is {}: poll /v1/jobs/{0}, or follow /v1/jobs/{0}/events",
+                record.id,
+                record.state.status().as_str()
+            )))
+        }
     }
 }
 
@@ -403,9 +391,8 @@ impl Watcher {
         }
     }
 
-    /// The event `name` for the job now (with its result once it completed).
+    /// The event `name` for the job now.
     fn event(&self, name: JobEventName) -> Result<Event, axum::Error> {
-        let full = matches!(name, JobEventName::Completion);
-        JobEvent::new(name, &JobView::of(&self.record, full)).map(JobEvent::into_sse)
+        JobEvent::new(name, &JobView::of(&self.record)).map(JobEvent::into_sse)
     }
 }

@@ -12,6 +12,7 @@ pub mod rolling;
 pub mod sweeps;
 pub mod three_body;
 
+use axum::body::Body;
 use axum::extract::{FromRequest, Request};
 use axum::http::{header, HeaderMap, HeaderName, HeaderValue, StatusCode};
 use axum::response::{IntoResponse, Response};
@@ -23,7 +24,8 @@ use super::accept::Accept;
 use super::body::{offload, JsonBody};
 use super::error::ApiError;
 use super::AppState;
-use crate::engine::cache::Solved;
+use crate::engine::cache::{picture, Solved};
+use crate::engine::spill::JobResult;
 use crate::engine::CacheStatus;
 use crate::job::meta::{GIT_COMMIT, SOFTWARE_VERSION};
 use crate::job::{Job, Meta};
@@ -169,34 +171,88 @@ impl Answering {
 
     /// The answer with its validators and provenance: the `ETag` is the cache key (per
     /// form), so an `If-None-Match` that names it gets `304` and no body. `cache` says
-    /// whether it was solved for this request, when it may have been.
+    /// whether it was solved for this request, when it may have been. A partial answer (of a
+    /// stopped job) has no `ETag`: another stop would give another answer.
     pub fn respond(
         &self,
         solved: &Solved,
         cache: Option<CacheStatus>,
     ) -> Result<Response, ApiError> {
-        let etag = match self.format {
-            Format::Json => format!("\"{}\"", solved.key),
-            other => format!("\"{}.{}\"", solved.key, other.name()),
+        self.answer(&solved.key, solved.complete, cache, || {
+            solved
+                .body(self.format)
+                .map(Body::from)
+                .map_err(|e| ApiError::internal(e.to_string()))
+        })
+    }
+
+    /// A job's result as [`Answering::respond`] gives an answer, wherever it is kept: a
+    /// result spilled to disk is streamed from its file (its picture drawn from it).
+    pub async fn respond_result(&self, result: &JobResult) -> Result<Response, ApiError> {
+        let spilled = match result {
+            JobResult::Ready(solved) => return self.respond(solved, None),
+            JobResult::Spilled(spilled) => spilled.clone(),
         };
-        let mut response = if if_none_match(&self.if_none_match, &etag) {
+        let unreadable = |e: std::io::Error| {
+            ApiError::internal(format!(
+                "the job's result cannot be read back from disk: {e}"
+            ))
+        };
+        let body = match self.format {
+            Format::Svg => {
+                let json = spilled.json().await.map_err(unreadable)?;
+                let kind = spilled.kind;
+                let svg = tokio::task::spawn_blocking(move || picture(kind, &json))
+                    .await
+                    .map_err(|e| ApiError::internal(e.to_string()))?
+                    .map_err(|e| ApiError::internal(e.to_string()))?;
+                Body::from(svg)
+            }
+            format => {
+                let file = tokio::fs::File::open(spilled.file(format))
+                    .await
+                    .map_err(unreadable)?;
+                Body::from_stream(tokio_util::io::ReaderStream::new(file))
+            }
+        };
+        let mut body = Some(body);
+        self.answer(&spilled.key, spilled.complete, None, || {
+            body.take()
+                .ok_or_else(|| ApiError::internal("the body was taken twice"))
+        })
+    }
+
+    /// The response carrying `body` (called unless the client holds it already) for the
+    /// answer whose cache key is `key`.
+    fn answer(
+        &self,
+        key: &str,
+        complete: bool,
+        cache: Option<CacheStatus>,
+        body: impl FnOnce() -> Result<Body, ApiError>,
+    ) -> Result<Response, ApiError> {
+        let etag = complete.then(|| match self.format {
+            Format::Json => format!("\"{key}\""),
+            other => format!("\"{key}.{}\"", other.name()),
+        });
+        let held = etag
+            .as_ref()
+            .is_some_and(|etag| if_none_match(&self.if_none_match, etag));
+        let mut response = if held {
             StatusCode::NOT_MODIFIED.into_response()
         } else {
-            let body = solved
-                .body(self.format)
-                .map_err(|e| ApiError::internal(e.to_string()))?;
             let content_type = [(header::CONTENT_TYPE, self.format.content_type())];
-            (content_type, body).into_response()
+            (content_type, body()?).into_response()
         };
         let h = response.headers_mut();
-        if let Ok(etag) = HeaderValue::from_str(&etag) {
+        if let Some(etag) = etag.and_then(|etag| HeaderValue::from_str(&etag).ok()) {
             h.insert(header::ETAG, etag);
         }
         if let Some(cache) = cache {
             h.insert(X_CACHE, HeaderValue::from_static(cache.as_str()));
         }
         h.insert(header::VARY, HeaderValue::from_static("accept"));
-        for (name, value) in PROVENANCE.into_iter().zip(provenance(&solved.key)) {
+        for (name, value) in PROVENANCE.into_iter().zip(provenance(key)) {
             if let Ok(value) = HeaderValue::from_str(value) {
                 h.insert(name, value);
             }

@@ -23,6 +23,7 @@ pub use output::{
 };
 
 use super::input as wire;
+use super::kind::SMALL_ANSWER;
 use super::meta::ROLLING_REFERENCES;
 use super::pictures::PictureError;
 use super::{Control, FieldError, JobError, Kind, Limits, Meta, Reference, Validated, Work};
@@ -68,6 +69,14 @@ impl Kind for FitJob {
 
     fn work(&self) -> Work {
         Work::Unknown
+    }
+
+    /// A residual is a row of a dozen numbers in JSON and CSV (at most 1 kB), a fitted curve
+    /// `CURVE_POINTS` points of a few numbers each.
+    fn result_bytes(&self) -> u64 {
+        let points: usize = self.series.iter().sum();
+        let curves = self.series.len() * CURVE_POINTS * 256;
+        SMALL_ANSWER + (points * 1024 + curves) as u64
     }
 
     fn run(&self, meta: Meta, control: &Control) -> Result<FitOutput, JobError> {

@@ -309,14 +309,19 @@ pub struct ContactState {
 }
 
 impl ContactState {
-    /// A_total/n_a (eq. 8).
-    pub fn mean_area(&self) -> f64 {
-        self.areas.total / self.particles_in_contact
+    /// A_total/n_a (eq. 8); `None` when no particle is in contact (the asperities carry
+    /// the load alone).
+    pub fn mean_area(&self) -> Option<f64> {
+        self.per_particle(self.areas.total)
     }
 
-    /// W/n_a.
-    pub fn mean_load(&self) -> f64 {
-        self.loads.total / self.particles_in_contact
+    /// W/n_a; `None` when no particle is in contact.
+    pub fn mean_load(&self) -> Option<f64> {
+        self.per_particle(self.loads.total)
+    }
+
+    fn per_particle(&self, total: f64) -> Option<f64> {
+        (self.particles_in_contact > 0.0).then(|| total / self.particles_in_contact)
     }
 }
 
@@ -406,8 +411,8 @@ pub fn solve(
                 s.areas.particle_layer,
                 s.loads.total,
                 s.friction_coefficient,
-                s.mean_area(),
-                s.mean_load(),
+                s.mean_area().unwrap_or(0.0),
+                s.mean_load().unwrap_or(0.0),
             ]
         });
     if numbers
@@ -583,10 +588,12 @@ impl<'a> Model<'a> {
                 })?
             }
         };
-        if state.particles_in_contact == 0.0 {
+        // The asperities alone may carry the load (no particle in contact: answered, with a
+        // warning); with nothing in contact there is no load, and no friction coefficient.
+        if state.loads.total <= 0.0 {
             return Err(ModelError::OutOfModel(format!(
-                "no particle is in contact at separation d = {:e} m (the largest particle is \
-                 x_max = {:e} m)",
+                "nothing is in contact at separation d = {:e} m: no particle (the largest is \
+                 x_max = {:e} m) and no asperity touches, so the system carries no load",
                 state.separation, d.max
             )));
         }

@@ -1,0 +1,141 @@
+//! Results too large for the memory budget, kept on disk: a directory of this process's own
+//! (made at start, removed at exit), bounded in bytes by the job store's reservations. A
+//! result spilled is its JSON and its CSV, two files named by the job's id; the files go
+//! when the last handle on them does (the record forgotten, and no response still reading
+//! them).
+
+use std::fs;
+use std::io;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use bytes::Bytes;
+use uuid::Uuid;
+
+use super::cache::Solved;
+use crate::render::Format;
+
+/// The directory results are spilled to.
+#[derive(Debug)]
+pub struct SpillDir {
+    path: PathBuf,
+    /// Bytes the directory may hold.
+    pub limit: u64,
+}
+
+impl SpillDir {
+    /// A new directory under `parent` for this process, holding at most `limit` bytes.
+    pub fn create(parent: &Path, limit: u64) -> io::Result<SpillDir> {
+        let path = parent.join(format!(
+            "thirdbody-results-{}-{}",
+            std::process::id(),
+            &Uuid::new_v4().simple().to_string()[..8]
+        ));
+        fs::create_dir_all(&path)?;
+        Ok(SpillDir { path, limit })
+    }
+
+    /// Writes the result `solved` of job `id` (its JSON and CSV, rendered); blocking.
+    pub fn write(&self, id: Uuid, solved: &Solved) -> io::Result<Spilled> {
+        let csv = solved
+            .body(Format::Csv)
+            .map_err(|e| io::Error::other(e.to_string()))?;
+        let spilled = Spilled {
+            key: solved.key.clone(),
+            kind: solved.kind,
+            complete: solved.complete,
+            json: self.path.join(format!("{id}.json")),
+            csv: self.path.join(format!("{id}.csv")),
+            bytes: (solved.json().len() + csv.len()) as u64,
+        };
+        fs::write(&spilled.json, solved.json())?;
+        fs::write(&spilled.csv, &csv)?;
+        Ok(spilled)
+    }
+}
+
+impl Drop for SpillDir {
+    /// The directory goes with the process's store (its results with their records).
+    fn drop(&mut self) {
+        let _ = fs::remove_dir_all(&self.path);
+    }
+}
+
+/// A result kept on disk.
+#[derive(Debug)]
+pub struct Spilled {
+    /// The job's cache key.
+    pub key: String,
+    /// The job's kind (which draws its picture).
+    pub kind: &'static str,
+    /// Whether the answer is whole (see [`Solved::complete`]).
+    pub complete: bool,
+    json: PathBuf,
+    csv: PathBuf,
+    /// The bytes of both files.
+    pub bytes: u64,
+}
+
+impl Spilled {
+    /// The file holding the answer in `format` (JSON or CSV; a picture is drawn from the
+    /// JSON).
+    pub fn file(&self, format: Format) -> &Path {
+        match format {
+            Format::Csv => &self.csv,
+            Format::Json | Format::Svg => &self.json,
+        }
+    }
+
+    /// Reads the answer's JSON back.
+    pub async fn json(&self) -> io::Result<Bytes> {
+        tokio::fs::read(&self.json).await.map(Bytes::from)
+    }
+}
+
+impl Drop for Spilled {
+    fn drop(&mut self) {
+        let _ = fs::remove_file(&self.json);
+        let _ = fs::remove_file(&self.csv);
+    }
+}
+
+/// Where a job's result is: in memory, or spilled to disk.
+#[derive(Clone, Debug)]
+pub enum JobResult {
+    Ready(Arc<Solved>),
+    Spilled(Arc<Spilled>),
+}
+
+impl JobResult {
+    /// Whether the answer is whole (else what a stopped job finished).
+    pub fn complete(&self) -> bool {
+        match self {
+            JobResult::Ready(solved) => solved.complete,
+            JobResult::Spilled(spilled) => spilled.complete,
+        }
+    }
+
+    /// The answer's JSON and CSV.
+    pub async fn bodies(&self) -> io::Result<(Bytes, Bytes)> {
+        match self {
+            JobResult::Ready(solved) => {
+                let csv = solved
+                    .body(Format::Csv)
+                    .map_err(|e| io::Error::other(e.to_string()))?;
+                Ok((solved.json().clone(), csv))
+            }
+            JobResult::Spilled(spilled) => {
+                let csv = tokio::fs::read(&spilled.csv).await?;
+                Ok((spilled.json().await?, Bytes::from(csv)))
+            }
+        }
+    }
+
+    /// Bytes held in memory, or on disk.
+    pub fn weight(&self) -> u64 {
+        match self {
+            JobResult::Ready(solved) => solved.weight(),
+            JobResult::Spilled(spilled) => spilled.bytes,
+        }
+    }
+}
