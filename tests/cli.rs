@@ -368,3 +368,24 @@ fn check_exits_0_when_every_check_holds_1_when_one_fails_2_on_bad_input() {
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("unknown kind \"nope\""));
 }
+
+#[test]
+fn a_check_s_misspelt_path_names_the_nearest_fields_of_the_answer() {
+    let checks = scratch("misspelt").join("checks.json");
+    std::fs::write(
+        &checks,
+        r#"{"checks": [{"name": "mu stays low", "job": {"kind": "rolling"},
+            "expect": {"friction_coeficient": {"max": 0.1}}}]}"#,
+    )
+    .unwrap();
+    let out = thirdbody(&["check", checks.to_str().unwrap()], None);
+    assert_eq!(out.status.code(), Some(1));
+    let report = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        report.contains(
+            "FAIL  mu stays low\n      friction_coeficient: the answer has no field at this \
+             path; nearest: friction_coefficient, static.friction_coefficient\n"
+        ),
+        "{report}"
+    );
+}

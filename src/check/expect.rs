@@ -2,6 +2,7 @@
 
 use serde_json::Value;
 
+use super::path::FieldPath;
 use super::report::Outcome;
 use super::{ExpectInput, GoldenInput};
 use crate::render::format_number;
@@ -16,15 +17,6 @@ fn within(x: f64, value: f64, rtol: f64, atol: f64) -> bool {
     (x - value).abs() <= atol + rtol * value.abs()
 }
 
-/// A step of a field path.
-#[derive(Clone, Debug, PartialEq)]
-enum Step {
-    Key(String),
-    Index(usize),
-    /// `[]`: every element.
-    Each,
-}
-
 /// What a number must satisfy.
 #[derive(Clone, Debug, PartialEq)]
 enum Bound {
@@ -35,68 +27,8 @@ enum Bound {
 /// An expectation on the numbers at one path of an answer.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Expectation {
-    path: String,
-    steps: Vec<Step>,
+    path: FieldPath,
     bound: Bound,
-}
-
-/// Reads `a.b[2].c` or `points[].contact_area` into steps.
-fn parse_path(path: &str) -> Result<Vec<Step>, String> {
-    let bad = || {
-        format!("\"{path}\" is not a field path (write e.g. static.friction_coefficient or points[].load)")
-    };
-    let mut steps = Vec::new();
-    for part in path.split('.') {
-        let (key, mut rest) = part.split_at(part.find('[').unwrap_or(part.len()));
-        if key.is_empty() {
-            return Err(bad());
-        }
-        steps.push(Step::Key(key.to_string()));
-        while !rest.is_empty() {
-            let inner = rest.strip_prefix('[').ok_or_else(bad)?;
-            let (index, after) = inner.split_once(']').ok_or_else(bad)?;
-            steps.push(if index.is_empty() {
-                Step::Each
-            } else {
-                Step::Index(index.parse().map_err(|_| bad())?)
-            });
-            rest = after;
-        }
-    }
-    Ok(steps)
-}
-
-/// The values at `steps` below `value`, each with its concrete path.
-fn resolve<'a>(value: &'a Value, steps: &[Step], at: String, out: &mut Vec<(String, &'a Value)>) {
-    let Some((step, rest)) = steps.split_first() else {
-        out.push((at, value));
-        return;
-    };
-    let join = |name: &str| {
-        if at.is_empty() {
-            name.to_string()
-        } else {
-            format!("{at}.{name}")
-        }
-    };
-    match (step, value) {
-        (Step::Key(k), Value::Object(map)) => {
-            if let Some(v) = map.get(k) {
-                resolve(v, rest, join(k), out);
-            }
-        }
-        (Step::Index(i), Value::Array(items)) => {
-            if let Some(v) = items.get(*i) {
-                resolve(v, rest, format!("{at}[{i}]"), out);
-            }
-        }
-        (Step::Each, Value::Array(items)) => {
-            for (i, v) in items.iter().enumerate() {
-                resolve(v, rest, format!("{at}[{i}]"), out);
-            }
-        }
-        _ => {}
-    }
 }
 
 fn finite(name: &str, x: Option<f64>) -> Result<Option<f64>, String> {
@@ -116,7 +48,7 @@ fn tolerance(name: &str, x: Option<f64>, default: f64) -> Result<f64, String> {
 impl Expectation {
     /// The expectation `input` on the field at `path`, or why it cannot be one.
     pub fn new(path: String, input: ExpectInput) -> Result<Expectation, String> {
-        let steps = parse_path(&path)?;
+        let path = FieldPath::parse(path)?;
         let (min, max) = (finite("min", input.min)?, finite("max", input.max)?);
         let equals = finite("equals", input.equals)?;
         let bound = match (equals, min, max) {
@@ -139,7 +71,7 @@ impl Expectation {
             }
             (None, min, max) => Bound::Range { min, max },
         };
-        Ok(Expectation { path, steps, bound })
+        Ok(Expectation { path, bound })
     }
 
     /// What the bound says, for reports.
@@ -175,20 +107,15 @@ impl Expectation {
     /// at it fails.
     pub fn judge(&self, answer: &Value) -> Vec<Outcome> {
         let expected = self.expected();
-        let mut found = Vec::new();
-        resolve(answer, &self.steps, String::new(), &mut found);
+        let found = self.path.resolve(answer);
         if found.is_empty() {
-            return vec![Outcome::failed(
-                &self.path,
-                &expected,
-                None,
-                "the answer has no such field",
-            )];
+            let why = self.path.miss(answer);
+            return vec![Outcome::failed(self.path.as_str(), &expected, None, &why)];
         }
         found
             .into_iter()
             .map(|(path, value)| match value.as_f64() {
-                None => Outcome::failed(&path, &expected, None, "not a number"),
+                None => Outcome::failed(&path, &expected, None, &format!("{path}: not a number")),
                 Some(x) if self.holds(x) => Outcome::passed(&path, &expected, x),
                 Some(x) => Outcome::failed(
                     &path,
@@ -309,23 +236,7 @@ mod tests {
     use serde_json::json;
 
     #[test]
-    fn paths_reach_nested_fields_indices_and_every_element() {
-        assert_eq!(
-            parse_path("points[].static.contact_area").unwrap(),
-            vec![
-                Step::Key("points".into()),
-                Step::Each,
-                Step::Key("static".into()),
-                Step::Key("contact_area".into())
-            ]
-        );
-        assert_eq!(
-            parse_path("a[2][0]").unwrap()[1..],
-            [Step::Index(2), Step::Index(0)]
-        );
-        for bad in ["", "a..b", "a[x]", "a[1", "[1]"] {
-            assert!(parse_path(bad).is_err(), "{bad}");
-        }
+    fn every_number_at_a_path_is_judged_and_a_path_reaching_none_fails() {
         let answer = json!({"points": [{"mu": 0.05}, {"mu": 0.2}], "static": {"mu": 0.3}});
         let at_most = |path: &str, max| {
             Expectation::new(
@@ -345,7 +256,16 @@ mod tests {
         );
         assert_eq!(outcomes[1].path, "points[1].mu");
         assert!(at_most("static.mu", 0.5)[0].passed);
-        assert!(!at_most("static.nu", 0.5)[0].passed);
+        let miss = &at_most("static.nu", 0.5)[0];
+        assert!(!miss.passed);
+        assert_eq!(miss.path, "static.nu");
+        assert!(
+            miss.message.ends_with("nearest: static.mu"),
+            "{}",
+            miss.message
+        );
+        let object = &at_most("static", 0.5)[0];
+        assert_eq!(object.message, "static: not a number");
     }
 
     #[test]

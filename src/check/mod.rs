@@ -8,6 +8,7 @@
 
 mod expect;
 mod file;
+mod path;
 mod report;
 
 use std::collections::BTreeMap;

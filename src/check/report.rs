@@ -137,6 +137,24 @@ impl Report {
         }
     }
 
+    /// Which checks failed, in a sentence for a failed report: "2 of 5 checks failed: mu
+    /// stays low, area at 1 nN".
+    pub fn failed_checks(&self) -> String {
+        let failed: Vec<&str> = self
+            .checks
+            .iter()
+            .filter(|c| !c.passed)
+            .map(|c| c.name.as_str())
+            .collect();
+        let of = self.summary.checks;
+        let noun = if of == 1 { "check" } else { "checks" };
+        format!(
+            "{} of {of} {noun} failed: {}",
+            failed.len(),
+            failed.join(", ")
+        )
+    }
+
     /// For people: one line per check, the failures under it, and the counts.
     pub fn to_text(&self) -> String {
         let mut text = String::new();
@@ -239,5 +257,6 @@ mod tests {
             "{text}"
         );
         assert!(text.ends_with("2 checks: 1 passed, 1 failed\n"));
+        assert_eq!(report.failed_checks(), "1 of 2 checks failed: area");
     }
 }

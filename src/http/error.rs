@@ -7,9 +7,10 @@ use axum::extract::rejection::BytesRejection;
 use axum::http::{header, HeaderValue, StatusCode};
 use axum::response::{IntoResponse, Response};
 use serde::Serialize;
-use serde_json::Value;
+use serde_json::{Map, Value};
 use utoipa::ToSchema;
 
+use crate::check::Report;
 use crate::engine::EngineError;
 use crate::job::{FieldError, JobError};
 
@@ -27,6 +28,8 @@ pub struct Problem {
     /// `solve-failed` (422: valid values for which the model cannot produce a number, e.g. a
     /// root finder that did not converge; change the input), `out-of-domain` (422: an
     /// assumption of the model fails for these values, see `meta.validity`),
+    /// `checks-failed` (422: checks run by `POST /v1/checks` failed; the report's fields are
+    /// extension members),
     /// `unsupported-media-type` (415),
     /// `not-acceptable` (406: the `Accept` header names no form the resource offers),
     /// `payload-too-large` (413), `not-found` (404), `interrupted` (410: the service stopped
@@ -49,6 +52,11 @@ pub struct Problem {
     /// (`invalid-input` only).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub errors: Vec<FieldError>,
+    /// Extension members (RFC 9457 §3.2) at the top level: for `checks-failed`, the report's
+    /// own fields (`passed`, `summary`, `checks`), read as in the 200 answer of checks that
+    /// passed.
+    #[serde(flatten)]
+    pub extensions: Map<String, Value>,
 }
 
 /// The kinds of problem the service names.
@@ -58,6 +66,7 @@ enum Kind {
     InvalidInput,
     SolveFailed,
     OutOfDomain,
+    ChecksFailed,
     UnsupportedMediaType,
     NotAcceptable,
     PayloadTooLarge,
@@ -80,9 +89,13 @@ impl Kind {
     fn status(self) -> StatusCode {
         match self {
             Kind::MalformedJson => StatusCode::BAD_REQUEST,
-            Kind::InvalidInput | Kind::SolveFailed | Kind::OutOfDomain | Kind::ResultTooLarge => {
-                StatusCode::UNPROCESSABLE_ENTITY
-            }
+            // Not 417 for failed checks: curl resends a request answered 417 (as a refusal
+            // of `Expect: 100-continue`), so a pipeline would run its checks twice.
+            Kind::InvalidInput
+            | Kind::SolveFailed
+            | Kind::OutOfDomain
+            | Kind::ChecksFailed
+            | Kind::ResultTooLarge => StatusCode::UNPROCESSABLE_ENTITY,
             Kind::UnsupportedMediaType => StatusCode::UNSUPPORTED_MEDIA_TYPE,
             Kind::NotAcceptable => StatusCode::NOT_ACCEPTABLE,
             Kind::PayloadTooLarge => StatusCode::PAYLOAD_TOO_LARGE,
@@ -106,6 +119,7 @@ impl Kind {
             Kind::InvalidInput => ("invalid-input", "The input is not valid"),
             Kind::SolveFailed => ("solve-failed", "The model cannot solve this input"),
             Kind::OutOfDomain => ("out-of-domain", "Outside the model's domain of validity"),
+            Kind::ChecksFailed => ("checks-failed", "Checks failed"),
             Kind::UnsupportedMediaType => ("unsupported-media-type", "Send application/json"),
             Kind::NotAcceptable => ("not-acceptable", "No acceptable form of the answer"),
             Kind::PayloadTooLarge => ("payload-too-large", "The body is too large"),
@@ -138,12 +152,18 @@ impl Kind {
     }
 }
 
+/// Marks a response as an error the service answered itself (a problem, or another form of
+/// one that the client asked for), which [`problem_for_errors`] leaves as it is.
+#[derive(Clone, Copy, Debug)]
+struct Answered;
+
 /// An error on its way to the client.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ApiError {
     kind: Kind,
     detail: String,
     errors: Vec<FieldError>,
+    extensions: Map<String, Value>,
     /// Seconds to wait before trying again, when this case knows better than its kind.
     retry_after: Option<u32>,
 }
@@ -154,7 +174,21 @@ impl ApiError {
             kind,
             detail: detail.into(),
             errors: Vec::new(),
+            extensions: Map::new(),
             retry_after: None,
+        }
+    }
+
+    /// Checks run by `POST /v1/checks` failed: an error status, so that a pipeline calling
+    /// `curl --fail-with-body` fails and still prints the report, whose fields are the
+    /// problem's extension members.
+    pub fn checks_failed(report: &Report) -> Self {
+        let Ok(Value::Object(extensions)) = serde_json::to_value(report) else {
+            unreachable!("a report is a JSON object");
+        };
+        ApiError {
+            extensions,
+            ..ApiError::new(Kind::ChecksFailed, report.failed_checks())
         }
     }
 
@@ -215,7 +249,27 @@ impl ApiError {
             status: status.as_u16(),
             detail: self.detail.clone(),
             errors: self.errors.clone(),
+            extensions: self.extensions.clone(),
         }
+    }
+
+    /// The answer with this error's status and headers, and `body` (of `content_type`)
+    /// instead of the problem document: the form of the problem the client asked for, e.g.
+    /// the JUnit report of failed checks for a CI system that reads JUnit.
+    pub fn respond_as(self, content_type: &'static str, body: impl Into<Body>) -> Response {
+        let status = self.status();
+        if status.is_server_error() {
+            tracing::error!(status = status.as_u16(), detail = %self.detail, "request failed");
+        }
+        let mut response =
+            (status, [(header::CONTENT_TYPE, content_type)], body.into()).into_response();
+        if let Some(seconds) = self.retry_after.or(self.kind.retry_after()) {
+            response
+                .headers_mut()
+                .insert(header::RETRY_AFTER, HeaderValue::from(seconds));
+        }
+        response.extensions_mut().insert(Answered);
+        response
     }
 }
 
@@ -310,30 +364,17 @@ impl From<BytesRejection> for ApiError {
 
 impl IntoResponse for ApiError {
     fn into_response(self) -> Response {
-        let status = self.status();
-        if status.is_server_error() {
-            tracing::error!(status = status.as_u16(), detail = %self.detail, "request failed");
-        }
         let body = serde_json::to_vec(&self.problem()).unwrap_or_default();
-        let mut response = (status, [(header::CONTENT_TYPE, PROBLEM_JSON)], body).into_response();
-        if let Some(seconds) = self.retry_after.or(self.kind.retry_after()) {
-            response
-                .headers_mut()
-                .insert(header::RETRY_AFTER, HeaderValue::from(seconds));
-        }
-        response
+        self.respond_as(PROBLEM_JSON, body)
     }
 }
 
-/// Turns an error response that is not yet a problem (axum's 405, a timeout, a rejection
-/// with a plain-text body) into one, keeping its status, headers and text.
+/// Turns an error response the service did not answer itself (axum's 405, a timeout, a
+/// rejection with a plain-text body) into a problem, keeping its status, headers and text.
 pub async fn problem_for_errors(response: Response) -> Response {
     let status = response.status();
-    let is_problem = response
-        .headers()
-        .get(header::CONTENT_TYPE)
-        .is_some_and(|v| v.as_bytes().starts_with(PROBLEM_JSON.as_bytes()));
-    if !(status.is_client_error() || status.is_server_error()) || is_problem {
+    let answered = response.extensions().get::<Answered>().is_some();
+    if !(status.is_client_error() || status.is_server_error()) || answered {
         return response;
     }
     let (mut parts, body) = response.into_parts();
@@ -431,5 +472,39 @@ mod tests {
         let ok = problem_for_errors(StatusCode::NOT_MODIFIED.into_response()).await;
         assert_eq!(ok.status(), StatusCode::NOT_MODIFIED);
         assert!(!ok.headers().contains_key(header::CONTENT_TYPE));
+    }
+
+    #[tokio::test]
+    async fn failed_checks_are_a_problem_carrying_the_report_in_any_form() {
+        use crate::check::{CheckReport, Outcome};
+        let mut low = CheckReport::new("mu stays low", "rolling");
+        low.outcomes
+            .push(Outcome::failed("x", "at most 1", Some(2.0), "x = 2"));
+        low.settle();
+        let mut area = CheckReport::new("area", "rolling");
+        area.settle();
+        let report = Report::new(vec![low, area]);
+        let failed = ApiError::checks_failed(&report);
+
+        let problem = serde_json::to_value(failed.problem()).unwrap();
+        let mut members = serde_json::to_value(&report).unwrap();
+        for (name, value) in [
+            ("type", format!("{TYPE_PREFIX}checks-failed").into()),
+            ("title", "Checks failed".into()),
+            ("status", 422.into()),
+            ("detail", "1 of 2 checks failed: mu stays low".into()),
+        ] {
+            members[name] = value;
+        }
+        assert_eq!(problem, members, "the report's fields at the top level");
+
+        let junit = failed.respond_as("application/xml", report.to_junit());
+        let kept = problem_for_errors(junit).await;
+        assert_eq!(kept.status(), StatusCode::UNPROCESSABLE_ENTITY);
+        assert_eq!(kept.headers()[header::CONTENT_TYPE], "application/xml");
+        let body = axum::body::to_bytes(kept.into_body(), 1 << 16)
+            .await
+            .unwrap();
+        assert_eq!(body, report.to_junit().as_bytes());
     }
 }

@@ -6,6 +6,7 @@ use std::collections::BTreeMap;
 
 use utoipa::openapi::header::HeaderBuilder;
 use utoipa::openapi::response::ResponseBuilder;
+use utoipa::openapi::schema::{AllOfBuilder, AnyOfBuilder, ObjectBuilder, Type};
 use utoipa::openapi::{ContentBuilder, Ref, RefOr, Response};
 use utoipa::IntoResponses;
 
@@ -46,18 +47,53 @@ macro_rules! problems {
 
 const DRAINING: &str = "draining: the service is shutting down";
 
+const INVALID_INPUT: &str = "invalid-input: fields of the wrong shape or out of range, each \
+    named in `errors` with its value and the allowed range";
+
 problems!(
     /// Errors of a request body.
     BadBody {
         (400, "malformed-json: the body is not JSON", false),
         (413, "payload-too-large: the body is larger than the body limit", false),
         (415, "unsupported-media-type: the body is not application/json", false),
-        (422, "invalid-input: fields of the wrong shape or out of range, each named in \
-            `errors` with its value and the allowed range; solve-failed: valid values \
-            the model cannot solve; or out-of-domain: values for which an assumption of the \
-            model fails (the detail names it, with its numbers)", false),
+        (422, &format!("{INVALID_INPUT}; solve-failed: valid values the model cannot solve; or \
+            out-of-domain: values for which an assumption of the model fails (the detail names \
+            it, with its numbers)"), false),
     }
 );
+
+/// The 422 of `POST /v1/checks`: checks that failed, or a checks document that is not valid.
+/// Listed after [`BadBody`] in the route's responses, whose 422 it replaces (a later entry
+/// for a status wins).
+pub enum ChecksFailed {}
+
+impl IntoResponses for ChecksFailed {
+    fn responses() -> BTreeMap<String, RefOr<Response>> {
+        let report = AllOfBuilder::new()
+            .item(Ref::from_schema_name("Problem"))
+            .item(Ref::from_schema_name("Report"));
+        let problem = AnyOfBuilder::new()
+            .item(report)
+            .item(Ref::from_schema_name("Problem"));
+        let junit = ObjectBuilder::new().schema_type(Type::String);
+        let response = ResponseBuilder::new()
+            .description(format!(
+                "checks-failed: one or more checks failed: the detail names them, and the \
+                 report's fields (`passed`, `summary`, `checks`, as in the 200 answer) are \
+                 members of the problem (with `Accept: application/xml`, the body is the \
+                 JUnit report); or {INVALID_INPUT}"
+            ))
+            .content(
+                PROBLEM_JSON,
+                ContentBuilder::new().schema(Some(problem)).build(),
+            )
+            .content(
+                "application/xml",
+                ContentBuilder::new().schema(Some(junit)).build(),
+            );
+        BTreeMap::from([("422".to_string(), response.build().into())])
+    }
+}
 
 problems!(
     /// Refusals of new work.

@@ -1,13 +1,17 @@
 //! `POST /v1/checks` and the provenance of answers: what a CI pipeline without the binary
 //! uses.
 
+use std::process::{Command, Output};
+
 use reqwest::Method;
 use serde_json::{json, Value};
 
-use crate::helpers::{problem, problem_type, spawn_app};
+use crate::helpers::{problem, problem_type, spawn_app, within};
 
+/// Checks that fail answer 422 (before issue 20, 200 with `passed: false`, which let a
+/// pipeline's `curl -f` pass): the problem carries the report's fields, or the JUnit report.
 #[tokio::test]
-async fn checks_run_over_http_and_report_as_json_or_junit() {
+async fn failed_checks_answer_422_with_the_report_as_a_problem_or_as_junit() {
     let app = spawn_app(&[]).await;
     let checks = json!({"checks": [
         {"name": "mu stays low", "job": {"kind": "rolling", "input": {"load": "1.2 nN"}},
@@ -18,9 +22,12 @@ async fn checks_run_over_http_and_report_as_json_or_junit() {
         {"name": "pierced", "job": {"kind": "rolling", "input": {"load": "1 mN"}},
          "expect": {"friction_coefficient": {"max": 1}}}
     ]});
-    let response = app.post("/v1/checks", &checks).await;
-    assert_eq!(response.status(), 200);
-    let report: Value = response.json().await.unwrap();
+    let report = problem(app.post("/v1/checks", &checks).await, 422).await;
+    assert_eq!(report["type"], problem_type("checks-failed"));
+    assert_eq!(
+        report["detail"],
+        "2 of 3 checks failed: too strict, pierced"
+    );
     assert_eq!(report["passed"], false);
     assert_eq!(
         report["summary"],
@@ -43,6 +50,7 @@ async fn checks_run_over_http_and_report_as_json_or_junit() {
             Some(&checks),
         )
         .await;
+    assert_eq!(xml.status(), 422);
     assert_eq!(xml.headers()["content-type"], "application/xml");
     let xml = xml.text().await.unwrap();
     assert!(xml.contains("tests=\"3\" failures=\"2\""), "{xml}");
@@ -115,11 +123,108 @@ async fn every_answer_says_where_it_comes_from_and_a_job_result_comes_as_csv() {
 }
 
 #[tokio::test]
-async fn the_readme_s_checks_pass_against_the_service() {
+async fn the_readme_s_checks_pass_against_the_service_with_200() {
     let app = spawn_app(&[]).await;
     let checks: Value =
         serde_json::from_str(include_str!("../../examples/checks-inline.json")).unwrap();
-    let report: Value = app.post("/v1/checks", &checks).await.json().await.unwrap();
+    let response = app.post("/v1/checks", &checks).await;
+    assert_eq!(response.status(), 200);
+    assert_eq!(response.headers()["content-type"], "application/json");
+    let report: Value = response.json().await.unwrap();
     assert_eq!(report["passed"], true, "{report}");
     assert_eq!(report["summary"]["checks"], 4);
+
+    let accept = [("accept", "application/xml")];
+    let xml = app
+        .send(Method::POST, "/v1/checks", &accept, Some(&checks))
+        .await;
+    assert_eq!(xml.status(), 200);
+    assert!(xml
+        .text()
+        .await
+        .unwrap()
+        .contains("tests=\"4\" failures=\"0\""));
+}
+
+#[tokio::test]
+async fn a_misspelt_path_names_the_nearest_fields_of_the_answer() {
+    let app = spawn_app(&[]).await;
+    let checks = json!({"checks": [{"name": "typo", "job": {"kind": "rolling"},
+        "expect": {"friction_coeficient": {"max": 0.1}}}]});
+    let report = problem(app.post("/v1/checks", &checks).await, 422).await;
+    assert_eq!(
+        report["checks"][0]["outcomes"][0]["message"],
+        "friction_coeficient: the answer has no field at this path; \
+         nearest: friction_coefficient, static.friction_coefficient"
+    );
+}
+
+/// Runs the real `curl` with `args` (off the test's runtime, which serves the app).
+async fn curl(args: Vec<String>) -> Output {
+    let run = tokio::task::spawn_blocking(move || {
+        Command::new("curl")
+            .args(["--silent", "--show-error", "--max-time", "120"])
+            .args(&args)
+            .current_dir(env!("CARGO_MANIFEST_DIR"))
+            .output()
+            .unwrap_or_else(|e| {
+                panic!(
+                    "cannot run curl ({e}): this test runs README's recipe with it; install curl"
+                )
+            })
+    });
+    within(run).await.unwrap()
+}
+
+/// README's recipe as a pipeline runs it: failed checks fail the step (`-f`), and
+/// `--fail-with-body` still prints the report, as JSON or JUnit; checks that pass exit 0.
+#[tokio::test]
+async fn curl_fails_the_pipeline_on_failed_checks_and_prints_the_report() {
+    let app = spawn_app(&[]).await;
+    let failing = json!({"checks": [{"name": "too strict", "job": {"kind": "rolling"},
+        "expect": {"friction_coefficient": {"max": 0.01}}}]});
+    let request = |fail: &str, accept: &str, data: String| -> Vec<String> {
+        let url = app.url("/v1/checks");
+        [
+            fail,
+            "-X",
+            "POST",
+            &url,
+            "-H",
+            "content-type: application/json",
+        ]
+        .into_iter()
+        .chain(["-H", accept, "--data", &data])
+        .map(str::to_string)
+        .collect()
+    };
+    let json = "accept: application/json";
+    let xml = "accept: application/xml";
+
+    let quiet = curl(request("--fail", json, failing.to_string())).await;
+    assert_eq!(quiet.status.code(), Some(22), "curl -f exits 22 on 422");
+    assert!(quiet.stdout.is_empty());
+
+    let out = curl(request("--fail-with-body", json, failing.to_string())).await;
+    assert_eq!(out.status.code(), Some(22));
+    let report: Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(report["type"], problem_type("checks-failed"));
+    assert_eq!(report["passed"], false);
+    assert_eq!(report["checks"][0]["name"], "too strict");
+
+    let out = curl(request("--fail-with-body", xml, failing.to_string())).await;
+    assert_eq!(out.status.code(), Some(22));
+    let junit = String::from_utf8(out.stdout).unwrap();
+    assert!(junit.contains("tests=\"1\" failures=\"1\""), "{junit}");
+
+    let readme = "@examples/checks-inline.json".to_string();
+    let out = curl(request("--fail-with-body", xml, readme)).await;
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let junit = String::from_utf8(out.stdout).unwrap();
+    assert!(junit.contains("tests=\"4\" failures=\"0\""), "{junit}");
 }

@@ -10,7 +10,7 @@ use crate::engine::EngineError;
 use crate::http::accept::Accept;
 use crate::http::body::JsonBody;
 use crate::http::error::ApiError;
-use crate::http::responses::{BadBody, Busy, NotAcceptable};
+use crate::http::responses::{BadBody, Busy, ChecksFailed, NotAcceptable};
 use crate::http::AppState;
 use crate::job::JobError;
 
@@ -21,9 +21,10 @@ const FORMS: [&str; 2] = ["application/json", "application/xml"];
 ///
 /// The body is a checks document, as `thirdbody check` takes (golden answers inline, as
 /// `golden.answer`): each check a job and expectations on its answer. Every job is solved
-/// through the cache like a synchronous request. The answer is the report (200 whether the
-/// checks passed or not: see `passed`), as JSON or, with `Accept: application/xml`, as
-/// JUnit XML.
+/// through the cache like a synchronous request. The answer is the report, as JSON or, with
+/// `Accept: application/xml`, as JUnit XML: 200 when every check passed, 422 when one
+/// failed (as JSON, the problem `checks-failed` with the report's fields as members), so
+/// that `curl --fail-with-body` fails a pipeline and still prints the report.
 #[utoipa::path(
     post,
     path = "/v1/checks",
@@ -31,9 +32,9 @@ const FORMS: [&str; 2] = ["application/json", "application/xml"];
     tag = "solve",
     request_body(content = ChecksInput, content_type = "application/json"),
     responses(
-        (status = 200, description = "The report", content(
+        (status = 200, description = "The report: every check passed", content(
             (Report = "application/json"), (String = "application/xml"))),
-        BadBody, NotAcceptable, Busy,
+        BadBody, ChecksFailed, NotAcceptable, Busy,
     )
 )]
 pub async fn run(
@@ -76,9 +77,11 @@ pub async fn run(
         reports.push(spec.judge(answer));
     }
     let report = Report::new(reports);
-    Ok(if xml {
-        ([(header::CONTENT_TYPE, FORMS[1])], report.to_junit()).into_response()
-    } else {
-        axum::Json(report).into_response()
+    let failed = (!report.passed).then(|| ApiError::checks_failed(&report));
+    Ok(match (failed, xml) {
+        (None, false) => axum::Json(report).into_response(),
+        (None, true) => ([(header::CONTENT_TYPE, FORMS[1])], report.to_junit()).into_response(),
+        (Some(failed), false) => failed.into_response(),
+        (Some(failed), true) => failed.respond_as(FORMS[1], report.to_junit()),
     })
 }

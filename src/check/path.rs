@@ -1,0 +1,275 @@
+//! Field paths of an answer, as checks name them (`static.friction_coefficient`,
+//! `points[2].load`, `points[].contact_area`): reading one, finding what it reaches
+//! ([`FieldPath::resolve`]), and saying what is there instead when it reaches nothing
+//! ([`FieldPath::miss`]).
+
+use std::collections::BTreeSet;
+use std::fmt;
+
+use serde_json::Value;
+
+/// Existing paths a miss names, at most: enough for the likely typos, short enough for a
+/// line of a CI log.
+const NEAREST: usize = 3;
+
+/// A step of a field path.
+#[derive(Clone, Debug, PartialEq)]
+enum Step {
+    Key(String),
+    Index(usize),
+    /// `[]`: every element.
+    Each,
+}
+
+/// A field path, as written and as steps.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FieldPath {
+    text: String,
+    steps: Vec<Step>,
+}
+
+impl FieldPath {
+    /// Reads `a.b[2].c` or `points[].contact_area`.
+    pub fn parse(text: String) -> Result<FieldPath, String> {
+        let bad = || {
+            format!("\"{text}\" is not a field path (write e.g. static.friction_coefficient or points[].load)")
+        };
+        let mut steps = Vec::new();
+        for part in text.split('.') {
+            let (key, mut rest) = part.split_at(part.find('[').unwrap_or(part.len()));
+            if key.is_empty() {
+                return Err(bad());
+            }
+            steps.push(Step::Key(key.to_string()));
+            while !rest.is_empty() {
+                let inner = rest.strip_prefix('[').ok_or_else(bad)?;
+                let (index, after) = inner.split_once(']').ok_or_else(bad)?;
+                steps.push(if index.is_empty() {
+                    Step::Each
+                } else {
+                    Step::Index(index.parse().map_err(|_| bad())?)
+                });
+                rest = after;
+            }
+        }
+        Ok(FieldPath { text, steps })
+    }
+
+    /// The path as written.
+    pub fn as_str(&self) -> &str {
+        &self.text
+    }
+
+    /// The values the path reaches in `answer`, each with its concrete path (`[]` may reach
+    /// several, a miss none).
+    pub fn resolve<'a>(&self, answer: &'a Value) -> Vec<(String, &'a Value)> {
+        let mut found = Vec::new();
+        resolve(answer, &self.steps, String::new(), &mut found);
+        found
+    }
+
+    /// Why the path reaches nothing in `answer`, naming the path and the existing paths
+    /// nearest to it: a typo in a CI check is then fixed from the log alone.
+    pub fn miss(&self, answer: &Value) -> String {
+        let nearest = nearest(&self.text, answer);
+        let mut message = format!("{}: the answer has no field at this path", self.text);
+        if !nearest.is_empty() {
+            message.push_str("; nearest: ");
+            message.push_str(&nearest.join(", "));
+        }
+        message
+    }
+}
+
+impl fmt::Display for FieldPath {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.text)
+    }
+}
+
+/// `name` below the path `at`.
+fn child(at: &str, name: &str) -> String {
+    if at.is_empty() {
+        name.to_string()
+    } else {
+        format!("{at}.{name}")
+    }
+}
+
+/// Puts the values at `steps` below `value` into `out`, each with its concrete path.
+fn resolve<'a>(value: &'a Value, steps: &[Step], at: String, out: &mut Vec<(String, &'a Value)>) {
+    let Some((step, rest)) = steps.split_first() else {
+        out.push((at, value));
+        return;
+    };
+    match (step, value) {
+        (Step::Key(k), Value::Object(map)) => {
+            if let Some(v) = map.get(k) {
+                resolve(v, rest, child(&at, k), out);
+            }
+        }
+        (Step::Index(i), Value::Array(items)) => {
+            if let Some(v) = items.get(*i) {
+                resolve(v, rest, format!("{at}[{i}]"), out);
+            }
+        }
+        (Step::Each, Value::Array(items)) => {
+            for (i, v) in items.iter().enumerate() {
+                resolve(v, rest, format!("{at}[{i}]"), out);
+            }
+        }
+        _ => {}
+    }
+}
+
+/// Puts the path of every number below `value` into `out`, with `[]` for the elements of a
+/// list: the paths a check can expect something of (only numbers are judged).
+fn number_paths(value: &Value, at: String, out: &mut BTreeSet<String>) {
+    match value {
+        Value::Number(_) => {
+            out.insert(at);
+        }
+        Value::Object(map) => {
+            for (key, v) in map {
+                number_paths(v, child(&at, key), out);
+            }
+        }
+        Value::Array(items) => {
+            for v in items {
+                number_paths(v, format!("{at}[]"), out);
+            }
+        }
+        _ => {}
+    }
+}
+
+/// The number paths of `answer` nearest to `written`, nearest first. A path is as near as
+/// the nearest of its dotted tails (so `friction_coeficient` finds
+/// `static.friction_coefficient` as well as `friction_coefficient`), ties broken by the
+/// distance of the whole path; only the paths at the least distance are named.
+fn nearest(written: &str, answer: &Value) -> Vec<String> {
+    let mut paths = BTreeSet::new();
+    number_paths(answer, String::new(), &mut paths);
+    let mut ranked: Vec<(usize, usize, String)> = paths
+        .into_iter()
+        .map(|path| {
+            let whole = levenshtein(written, &path);
+            let tails = path.match_indices('.').map(|(i, _)| &path[i + 1..]);
+            let near = tails
+                .map(|t| levenshtein(written, t))
+                .fold(whole, usize::min);
+            (near, whole, path)
+        })
+        .collect();
+    ranked.sort();
+    let best = ranked.first().map(|r| r.0);
+    ranked
+        .into_iter()
+        .take_while(|r| Some(r.0) == best)
+        .take(NEAREST)
+        .map(|r| r.2)
+        .collect()
+}
+
+/// The Levenshtein distance of `a` and `b`, in characters: the fewest insertions,
+/// deletions and substitutions that turn one into the other.
+fn levenshtein(a: &str, b: &str) -> usize {
+    let b: Vec<char> = b.chars().collect();
+    // `row[j]`: the distance of the part of `a` read so far and the first j characters of b.
+    let mut row: Vec<usize> = (0..=b.len()).collect();
+    for (i, ca) in a.chars().enumerate() {
+        let mut diagonal = row[0];
+        row[0] = i + 1;
+        for (j, cb) in b.iter().enumerate() {
+            let substitution = diagonal + usize::from(ca != *cb);
+            diagonal = row[j + 1];
+            row[j + 1] = substitution.min(row[j] + 1).min(diagonal + 1);
+        }
+    }
+    row[b.len()]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use serde_json::json;
+
+    fn path(text: &str) -> FieldPath {
+        FieldPath::parse(text.to_string()).unwrap()
+    }
+
+    #[test]
+    fn paths_reach_nested_fields_indices_and_every_element() {
+        assert_eq!(
+            path("points[].static.contact_area").steps,
+            vec![
+                Step::Key("points".into()),
+                Step::Each,
+                Step::Key("static".into()),
+                Step::Key("contact_area".into())
+            ]
+        );
+        assert_eq!(path("a[2][0]").steps[1..], [Step::Index(2), Step::Index(0)]);
+        for bad in ["", "a..b", "a[x]", "a[1", "[1]"] {
+            assert!(FieldPath::parse(bad.to_string()).is_err(), "{bad}");
+        }
+        let answer = json!({"points": [{"mu": 0.05}, {"mu": 0.2}], "static": {"mu": 0.3}});
+        let reached = |text: &str| {
+            let found = path(text).resolve(&answer);
+            found.into_iter().map(|(at, _)| at).collect::<Vec<_>>()
+        };
+        assert_eq!(reached("points[].mu"), ["points[0].mu", "points[1].mu"]);
+        assert_eq!(reached("points[1].mu"), ["points[1].mu"]);
+        assert_eq!(reached("static.mu"), ["static.mu"]);
+        for miss in ["static.nu", "points[2].mu", "static[]", "points.mu"] {
+            assert!(reached(miss).is_empty(), "{miss}");
+        }
+    }
+
+    #[test]
+    fn a_miss_names_the_path_and_the_nearest_existing_ones() {
+        let rolling = json!({"friction_coefficient": 0.09, "contact_area": 8e-17,
+            "static": {"friction_coefficient": 0.1, "contact_area": 9e-17},
+            "boundary": [[1.0, 2.0], [3.0, 4.0]], "meta": {"model_version": "1"}});
+        assert_eq!(
+            path("friction_coeficient").miss(&rolling),
+            "friction_coeficient: the answer has no field at this path; \
+             nearest: friction_coefficient, static.friction_coefficient"
+        );
+        assert_eq!(
+            path("statik.contact_area").miss(&rolling),
+            "statik.contact_area: the answer has no field at this path; \
+             nearest: static.contact_area"
+        );
+        assert_eq!(
+            path("boundary[][2]").miss(&rolling),
+            "boundary[][2]: the answer has no field at this path; nearest: boundary[][]"
+        );
+        let sweep = json!({"points": [{"load": 1e-9, "static": {"friction_coefficient": 0.1}},
+                                      {"load": 2e-9, "static": {"friction_coefficient": 0.2}}]});
+        assert_eq!(
+            path("points[].lod").miss(&sweep),
+            "points[].lod: the answer has no field at this path; nearest: points[].load"
+        );
+        assert_eq!(
+            path("x").miss(&json!({"meta": {"kind": "rolling"}})),
+            "x: the answer has no field at this path"
+        );
+    }
+
+    #[test]
+    fn levenshtein_counts_insertions_deletions_and_substitutions() {
+        for (a, b, d) in [
+            ("", "", 0),
+            ("", "abc", 3),
+            ("abc", "", 3),
+            ("kitten", "sitting", 3),
+            ("friction_coeficient", "friction_coefficient", 1),
+            ("flaw", "lawn", 2),
+            ("µm", "nm", 1),
+        ] {
+            assert_eq!(levenshtein(a, b), d, "{a} {b}");
+            assert_eq!(levenshtein(b, a), d, "{b} {a}");
+        }
+    }
+}
