@@ -73,8 +73,9 @@ struct OutputArgs {
     /// Output format.
     #[arg(long, value_enum, default_value_t = OutputFormat::Json)]
     format: OutputFormat,
-    /// Print first a line saying where the answer comes from: software version and git
-    /// commit, model version, SHA-256 of the input.
+    /// Say where the answer comes from (software version and git commit, model version,
+    /// SHA-256 of the input) where the output still parses: a first `#` line of a CSV, an
+    /// XML comment of an SVG; a JSON answer holds it already in `meta`.
     #[arg(long)]
     provenance: bool,
 }
@@ -124,9 +125,10 @@ fn main() -> ExitCode {
         let meta = job.meta();
         let provenance = output.provenance.then(|| meta.provenance());
         let answer = job.run(meta, &Control::default())?;
-        let text = render(&answer, output.format.format())?;
+        let format = output.format.format();
+        let text = render(&answer, format)?;
         Ok(match provenance {
-            Some(line) => format!("{line}\n{text}"),
+            Some(line) => format.with_provenance(text, &line),
             None => text,
         })
     });

@@ -287,6 +287,83 @@ fn a_csv_can_say_where_it_comes_from_and_warnings_reach_standard_error() {
     );
 }
 
+/// The records of a CSV text (RFC 4180: quoted fields may hold commas, quotes doubled and
+/// line breaks).
+fn csv_records(text: &str) -> Vec<Vec<String>> {
+    let (mut records, mut record, mut field) = (Vec::new(), Vec::new(), String::new());
+    let (mut quoted, mut chars) = (false, text.chars().peekable());
+    while let Some(c) = chars.next() {
+        match (quoted, c) {
+            (true, '"') if chars.peek() == Some(&'"') => {
+                field.push('"');
+                chars.next();
+            }
+            (true, '"') => quoted = false,
+            (true, c) => field.push(c),
+            (false, '"') if field.is_empty() => quoted = true,
+            (false, ',') => record.push(std::mem::take(&mut field)),
+            (false, '\n') => {
+                record.push(std::mem::take(&mut field));
+                records.push(std::mem::take(&mut record));
+            }
+            (false, c) => field.push(c),
+        }
+    }
+    assert!(!quoted, "an unterminated quoted field");
+    if !field.is_empty() || !record.is_empty() {
+        record.push(field);
+        records.push(record);
+    }
+    records
+}
+
+#[test]
+fn every_output_parses_with_its_provenance() {
+    let solve = |job: &str, format: &str| {
+        let out = thirdbody(&["solve", job, "--format", format, "--provenance"], None);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        String::from_utf8(out.stdout).unwrap()
+    };
+    for job in ["examples/rolling.json", "examples/sweep.json"] {
+        // JSON: nothing in front; its meta says where it comes from.
+        let json: Value = serde_json::from_str(&solve(job, "json")).unwrap();
+        let hash = json["meta"]["input_hash"].as_str().unwrap().to_string();
+        let line = format!(
+            "thirdbody {} (commit {}), model {}, input sha256 {hash}",
+            env!("CARGO_PKG_VERSION"),
+            json["meta"]["software"]["commit"].as_str().unwrap(),
+            thirdbody::model::MODEL_VERSION
+        );
+
+        // CSV: a first `#` line, then a table whose records all have the header's fields.
+        let csv = solve(job, "csv");
+        let (first, table) = csv.split_once('\n').unwrap();
+        assert_eq!(first, format!("# {line}"));
+        let records = csv_records(table);
+        assert!(records.len() >= 2, "{table}");
+        assert!(
+            records.iter().all(|r| r.len() == records[0].len()),
+            "{table}"
+        );
+
+        // SVG: well-formed XML, the provenance in a comment, the root still <svg>.
+        let svg = solve(job, "svg");
+        let doc = roxmltree::Document::parse(&svg).unwrap_or_else(|e| panic!("{e}: {svg}"));
+        assert_eq!(doc.root_element().tag_name().name(), "svg");
+        let comments: Vec<&str> = doc
+            .root()
+            .descendants()
+            .filter(|n| n.is_comment())
+            .filter_map(|n| n.text())
+            .collect();
+        assert_eq!(comments, [format!(" {line} ")], "{svg}");
+    }
+}
+
 /// A fresh directory for files a test writes.
 fn scratch(name: &str) -> std::path::PathBuf {
     let dir = std::env::temp_dir().join(format!("thirdbody-{name}-{}", std::process::id()));
