@@ -6,7 +6,7 @@ use std::rc::Rc;
 
 use serde_json::{json, Value};
 
-use super::units::{parse_quantity, Dimension, UnitError};
+use super::units::{is_bare_number, parse_quantity, Dimension, UnitError};
 use super::{Field, Quantity};
 use crate::job::{FieldError, InputWarning, JobError, Validated};
 use crate::model::{OptionError, Parameter, ParameterError, SolveOption};
@@ -195,23 +195,27 @@ impl Checker {
             .collect()
     }
 
-    /// Reads one quantity at `at`.
+    /// Reads one quantity at `at`; a bare number, or a string holding one without a unit
+    /// (`"50"`), far from the field's scale is read as sent (SI) with a warning.
     fn read(&mut self, at: &Location, quantity: &Quantity, parameter: Parameter) -> f64 {
-        let parsed = match quantity {
-            Quantity::Number(x) => {
-                if let Some(message) = implausible(parameter, *x) {
-                    let path = at.path();
-                    let message = format!("{path}: {message}");
-                    self.warnings.push(InputWarning {
-                        field: path,
-                        value: quantity.sent(),
-                        message,
-                    });
-                }
-                Ok(*x)
-            }
-            Quantity::Text(text) => parse_quantity(text, dimension(parameter)),
+        let (parsed, bare) = match quantity {
+            Quantity::Number(x) => (Ok(*x), true),
+            Quantity::Text(text) => (
+                parse_quantity(text, dimension(parameter)),
+                is_bare_number(text),
+            ),
         };
+        if let (true, Ok(x)) = (bare, &parsed) {
+            if let Some(message) = implausible(parameter, *x) {
+                let path = at.path();
+                let message = format!("{path}: {message}");
+                self.warnings.push(InputWarning {
+                    field: path,
+                    value: quantity.sent(),
+                    message,
+                });
+            }
+        }
         // -0 is 0: one value, one canonical form, one cache key.
         let read = parsed.map(super::si);
         // A report of a value out of range shows it as sent, or as its SI number when that
@@ -428,6 +432,46 @@ mod tests {
         ] {
             assert_eq!(implausible(parameter, x), None, "{parameter} {x}");
         }
+    }
+
+    /// The warning of a bare number, for the same number sent as a string without a unit,
+    /// at the top and in a nested object.
+    #[test]
+    fn a_string_without_a_unit_is_warned_like_the_bare_number() {
+        let read = |value: Quantity| {
+            let mut checker = Checker::new();
+            let field = Field {
+                name: "radius",
+                value: Some(&value),
+            };
+            let x = checker.quantity(field, Parameter::Radius, 1e-8);
+            let thickness = Field {
+                name: "thickness",
+                value: Some(&value),
+            };
+            let layer = Field {
+                name: "layer",
+                value: Some(&()),
+            };
+            checker.nested(layer, |c, _| {
+                c.quantity(thickness, Parameter::Thickness, 1e-7)
+            });
+            let messages: Vec<String> = checker.warnings.into_iter().map(|w| w.message).collect();
+            (x, messages)
+        };
+        let expected = [
+            "radius: 50 is 50 m; did you mean \"50 nm\"?",
+            "layer.thickness: 50 is 50 m; did you mean \"50 nm\"?",
+        ];
+        assert_eq!(
+            read(Quantity::Number(50.0)),
+            (50.0, expected.map(String::from).to_vec())
+        );
+        assert_eq!(
+            read(Quantity::Text(" 50 ".into())),
+            (50.0, expected.map(String::from).to_vec())
+        );
+        assert_eq!(read(Quantity::Text("50 m".into())), (50.0, Vec::new()));
     }
 
     /// Out-of-range values in a list, each reported at its path with its value as sent: as
