@@ -10,6 +10,7 @@ use crate::job::three_body::{OperatingInput, ThreeBodyInput, ThreeBodyJob};
 use crate::model::fit::{
     Bounds, Datum, FitParameter, Measured, Parameterization, Point, Problem, Setting,
 };
+use crate::model::text::quantity;
 use crate::model::three_body::{OperatingPoint, ThreeBody, ThreeBodyOptions};
 use crate::model::{Layer, Parameter, Rolling};
 
@@ -322,10 +323,14 @@ fn read_parameters(
                     "min",
                     min,
                     model.unit(),
-                    &format!("≤ max = {max:e} {}", model.unit()),
+                    &format!("≤ max = {}", quantity(max, model.unit())),
                 );
             } else if !(min..=max).contains(&start) {
-                let allowed = format!("within [min, max] = [{min:e}, {max:e}] {}", model.unit());
+                let allowed = format!(
+                    "within [min, max] = [{}, {}]",
+                    quantity(min, model.unit()),
+                    quantity(max, model.unit())
+                );
                 c.out_of_range("start", start, model.unit(), &allowed);
             }
             Bounds { start, min, max }
