@@ -26,7 +26,10 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Solve a job {"kind": "rolling" | "three_body" | "sweep" | "figure", "input": {...}} and print the result as JSON.
+    /// Solve a job {"kind": "rolling" | "three_body" | "sweep" | "figure" | "fit", "input": {...}} and print the result as JSON.
+    ///
+    /// Exits 0 with an answer, 1 when a valid job cannot be solved, 2 when the job cannot be
+    /// used (the file cannot be read, is not JSON, or is not a valid job).
     Solve {
         /// The job file, or - for standard input.
         job: String,
@@ -99,14 +102,21 @@ impl OutputFormat {
     }
 }
 
-/// Exit status for a job that is not valid (as distinct from one that failed to solve), and
-/// for a `serve` setting that is not valid.
+/// Exit status for a job that cannot be used: a job file that cannot be read, is not JSON or
+/// is not a valid job (as distinct from a valid job that failed to solve, 1); and for a
+/// `serve` setting that is not valid.
 const INVALID_JOB: u8 = 2;
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let (job, output) = match cli.command {
-        Command::Solve { job, output } => (read_job(&job), output),
+        Command::Solve { job, output } => match read_input(&job) {
+            Ok(text) => (Job::from_json(&text, &Limits::default()), output),
+            Err(why) => {
+                eprintln!("thirdbody: {why}");
+                return ExitCode::from(INVALID_JOB);
+            }
+        },
         Command::Figure { number, output } => (FigureJob::new(number).map(Job::new), output),
         Command::Check {
             checks,
@@ -325,15 +335,17 @@ async fn shutdown_signal() {
     }
 }
 
-fn read_job(path: &str) -> Result<Job, JobError> {
-    let mut text = Vec::new();
-    let read = if path == "-" {
-        std::io::stdin().read_to_end(&mut text).map(|_| ())
+/// The text of the job file at `path` (`-`: standard input), or why it cannot be read.
+fn read_input(path: &str) -> Result<Vec<u8>, String> {
+    if path == "-" {
+        let mut text = Vec::new();
+        std::io::stdin()
+            .read_to_end(&mut text)
+            .map(|_| text)
+            .map_err(|e| format!("cannot read standard input: {e}"))
     } else {
-        std::fs::read(path).map(|t| text = t)
-    };
-    read.map_err(|e| JobError::Syntax(format!("cannot read {path}: {e}")))?;
-    Job::from_json(&text, &Limits::default())
+        std::fs::read(path).map_err(|e| format!("cannot read {path}: {e}"))
+    }
 }
 
 /// The answer as text in `format`; failing to render it is a fault of ours, not the job's.

@@ -116,9 +116,38 @@ fn a_bad_job_fails_with_status_2_and_says_which_field() {
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("3 to 9"));
 
+    // A file that cannot be read is said so, not taken for malformed JSON.
     let out = thirdbody(&["solve", "no/such/file.json"], None);
     assert_eq!(out.status.code(), Some(2));
-    assert!(String::from_utf8_lossy(&out.stderr).contains("cannot read"));
+    assert_eq!(
+        String::from_utf8_lossy(&out.stderr),
+        "thirdbody: cannot read no/such/file.json: No such file or directory (os error 2)\n"
+    );
+
+    // A valid job the model cannot solve: status 1, its numbers in the units a person reads.
+    let out = thirdbody(
+        &["solve", "-"],
+        Some(r#"{"kind": "three_body", "input": {"operating": {"total_load": 10}}}"#),
+    );
+    assert_eq!(out.status.code(), Some(1));
+    assert_eq!(
+        String::from_utf8_lossy(&out.stderr),
+        "thirdbody: total_load = 10 N cannot be carried: even at zero separation the system \
+         carries only 5.52 N\n"
+    );
+
+    // Every bad field in a sentence.
+    let out = thirdbody(
+        &["solve", "-"],
+        Some(r#"{"kind": "three_body", "input": {"velocity": "-4 nm/s"}}"#),
+    );
+    assert_eq!(out.status.code(), Some(2));
+    assert_eq!(
+        String::from_utf8_lossy(&out.stderr),
+        "thirdbody: operating is required; expected exactly one of separation (m), \
+         total_load (N), particle_load (N); velocity = \"-4 nm/s\" is out of range; expected \
+         finite and ≥ 0 m/s\n"
+    );
 }
 
 #[test]

@@ -140,14 +140,31 @@ impl Checker {
         Some(self.read(&at, field.value?, parameter))
     }
 
-    /// [`Checker::optional`] for a field the object needs (`why` says when).
-    pub fn required(&mut self, field: Field<Quantity>, parameter: Parameter, why: &str) -> f64 {
+    /// [`Checker::optional`] for a field the object needs (`when`: "with asperities").
+    pub fn required(&mut self, field: Field<Quantity>, parameter: Parameter, when: &str) -> f64 {
         self.optional(field, parameter).unwrap_or_else(|| {
-            let dimension = dimension(parameter);
-            let allowed = format!("{}: required {why}", dimension.describe());
-            self.invalid(field.name, Value::Null, &allowed);
+            self.missing(field.name, &dimension(parameter).describe(), when);
             f64::NAN
         })
+    }
+
+    /// Records that `field` (in the object being read) is absent though needed (`when`:
+    /// "with asperities", or "" if always): `asperities.density is required with asperities;
+    /// expected a number per area (…)`.
+    pub fn missing(&mut self, field: &str, allowed: &str, when: &str) {
+        let path = self.path(field);
+        let when = if when.is_empty() {
+            String::new()
+        } else {
+            format!(" {when}")
+        };
+        let message = format!("{path} is required{when}; expected {allowed}");
+        self.report(FieldError {
+            field: path,
+            value: Value::Null,
+            allowed: allowed.to_string(),
+            message,
+        });
     }
 
     /// A count such as a number of nodes, the solver `option` (its range is the model's to
@@ -274,18 +291,14 @@ impl Checker {
             .get(&path)
             .cloned()
             .unwrap_or_else(|| Value::from(value));
-        let number = format_number(value);
-        let si = if unit.is_empty() {
-            number
-        } else {
-            format!("{number} {unit}")
+        // The value as sent, so that the sender finds it: text as typed, a number exactly
+        // (rounded, 0.09999 s would read as the 100 ms it must not be below).
+        let shown = match &sent {
+            Value::String(s) => format!("\"{s}\""),
+            _ if unit.is_empty() => format_number(value),
+            _ => format!("{} {unit}", format_number(value)),
         };
-        let message = match &sent {
-            Value::String(s) => {
-                format!("{path} = \"{s}\" ({si}) is out of range: allowed {allowed}")
-            }
-            _ => format!("{path} = {si} is out of range: allowed {allowed}"),
-        };
+        let message = format!("{path} = {shown} is out of range; expected {allowed}");
         self.report(FieldError {
             field: path,
             value: sent,
@@ -318,10 +331,15 @@ impl Checker {
         }
     }
 
-    /// Records an error of `field` that is not a range (e.g. an empty list).
+    /// Records an error of `field` that is not a range (e.g. an empty list): `vary.radius: []
+    /// is not a valid value; expected a list of at least one value`. With `value` null there
+    /// is nothing to echo, and `allowed` says it all (`checks[0].job: a valid job: …`).
     pub fn invalid(&mut self, field: &str, value: Value, allowed: &str) {
         let path = self.path(field);
-        let message = format!("{path}: {value} is not allowed: allowed {allowed}");
+        let message = match value {
+            Value::Null => format!("{path}: {allowed}"),
+            _ => format!("{path}: {value} is not a valid value; expected {allowed}"),
+        };
         self.report(FieldError {
             field: path,
             value,
@@ -512,9 +530,14 @@ mod tests {
                 ("base.radius[2]", "-0.0".to_string()),
             ]
         );
-        assert!(errors[0]
-            .message
-            .starts_with("base.radius[0] = \"-5 nm\" (-5e-9 m)"));
+        assert_eq!(
+            errors[0].message,
+            "base.radius[0] = \"-5 nm\" is out of range; expected finite and > 0 m"
+        );
+        assert_eq!(
+            errors[1].message,
+            "base.radius[1] = -2 m is out of range; expected finite and > 0 m"
+        );
     }
 
     #[test]
