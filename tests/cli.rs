@@ -291,6 +291,111 @@ fn the_container_configuration_starts_a_service_that_drains_on_sigterm() {
     );
 }
 
+/// POSTs the JSON `body` to `path`; the answer's status line and body.
+fn post(port: u16, path: &str, body: &str) -> (String, String) {
+    use std::io::Read;
+    let mut stream = std::net::TcpStream::connect(("127.0.0.1", port)).unwrap();
+    write!(
+        stream,
+        "POST {path} HTTP/1.1\r\nHost: localhost\r\nConnection: close\r\n\
+         Content-Type: application/json\r\nContent-Length: {}\r\n\r\n{body}",
+        body.len()
+    )
+    .unwrap();
+    let mut answer = String::new();
+    stream.read_to_string(&mut answer).unwrap();
+    let (head, body) = answer.split_once("\r\n\r\n").unwrap();
+    (head.lines().next().unwrap().to_string(), body.to_string())
+}
+
+/// A free loopback port (free once the listener that found it is dropped).
+fn free_port() -> u16 {
+    let listener = std::net::TcpListener::bind("127.0.0.1:0").unwrap();
+    listener.local_addr().unwrap().port()
+}
+
+#[test]
+fn ctrl_c_says_what_the_drain_waits_for_and_a_second_exits_at_once() {
+    use std::io::BufRead;
+    use std::time::{Duration, Instant};
+    for format in ["json", "text"] {
+        let port = free_port();
+        let mut child = Command::new(env!("CARGO_BIN_EXE_thirdbody"))
+            .args(["serve", "--bind", &format!("127.0.0.1:{port}")])
+            .args(["--log-format", format, "--shutdown-timeout", "30s"])
+            .env("THIRDBODY_DRAIN_DELAY", "0s")
+            .env("RUST_LOG", "info")
+            .stdout(Stdio::null())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        // Log lines as they come, read on another thread.
+        let (lines, logged) = std::sync::mpsc::channel();
+        let stderr = child.stderr.take().unwrap();
+        std::thread::spawn(move || {
+            for line in std::io::BufReader::new(stderr).lines() {
+                let Ok(line) = line else { break };
+                if lines.send(line).is_err() {
+                    break;
+                }
+            }
+        });
+        let wait_for = |needle: &str| -> String {
+            let end = Instant::now() + Duration::from_secs(10);
+            loop {
+                let left = end.saturating_duration_since(Instant::now());
+                match logged.recv_timeout(left) {
+                    Ok(line) if line.contains(needle) => return line,
+                    Ok(_) => {}
+                    Err(e) => panic!("no log line with {needle:?} ({format}): {e}"),
+                }
+            }
+        };
+        wait_for("listening");
+        // A job whose answer is cached finishes as it is accepted; nobody reads it.
+        let job = r#"{"kind": "rolling", "input": {"radius": "30 nm"}}"#;
+        let (status, _) = post(port, "/v1/rolling", r#"{"radius": "30 nm"}"#);
+        assert!(status.starts_with("HTTP/1.1 200"), "{status}");
+        let (status, body) = post(port, "/v1/jobs", job);
+        assert!(status.starts_with("HTTP/1.1 202"), "{status}");
+        assert!(body.contains(r#""status":"succeeded""#), "{body}");
+
+        let pid = child.id().to_string();
+        let signal = |name: &str| {
+            let sent = Command::new("kill").args([name, &pid]).status().unwrap();
+            assert!(sent.success());
+        };
+        signal("-INT");
+        let line = wait_for("shutting down");
+        assert!(
+            line.contains(
+                "shutting down: waiting up to 30 s for 1 finished job whose client has not \
+                 read it; press Ctrl-C again to exit now"
+            ),
+            "{line}"
+        );
+        // The drain waits for the unread result...
+        std::thread::sleep(Duration::from_millis(300));
+        assert!(child.try_wait().unwrap().is_none(), "it did not wait");
+        // ...until a second Ctrl-C, which exits at once.
+        let second = Instant::now();
+        signal("-INT");
+        let line = wait_for("exiting now");
+        assert!(
+            line.contains("exiting now: 1 unread result dropped"),
+            "{line}"
+        );
+        let status = loop {
+            if let Some(status) = child.try_wait().unwrap() {
+                break status;
+            }
+            assert!(second.elapsed() < Duration::from_secs(5), "still running");
+            std::thread::sleep(Duration::from_millis(10));
+        };
+        assert_eq!(status.code(), Some(130), "{format}");
+    }
+}
+
 #[test]
 fn a_csv_can_say_where_it_comes_from_and_warnings_reach_standard_error() {
     let out = thirdbody(
