@@ -99,6 +99,10 @@ async fn unknown_routes_jobs_and_figures_are_404_and_wrong_methods_405() {
     assert_eq!(response.headers()["allow"], "POST");
     let not_allowed = problem(response, 405).await;
     assert_eq!(not_allowed["type"], "about:blank");
+    assert_eq!(
+        not_allowed["detail"],
+        "this route does not take this method; the Allow header names those it takes"
+    );
 }
 
 #[tokio::test]
