@@ -4,13 +4,16 @@
 use std::io::{IsTerminal, Read, Write};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+use std::sync::Arc;
 use std::time::Duration;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
 
 use thirdbody::check;
+use thirdbody::engine::Engine;
 use thirdbody::http::{self, AppState, Config, LogFormat, ServeArgs};
 use thirdbody::job::{Control, FigureJob, Job, JobError, Limits};
+use thirdbody::model::text::{count, quantity};
 use thirdbody::render::{Answer, Format};
 
 #[derive(Parser)]
@@ -26,7 +29,10 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Solve a job {"kind": "rolling" | "three_body" | "sweep" | "figure", "input": {...}} and print the result as JSON.
+    /// Solve a job {"kind": "rolling" | "three_body" | "sweep" | "figure" | "fit", "input": {...}} and print the result as JSON.
+    ///
+    /// Exits 0 with an answer, 1 when a valid job cannot be solved, 2 when the job cannot be
+    /// used (the file cannot be read, is not JSON, or is not a valid job).
     Solve {
         /// The job file, or - for standard input.
         job: String,
@@ -73,8 +79,9 @@ struct OutputArgs {
     /// Output format.
     #[arg(long, value_enum, default_value_t = OutputFormat::Json)]
     format: OutputFormat,
-    /// Print first a line saying where the answer comes from: software version and git
-    /// commit, model version, SHA-256 of the input.
+    /// Say where the answer comes from (software version and git commit, model version,
+    /// SHA-256 of the input) where the output still parses: a first `#` line of a CSV, an
+    /// XML comment of an SVG; a JSON answer holds it already in `meta`.
     #[arg(long)]
     provenance: bool,
 }
@@ -98,14 +105,21 @@ impl OutputFormat {
     }
 }
 
-/// Exit status for a job that is not valid (as distinct from one that failed to solve), and
-/// for a `serve` setting that is not valid.
+/// Exit status for a job that cannot be used: a job file that cannot be read, is not JSON or
+/// is not a valid job (as distinct from a valid job that failed to solve, 1); and for a
+/// `serve` setting that is not valid.
 const INVALID_JOB: u8 = 2;
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let (job, output) = match cli.command {
-        Command::Solve { job, output } => (read_job(&job), output),
+        Command::Solve { job, output } => match read_input(&job) {
+            Ok(text) => (Job::from_json(&text, &Limits::default()), output),
+            Err(why) => {
+                eprintln!("thirdbody: {why}");
+                return ExitCode::from(INVALID_JOB);
+            }
+        },
         Command::Figure { number, output } => (FigureJob::new(number).map(Job::new), output),
         Command::Check {
             checks,
@@ -124,9 +138,10 @@ fn main() -> ExitCode {
         let meta = job.meta();
         let provenance = output.provenance.then(|| meta.provenance());
         let answer = job.run(meta, &Control::default())?;
-        let text = render(&answer, output.format.format())?;
+        let format = output.format.format();
+        let text = render(&answer, format)?;
         Ok(match provenance {
-            Some(line) => format!("{line}\n{text}"),
+            Some(line) => format.with_provenance(text, &line),
             None => text,
         })
     });
@@ -255,7 +270,7 @@ fn worker(args: ServeArgs) -> ExitCode {
         let engine = state.engine();
         engine.start_workers(pool_size, false);
         tracing::info!(workers = pool_size, "taking work from Redis");
-        shutdown_signal().await;
+        Signals::new().next().await;
         engine.begin_drain();
         engine
             .finish_jobs(tokio::time::Instant::now() + timeout)
@@ -264,14 +279,16 @@ fn worker(args: ServeArgs) -> ExitCode {
     })
 }
 
-/// `thirdbody serve`: validates the settings, then serves until SIGTERM or Ctrl-C.
+/// `thirdbody serve`: validates the settings, then serves until SIGTERM or Ctrl-C, and drains
+/// (a second Ctrl-C or SIGTERM exits at once, with status 130 or 143).
 fn serve(args: ServeArgs) -> ExitCode {
     let (config, runtime) = match start("serve", args) {
         Ok(started) => started,
         Err(code) => return code,
     };
     let served = runtime.block_on(async {
-        let bind = config.bind;
+        let signals = Signals::new();
+        let (bind, timeout) = (config.bind, config.shutdown_timeout);
         let listener = tokio::net::TcpListener::bind(bind)
             .await
             .map_err(|e| format!("cannot listen on {bind}: {e}"))?;
@@ -279,7 +296,8 @@ fn serve(args: ServeArgs) -> ExitCode {
         let address = listener.local_addr().unwrap_or(bind);
         tracing::info!(%address, "listening; dashboard at /, API docs at /docs");
         let state = AppState::new(config)?;
-        http::run(listener, state, shutdown_signal())
+        let shutdown = shut_down_on(signals, state.engine().clone(), timeout);
+        http::run(listener, state, shutdown)
             .await
             .map_err(|e| format!("the server failed: {e}"))
     });
@@ -306,39 +324,117 @@ fn init_logging(format: LogFormat) {
     }
 }
 
-/// Resolves on Ctrl-C or SIGTERM.
-async fn shutdown_signal() {
-    let ctrl_c = async {
-        if tokio::signal::ctrl_c().await.is_err() {
-            std::future::pending::<()>().await;
+/// Resolves on the first of `signals`, saying at once what the drain will wait for and for
+/// how long at most (`timeout`): a person who pressed Ctrl-C learns why the prompt does not
+/// come back. The second signal exits at once, saying what it abandons.
+async fn shut_down_on(mut signals: Signals, engine: Arc<Engine>, timeout: Duration) {
+    signals.next().await;
+    let unfinished = engine.unfinished_jobs() as f64;
+    let unread = engine.unread_jobs() as f64;
+    let mut waited = Vec::new();
+    if unfinished > 0.0 {
+        waited.push(count(unfinished, "unfinished job", "unfinished jobs"));
+    }
+    if unread > 0.0 {
+        waited.push(count(
+            unread,
+            "finished job whose client has not read it",
+            "finished jobs whose clients have not read them",
+        ));
+    }
+    if waited.is_empty() {
+        waited.push("the requests in flight".to_string());
+    }
+    tracing::info!(
+        "shutting down: waiting up to {} for {}; press Ctrl-C again to exit now",
+        quantity(timeout.as_secs_f64(), "s"),
+        waited.join(" and ")
+    );
+    tokio::spawn(async move {
+        let status = signals.next().await;
+        let mut abandoned = Vec::new();
+        let unfinished = engine.unfinished_jobs() as f64;
+        if unfinished > 0.0 {
+            let jobs = count(unfinished, "unfinished job", "unfinished jobs");
+            abandoned.push(format!("{jobs} interrupted"));
         }
-    };
+        let unread = engine.unread_jobs() as f64;
+        if unread > 0.0 {
+            let results = count(unread, "unread result", "unread results");
+            abandoned.push(format!("{results} dropped"));
+        }
+        if abandoned.is_empty() {
+            abandoned.push("nothing was left to wait for".to_string());
+        }
+        tracing::warn!("exiting now: {}", abandoned.join(", "));
+        std::process::exit(i32::from(status));
+    });
+}
+
+/// Ctrl-C (SIGINT) and SIGTERM, listened for from start-up on, so that a second one is not
+/// missed while the first is handled.
+struct Signals {
     #[cfg(unix)]
-    let terminate = async {
-        match tokio::signal::unix::signal(tokio::signal::unix::SignalKind::terminate()) {
-            Ok(mut signal) => {
-                signal.recv().await;
+    interrupt: Option<tokio::signal::unix::Signal>,
+    #[cfg(unix)]
+    terminate: Option<tokio::signal::unix::Signal>,
+}
+
+impl Signals {
+    /// Starts listening (within a runtime); a signal that cannot be listened for never comes.
+    fn new() -> Signals {
+        #[cfg(unix)]
+        {
+            use tokio::signal::unix::{signal, SignalKind};
+            Signals {
+                interrupt: signal(SignalKind::interrupt()).ok(),
+                terminate: signal(SignalKind::terminate()).ok(),
             }
-            Err(_) => std::future::pending::<()>().await,
         }
-    };
-    #[cfg(not(unix))]
-    let terminate = std::future::pending::<()>();
-    tokio::select! {
-        () = ctrl_c => {}
-        () = terminate => {}
+        #[cfg(not(unix))]
+        Signals {}
+    }
+
+    /// Waits for the next signal; returns the conventional status of a process it ends
+    /// (128 + its number: 130 for Ctrl-C, 143 for SIGTERM).
+    async fn next(&mut self) -> u8 {
+        #[cfg(unix)]
+        {
+            async fn recv(signal: &mut Option<tokio::signal::unix::Signal>) {
+                let received = match signal {
+                    Some(signal) => signal.recv().await,
+                    None => None,
+                };
+                if received.is_none() {
+                    std::future::pending::<()>().await;
+                }
+            }
+            tokio::select! {
+                () = recv(&mut self.interrupt) => 130,
+                () = recv(&mut self.terminate) => 143,
+            }
+        }
+        #[cfg(not(unix))]
+        {
+            if tokio::signal::ctrl_c().await.is_err() {
+                std::future::pending::<()>().await;
+            }
+            130
+        }
     }
 }
 
-fn read_job(path: &str) -> Result<Job, JobError> {
-    let mut text = Vec::new();
-    let read = if path == "-" {
-        std::io::stdin().read_to_end(&mut text).map(|_| ())
+/// The text of the job file at `path` (`-`: standard input), or why it cannot be read.
+fn read_input(path: &str) -> Result<Vec<u8>, String> {
+    if path == "-" {
+        let mut text = Vec::new();
+        std::io::stdin()
+            .read_to_end(&mut text)
+            .map(|_| text)
+            .map_err(|e| format!("cannot read standard input: {e}"))
     } else {
-        std::fs::read(path).map(|t| text = t)
-    };
-    read.map_err(|e| JobError::Syntax(format!("cannot read {path}: {e}")))?;
-    Job::from_json(&text, &Limits::default())
+        std::fs::read(path).map_err(|e| format!("cannot read {path}: {e}"))
+    }
 }
 
 /// The answer as text in `format`; failing to render it is a fault of ours, not the job's.

@@ -116,9 +116,38 @@ fn a_bad_job_fails_with_status_2_and_says_which_field() {
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("3 to 9"));
 
+    // A file that cannot be read is said so, not taken for malformed JSON.
     let out = thirdbody(&["solve", "no/such/file.json"], None);
     assert_eq!(out.status.code(), Some(2));
-    assert!(String::from_utf8_lossy(&out.stderr).contains("cannot read"));
+    assert_eq!(
+        String::from_utf8_lossy(&out.stderr),
+        "thirdbody: cannot read no/such/file.json: No such file or directory (os error 2)\n"
+    );
+
+    // A valid job the model cannot solve: status 1, its numbers in the units a person reads.
+    let out = thirdbody(
+        &["solve", "-"],
+        Some(r#"{"kind": "three_body", "input": {"operating": {"total_load": 10}}}"#),
+    );
+    assert_eq!(out.status.code(), Some(1));
+    assert_eq!(
+        String::from_utf8_lossy(&out.stderr),
+        "thirdbody: total_load = 10 N cannot be carried: even at zero separation the system \
+         carries only 5.52 N\n"
+    );
+
+    // Every bad field in a sentence.
+    let out = thirdbody(
+        &["solve", "-"],
+        Some(r#"{"kind": "three_body", "input": {"velocity": "-4 nm/s"}}"#),
+    );
+    assert_eq!(out.status.code(), Some(2));
+    assert_eq!(
+        String::from_utf8_lossy(&out.stderr),
+        "thirdbody: operating is required; expected exactly one of separation (m), \
+         total_load (N), particle_load (N); velocity = \"-4 nm/s\" is out of range; expected \
+         finite and ≥ 0 m/s\n"
+    );
 }
 
 #[test]
@@ -262,6 +291,111 @@ fn the_container_configuration_starts_a_service_that_drains_on_sigterm() {
     );
 }
 
+/// POSTs the JSON `body` to `path`; the answer's status line and body.
+fn post(port: u16, path: &str, body: &str) -> (String, String) {
+    use std::io::Read;
+    let mut stream = std::net::TcpStream::connect(("127.0.0.1", port)).unwrap();
+    write!(
+        stream,
+        "POST {path} HTTP/1.1\r\nHost: localhost\r\nConnection: close\r\n\
+         Content-Type: application/json\r\nContent-Length: {}\r\n\r\n{body}",
+        body.len()
+    )
+    .unwrap();
+    let mut answer = String::new();
+    stream.read_to_string(&mut answer).unwrap();
+    let (head, body) = answer.split_once("\r\n\r\n").unwrap();
+    (head.lines().next().unwrap().to_string(), body.to_string())
+}
+
+/// A free loopback port (free once the listener that found it is dropped).
+fn free_port() -> u16 {
+    let listener = std::net::TcpListener::bind("127.0.0.1:0").unwrap();
+    listener.local_addr().unwrap().port()
+}
+
+#[test]
+fn ctrl_c_says_what_the_drain_waits_for_and_a_second_exits_at_once() {
+    use std::io::BufRead;
+    use std::time::{Duration, Instant};
+    for format in ["json", "text"] {
+        let port = free_port();
+        let mut child = Command::new(env!("CARGO_BIN_EXE_thirdbody"))
+            .args(["serve", "--bind", &format!("127.0.0.1:{port}")])
+            .args(["--log-format", format, "--shutdown-timeout", "30s"])
+            .env("THIRDBODY_DRAIN_DELAY", "0s")
+            .env("RUST_LOG", "info")
+            .stdout(Stdio::null())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        // Log lines as they come, read on another thread.
+        let (lines, logged) = std::sync::mpsc::channel();
+        let stderr = child.stderr.take().unwrap();
+        std::thread::spawn(move || {
+            for line in std::io::BufReader::new(stderr).lines() {
+                let Ok(line) = line else { break };
+                if lines.send(line).is_err() {
+                    break;
+                }
+            }
+        });
+        let wait_for = |needle: &str| -> String {
+            let end = Instant::now() + Duration::from_secs(10);
+            loop {
+                let left = end.saturating_duration_since(Instant::now());
+                match logged.recv_timeout(left) {
+                    Ok(line) if line.contains(needle) => return line,
+                    Ok(_) => {}
+                    Err(e) => panic!("no log line with {needle:?} ({format}): {e}"),
+                }
+            }
+        };
+        wait_for("listening");
+        // A job whose answer is cached finishes as it is accepted; nobody reads it.
+        let job = r#"{"kind": "rolling", "input": {"radius": "30 nm"}}"#;
+        let (status, _) = post(port, "/v1/rolling", r#"{"radius": "30 nm"}"#);
+        assert!(status.starts_with("HTTP/1.1 200"), "{status}");
+        let (status, body) = post(port, "/v1/jobs", job);
+        assert!(status.starts_with("HTTP/1.1 202"), "{status}");
+        assert!(body.contains(r#""status":"succeeded""#), "{body}");
+
+        let pid = child.id().to_string();
+        let signal = |name: &str| {
+            let sent = Command::new("kill").args([name, &pid]).status().unwrap();
+            assert!(sent.success());
+        };
+        signal("-INT");
+        let line = wait_for("shutting down");
+        assert!(
+            line.contains(
+                "shutting down: waiting up to 30 s for 1 finished job whose client has not \
+                 read it; press Ctrl-C again to exit now"
+            ),
+            "{line}"
+        );
+        // The drain waits for the unread result...
+        std::thread::sleep(Duration::from_millis(300));
+        assert!(child.try_wait().unwrap().is_none(), "it did not wait");
+        // ...until a second Ctrl-C, which exits at once.
+        let second = Instant::now();
+        signal("-INT");
+        let line = wait_for("exiting now");
+        assert!(
+            line.contains("exiting now: 1 unread result dropped"),
+            "{line}"
+        );
+        let status = loop {
+            if let Some(status) = child.try_wait().unwrap() {
+                break status;
+            }
+            assert!(second.elapsed() < Duration::from_secs(5), "still running");
+            std::thread::sleep(Duration::from_millis(10));
+        };
+        assert_eq!(status.code(), Some(130), "{format}");
+    }
+}
+
 #[test]
 fn a_csv_can_say_where_it_comes_from_and_warnings_reach_standard_error() {
     let out = thirdbody(
@@ -285,6 +419,83 @@ fn a_csv_can_say_where_it_comes_from_and_warnings_reach_standard_error() {
         stderr.contains("warning: radius: 25 is 25 m; did you mean \"25 nm\"?"),
         "{stderr}"
     );
+}
+
+/// The records of a CSV text (RFC 4180: quoted fields may hold commas, quotes doubled and
+/// line breaks).
+fn csv_records(text: &str) -> Vec<Vec<String>> {
+    let (mut records, mut record, mut field) = (Vec::new(), Vec::new(), String::new());
+    let (mut quoted, mut chars) = (false, text.chars().peekable());
+    while let Some(c) = chars.next() {
+        match (quoted, c) {
+            (true, '"') if chars.peek() == Some(&'"') => {
+                field.push('"');
+                chars.next();
+            }
+            (true, '"') => quoted = false,
+            (true, c) => field.push(c),
+            (false, '"') if field.is_empty() => quoted = true,
+            (false, ',') => record.push(std::mem::take(&mut field)),
+            (false, '\n') => {
+                record.push(std::mem::take(&mut field));
+                records.push(std::mem::take(&mut record));
+            }
+            (false, c) => field.push(c),
+        }
+    }
+    assert!(!quoted, "an unterminated quoted field");
+    if !field.is_empty() || !record.is_empty() {
+        record.push(field);
+        records.push(record);
+    }
+    records
+}
+
+#[test]
+fn every_output_parses_with_its_provenance() {
+    let solve = |job: &str, format: &str| {
+        let out = thirdbody(&["solve", job, "--format", format, "--provenance"], None);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        String::from_utf8(out.stdout).unwrap()
+    };
+    for job in ["examples/rolling.json", "examples/sweep.json"] {
+        // JSON: nothing in front; its meta says where it comes from.
+        let json: Value = serde_json::from_str(&solve(job, "json")).unwrap();
+        let hash = json["meta"]["input_hash"].as_str().unwrap().to_string();
+        let line = format!(
+            "thirdbody {} (commit {}), model {}, input sha256 {hash}",
+            env!("CARGO_PKG_VERSION"),
+            json["meta"]["software"]["commit"].as_str().unwrap(),
+            thirdbody::model::MODEL_VERSION
+        );
+
+        // CSV: a first `#` line, then a table whose records all have the header's fields.
+        let csv = solve(job, "csv");
+        let (first, table) = csv.split_once('\n').unwrap();
+        assert_eq!(first, format!("# {line}"));
+        let records = csv_records(table);
+        assert!(records.len() >= 2, "{table}");
+        assert!(
+            records.iter().all(|r| r.len() == records[0].len()),
+            "{table}"
+        );
+
+        // SVG: well-formed XML, the provenance in a comment, the root still <svg>.
+        let svg = solve(job, "svg");
+        let doc = roxmltree::Document::parse(&svg).unwrap_or_else(|e| panic!("{e}: {svg}"));
+        assert_eq!(doc.root_element().tag_name().name(), "svg");
+        let comments: Vec<&str> = doc
+            .root()
+            .descendants()
+            .filter(|n| n.is_comment())
+            .filter_map(|n| n.text())
+            .collect();
+        assert_eq!(comments, [format!(" {line} ")], "{svg}");
+    }
 }
 
 /// A fresh directory for files a test writes.

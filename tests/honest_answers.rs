@@ -85,6 +85,31 @@ fn a_bare_number_far_from_its_scale_is_answered_with_a_warning_naming_what_was_m
 }
 
 #[test]
+fn a_string_without_a_unit_is_a_bare_number_and_warned_like_one() {
+    let sent_as_text = rolling(json!({"radius": "25", "layer": {"retardation_time": "2e6"}}));
+    let sent_as_number = rolling(json!({"radius": 25, "layer": {"retardation_time": 2e6}}));
+    let (text, number) = (sent_as_text.unwrap(), sent_as_number.unwrap());
+    let messages = |answer: &Value| -> Vec<String> {
+        let warnings = answer["meta"]["warnings"].as_array().unwrap();
+        warnings
+            .iter()
+            .map(|w| w["message"].as_str().unwrap().to_string())
+            .collect()
+    };
+    assert_eq!(
+        messages(&text),
+        [
+            "radius: 25 is 25 m; did you mean \"25 nm\"?",
+            "layer.retardation_time: 2e6 is 2e6 s; did you mean \"2e6 ms\"?"
+        ]
+    );
+    assert_eq!(messages(&text), messages(&number));
+    assert_eq!(text["meta"]["warnings"][0]["value"], "25");
+    // One input, one answer: the same canonical form, the same cache key.
+    assert_eq!(text["meta"]["input_hash"], number["meta"]["input_hash"]);
+}
+
+#[test]
 fn a_vanishing_load_is_answered_but_its_friction_warns() {
     let answer = rolling(json!({"load": "1e-300 N"})).unwrap();
     let mu = answer["friction_coefficient"].as_f64().unwrap();

@@ -138,6 +138,11 @@ fn a_three_body_system_shades_the_particles_in_contact_and_splits_the_area() {
     let separation = answer["separation"].as_f64().unwrap();
     assert!(outline.iter().all(|p| p.0 >= separation));
     assert!(svg.contains("particle diameter [nm]") && svg.contains("particle–upper: 100.0 %"));
+    // The count as a person reads it, not 5.4450e4.
+    assert!(
+        svg.contains("<title>Three-body system: 54,500 particles in contact</title>"),
+        "{svg}"
+    );
 }
 
 #[test]

@@ -643,6 +643,22 @@ impl Engine {
         }
     }
 
+    /// Asynchronous jobs of this process queued or running: those a drain waits to finish.
+    pub fn unfinished_jobs(&self) -> usize {
+        self.live().len()
+    }
+
+    /// Jobs finished that no client has read yet: those a drain waits for clients to read
+    /// (once it has begun, the jobs it owes that are finished; before, every one unread).
+    pub fn unread_jobs(&self) -> usize {
+        if self.is_draining() {
+            let live: HashSet<Uuid> = self.live().keys().copied().collect();
+            self.owed().iter().filter(|id| !live.contains(id)).count()
+        } else {
+            self.uncollected().ids.len()
+        }
+    }
+
     pub fn is_draining(&self) -> bool {
         self.draining.load(Ordering::SeqCst)
     }

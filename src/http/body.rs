@@ -18,16 +18,26 @@ const INLINE_BYTES: usize = 16 << 10;
 /// A JSON body, not yet parsed.
 pub struct JsonBody(Bytes);
 
-impl<S: Send + Sync> FromRequest<S> for JsonBody {
+impl FromRequest<AppState> for JsonBody {
     type Rejection = ApiError;
 
-    async fn from_request(request: Request, state: &S) -> Result<Self, ApiError> {
+    async fn from_request(request: Request, state: &AppState) -> Result<Self, ApiError> {
         if !is_json(request.headers()) {
-            return Err(ApiError::unsupported_media_type(
-                "send the body with Content-Type: application/json",
-            ));
+            let sent = match request.headers().get(header::CONTENT_TYPE) {
+                Some(value) => format!(
+                    "the body was sent as {}",
+                    String::from_utf8_lossy(value.as_bytes())
+                ),
+                None => "the body was sent without a Content-Type".to_string(),
+            };
+            return Err(ApiError::unsupported_media_type(format!(
+                "{sent}; send it as JSON, with Content-Type: application/json"
+            )));
         }
-        Ok(JsonBody(Bytes::from_request(request, state).await?))
+        Bytes::from_request(request, state)
+            .await
+            .map(JsonBody)
+            .map_err(|rejection| ApiError::unreadable_body(&rejection, state.config().body_limit))
     }
 }
 

@@ -13,6 +13,7 @@ use utoipa::ToSchema;
 use crate::check::Report;
 use crate::engine::EngineError;
 use crate::job::{FieldError, JobError};
+use crate::model::text::count;
 
 pub const PROBLEM_JSON: &str = "application/problem+json";
 
@@ -352,13 +353,33 @@ impl From<EngineError> for ApiError {
     }
 }
 
-impl From<BytesRejection> for ApiError {
-    fn from(rejection: BytesRejection) -> Self {
-        let detail = rejection.body_text();
+impl ApiError {
+    /// A body that could not be read: over the service's `limit` (bytes), or cut off.
+    pub fn unreadable_body(rejection: &BytesRejection, limit: usize) -> Self {
         match rejection.status() {
-            StatusCode::PAYLOAD_TOO_LARGE => ApiError::new(Kind::PayloadTooLarge, detail),
-            status => ApiError::from_status(status, detail),
+            StatusCode::PAYLOAD_TOO_LARGE => ApiError::payload_too_large(too_large(None, limit)),
+            status => ApiError::from_status(
+                status,
+                format!(
+                    "the body could not be read whole ({}): send it again",
+                    rejection.body_text().to_lowercase()
+                ),
+            ),
         }
+    }
+}
+
+/// Why a body is refused as too large: its size if it declared one, and the limit.
+pub fn too_large(declared: Option<u64>, limit: usize) -> String {
+    let limit = count(limit as f64, "byte", "bytes");
+    match declared {
+        Some(length) => format!(
+            "the body declares {}; this service takes at most {limit} (its --body-limit)",
+            count(length as f64, "byte", "bytes")
+        ),
+        None => format!(
+            "the body is longer than this service takes: at most {limit} (its --body-limit)"
+        ),
     }
 }
 
@@ -384,7 +405,17 @@ pub async fn problem_for_errors(response: Response) -> Response {
         .and_then(|b| String::from_utf8(b.to_vec()).ok())
         .map(|t| t.trim().to_string())
         .filter(|t| !t.is_empty());
-    let detail = text.unwrap_or_else(|| status.canonical_reason().unwrap_or("").to_string());
+    let detail = text.unwrap_or_else(|| match status {
+        // Axum sets the Allow header after this mapping: the detail points to it.
+        StatusCode::METHOD_NOT_ALLOWED => {
+            "this route does not take this method; the Allow header names those it takes"
+                .to_string()
+        }
+        StatusCode::REQUEST_TIMEOUT => "the request took longer than this service gives one \
+            (its --request-timeout): send less work at once, or submit it to /v1/jobs"
+            .to_string(),
+        _ => status.canonical_reason().unwrap_or("").to_string(),
+    });
     let problem = ApiError::from_status(status, detail).problem();
     parts.headers.remove(header::CONTENT_LENGTH);
     parts
@@ -468,6 +499,10 @@ mod tests {
         let problem: Value = serde_json::from_slice(&body).unwrap();
         assert_eq!(problem["type"], "about:blank");
         assert_eq!(problem["title"], "Method Not Allowed");
+        assert_eq!(
+            problem["detail"],
+            "this route does not take this method; the Allow header names those it takes"
+        );
 
         let ok = problem_for_errors(StatusCode::NOT_MODIFIED.into_response()).await;
         assert_eq!(ok.status(), StatusCode::NOT_MODIFIED);

@@ -269,7 +269,8 @@ pub async fn run(
     let engine = state.engine();
     let end = tokio::time::Instant::now() + config.shutdown_timeout;
     *deadline.lock().unwrap_or_else(|p| p.into_inner()) = Some(end);
-    tracing::info!("shutting down: draining");
+    // The caller says what the drain waits for, in its own words (`thirdbody serve`).
+    tracing::debug!("shutting down: draining");
     engine.begin_drain();
     tokio::time::sleep(config.drain_delay).await;
     if !engine.finish_jobs(end).await {

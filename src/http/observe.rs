@@ -9,7 +9,7 @@ use axum::middleware::Next;
 use axum::response::{IntoResponse, Response};
 use tracing::Span;
 
-use super::error::ApiError;
+use super::error::{too_large, ApiError};
 use super::AppState;
 
 /// The request id header, set by the client or by the service.
@@ -145,10 +145,9 @@ pub async fn refuse_declared_overflow(
         .and_then(|v| v.to_str().ok())
         .and_then(|v| v.parse::<u64>().ok());
     match declared {
-        Some(length) if length > limit as u64 => ApiError::payload_too_large(format!(
-            "the body declares {length} bytes; the limit is {limit}"
-        ))
-        .into_response(),
+        Some(length) if length > limit as u64 => {
+            ApiError::payload_too_large(too_large(Some(length), limit)).into_response()
+        }
         _ => next.run(request).await,
     }
 }

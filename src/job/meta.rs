@@ -232,7 +232,8 @@ impl Meta {
     }
 
     /// One line saying where the answer comes from, for files that travel without their
-    /// `meta` (CSV): `# thirdbody 0.1.0 (commit …), model 1.0.0, input sha256 …`.
+    /// `meta` (CSV, SVG; [`crate::render::Format::with_provenance`] puts it in each):
+    /// `thirdbody 0.1.0 (commit …), model 1.0.0, input sha256 …`.
     pub fn provenance(&self) -> String {
         provenance(&self.input_hash)
     }
@@ -242,7 +243,7 @@ impl Meta {
 /// [`Meta::provenance`]).
 pub fn provenance(input_hash: &str) -> String {
     format!(
-        "# thirdbody {SOFTWARE_VERSION} (commit {GIT_COMMIT}), model {MODEL_VERSION}, \
+        "thirdbody {SOFTWARE_VERSION} (commit {GIT_COMMIT}), model {MODEL_VERSION}, \
          input sha256 {input_hash}"
     )
 }

@@ -5,6 +5,7 @@
 
 use serde_json::Value;
 
+use crate::model::text::{count, quantity_to};
 use crate::render::svg::{Axis, Chart, Layer};
 
 /// Why an answer cannot be drawn: it is not the answer of the kind asked (a fault of ours).
@@ -22,24 +23,10 @@ fn list<'a>(value: &'a Value, what: &str) -> Result<&'a Vec<Value>, PictureError
         .ok_or_else(|| format!("the answer has no list at {what}"))
 }
 
-/// `value` (SI) in the unit a person reads, with it: `25 nm`.
+/// `value` (SI) in the unit a person reads, with it: `25 nm`; to four digits, so that the
+/// labels of close values in a legend differ.
 fn shown(value: f64, unit: &str) -> String {
-    if value == 0.0 {
-        return format!("0 {unit}").trim_end().to_string();
-    }
-    let (factor, unit) = crate::render::svg::display_unit(unit, value);
-    let x = value * factor;
-    // Four significant digits.
-    let text = if x != 0.0 && (x.abs() >= 1e4 || x.abs() < 1e-2) {
-        format!("{x:.3e}")
-    } else {
-        format!("{}", (x * 1000.0).round() / 1000.0)
-    };
-    if unit.is_empty() {
-        text
-    } else {
-        format!("{text} {unit}")
-    }
+    quantity_to(value, unit, 4)
 }
 
 /// A rolling contact as in the paper's Fig. 3: the contact region a(y) ≤ x ≤ b(y), the
@@ -106,10 +93,13 @@ pub fn rolling(answer: &Value) -> Result<Chart, PictureError> {
         hollow: true,
     });
     let title = format!(
-        "Contact region, R = {}, P = {}, μ = {:.4}",
+        "Contact region, R = {}, P = {}, μ = {}",
         shown(number(&input["radius"], "meta.input.radius")?, "m"),
         shown(number(&input["load"], "meta.input.load")?, "N"),
-        number(&answer["friction_coefficient"], "friction_coefficient")?
+        shown(
+            number(&answer["friction_coefficient"], "friction_coefficient")?,
+            ""
+        )
     );
     Ok(Chart {
         title,
@@ -337,7 +327,10 @@ pub fn three_body(answer: &Value) -> Result<Chart, PictureError> {
         dashed: true,
     });
     Ok(Chart {
-        title: format!("Three-body system: {particles:.4e} particles in contact"),
+        title: format!(
+            "Three-body system: {} in contact",
+            count(particles, "particle", "particles")
+        ),
         x: Axis::new("particle diameter", "m"),
         y: Axis::new("probability density per nm", ""),
         layers,

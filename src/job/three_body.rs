@@ -7,6 +7,7 @@ use serde::{Deserialize, Serialize};
 use serde_json::Value;
 use utoipa::ToSchema;
 
+use super::input::units::Dimension;
 use super::input::{self, field, Checker, LayerInput, QuadratureKind, Quantity};
 use super::meta::REFERENCES;
 use super::points::{PointNotes, PointNotesFields, PointStatus, Row, SweepVerification};
@@ -193,10 +194,10 @@ impl UpperSurfaceInput {
             hardness: checker.optional(field!(input.hardness), Parameter::UpperHardness),
         };
         if contact == UpperContact::Plastic && upper.hardness.is_none() {
-            checker.invalid(
+            checker.missing(
                 field!(input.hardness).name,
-                Value::Null,
-                "a hardness (Pa): required for plastic contact",
+                &Dimension::PRESSURE.describe(),
+                "for plastic contact",
             );
         }
         upper
@@ -335,15 +336,12 @@ impl ThreeBodyJob {
         let operating = match given.as_slice() {
             [one] => *one,
             _ => {
-                let sent = input
-                    .operating
-                    .as_ref()
-                    .map_or(Value::Null, input::canonical);
-                checker.invalid(
-                    field!(input.operating).name,
-                    sent,
-                    "exactly one of separation (m), total_load (N), particle_load (N)",
-                );
+                let name = field!(input.operating).name;
+                let allowed = "exactly one of separation (m), total_load (N), particle_load (N)";
+                match &input.operating {
+                    Some(sent) => checker.invalid(name, input::canonical(sent), allowed),
+                    None => checker.missing(name, allowed, ""),
+                }
                 OperatingPoint::Separation(f64::NAN)
             }
         };

@@ -6,6 +6,7 @@ use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
 use super::JobError;
+use crate::model::text::{count, quantity};
 use crate::model::validity::{Assumption, Check, Status};
 
 /// The units of a validity block's fields, under `$prefix` (a string literal).
@@ -333,30 +334,14 @@ impl<'de> Deserialize<'de> for ValidityTally {
     }
 }
 
-/// A length as people read it: 651 nm, 5.58 nm, 2.1 µm; far below a picometre, 3.2e-80 m.
+/// A length as people read it: 651 nm, 5.58 nm, 2.1 µm.
 fn length(x: f64) -> String {
-    if x != 0.0 && x.abs() < 1e-13 {
-        return format!("{x:.2e} m");
-    }
-    let (scale, unit) = [(1.0, "m"), (1e-3, "mm"), (1e-6, "µm"), (1e-9, "nm")]
-        .into_iter()
-        .find(|(scale, _)| x.abs() >= *scale)
-        .unwrap_or((1e-12, "pm"));
-    format!("{} {unit}", significant(x / scale))
+    quantity(x, "m")
 }
 
-/// Three significant digits, without trailing zeros.
+/// A plain number (a ratio, a percentage, a friction coefficient) to three digits.
 fn significant(x: f64) -> String {
-    if x == 0.0 || !x.is_finite() {
-        return format!("{x}");
-    }
-    let digits = (2 - x.abs().log10().floor() as i32).clamp(0, 12) as usize;
-    let text = format!("{x:.digits$}");
-    if text.contains('.') {
-        text.trim_end_matches('0').trim_end_matches('.').to_string()
-    } else {
-        text
-    }
+    quantity(x, "")
 }
 
 fn names(assumption: Assumption) -> (&'static str, &'static str, &'static str, &'static str) {
@@ -489,9 +474,9 @@ fn note(check: &Check, subject: Subject) -> String {
             length(reference)
         ),
         ParticlesInContact => format!(
-            "{when}only {} particles are in contact, fewer than one: the means per particle \
-             describe a fraction of a particle",
-            significant(value)
+            "{when}only {} are in contact, fewer than one: the means per particle describe \
+             a fraction of a particle",
+            count(value, "particle", "particles")
         ),
     }
 }
@@ -526,21 +511,4 @@ fn violation(check: &Check, subject: Subject) -> String {
         LocalLayer | AdhesiveFriction | AsperityGap | ParticlesInContact => note(check, subject),
     };
     format!("{when}{cause}{rest}")
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn lengths_read_as_people_write_them() {
-        assert_eq!(length(651.47e-9), "651 nm");
-        assert_eq!(length(5.5842e-9), "5.58 nm");
-        assert_eq!(length(1e-7), "100 nm");
-        assert_eq!(length(2.1e-6), "2.1 µm");
-        assert_eq!(length(25.0), "25 m");
-        assert_eq!(length(3e-13), "0.3 pm");
-        assert_eq!(length(6.79e-82), "6.79e-82 m");
-        assert_eq!(length(0.0), "0 pm");
-    }
 }

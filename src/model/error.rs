@@ -58,7 +58,7 @@ impl fmt::Display for ModelError {
             ModelError::InvalidParameter(e) => e.fmt(f),
             ModelError::InvalidOption(e) => write!(
                 f,
-                "{} = {} is out of range: allowed {}",
+                "{} = {} is out of range; expected {}",
                 e.option, e.value, e.allowed
             ),
             ModelError::NotRepresentable { what } => {

@@ -3,6 +3,8 @@
 
 use std::fmt;
 
+use super::text::quantity;
+
 /// A thin Kelvin layer bonded to a rigid base (docs/model.md eq. 4): locally
 /// v + T_ε ∂v/∂t = (H/E_L)(p + T_σ ∂p/∂t).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -76,8 +78,8 @@ impl Layer {
                 parameter: Parameter::RetardationTime,
                 value: self.retardation_time,
                 allowed: format!(
-                    "≥ relaxation time T_σ = {} s (T_ε ≥ T_σ; equal means elastic)",
-                    self.relaxation_time
+                    "≥ relaxation time T_σ = {} (T_ε ≥ T_σ; equal means elastic)",
+                    quantity(self.relaxation_time, "s")
                 ),
             });
         }
@@ -255,10 +257,9 @@ impl fmt::Display for ParameterError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         write!(
             f,
-            "{} = {} {} is out of range: allowed {}",
+            "{} = {} is out of range; expected {}",
             self.parameter,
-            self.value,
-            self.parameter.unit(),
+            quantity(self.value, self.parameter.unit()),
             self.allowed
         )
     }

@@ -14,6 +14,7 @@ pub mod similarity;
 mod special;
 pub mod strip;
 pub mod tables;
+pub mod text;
 pub mod three_body;
 pub mod validity;
 

@@ -65,6 +65,35 @@ impl Format {
         }
     }
 
+    /// `text`, an answer in this format, with the provenance `line` (where the answer comes
+    /// from, [`crate::job::Meta::provenance`]) where the format has room for it and still
+    /// parses: CSV as a first `#` line (the comment readers such as pandas' `comment="#"`
+    /// skip), SVG as an XML comment after any XML declaration, JSON not at all (its `meta`
+    /// holds the same and more).
+    pub fn with_provenance(self, text: String, line: &str) -> String {
+        match self {
+            Format::Json => text,
+            Format::Csv => format!("# {line}\n{text}"),
+            Format::Svg => {
+                // `--` may not appear in an XML comment.
+                let mut safe = line.to_string();
+                while safe.contains("--") {
+                    safe = safe.replace("--", "- -");
+                }
+                let after_declaration = match text.find("?>") {
+                    Some(end) if text.starts_with("<?xml") => end + 2,
+                    _ => 0,
+                };
+                let (declaration, root) = text.split_at(after_declaration);
+                let newline = if declaration.is_empty() { "" } else { "\n" };
+                format!(
+                    "{declaration}{newline}<!-- {safe} -->\n{}",
+                    root.trim_start()
+                )
+            }
+        }
+    }
+
     /// The format a client prefers among `offered`, from the values of its `Accept`
     /// headers; `None` when it accepts none of them.
     pub fn negotiate<'a>(
@@ -328,6 +357,27 @@ mod tests {
         assert!(!has_null(br#"{"a":"x: null"}"#));
         assert!(!has_null(br#"{"a":"quote \" null","b":true}"#));
         assert!(!has_null(br#"{"a":"back\\","b":false}"#));
+    }
+
+    #[test]
+    fn provenance_goes_where_each_format_still_parses() {
+        let line = "thirdbody 0.1.0 (commit a--b-), model 1.2.0";
+        assert_eq!(Format::Json.with_provenance("{}".into(), line), "{}");
+        assert_eq!(
+            Format::Csv.with_provenance("x\n1\n".into(), line),
+            "# thirdbody 0.1.0 (commit a--b-), model 1.2.0\nx\n1\n"
+        );
+        let svg = r#"<svg xmlns="http://www.w3.org/2000/svg"/>"#;
+        let comment = "<!-- thirdbody 0.1.0 (commit a- -b-), model 1.2.0 -->";
+        assert_eq!(
+            Format::Svg.with_provenance(svg.into(), line),
+            format!("{comment}\n{svg}")
+        );
+        let declared = format!("<?xml version=\"1.0\"?>\n{svg}");
+        assert_eq!(
+            Format::Svg.with_provenance(declared, line),
+            format!("<?xml version=\"1.0\"?>\n{comment}\n{svg}")
+        );
     }
 
     #[derive(Debug, PartialEq, Serialize)]

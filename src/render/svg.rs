@@ -7,6 +7,7 @@
 use std::fmt::Write;
 
 use super::number::format_number;
+use crate::model::text::prefixed;
 
 /// Width and height of every picture (px): readable on a screen and in print.
 pub const WIDTH: f64 = 800.0;
@@ -126,42 +127,6 @@ pub struct Chart {
     pub notes: Vec<String>,
 }
 
-/// A unit a person reads for an SI unit and the size of the numbers shown: the factor that
-/// turns SI values into it, and its name.
-pub fn display_unit(si: &str, largest: f64) -> (f64, String) {
-    let (base, power) = match si {
-        "m" => ("m", 1),
-        "m^2" | "m²" => ("m", 2),
-        "m/s" => ("m/s", 1),
-        "N" => ("N", 1),
-        "Pa" => ("Pa", 1),
-        _ => return (1.0, si.to_string()),
-    };
-    // Powers of ten of each prefix, largest first.
-    let prefixes: &[(i32, &str)] = if base == "Pa" {
-        &[(9, "GPa"), (6, "MPa"), (3, "kPa"), (0, "Pa")]
-    } else {
-        &[(0, ""), (-3, "m"), (-6, "µ"), (-9, "n"), (-12, "p")]
-    };
-    let largest = largest.abs();
-    let last = prefixes.len() - 1;
-    for (k, &(exponent, prefix)) in prefixes.iter().enumerate() {
-        let exponent = exponent * power;
-        // Areas step by 10⁶ between prefixes: show 0.2 µm² rather than 2e5 nm².
-        let least = if power == 2 { 1e-2 } else { 1.0 };
-        if largest >= least * 10f64.powi(exponent) || k == last {
-            let name = match (base, power) {
-                ("Pa", _) => prefix.to_string(),
-                ("m/s", _) => format!("{prefix}m/s"),
-                (_, 2) => format!("{prefix}{base}²"),
-                _ => format!("{prefix}{base}"),
-            };
-            return (10f64.powi(-exponent), name);
-        }
-    }
-    (1.0, si.to_string())
-}
-
 /// "Nice" tick values covering [lo, hi]: steps of 1, 2 or 5 × 10^k, about six of them.
 fn ticks(lo: f64, hi: f64) -> Vec<f64> {
     let span = hi - lo;
@@ -274,8 +239,8 @@ impl Chart {
         let points: Vec<(f64, f64)> = self.layers.iter().flat_map(Layer::extent).collect();
         let largest =
             |f: fn(&(f64, f64)) -> f64| points.iter().map(f).map(f64::abs).fold(0.0, f64::max);
-        let (x_factor, x_unit) = display_unit(&self.x.unit, largest(|p| p.0));
-        let (y_factor, y_unit) = display_unit(&self.y.unit, largest(|p| p.1));
+        let (x_factor, x_unit) = prefixed(&self.x.unit, largest(|p| p.0));
+        let (y_factor, y_unit) = prefixed(&self.y.unit, largest(|p| p.1));
         let (mut x_lo, mut x_hi) = range(points.iter().map(|p| p.0 * x_factor), self.x.log);
         let (mut y_lo, mut y_hi) = range(points.iter().map(|p| p.1 * y_factor), self.y.log);
         let (mut left, mut right) = (LEFT, WIDTH - RIGHT);
@@ -486,7 +451,7 @@ impl Chart {
         if x.len() < 2 || y.len() < 2 || top_value <= 0.0 {
             return;
         }
-        let (factor, unit) = display_unit(unit, top_value);
+        let (factor, unit) = prefixed(unit, top_value);
         let half = |v: &[f64], i: usize| {
             let lo = if i == 0 {
                 v[0]
@@ -640,16 +605,6 @@ const LEGEND_ROWS: usize = 14;
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn units_a_person_reads() {
-        assert_eq!(display_unit("m", 2.5e-8), (1e9, "nm".to_string()));
-        assert_eq!(display_unit("m^2", 8.5e-17), (1e18, "nm²".to_string()));
-        assert_eq!(display_unit("N", 1e-9).1, "nN");
-        assert_eq!(display_unit("m/s", 4e-9).1, "nm/s");
-        assert_eq!(display_unit("Pa", 3e8).1, "MPa");
-        assert_eq!(display_unit("", 0.1), (1.0, String::new()));
-    }
 
     #[test]
     fn ticks_are_round_and_cover_the_range() {

@@ -20,6 +20,10 @@ async fn a_body_that_is_not_json_is_415() {
     let response = app.post_raw("/v1/sweeps", "text/plain", "{}".into()).await;
     let unsupported = problem(response, 415).await;
     assert_eq!(unsupported["type"], problem_type("unsupported-media-type"));
+    assert_eq!(
+        unsupported["detail"],
+        "the body was sent as text/plain; send it as JSON, with Content-Type: application/json"
+    );
 }
 
 #[tokio::test]
@@ -31,6 +35,10 @@ async fn a_body_over_the_limit_is_413() {
         .await;
     let too_large = problem(response, 413).await;
     assert_eq!(too_large["type"], problem_type("payload-too-large"));
+    assert_eq!(
+        too_large["detail"],
+        "the body declares 2,050 bytes; this service takes at most 1,024 bytes (its --body-limit)"
+    );
 }
 
 #[tokio::test]
@@ -91,6 +99,10 @@ async fn unknown_routes_jobs_and_figures_are_404_and_wrong_methods_405() {
     assert_eq!(response.headers()["allow"], "POST");
     let not_allowed = problem(response, 405).await;
     assert_eq!(not_allowed["type"], "about:blank");
+    assert_eq!(
+        not_allowed["detail"],
+        "this route does not take this method; the Allow header names those it takes"
+    );
 }
 
 #[tokio::test]

@@ -2,7 +2,7 @@
 //! parameters to fit with their starts and bounds; read into a [`Problem`] of the model.
 
 use serde::{Deserialize, Serialize};
-use serde_json::{json, Value};
+use serde_json::json;
 use utoipa::ToSchema;
 
 use crate::job::input::{field, Checker, Field, LayerInput, Quantity};
@@ -10,6 +10,7 @@ use crate::job::three_body::{OperatingInput, ThreeBodyInput, ThreeBodyJob};
 use crate::model::fit::{
     Bounds, Datum, FitParameter, Measured, Parameterization, Point, Problem, Setting,
 };
+use crate::model::text::quantity;
 use crate::model::three_body::{OperatingPoint, ThreeBody, ThreeBodyOptions};
 use crate::model::{Layer, Parameter, Rolling};
 
@@ -196,12 +197,12 @@ impl FitInput {
             read_parameters(p, &base, c)
         });
         if free.is_empty() {
-            let sent = if input.parameters.is_some() {
-                json!({})
+            let allowed = "at least one parameter to fit";
+            if input.parameters.is_some() {
+                checker.invalid("parameters", json!({}), allowed);
             } else {
-                Value::Null
-            };
-            checker.invalid("parameters", sent, "at least one parameter to fit");
+                checker.missing("parameters", allowed, "");
+            }
         }
         let data = read_series(input.series.as_deref(), max_points, checker);
         let problem = Problem {
@@ -322,10 +323,14 @@ fn read_parameters(
                     "min",
                     min,
                     model.unit(),
-                    &format!("≤ max = {max:e} {}", model.unit()),
+                    &format!("≤ max = {}", quantity(max, model.unit())),
                 );
             } else if !(min..=max).contains(&start) {
-                let allowed = format!("within [min, max] = [{min:e}, {max:e}] {}", model.unit());
+                let allowed = format!(
+                    "within [min, max] = [{}, {}]",
+                    quantity(min, model.unit()),
+                    quantity(max, model.unit())
+                );
                 c.out_of_range("start", start, model.unit(), &allowed);
             }
             Bounds { start, min, max }
@@ -354,7 +359,7 @@ fn read_series(
     checker: &mut Checker,
 ) -> Vec<Datum> {
     let Some(series) = series else {
-        checker.invalid("series", Value::Null, "a list of measured series: required");
+        checker.missing("series", "a list of measured series", "");
         return Vec::new();
     };
     if series.is_empty() {
@@ -423,7 +428,7 @@ fn read_one(s: &SeriesInput, c: &mut Checker, data: &mut Vec<Datum>) {
                 velocity: condition(c, field!(p.velocity), Parameter::Velocity, velocity),
                 measured: quantity.model(),
             };
-            let why = "the measured value at this point";
+            let why = "at each measured point";
             let value = c.required(field!(p.value), quantity.parameter(), why);
             check_range(c, field!(p.value), quantity.parameter(), Some(value));
             let uncertainty = c.optional(field!(p.uncertainty), quantity.parameter());

@@ -6,7 +6,7 @@ use std::rc::Rc;
 
 use serde_json::{json, Value};
 
-use super::units::{parse_quantity, Dimension, UnitError};
+use super::units::{is_bare_number, parse_quantity, Dimension, UnitError};
 use super::{Field, Quantity};
 use crate::job::{FieldError, InputWarning, JobError, Validated};
 use crate::model::{OptionError, Parameter, ParameterError, SolveOption};
@@ -140,14 +140,31 @@ impl Checker {
         Some(self.read(&at, field.value?, parameter))
     }
 
-    /// [`Checker::optional`] for a field the object needs (`why` says when).
-    pub fn required(&mut self, field: Field<Quantity>, parameter: Parameter, why: &str) -> f64 {
+    /// [`Checker::optional`] for a field the object needs (`when`: "with asperities").
+    pub fn required(&mut self, field: Field<Quantity>, parameter: Parameter, when: &str) -> f64 {
         self.optional(field, parameter).unwrap_or_else(|| {
-            let dimension = dimension(parameter);
-            let allowed = format!("{}: required {why}", dimension.describe());
-            self.invalid(field.name, Value::Null, &allowed);
+            self.missing(field.name, &dimension(parameter).describe(), when);
             f64::NAN
         })
+    }
+
+    /// Records that `field` (in the object being read) is absent though needed (`when`:
+    /// "with asperities", or "" if always): `asperities.density is required with asperities;
+    /// expected a number per area (…)`.
+    pub fn missing(&mut self, field: &str, allowed: &str, when: &str) {
+        let path = self.path(field);
+        let when = if when.is_empty() {
+            String::new()
+        } else {
+            format!(" {when}")
+        };
+        let message = format!("{path} is required{when}; expected {allowed}");
+        self.report(FieldError {
+            field: path,
+            value: Value::Null,
+            allowed: allowed.to_string(),
+            message,
+        });
     }
 
     /// A count such as a number of nodes, the solver `option` (its range is the model's to
@@ -195,23 +212,27 @@ impl Checker {
             .collect()
     }
 
-    /// Reads one quantity at `at`.
+    /// Reads one quantity at `at`; a bare number, or a string holding one without a unit
+    /// (`"50"`), far from the field's scale is read as sent (SI) with a warning.
     fn read(&mut self, at: &Location, quantity: &Quantity, parameter: Parameter) -> f64 {
-        let parsed = match quantity {
-            Quantity::Number(x) => {
-                if let Some(message) = implausible(parameter, *x) {
-                    let path = at.path();
-                    let message = format!("{path}: {message}");
-                    self.warnings.push(InputWarning {
-                        field: path,
-                        value: quantity.sent(),
-                        message,
-                    });
-                }
-                Ok(*x)
-            }
-            Quantity::Text(text) => parse_quantity(text, dimension(parameter)),
+        let (parsed, bare) = match quantity {
+            Quantity::Number(x) => (Ok(*x), true),
+            Quantity::Text(text) => (
+                parse_quantity(text, dimension(parameter)),
+                is_bare_number(text),
+            ),
         };
+        if let (true, Ok(x)) = (bare, &parsed) {
+            if let Some(message) = implausible(parameter, *x) {
+                let path = at.path();
+                let message = format!("{path}: {message}");
+                self.warnings.push(InputWarning {
+                    field: path,
+                    value: quantity.sent(),
+                    message,
+                });
+            }
+        }
         // -0 is 0: one value, one canonical form, one cache key.
         let read = parsed.map(super::si);
         // A report of a value out of range shows it as sent, or as its SI number when that
@@ -270,18 +291,14 @@ impl Checker {
             .get(&path)
             .cloned()
             .unwrap_or_else(|| Value::from(value));
-        let number = format_number(value);
-        let si = if unit.is_empty() {
-            number
-        } else {
-            format!("{number} {unit}")
+        // The value as sent, so that the sender finds it: text as typed, a number exactly
+        // (rounded, 0.09999 s would read as the 100 ms it must not be below).
+        let shown = match &sent {
+            Value::String(s) => format!("\"{s}\""),
+            _ if unit.is_empty() => format_number(value),
+            _ => format!("{} {unit}", format_number(value)),
         };
-        let message = match &sent {
-            Value::String(s) => {
-                format!("{path} = \"{s}\" ({si}) is out of range: allowed {allowed}")
-            }
-            _ => format!("{path} = {si} is out of range: allowed {allowed}"),
-        };
+        let message = format!("{path} = {shown} is out of range; expected {allowed}");
         self.report(FieldError {
             field: path,
             value: sent,
@@ -314,10 +331,15 @@ impl Checker {
         }
     }
 
-    /// Records an error of `field` that is not a range (e.g. an empty list).
+    /// Records an error of `field` that is not a range (e.g. an empty list): `vary.radius: []
+    /// is not a valid value; expected a list of at least one value`. With `value` null there
+    /// is nothing to echo, and `allowed` says it all (`checks[0].job: a valid job: …`).
     pub fn invalid(&mut self, field: &str, value: Value, allowed: &str) {
         let path = self.path(field);
-        let message = format!("{path}: {value} is not allowed: allowed {allowed}");
+        let message = match value {
+            Value::Null => format!("{path}: {allowed}"),
+            _ => format!("{path}: {value} is not a valid value; expected {allowed}"),
+        };
         self.report(FieldError {
             field: path,
             value,
@@ -430,6 +452,46 @@ mod tests {
         }
     }
 
+    /// The warning of a bare number, for the same number sent as a string without a unit,
+    /// at the top and in a nested object.
+    #[test]
+    fn a_string_without_a_unit_is_warned_like_the_bare_number() {
+        let read = |value: Quantity| {
+            let mut checker = Checker::new();
+            let field = Field {
+                name: "radius",
+                value: Some(&value),
+            };
+            let x = checker.quantity(field, Parameter::Radius, 1e-8);
+            let thickness = Field {
+                name: "thickness",
+                value: Some(&value),
+            };
+            let layer = Field {
+                name: "layer",
+                value: Some(&()),
+            };
+            checker.nested(layer, |c, _| {
+                c.quantity(thickness, Parameter::Thickness, 1e-7)
+            });
+            let messages: Vec<String> = checker.warnings.into_iter().map(|w| w.message).collect();
+            (x, messages)
+        };
+        let expected = [
+            "radius: 50 is 50 m; did you mean \"50 nm\"?",
+            "layer.thickness: 50 is 50 m; did you mean \"50 nm\"?",
+        ];
+        assert_eq!(
+            read(Quantity::Number(50.0)),
+            (50.0, expected.map(String::from).to_vec())
+        );
+        assert_eq!(
+            read(Quantity::Text(" 50 ".into())),
+            (50.0, expected.map(String::from).to_vec())
+        );
+        assert_eq!(read(Quantity::Text("50 m".into())), (50.0, Vec::new()));
+    }
+
     /// Out-of-range values in a list, each reported at its path with its value as sent: as
     /// text, as a number, and -0 (which reads as 0).
     #[test]
@@ -468,9 +530,14 @@ mod tests {
                 ("base.radius[2]", "-0.0".to_string()),
             ]
         );
-        assert!(errors[0]
-            .message
-            .starts_with("base.radius[0] = \"-5 nm\" (-5e-9 m)"));
+        assert_eq!(
+            errors[0].message,
+            "base.radius[0] = \"-5 nm\" is out of range; expected finite and > 0 m"
+        );
+        assert_eq!(
+            errors[1].message,
+            "base.radius[1] = -2 m is out of range; expected finite and > 0 m"
+        );
     }
 
     #[test]

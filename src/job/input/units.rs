@@ -213,6 +213,14 @@ pub fn parse_quantity(text: &str, expected: Dimension) -> Result<f64, UnitError>
         .map_err(|_| UnitError::NoNumber)
 }
 
+/// Whether `text` is a number without a unit (`"50"`, `" 2.5e-8 "`): SI, as a JSON number
+/// is, and so as implausible as one far from its field's scale (docs/model.md §7).
+pub fn is_bare_number(text: &str) -> bool {
+    let text = text.trim();
+    let length = number_length(text);
+    length > 0 && length == text.len()
+}
+
 /// Length of the leading decimal number (sign, digits, point, exponent) of `text`.
 fn number_length(text: &str) -> usize {
     let bytes = text.as_bytes();
@@ -354,6 +362,16 @@ mod tests {
             let got = parse_quantity(text, dim).unwrap_or_else(|e| panic!("{text}: {e}"));
             // Exactly the double nearest the decimal value: one canonical form per quantity.
             assert_eq!(got, expected, "{text}");
+        }
+    }
+
+    #[test]
+    fn a_number_without_a_unit_is_bare() {
+        for text in ["50", " 2.5e-8 ", "-4", "1E3", ".5"] {
+            assert!(is_bare_number(text), "{text}");
+        }
+        for text in ["50 nm", "50nm", "", "e3", "1e3 m", "twenty"] {
+            assert!(!is_bare_number(text), "{text}");
         }
     }
 

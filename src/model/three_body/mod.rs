@@ -17,6 +17,7 @@ use super::quadrature::{gauss_legendre, GaussRule};
 use super::roots::brent;
 use super::similarity::SimilarityTable;
 use super::tables;
+use super::text::quantity;
 use super::{Layer, ModelError, OptionError, Parameter, ParameterError, Quadrature, SolveOption};
 
 /// Diameter nodes used when a job does not ask for a number: the particle sums then agree
@@ -204,14 +205,17 @@ impl ThreeBody {
                 add(
                     MaxDiameter,
                     d.max,
-                    format!("x_min ≤ x_a ≤ x_max when σ_a = 0 (x_a = {} m)", d.mean),
+                    format!(
+                        "x_min ≤ x_a ≤ x_max when σ_a = 0 (x_a = {})",
+                        quantity(d.mean, "m")
+                    ),
                 );
             }
         } else if d.min >= d.max {
             add(
                 MaxDiameter,
                 d.max,
-                format!("> minimum diameter {} m", d.min),
+                format!("> minimum diameter {}", quantity(d.min, "m")),
             );
         } else if [d.mean, d.std, d.min, d.max].iter().all(|x| x.is_finite())
             && d.normaliser() <= 1e-300
@@ -220,8 +224,9 @@ impl ThreeBody {
                 MaxDiameter,
                 d.max,
                 format!(
-                    "bounds that hold some of the Gaussian N({} m, ({} m)²)",
-                    d.mean, d.std
+                    "bounds that hold some of the Gaussian N({}, ({})²)",
+                    quantity(d.mean, "m"),
+                    quantity(d.std, "m")
                 ),
             );
         }
@@ -592,16 +597,18 @@ impl<'a> Model<'a> {
         // warning); with nothing in contact there is no load, and no friction coefficient.
         if state.loads.total <= 0.0 {
             return Err(ModelError::OutOfModel(format!(
-                "nothing is in contact at separation d = {:e} m: no particle (the largest is \
-                 x_max = {:e} m) and no asperity touches, so the system carries no load",
-                state.separation, d.max
+                "nothing is in contact at separation d = {}: no particle (the largest is \
+                 x_max = {}) and no asperity touches, so the system carries no load",
+                quantity(state.separation, "m"),
+                quantity(d.max, "m")
             )));
         }
         if state.max_layer_penetration > system.layer.thickness {
             return Err(ModelError::OutOfModel(format!(
-                "the largest particle would penetrate the layer by {:e} m, more than its \
-                 thickness H = {:e} m",
-                state.max_layer_penetration, system.layer.thickness
+                "the largest particle would penetrate the layer by {}, more than its \
+                 thickness H = {}",
+                quantity(state.max_layer_penetration, "m"),
+                quantity(system.layer.thickness, "m")
             )));
         }
         Ok((state, iterations, residual))
@@ -618,8 +625,10 @@ impl<'a> Model<'a> {
         let most = carried(&self.state(0.0)?);
         if most < target {
             return Err(ModelError::OutOfModel(format!(
-                "{what} = {target:e} N cannot be carried: even at zero separation the system \
-                 carries {most:e} N"
+                "{what} = {} cannot be carried: even at zero separation the system carries \
+                 only {}",
+                quantity(target, "N"),
+                quantity(most, "N")
             )));
         }
         let mut failure = None;
