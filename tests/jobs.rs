@@ -393,3 +393,39 @@ fn parallel_and_serial_engines_give_identical_answers() {
     let parallel = engine::run(&sweep, &Control::new(None, 4)).unwrap();
     assert_eq!(serial, parallel);
 }
+
+/// The room an asynchronous job's store makes for its result (`Job::result_bytes`) holds the
+/// result's JSON and CSV, for every kind and at the sizes that make answers large: an estimate
+/// too small would let the store hold more than its budget.
+#[test]
+fn the_room_made_for_a_result_holds_it() {
+    let loads: Vec<String> = (0..50).map(|i| format!("{} pN", 900 + 7 * i)).collect();
+    let jobs = [
+        json!({"kind": "rolling"}),
+        json!({"kind": "rolling", "input": {"options": {"boundary_points": 10001}}}),
+        json!({"kind": "rolling", "input": {"options": {"pressure_grid": 201}}}),
+        json!({"kind": "three_body", "input": {"operating": {"total_load": "1 mN"}}}),
+        json!({"kind": "sweep", "input": {"vary": {"load": loads, "radius": ["25 nm", "3 um"],
+            "velocity": [0, "1e-13 m/s", "0.3 m/s"]}}}),
+        json!({"kind": "sweep", "input": {"vary": {"load": ["1 nN", "1 mN", "10 mN"]}}}),
+        json!({"kind": "sweep", "input": {"kind": "three_body",
+            "base": {"operating": {"total_load": "1 mN"}},
+            "vary": {"velocity": ["0 nm/s", "4 nm/s"], "mean_diameter": ["30 nm", "50 nm"]}}}),
+        json!({"kind": "figure", "input": {"number": 9}}),
+        serde_json::from_str(include_str!("../examples/fit.json")).unwrap(),
+    ];
+    for envelope in jobs {
+        let job = Job::from_value(envelope.clone(), &Limits::default()).unwrap();
+        let answer = engine::run(&job, &Control::default()).unwrap();
+        let bytes = answer
+            .render(thirdbody::render::Format::Json)
+            .unwrap()
+            .len()
+            + answer.render(thirdbody::render::Format::Csv).unwrap().len();
+        assert!(
+            bytes as u64 <= job.result_bytes(),
+            "{envelope}: {bytes} bytes, room for {}",
+            job.result_bytes()
+        );
+    }
+}

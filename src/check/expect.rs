@@ -2,7 +2,7 @@
 
 use serde_json::Value;
 
-use super::path::FieldPath;
+use super::path::{unanswered, FieldPath};
 use super::report::Outcome;
 use super::{ExpectInput, GoldenInput};
 use crate::render::format_number;
@@ -115,7 +115,10 @@ impl Expectation {
         found
             .into_iter()
             .map(|(path, value)| match value.as_f64() {
-                None => Outcome::failed(&path, &expected, None, &format!("{path}: not a number")),
+                None => {
+                    let why = unanswered(value).unwrap_or_else(|| "not a number".to_string());
+                    Outcome::failed(&path, &expected, None, &format!("{path}: {why}"))
+                }
                 Some(x) if self.holds(x) => Outcome::passed(&path, &expected, x),
                 Some(x) => Outcome::failed(
                     &path,
@@ -234,6 +237,36 @@ impl Golden {
 mod tests {
     use super::*;
     use serde_json::json;
+
+    #[test]
+    fn an_expectation_on_a_refused_or_missing_point_fails_saying_why() {
+        let answer = json!({"points": [
+            {"load": 1e-9, "status": "ok", "mu": 0.05},
+            {"load": 1e-3, "status": "refused", "reason": "the penetration reaches the base"},
+            {"load": 2e-9, "status": "missing"}]});
+        let outcomes = Expectation::new(
+            "points[].mu".to_string(),
+            ExpectInput {
+                max: Some(0.1),
+                ..Default::default()
+            },
+        )
+        .unwrap()
+        .judge(&answer);
+        assert_eq!(
+            outcomes.iter().map(|o| o.passed).collect::<Vec<_>>(),
+            [true, false, false]
+        );
+        assert_eq!(
+            outcomes[1].message,
+            "points[1].mu: the model refused this point: the penetration reaches the base"
+        );
+        assert!(
+            outcomes[2].message.contains("not solved"),
+            "{}",
+            outcomes[2].message
+        );
+    }
 
     #[test]
     fn every_number_at_a_path_is_judged_and_a_path_reaching_none_fails() {

@@ -15,7 +15,7 @@ use utoipa::ToSchema;
 
 use super::rolling::VerificationOutput;
 use super::three_body::ThreeBodyVerificationOutput;
-use super::validity::{PointValidity, Subject, SweepValidityOutput, ValidityTally};
+use super::validity::{PointValidity, Subject, SweepValidityOutput, ValidityStatus, ValidityTally};
 use super::{JobError, Swept};
 
 /// What became of a point of a sweep.
@@ -58,8 +58,10 @@ impl PointNotes {
     /// The row's status.
     pub fn status(&self) -> PointStatus {
         match self {
-            PointNotes::Answered(v) if v.warned().next().is_some() => PointStatus::Warn,
-            PointNotes::Answered(_) => PointStatus::Ok,
+            PointNotes::Answered(v) => match v.status() {
+                ValidityStatus::Ok => PointStatus::Ok,
+                ValidityStatus::Warn => PointStatus::Warn,
+            },
             PointNotes::Refused(_) => PointStatus::Refused,
             PointNotes::Missing => PointStatus::Missing,
         }
@@ -85,15 +87,23 @@ impl Serialize for PointNotes {
         match self {
             PointNotes::Answered(validity) => {
                 map.serialize_entry("validity", validity)?;
-                let warned: Vec<&str> = validity.warned().collect();
-                if !warned.is_empty() {
-                    map.serialize_entry("warn", &warned)?;
+                if validity.status() == ValidityStatus::Warn {
+                    map.serialize_entry("warn", &Warned(validity))?;
                 }
             }
             PointNotes::Refused(reason) => map.serialize_entry("reason", reason)?,
             PointNotes::Missing => {}
         }
         map.end()
+    }
+}
+
+/// The names of the assumptions a point warns on, as a list.
+struct Warned<'a>(&'a PointValidity);
+
+impl Serialize for Warned<'_> {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.collect_seq(self.0.warned())
     }
 }
 

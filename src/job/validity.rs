@@ -113,33 +113,47 @@ pub fn summary(validity: &ValidityOutput) -> String {
 #[derive(Clone, Debug, PartialEq)]
 pub struct PointValidity {
     checks: Vec<Check>,
+    /// Bit `i` set: `checks[i]` warns (measured once: a row asks for it several times).
+    warned: u16,
 }
 
 impl PointValidity {
     /// The validity of a point measured by `checks`, or the reason it is refused (the first
     /// violated assumption, in words).
     pub fn assess(checks: Vec<Check>, subject: Subject) -> Result<PointValidity, JobError> {
-        if let Some(check) = checks.iter().find(|c| c.status() == Status::Violated) {
-            return Err(JobError::OutOfDomain(violation(check, subject)));
+        let mut warned = 0;
+        for (i, check) in checks.iter().enumerate() {
+            match check.status() {
+                Status::Violated => return Err(JobError::OutOfDomain(violation(check, subject))),
+                Status::Warn => warned |= 1 << i,
+                Status::Ok => {}
+            }
         }
-        Ok(PointValidity { checks })
+        Ok(PointValidity { checks, warned })
     }
 
     /// The worst status of the assumptions.
     pub fn status(&self) -> ValidityStatus {
-        if self.warned().next().is_some() {
-            ValidityStatus::Warn
-        } else {
+        if self.warned == 0 {
             ValidityStatus::Ok
+        } else {
+            ValidityStatus::Warn
         }
+    }
+
+    /// The checks that warn.
+    fn warning(&self) -> impl Iterator<Item = &Check> + '_ {
+        let warned = self.warned;
+        self.checks
+            .iter()
+            .enumerate()
+            .filter(move |(i, _)| warned & (1 << i) != 0)
+            .map(|(_, c)| c)
     }
 
     /// The names of the assumptions that warn.
     pub fn warned(&self) -> impl Iterator<Item = &'static str> + '_ {
-        self.checks
-            .iter()
-            .filter(|c| c.status() != Status::Ok)
-            .map(|c| names(c.assumption).0)
+        self.warning().map(|c| names(c.assumption).0)
     }
 
     /// The names of the assumptions that warn, as a CSV cell: space-separated.
@@ -196,11 +210,12 @@ impl ValidityTally {
     /// Counts point `index`, measured as `validity`.
     pub fn count(&mut self, index: usize, validity: &PointValidity, subject: Subject) {
         for check in &validity.checks {
+            self.tally(check.assumption);
+        }
+        for check in validity.warning() {
             let tally = self.tally(check.assumption);
-            if check.status() != Status::Ok {
-                tally.warned += 1;
-                tally.offer(index, || note(check, subject));
-            }
+            tally.warned += 1;
+            tally.offer(index, || note(check, subject));
         }
     }
 

@@ -148,7 +148,12 @@ trait Render: fmt::Debug + Send + Sync {
 impl<T: Output> Render for T {
     fn json(&self, pretty: bool) -> serde_json::Result<Vec<u8>> {
         if pretty {
-            serde_json::to_vec_pretty(self)
+            let mut json = Vec::with_capacity(SCRATCH_KEPT);
+            self.serialize(&mut serde_json::Serializer::with_formatter(
+                &mut json,
+                Rows::default(),
+            ))?;
+            Ok(json)
         } else {
             scratch(|buffer| serde_json::to_writer(buffer, self))
         }
@@ -168,6 +173,121 @@ impl<T: Output> Render for T {
 
     fn same(&self, other: &dyn Any) -> bool {
         other.downcast_ref::<T>() == Some(self)
+    }
+}
+
+/// JSON for people: objects indented a field a line, as `serde_json`'s pretty form, but each
+/// element of a list on one line of its own. A sweep then reads a point a line (a table, as
+/// in its CSV) rather than twenty lines a point, and is written in a quarter less time.
+#[derive(Debug, Default)]
+struct Rows {
+    /// Indentation of the innermost indented container.
+    level: usize,
+    /// Containers opened inside a one-line list element, still open (0: indenting).
+    inline: usize,
+    /// Of the indented containers open, whether each is a list.
+    lists: Vec<bool>,
+    /// Whether the innermost indented container has a value yet.
+    has_value: bool,
+}
+
+impl Rows {
+    fn open<W: ?Sized + std::io::Write>(&mut self, w: &mut W, list: bool) -> std::io::Result<()> {
+        if self.inline > 0 || self.lists.last() == Some(&true) {
+            self.inline += 1;
+        } else {
+            self.level += 1;
+            self.lists.push(list);
+            self.has_value = false;
+        }
+        w.write_all(if list { b"[" } else { b"{" })
+    }
+
+    fn close<W: ?Sized + std::io::Write>(&mut self, w: &mut W, list: bool) -> std::io::Result<()> {
+        if self.inline > 0 {
+            self.inline -= 1;
+        } else {
+            self.level -= 1;
+            self.lists.pop();
+            if self.has_value {
+                self.newline(w)?;
+            }
+        }
+        w.write_all(if list { b"]" } else { b"}" })
+    }
+
+    /// Before a field or an element: a comma unless it is the first, and a new line when
+    /// indenting.
+    fn next<W: ?Sized + std::io::Write>(&mut self, w: &mut W, first: bool) -> std::io::Result<()> {
+        if !first {
+            w.write_all(b",")?;
+        }
+        if self.inline == 0 {
+            self.newline(w)?;
+        }
+        Ok(())
+    }
+
+    fn newline<W: ?Sized + std::io::Write>(&self, w: &mut W) -> std::io::Result<()> {
+        w.write_all(b"\n")?;
+        for _ in 0..self.level {
+            w.write_all(b"  ")?;
+        }
+        Ok(())
+    }
+
+    fn valued(&mut self) {
+        if self.inline == 0 {
+            self.has_value = true;
+        }
+    }
+}
+
+impl serde_json::ser::Formatter for Rows {
+    fn begin_array<W: ?Sized + std::io::Write>(&mut self, w: &mut W) -> std::io::Result<()> {
+        self.open(w, true)
+    }
+
+    fn end_array<W: ?Sized + std::io::Write>(&mut self, w: &mut W) -> std::io::Result<()> {
+        self.close(w, true)
+    }
+
+    fn begin_array_value<W: ?Sized + std::io::Write>(
+        &mut self,
+        w: &mut W,
+        first: bool,
+    ) -> std::io::Result<()> {
+        self.next(w, first)
+    }
+
+    fn end_array_value<W: ?Sized + std::io::Write>(&mut self, _: &mut W) -> std::io::Result<()> {
+        self.valued();
+        Ok(())
+    }
+
+    fn begin_object<W: ?Sized + std::io::Write>(&mut self, w: &mut W) -> std::io::Result<()> {
+        self.open(w, false)
+    }
+
+    fn end_object<W: ?Sized + std::io::Write>(&mut self, w: &mut W) -> std::io::Result<()> {
+        self.close(w, false)
+    }
+
+    fn begin_object_key<W: ?Sized + std::io::Write>(
+        &mut self,
+        w: &mut W,
+        first: bool,
+    ) -> std::io::Result<()> {
+        self.next(w, first)
+    }
+
+    fn begin_object_value<W: ?Sized + std::io::Write>(&mut self, w: &mut W) -> std::io::Result<()> {
+        w.write_all(if self.inline == 0 { b": " } else { b":" })
+    }
+
+    fn end_object_value<W: ?Sized + std::io::Write>(&mut self, _: &mut W) -> std::io::Result<()> {
+        self.valued();
+        Ok(())
     }
 }
 

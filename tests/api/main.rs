@@ -11,5 +11,6 @@ mod jobs;
 mod limits;
 mod ops;
 mod pictures;
+mod results;
 mod solve;
 mod storage;

@@ -79,6 +79,17 @@ try {
   if (!progress.includes("200 / 200 (100 %)")) fail(`progress reads ${progress}`);
   await page.screenshot({ path: `${shots}/sweep.png`, fullPage: true });
 
+  // A sweep with a point the model refuses: the other points are answered, the refusal said.
+  await page.fill("input[name='vary.load']", "1 nN, 1 mN, 2 nN");
+  await page.fill("input[name='vary.velocity']", "4 nm/s");
+  await page.getByRole("button", { name: "Run" }).click();
+  await page.waitForFunction(() => document.querySelector("#warnings").textContent.includes("refused"), null, { timeout: 60000 });
+  const refused = await page.locator("#warnings").textContent();
+  if (!refused.includes("1 of 3 points refused")) fail(`the refused point reads ${refused}`);
+  const answered = await page.locator("#table tr", { hasText: "points.warn" }).first().textContent();
+  if (!/2/.test(answered)) fail(`the sweep's table reads ${answered}`);
+  await page.screenshot({ path: `${shots}/sweep-refused.png`, fullPage: true });
+
   // Figure 6 from the gallery.
   await page.getByRole("tab", { name: "Figures 3–9" }).click();
   await page.getByRole("button", { name: "Figure 6" }).click();
@@ -94,7 +105,7 @@ try {
 
   if (errors.length) fail(`console errors: ${errors.join(" | ")}`);
   if (outside.length) fail(`requests left the server: ${outside.join(", ")}`);
-  if (!process.exitCode) console.log(`dashboard: rolling, three-body, a 200-point sweep and Figure 6 work; screenshots in ${shots}`);
+  if (!process.exitCode) console.log(`dashboard: rolling, three-body, a 200-point sweep, a sweep with a refused point and Figure 6 work; screenshots in ${shots}`);
 } finally {
   await browser.close();
   child.kill();

@@ -101,7 +101,8 @@ function showTable(answer) {
     head.append(th);
   }
   const units = (answer.meta && answer.meta.units) || {};
-  const shown = answer.points ? { points: answer.points.length } : answer;
+  // A sweep's table is what its meta says of its points; its rows are in the downloads.
+  const shown = answer.points ? { points: (answer.meta && answer.meta.counts) || answer.points.length } : answer;
   for (const [name, value, unit] of rows(shown, units)) {
     const row = table.insertRow();
     for (const cell of [name, value, unit]) row.insertCell().textContent = cell;
@@ -114,10 +115,16 @@ function showWarnings(answer) {
   const meta = answer.meta || {};
   const notes = (meta.warnings || []).map((w) => w.message);
   for (const a of (meta.validity && meta.validity.assumptions) || []) {
-    if (a.status !== "ok") {
+    if (a.warned !== undefined) {
+      // A sweep: how many points each assumption warns on, and why on the first.
+      if (a.warned > 0) notes.push(`warn on ${a.warned} points: ${a.assumption} (first, points[${a.first_warned}]: ${a.note})`);
+    } else if (a.status !== "ok") {
       notes.push(`${a.status}: ${a.assumption} (${a.ratio} = ${Number(a.value).toPrecision(3)}; ${a.rule})`);
     }
   }
+  const counts = meta.counts;
+  if (counts && counts.refused > 0) notes.push(`${counts.refused} of ${counts.total} points refused by the model: see their reason in the CSV or JSON`);
+  if (meta.complete === false) notes.push(`partial answer: ${counts.missing} of ${counts.total} points not solved (${meta.stopped})`);
   for (const text of notes) {
     const p = document.createElement("p");
     p.className = "warning";
@@ -209,14 +216,19 @@ function follow(id) {
     cancel.disabled = true;
     const view = JSON.parse(e.data);
     update(view);
-    if (view.status !== "succeeded") {
-      if (view.problem) showProblem(view.problem);
-      return;
-    }
-    const result = `/v1/jobs/${id}/result`;
-    const answer = await (await fetch(result, { headers: { accept: "application/json" } })).json();
+    if (view.problem) showProblem(view.problem);
+    // A failed or cancelled sweep may still link to the points it finished.
+    if (!view.result_url) return;
+    const result = view.result_url;
+    const response = await fetch(result, { headers: { accept: "application/json" } });
+    const answer = await response.json();
+    if (!response.ok) return showProblem(answer);
     showTable(answer);
     showWarnings(answer);
+    if (view.partial) {
+      const why = view.problem ? `: ${view.problem.detail}` : "";
+      status(`Job ${view.status}${why}. A partial answer: the points it finished.`, view.status === "failed");
+    }
     const picture = await fetch(`${result}?format=svg`);
     if (picture.ok) showPicture(await picture.text());
     showDownloads((accept) => fetch(result, { headers: { accept } }), `job-${id}`);
