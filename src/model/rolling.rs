@@ -9,7 +9,7 @@ use std::f64::consts::{FRAC_PI_2, FRAC_PI_4, PI};
 use std::sync::Arc;
 
 use super::limits::{relaxed, ElasticContact};
-use super::quadrature::StripRule;
+use super::quadrature::{Spacing, StripRule};
 use super::similarity::{ExactRatios, Ratios, SimilarityTable};
 use super::strip::Strip;
 use super::{Layer, ModelError, OptionError, Parameter, Quadrature, SolveOption};
@@ -264,18 +264,21 @@ pub(super) fn solve_with(
 /// The contact at a given penetration δ rather than a given load (the forward map of the
 /// three-body model, docs/model.md §4, and the builder of the similarity tables), as the
 /// ratios of the similarity law ([`Ratios`]), which depend only on ξ = V T_σ/√(2Rδ) and κ,
-/// with the quadrature error estimate a rolling answer would report there. Φ_P runs from 1
-/// (ξ = 0) to 1 + κ (ξ → ∞); Φ_A is 1 at both ends and dips in between.
+/// with the quadrature error estimate a rolling answer would report there, under `quadrature`
+/// (its nodes spaced for ξ, [`Spacing::for_speed`]). Φ_P runs from 1 (ξ = 0) to 1 + κ
+/// (ξ → ∞); Φ_A is 1 at both ends and dips in between.
 pub fn penetration_contact(
     xi: f64,
     kappa: f64,
-    rule: &StripRule,
-    companion: &StripRule,
+    quadrature: Quadrature,
 ) -> Result<ExactRatios, ModelError> {
+    let spacing = Spacing::for_speed(xi);
+    let rule = StripRule::shared(quadrature, spacing)?;
+    let companion = StripRule::shared(quadrature.companion(), spacing)?;
     let section = Section::new(1.0, xi, kappa);
     let mut roots = vec![f64::NAN; rule.len()];
-    let integrals = section.integrate(rule, Some(&mut roots))?;
-    let (moment, error) = section.moment_and_error(rule, &roots, &integrals, companion, None)?;
+    let integrals = section.integrate(&rule, Some(&mut roots))?;
+    let (moment, error) = section.moment_and_error(&rule, &roots, &integrals, &companion, None)?;
     let ratios = Ratios {
         load: integrals.load / FRAC_PI_4,
         area: integrals.area / PI,
@@ -378,7 +381,7 @@ impl Contact {
     /// same integrals under the companion rule for the quadrature error estimate.
     fn exact(xi: f64, kappa: f64, quadrature: Quadrature) -> Result<Contact, ModelError> {
         let (shape, coarse) = Shape::nested(xi, kappa, quadrature)?;
-        let companion = StripRule::shared(quadrature.companion())?;
+        let companion = StripRule::shared(quadrature.companion(), Spacing::for_speed(xi))?;
         let section = shape.section(xi, kappa);
         let (pressure_moment, quadrature_error_estimate) = section.moment_and_error(
             &shape.rule,
@@ -490,7 +493,7 @@ impl Shape {
     ) -> Result<(Shape, Option<Shape>), ModelError> {
         /// Rules of fewer strips start cold.
         const NESTED_FROM: usize = 16;
-        let rule = StripRule::shared(quadrature)?;
+        let rule = StripRule::shared(quadrature, Spacing::for_speed(xi))?;
         let companion = quadrature.companion();
         // An elastic contact (at rest, or no viscosity) has its root at t = 0, found in one
         // pass: nothing to start.
@@ -935,9 +938,9 @@ mod tests {
     #[test]
     fn nested_solves_agree_with_the_fine_rule_alone_in_fewer_exit_root_steps() {
         let quadrature = Quadrature::default();
-        let rule = StripRule::shared(quadrature).unwrap();
         for kappa in [0.5, 4.0, 100.0] {
-            for xi in [1e-3, 0.07, 0.5, 3.0, 100.0] {
+            for xi in [1e-5, 1e-3, 0.07, 0.5, 3.0, 100.0] {
+                let rule = StripRule::shared(quadrature, Spacing::for_speed(xi)).unwrap();
                 let cold = Shape::solve(xi, kappa, rule.clone(), Start::cold(rule.len())).unwrap();
                 let (nested, coarse) = Shape::nested(xi, kappa, quadrature).unwrap();
                 let coarse = coarse.expect("the default rule's companion is coarser");
@@ -965,12 +968,11 @@ mod tests {
     /// guesses there are only rough; the nested test above still holds.)
     #[test]
     fn root_guides_guess_other_strips_roots_closely() {
-        let (fine, coarse) = (
-            StripRule::shared(Quadrature::Gauss { nodes: 64 }).unwrap(),
-            StripRule::shared(Quadrature::Gauss { nodes: 32 }).unwrap(),
-        );
         for kappa in [0.5, 4.0, 100.0] {
             for xi in [0.07, 0.5, 3.0, 30.0] {
+                let rule =
+                    |nodes| StripRule::shared(Quadrature::Gauss { nodes }, Spacing::for_speed(xi));
+                let (fine, coarse) = (rule(64).unwrap(), rule(32).unwrap());
                 let section = Section::new(0.9, xi, kappa);
                 let mut known = vec![f64::NAN; coarse.len()];
                 section.integrate(&coarse, Some(&mut known)).unwrap();
