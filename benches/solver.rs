@@ -11,7 +11,6 @@ use criterion::{criterion_group, criterion_main, Criterion};
 use serde_json::json;
 use thirdbody::engine::{self, cache::Solved};
 use thirdbody::job::{Control, Job, Kind, Limits, RollingJob, Work};
-use thirdbody::model::quadrature::StripRule;
 use thirdbody::model::rolling::penetration_contact;
 use thirdbody::model::similarity::SimilarityTable;
 use thirdbody::model::tables::{self, Use};
@@ -149,11 +148,9 @@ fn three_body(c: &mut Criterion) {
         b.iter(|| three_body::solve(black_box(&hertz), &options).unwrap())
     });
     group.bench_function("similarity_table_build", |b| {
-        let rule = StripRule::shared(Quadrature::default()).unwrap();
-        let companion = StripRule::shared(Quadrature::default().companion()).unwrap();
         b.iter(|| {
             SimilarityTable::build(black_box(4.0), |xi| {
-                penetration_contact(xi, 4.0, &rule, &companion)
+                penetration_contact(xi, 4.0, Quadrature::default())
             })
             .unwrap()
         })

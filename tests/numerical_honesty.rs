@@ -97,7 +97,7 @@ fn tiny_rules_do_not_claim_to_be_exact() {
 #[test]
 fn the_shifts_keep_their_relative_precision_as_the_viscosity_vanishes() {
     // x_c and x_p vanish like κ: x/κ tends to a limit, to first order in κ. (κ is the
-    // layer's own T_ε/T_σ − 1: T_ε = T_σ(1 + κ) rounds it by up to 1e-16.)
+    // layer's own (T_ε − T_σ)/T_σ: T_ε = T_σ(1 + κ) rounds it by up to 1e-16.)
     let shifts = |kappa: f64| {
         let contact = at(25e-9, 1e-9, 4e-9, kappa);
         let kappa = contact.layer.kappa();

@@ -4,7 +4,7 @@
 //!
 //! Notation (docs/model.md §1, §3): R radius, P load, V speed, δ penetration, A contact area,
 //! r = √(2Rδ) half-width, x_c area centroid, x_p centre of pressure, μ_r = x_p/R, μ = τ_a A/P,
-//! k = E_L/H, κ = T_ε/T_σ − 1, ξ = V T_σ / r₀, r₀ = √(2Rδ₀) the static half-width.
+//! k = E_L/H, κ = (T_ε − T_σ)/T_σ, ξ = V T_σ / r₀, r₀ = √(2Rδ₀) the static half-width.
 
 use std::panic::{catch_unwind, AssertUnwindSafe};
 

@@ -244,8 +244,9 @@ pub struct StaticOutput {
 pub struct VerificationOutput {
     /// |P(δ) − P|/P at the returned δ (dimensionless).
     pub relative_load_residual: f64,
-    /// Relative change of A when the quadrature is halved (an estimate of its error;
-    /// dimensionless).
+    /// A bound on the relative error of every reported quantity: twice its change when the
+    /// quadrature is halved, with the load residual carried through, never below rounding
+    /// (dimensionless). For a table answer, add `table_error`.
     pub quadrature_error_estimate: f64,
     /// Nodes (or strips) of the y-quadrature (count).
     pub quadrature_nodes: usize,

@@ -40,9 +40,16 @@ impl Layer {
         self.elastic_modulus / self.thickness
     }
 
-    /// κ = T_ε/T_σ − 1, the strength of the viscosity: the instantaneous stiffness is k(1 + κ).
+    /// κ = (T_ε − T_σ)/T_σ, the strength of the viscosity: the instantaneous stiffness is
+    /// k(1 + κ) (docs/model.md §1).
+    ///
+    /// Written as a difference over T_σ, not as T_ε/T_σ − 1: the quotient rounds by up to
+    /// ε/2 ≈ 1.1e-16 before the 1 is taken off, a relative error of 1e-16/κ in κ and so in
+    /// everything that vanishes with it (x_c, x_p, μ_r erred by 5.6e-5 at T_ε − T_σ = 1e-13 s,
+    /// T_σ = 0.1 s). T_ε − T_σ is exact whenever T_ε ≤ 2T_σ (Sterbenz), so κ is then correct
+    /// to one rounding.
     pub fn kappa(&self) -> f64 {
-        self.retardation_time / self.relaxation_time - 1.0
+        (self.retardation_time - self.relaxation_time) / self.relaxation_time
     }
 
     /// G = E/(2(1 + ν)) (eq. 13).
@@ -127,7 +134,7 @@ pub enum Parameter {
     TotalLoad,
     /// Mean load per particle in contact.
     ParticleLoad,
-    /// κ = T_ε/T_σ − 1, as a fit gives it.
+    /// κ = (T_ε − T_σ)/T_σ, as a fit gives it.
     Kappa,
     /// k = E_L/H, as a fit gives it.
     Stiffness,

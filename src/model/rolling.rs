@@ -9,7 +9,7 @@ use std::f64::consts::{FRAC_PI_2, FRAC_PI_4, PI};
 use std::sync::Arc;
 
 use super::limits::{relaxed, ElasticContact};
-use super::quadrature::StripRule;
+use super::quadrature::{Spacing, StripRule};
 use super::similarity::{ExactRatios, Ratios, SimilarityTable};
 use super::strip::Strip;
 use super::{Layer, ModelError, OptionError, Parameter, Quadrature, SolveOption};
@@ -25,6 +25,10 @@ const LOAD_ROUNDING: f64 = 1e-12;
 /// d ln P̂/d ln r̂ at both elastic limits (P ∝ δ² ∝ r̂⁴), the first guess of the load
 /// equation's slope.
 const ELASTIC_SLOPE: f64 = 4.0;
+/// The error bound of an answer is this many times the error it measures
+/// ([`quadrature_error`]): it covers rules whose error shrinks by less than 2 when the strips
+/// double (midpoint strips: by 2^1.5).
+const ERROR_SAFETY: f64 = 2.0;
 /// Largest number of boundary points a solve returns.
 pub const MAX_BOUNDARY_POINTS: usize = 10_001;
 /// Largest pressure grid (points per side).
@@ -147,10 +151,13 @@ pub struct PressureGrid {
 pub struct Verification {
     /// |P(δ) − P|/P, with P(δ) recomputed from the returned penetration.
     pub load_residual: f64,
-    /// A bound on the relative quadrature error of every integral quantity returned (δ, A,
-    /// x_c, x_p, μ, μ_r): twice their largest relative change against a companion rule of
-    /// half (for rules of fewer than 8 strips, twice) the strips, propagated through the
-    /// load equation. Never below rounding (4 ε).
+    /// A bound on the relative error of every quantity returned (δ, A, the half-width, x_c,
+    /// x_p, μ, μ_r and the static companion) against the exact solution of docs/model.md §3:
+    /// twice their largest relative change against a companion rule of half (for rules of
+    /// fewer than 8 strips, twice) the strips, with the load residual, propagated through
+    /// the load equation ([`quadrature_error`]). Never below rounding (16 ε). A table answer
+    /// reports the exact solver's bound near its ξ here, and `table_error` beside it: the
+    /// two add up.
     pub quadrature_error_estimate: f64,
     /// Strips (quadrature nodes) in the half-width.
     pub quadrature_nodes: usize,
@@ -163,7 +170,8 @@ pub struct Verification {
     pub converged: bool,
     /// When the load equation was solved through the layer's similarity table rather than
     /// by strip sums: the table's certified bound on the relative difference from the exact
-    /// solve ([`SimilarityTable::error`]).
+    /// solve ([`SimilarityTable::error`]); the answer's error is then bounded by
+    /// `quadrature_error_estimate + table_error`.
     pub table_error: Option<f64>,
 }
 
@@ -264,18 +272,23 @@ pub(super) fn solve_with(
 /// The contact at a given penetration δ rather than a given load (the forward map of the
 /// three-body model, docs/model.md §4, and the builder of the similarity tables), as the
 /// ratios of the similarity law ([`Ratios`]), which depend only on ξ = V T_σ/√(2Rδ) and κ,
-/// with the quadrature error estimate a rolling answer would report there. Φ_P runs from 1
-/// (ξ = 0) to 1 + κ (ξ → ∞); Φ_A is 1 at both ends and dips in between.
+/// with the quadrature error estimate a rolling answer would report there, under `quadrature`
+/// (its nodes spaced for ξ, [`Spacing::for_speed`]). Φ_P runs from 1 (ξ = 0) to 1 + κ
+/// (ξ → ∞); Φ_A is 1 at both ends and dips in between.
 pub fn penetration_contact(
     xi: f64,
     kappa: f64,
-    rule: &StripRule,
-    companion: &StripRule,
+    quadrature: Quadrature,
 ) -> Result<ExactRatios, ModelError> {
+    let spacing = Spacing::for_speed(xi);
+    let rule = StripRule::shared(quadrature, spacing)?;
+    let companion = StripRule::shared(quadrature.companion(), spacing)?;
     let section = Section::new(1.0, xi, kappa);
     let mut roots = vec![f64::NAN; rule.len()];
-    let integrals = section.integrate(rule, Some(&mut roots))?;
-    let (moment, error) = section.moment_and_error(rule, &roots, &integrals, companion, None)?;
+    let integrals = section.integrate(&rule, Some(&mut roots))?;
+    // At a given penetration there is no load equation, and so no residual to carry.
+    let (moment, error) =
+        section.moment_and_error(&rule, &roots, &integrals, &companion, None, 0.0)?;
     let ratios = Ratios {
         load: integrals.load / FRAC_PI_4,
         area: integrals.area / PI,
@@ -285,17 +298,25 @@ pub fn penetration_contact(
     Ok((ratios, error))
 }
 
-/// A bound on the relative quadrature error of every reported integral quantity (δ, A,
-/// x_c, x_p, and so μ and μ_r), from the integrals and pressure moment of the rule and of
-/// its companion ([`Quadrature::companion`]) at the same penetration. δ solves P(δ) = P, so
-/// a relative error e in P moves δ by about e/2 (P ∝ δ² at both elastic limits): e bounds
-/// it. A, x_c and x_p follow δ at most linearly and add their own quadrature error
-/// (x_c = ∬x dA/A and x_p = ∬x p dA/P add both of theirs). The factor 2 covers rules whose
-/// error shrinks by less than 2 when the strips double (midpoint strips: by 2^1.5).
-fn quadrature_error(rule: (&Integrals, f64), companion: (&Integrals, f64)) -> f64 {
-    /// The bound never claims less than rounding.
-    const ROUNDING: f64 = 4.0 * f64::EPSILON;
-    const SAFETY: f64 = 2.0;
+/// A bound on the relative error of every reported integral quantity (δ, A, x_c, x_p, and
+/// so μ and μ_r), from the integrals and pressure moment of the rule and of its companion
+/// ([`Quadrature::companion`]) at the same penetration, and from the relative residual
+/// `load_residual` of the load equation there. δ solves P(δ) = P, so a relative error e in
+/// P (of the quadrature, or left by the root) moves δ by e/2 to e/1.5 (d ln P/d ln δ lies
+/// between 1.5 and 2): e bounds it. A, x_c and x_p follow δ at most linearly and add their
+/// own quadrature error (x_c = ∬x dA/A and x_p = ∬x p dA/P add both of theirs); then
+/// [`ERROR_SAFETY`].
+fn quadrature_error(
+    rule: (&Integrals, f64),
+    companion: (&Integrals, f64),
+    load_residual: f64,
+) -> f64 {
+    /// The bound never claims less than the rounding of the strip sums, the roots and the
+    /// scaling to SI units: against 40-digit references (tests/honest_edges.rs) exact
+    /// answers whose quadrature and load residual leave next to nothing err by up to 1.3e-15
+    /// (μ, which also rounds τ_a and P); 16 ε ≈ 3.6e-15 bounds that with a margin of 2.7
+    /// (4 ε, 8.9e-16, did not).
+    const ROUNDING: f64 = 16.0 * f64::EPSILON;
     let relative = |fine: f64, other: f64| {
         if fine == other {
             0.0
@@ -308,7 +329,7 @@ fn quadrature_error(rule: (&Integrals, f64), companion: (&Integrals, f64)) -> f6
     let area = relative(fine.area, other.area);
     let area_moment = relative(fine.area_moment, other.area_moment);
     let moment = relative(fine_moment, other_moment);
-    let penetration = load;
+    let penetration = load + load_residual;
     let worst = [
         penetration,
         area + penetration,
@@ -317,7 +338,7 @@ fn quadrature_error(rule: (&Integrals, f64), companion: (&Integrals, f64)) -> f6
     ]
     .into_iter()
     .fold(0.0, f64::max);
-    (SAFETY * worst).max(ROUNDING)
+    (ERROR_SAFETY * worst).max(ROUNDING)
 }
 
 /// Refuses to hand out a non-finite number (serde_json would write it as a silent `null`).
@@ -378,7 +399,7 @@ impl Contact {
     /// same integrals under the companion rule for the quadrature error estimate.
     fn exact(xi: f64, kappa: f64, quadrature: Quadrature) -> Result<Contact, ModelError> {
         let (shape, coarse) = Shape::nested(xi, kappa, quadrature)?;
-        let companion = StripRule::shared(quadrature.companion())?;
+        let companion = StripRule::shared(quadrature.companion(), Spacing::for_speed(xi))?;
         let section = shape.section(xi, kappa);
         let (pressure_moment, quadrature_error_estimate) = section.moment_and_error(
             &shape.rule,
@@ -386,6 +407,7 @@ impl Contact {
             &shape.integrals,
             &companion,
             coarse.map(|coarse| coarse.exit_roots),
+            shape.load_residual,
         )?;
         Ok(Contact {
             half_width: shape.half_width,
@@ -424,14 +446,18 @@ impl Contact {
             },
         )?;
         let (r, ratios) = (root.t.exp(), root.at);
+        let load_residual = root.value.exp_m1().abs();
         Ok(Contact {
             half_width: r,
             area: PI * r * r * ratios.area,
             centroid: r * ratios.centroid,
             pressure_centre: r * ratios.pressure_centre,
             verification: Verification {
-                load_residual: root.value.exp_m1().abs(),
-                quadrature_error_estimate: table.quadrature_error(xi / r),
+                load_residual,
+                // The exact solver's bound near ξ (at a given penetration) and what this
+                // root leaves, as [`quadrature_error`] carries it.
+                quadrature_error_estimate: table.quadrature_error(xi / r)
+                    + ERROR_SAFETY * load_residual,
                 quadrature_nodes: 0,
                 iterations: root.iterations,
                 exit_root_iterations: 0,
@@ -490,7 +516,7 @@ impl Shape {
     ) -> Result<(Shape, Option<Shape>), ModelError> {
         /// Rules of fewer strips start cold.
         const NESTED_FROM: usize = 16;
-        let rule = StripRule::shared(quadrature)?;
+        let rule = StripRule::shared(quadrature, Spacing::for_speed(xi))?;
         let companion = quadrature.companion();
         // An elastic contact (at rest, or no viscosity) has its root at t = 0, found in one
         // pass: nothing to start.
@@ -797,10 +823,10 @@ impl Section {
     }
 
     /// The pressure moment under `rule` (whose exit roots `rho` and `integrals` are known)
-    /// and the quadrature error estimate of everything reported ([`quadrature_error`]),
-    /// from the same integrals under `companion`, whose exit roots start from
-    /// `companion_roots` if given (e.g. its own at a nearby penetration), else from those of
-    /// `rule` ([`RootGuide`]).
+    /// and the error bound of everything reported ([`quadrature_error`]), from the same
+    /// integrals under `companion`, whose exit roots start from `companion_roots` if given
+    /// (e.g. its own at a nearby penetration), else from those of `rule` ([`RootGuide`]),
+    /// and the load equation's relative residual `load_residual`.
     fn moment_and_error(
         &self,
         rule: &StripRule,
@@ -808,6 +834,7 @@ impl Section {
         integrals: &Integrals,
         companion: &StripRule,
         companion_roots: Option<Vec<f64>>,
+        load_residual: f64,
     ) -> Result<(f64, f64), ModelError> {
         let moment = self.pressure_moment(rule, rho);
         let mut companion_roots = companion_roots
@@ -817,6 +844,7 @@ impl Section {
         let error = quadrature_error(
             (integrals, moment),
             (&companion_integrals, companion_moment),
+            load_residual,
         );
         Ok((moment, error))
     }
@@ -935,9 +963,9 @@ mod tests {
     #[test]
     fn nested_solves_agree_with_the_fine_rule_alone_in_fewer_exit_root_steps() {
         let quadrature = Quadrature::default();
-        let rule = StripRule::shared(quadrature).unwrap();
         for kappa in [0.5, 4.0, 100.0] {
-            for xi in [1e-3, 0.07, 0.5, 3.0, 100.0] {
+            for xi in [1e-5, 1e-3, 0.07, 0.5, 3.0, 100.0] {
+                let rule = StripRule::shared(quadrature, Spacing::for_speed(xi)).unwrap();
                 let cold = Shape::solve(xi, kappa, rule.clone(), Start::cold(rule.len())).unwrap();
                 let (nested, coarse) = Shape::nested(xi, kappa, quadrature).unwrap();
                 let coarse = coarse.expect("the default rule's companion is coarser");
@@ -965,12 +993,11 @@ mod tests {
     /// guesses there are only rough; the nested test above still holds.)
     #[test]
     fn root_guides_guess_other_strips_roots_closely() {
-        let (fine, coarse) = (
-            StripRule::shared(Quadrature::Gauss { nodes: 64 }).unwrap(),
-            StripRule::shared(Quadrature::Gauss { nodes: 32 }).unwrap(),
-        );
         for kappa in [0.5, 4.0, 100.0] {
             for xi in [0.07, 0.5, 3.0, 30.0] {
+                let rule =
+                    |nodes| StripRule::shared(Quadrature::Gauss { nodes }, Spacing::for_speed(xi));
+                let (fine, coarse) = (rule(64).unwrap(), rule(32).unwrap());
                 let section = Section::new(0.9, xi, kappa);
                 let mut known = vec![f64::NAN; coarse.len()];
                 section.integrate(&coarse, Some(&mut known)).unwrap();

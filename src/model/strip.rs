@@ -26,7 +26,7 @@ pub struct Strip {
     pub entry: f64,
     /// λ_σ = V T_σ (0 for a sphere at rest).
     pub relaxation_length: f64,
-    /// κ = T_ε/T_σ − 1 ≥ 0.
+    /// κ = (T_ε − T_σ)/T_σ ≥ 0 ([`super::Layer::kappa`]).
     pub kappa: f64,
 }
 

@@ -9,7 +9,6 @@
 
 use std::sync::{Arc, Mutex, OnceLock};
 
-use super::quadrature::StripRule;
 use super::rolling::{penetration_contact, solve_with};
 use super::similarity::SimilarityTable;
 use super::{ModelError, Quadrature, Rolling, RollingSolution, SolveOptions};
@@ -40,10 +39,10 @@ pub fn get_or_build(
     if let Some(table) = built(kappa, quadrature) {
         return Ok(table);
     }
-    let rule = StripRule::shared(quadrature)?;
-    let companion = StripRule::shared(quadrature.companion())?;
+    // Fail on an invalid rule before building.
+    quadrature.check().map_err(ModelError::InvalidOption)?;
     let table = Arc::new(SimilarityTable::build(kappa, |xi| {
-        penetration_contact(xi, kappa, &rule, &companion)
+        penetration_contact(xi, kappa, quadrature)
     })?);
     let mut tables = lock();
     let key = (kappa.to_bits(), quadrature);
