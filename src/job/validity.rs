@@ -160,11 +160,6 @@ impl PointValidity {
     pub fn warned_text(&self) -> String {
         self.warned().collect::<Vec<_>>().join(" ")
     }
-
-    /// The checks measured.
-    pub fn checks(&self) -> &[Check] {
-        &self.checks
-    }
 }
 
 /// `{"inside_layer": 0.0062, ...}`: each ratio at the point's speed.

@@ -322,16 +322,9 @@ fn panel_centre(panel: usize) -> f64 {
 /// for the four functions.
 fn chebyshev_coefficients(values: &[[f64; 4]]) -> Vec<[f64; 4]> {
     let n = values.len();
-    // cos(π k(2j + 1)/(2n)) takes only the 4n values cos(π m/(2n)), m = k(2j + 1) mod 4n:
-    // computed once each rather than n² times (the cosines were a quarter of a table's build),
-    // and from a reduced argument, so no less exact.
-    let period = 4 * n;
-    let cosines: Vec<f64> = (0..period)
-        .map(|m| (PI * m as f64 / (2 * n) as f64).cos())
-        .collect();
     let transform = DMatrix::from_fn(n, n, |k, j| {
         let scale = if k == 0 { 1.0 } else { 2.0 } / n as f64;
-        scale * cosines[(k * (2 * j + 1)) % period]
+        scale * (PI * (k * (2 * j + 1)) as f64 / (2 * n) as f64).cos()
     });
     let coefficients = transform * DMatrix::from_fn(n, 4, |j, f| values[j][f]);
     coefficients
