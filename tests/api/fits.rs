@@ -90,6 +90,13 @@ async fn a_fit_job_reports_progress_and_stops_on_cancel() {
     );
     let cancelled: Value = app.cancel(&location).await.json().await.unwrap();
     assert_eq!(cancelled["status"], "cancelled", "{cancelled}");
+    // Cancelled after a first minimisation finished, the fit keeps the best of those run.
+    if cancelled.get("result_url").is_some() {
+        assert_eq!(cancelled["partial"], true);
+        let partial = app.result(&cancelled).await;
+        assert_eq!(partial["meta"]["complete"], false);
+        assert!(partial["search"]["finished"].as_u64() < partial["search"]["starts"].as_u64());
+    }
 
     let location = app.submit(&example()).await;
     let done = app

@@ -18,8 +18,8 @@ pub use input::{
     BoundsInput, FitInput, MeasuredQuantity, ParametersInput, PointInput, SeriesInput,
 };
 pub use output::{
-    Comparison, Conditions, Curve, CurvePoint, Estimate, FitOutput, Identifiability, Residual,
-    Search, UncertaintySource, Undetermined,
+    Comparison, Conditions, Curve, CurvePoint, Estimate, FitMeta, FitOutput, Identifiability,
+    Residual, Search, UncertaintySource, Undetermined,
 };
 
 use super::input as wire;
@@ -85,11 +85,15 @@ impl Kind for FitJob {
             control.advance(1);
             Ok(())
         };
-        let fitted = fit::fit(&self.problem, &check).map_err(|e| self.refused(e))?;
+        let (fitted, stop) = fit::fit(&self.problem, &check).map_err(|e| self.refused(e))?;
         let layer = self.problem.parameterization.layer(&fitted.values);
+        // A stopped fit answers with the minimisations it finished; its curves (a few dozen
+        // solves a series) are still drawn, under a control of their own that is not stopped.
+        let drawing = Control::new(None, 1);
+        let curves_control = if stop.is_none() { control } else { &drawing };
         let mut curves = Vec::new();
         for (index, points) in self.series_data().enumerate() {
-            curves.push(curve(index, points, &layer, control)?);
+            curves.push(curve(index, points, &layer, curves_control)?);
         }
         Ok(FitOutput {
             parameter_names: self.names(),
@@ -115,9 +119,19 @@ impl Kind for FitJob {
                 starts: fitted.starts,
                 steps: fitted.steps,
                 converged: fitted.converged,
+                finished: fitted.finished,
             },
-            meta,
+            meta: FitMeta {
+                meta,
+                complete: stop.is_none(),
+                stopped: stop.as_ref().map(ToString::to_string),
+            },
+            stop,
         })
+    }
+
+    fn unfinished(output: &FitOutput) -> Option<JobError> {
+        output.stop.clone()
     }
 
     fn picture(answer: &Value) -> Result<Chart, PictureError> {

@@ -7,7 +7,7 @@ use serde::Serialize;
 use utoipa::ToSchema;
 
 use super::input::MeasuredQuantity;
-use crate::job::Meta;
+use crate::job::{JobError, Meta};
 use crate::render::{Column, Output, Table, Units};
 
 /// The answer to a fit.
@@ -35,7 +35,24 @@ pub struct FitOutput {
     pub identifiability: Identifiability,
     /// How the minimum was found.
     pub search: Search,
+    pub meta: FitMeta,
+    /// Why the fit stopped before its end, if it did (`meta.stopped` in words).
+    #[serde(skip)]
+    pub stop: Option<JobError>,
+}
+
+/// The `meta` block of a fit.
+#[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
+pub struct FitMeta {
+    #[serde(flatten)]
     pub meta: Meta,
+    /// Whether the fit ran every minimisation it planned. False: it was stopped (a cancel,
+    /// its deadline) after `search.finished` of `search.starts`; the answer is the best of
+    /// those, with its intervals and curves.
+    pub complete: bool,
+    /// Why it stopped, when it did.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub stopped: Option<String>,
 }
 
 /// Where the uncertainties came from.
@@ -184,6 +201,8 @@ pub struct Search {
     pub steps: usize,
     /// Whether the best run stopped by its tolerances (not its step limit).
     pub converged: bool,
+    /// Runs finished: `starts`, unless the fit was stopped.
+    pub finished: usize,
 }
 
 impl Output for FitOutput {

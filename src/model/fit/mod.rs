@@ -231,6 +231,9 @@ pub struct Fitted {
     pub steps: usize,
     /// Whether the best minimisation stopped by its tolerances.
     pub converged: bool,
+    /// Minimisations run to their end: fewer than `starts` when the caller's check stopped
+    /// the fit after the first (the answer is then the best of those run).
+    pub finished: usize,
 }
 
 /// Why a fit has no answer.
@@ -249,10 +252,13 @@ const STARTS: usize = 2;
 
 /// Fits `problem`. `check` is called before each point is evaluated (one to five solves);
 /// an error from it stops the fit.
+/// The fit of `problem`, checking `check` between evaluations of the model. Stopped by it
+/// after a first minimisation ran to its end, the fit answers with the best minimisation run
+/// so far, and the check's error: a stopped fit keeps what it finished.
 pub fn fit<E>(
     problem: &Problem,
     check: &(dyn Fn() -> Result<(), E> + Sync),
-) -> Result<Fitted, FitError<E>> {
+) -> Result<(Fitted, Option<E>), FitError<E>> {
     let ln = |f: fn(&Bounds) -> f64| {
         DVector::from_iterator(
             problem.bounds.len(),
@@ -285,10 +291,17 @@ pub fn fit<E>(
             .take(STARTS - 1),
     );
     let mut best: Option<lm::Minimum> = None;
-    let mut steps = 0;
+    let (mut steps, mut finished, mut stopped) = (0, 0, None);
     for &i in &starts {
-        let found = lm::minimize(&mut residuals, &candidates[i], &lower, &upper)
-            .map_err(FitError::Stopped)?;
+        let found = match lm::minimize(&mut residuals, &candidates[i], &lower, &upper) {
+            Ok(found) => found,
+            Err(e) if best.is_some() => {
+                stopped = Some(e);
+                break;
+            }
+            Err(e) => return Err(FitError::Stopped(e)),
+        };
+        finished += 1;
         if let Some(m) = found {
             steps += m.steps;
             if best.as_ref().map_or(true, |b| m.cost < b.cost) {
@@ -312,7 +325,7 @@ pub fn fit<E>(
         .zip(best.residuals.iter())
         .map(|(d, r)| d.value + r * d.sigma())
         .collect();
-    Ok(Fitted {
+    let fitted = Fitted {
         values: best.x.iter().map(|x| x.exp()).collect(),
         analysis,
         chi_squared: best.cost,
@@ -323,7 +336,9 @@ pub fn fit<E>(
         starts: starts.len(),
         steps,
         converged: best.converged,
-    })
+        finished,
+    };
+    Ok((fitted, stopped))
 }
 
 /// The weighted residuals of a problem in the logarithms of its free parameters.
@@ -447,6 +462,61 @@ mod tests {
     }
 
     #[test]
+    fn a_fit_stopped_after_its_first_minimisation_answers_with_the_best_it_finished() {
+        let truth = Layer::default();
+        let problem = Problem {
+            parameterization: Parameterization {
+                base: Layer {
+                    relaxation_time: 0.05,
+                    retardation_time: 0.2,
+                    ..truth
+                },
+                free: vec![FitParameter::RelaxationTime, FitParameter::RetardationTime],
+            },
+            bounds: vec![
+                Bounds {
+                    start: 0.05,
+                    min: 1e-3,
+                    max: 10.0,
+                },
+                Bounds {
+                    start: 0.2,
+                    min: 1e-3,
+                    max: 100.0,
+                },
+            ],
+            data: friction_at(&[0.0, 1.0, 2.0, 4.0, 8.0, 16.0, 32.0], &truth),
+        };
+        let calls = std::sync::atomic::AtomicUsize::new(0);
+        let counting = || {
+            calls.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+            Ok::<(), ()>(())
+        };
+        let (whole, stop) = fit(&problem, &counting).unwrap();
+        assert!(stop.is_none() && whole.finished == whole.starts && whole.starts >= 2);
+        // Stopped at its last evaluation: every run but the last finished.
+        let last = calls.load(std::sync::atomic::Ordering::Relaxed);
+        let seen = std::sync::atomic::AtomicUsize::new(0);
+        let stopping = || {
+            let n = seen.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+            if n >= last {
+                Err("stopped")
+            } else {
+                Ok(())
+            }
+        };
+        let (partial, stop) = fit(&problem, &stopping).unwrap();
+        assert_eq!(stop, Some("stopped"));
+        assert_eq!(partial.finished, whole.starts - 1);
+        assert!(partial.chi_squared.is_finite() && partial.values.len() == 2);
+        // Stopped before any run finished, it has nothing to answer with.
+        assert!(matches!(
+            fit(&problem, &|| Err::<(), _>("at once")),
+            Err(FitError::Stopped("at once"))
+        ));
+    }
+
+    #[test]
     fn noiseless_data_give_back_the_layer_they_came_from() {
         let truth = Layer::default();
         let problem = Problem {
@@ -472,7 +542,7 @@ mod tests {
             ],
             data: friction_at(&[0.0, 1.0, 2.0, 4.0, 8.0, 16.0, 32.0], &truth),
         };
-        let fitted = fit(&problem, &|| Ok::<(), ()>(())).unwrap();
+        let (fitted, _) = fit(&problem, &|| Ok::<(), ()>(())).unwrap();
         assert!(
             (fitted.values[0] / 0.1 - 1.0).abs() < 1e-6,
             "{:?}",
