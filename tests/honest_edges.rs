@@ -543,18 +543,7 @@ fn rolling(r: &Reference) -> Rolling {
 
 /// The true relative error of every reported quantity.
 fn errors(s: &RollingSolution, r: &Reference) -> [f64; 10] {
-    let reported = [
-        s.penetration,
-        s.contact_area,
-        s.half_width,
-        s.centroid_shift,
-        s.pressure_centre_shift,
-        s.rolling_resistance_coefficient,
-        s.friction_coefficient,
-        s.static_contact.penetration,
-        s.static_contact.contact_area,
-        s.static_contact.friction_coefficient,
-    ];
+    let reported = s.quantities();
     std::array::from_fn(|q| ((reported[q] - r.values[q]) / r.values[q]).abs())
 }
 

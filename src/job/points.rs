@@ -125,10 +125,8 @@ pub struct PointNotesFields {
 pub trait Row: Sized {
     /// The point a row is made for.
     type Point;
-    /// The row of `point`, which the model refuses for `reason`.
-    fn refused(point: &Self::Point, reason: String) -> Self;
-    /// The row of `point`, not solved.
-    fn missing(point: &Self::Point) -> Self;
+    /// The row of `point` without numbers, with `notes` (refused or missing).
+    fn unanswered(point: &Self::Point, notes: PointNotes) -> Self;
     fn notes(&self) -> &PointNotes;
     /// The numerical error of an answered point.
     fn verification(&self) -> Option<SweepVerification>;
@@ -154,8 +152,8 @@ pub fn rows<R: Row>(
         .zip(swept.outcomes)
         .map(|(point, outcome)| match outcome {
             Some(Ok(row)) => row,
-            Some(Err(e)) => R::refused(point, reason(e)),
-            None => R::missing(point),
+            Some(Err(e)) => R::unanswered(point, PointNotes::Refused(reason(e))),
+            None => R::unanswered(point, PointNotes::Missing),
         })
         .collect();
     for (i, row) in rows.iter().enumerate() {

@@ -365,29 +365,10 @@ impl SweepPoint {
         verification: VerificationOutput,
         validity: PointValidity,
     ) -> SweepPoint {
-        let notes = PointNotes::Answered(validity);
-        SweepPoint {
-            radius: rolling.radius,
-            load: rolling.load,
-            velocity: rolling.velocity,
-            status: notes.status(),
-            contact: Some(contact),
-            notes,
-            verification: Some(verification),
-        }
-    }
-
-    /// The row of `rolling` without numbers.
-    fn unanswered(rolling: &Rolling, notes: PointNotes) -> SweepPoint {
-        SweepPoint {
-            radius: rolling.radius,
-            load: rolling.load,
-            velocity: rolling.velocity,
-            status: notes.status(),
-            contact: None,
-            notes,
-            verification: None,
-        }
+        let mut row = SweepPoint::unanswered(rolling, PointNotes::Answered(validity));
+        row.contact = Some(contact);
+        row.verification = Some(verification);
+        row
     }
 
     /// A number of the contact, for a column.
@@ -430,12 +411,16 @@ impl SweepPoint {
 impl Row for SweepPoint {
     type Point = Rolling;
 
-    fn refused(point: &Rolling, reason: String) -> Self {
-        SweepPoint::unanswered(point, PointNotes::Refused(reason))
-    }
-
-    fn missing(point: &Rolling) -> Self {
-        SweepPoint::unanswered(point, PointNotes::Missing)
+    fn unanswered(rolling: &Rolling, notes: PointNotes) -> Self {
+        SweepPoint {
+            radius: rolling.radius,
+            load: rolling.load,
+            velocity: rolling.velocity,
+            status: notes.status(),
+            contact: None,
+            notes,
+            verification: None,
+        }
     }
 
     fn notes(&self) -> &PointNotes {

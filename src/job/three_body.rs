@@ -768,24 +768,10 @@ impl ThreeBodySweepPoint {
         verification: ThreeBodyVerificationOutput,
         validity: PointValidity,
     ) -> ThreeBodySweepPoint {
-        let mut row = ThreeBodySweepPoint::unanswered(system, PointNotes::Answered(validity));
+        let mut row = Self::unanswered(system, PointNotes::Answered(validity));
         row.result = Some(result);
         row.verification = Some(verification);
         row
-    }
-
-    /// The row of `system` without results.
-    fn unanswered(system: &ThreeBody, notes: PointNotes) -> ThreeBodySweepPoint {
-        ThreeBodySweepPoint {
-            operating: operating_canonical(system.operating),
-            velocity: system.velocity,
-            mean_diameter: system.diameters.mean,
-            status: notes.status(),
-            result: None,
-            notes,
-            verification: None,
-            operating_point: system.operating,
-        }
     }
 
     /// A result, for a column.
@@ -864,12 +850,17 @@ impl ThreeBodySweepPoint {
 impl Row for ThreeBodySweepPoint {
     type Point = ThreeBody;
 
-    fn refused(point: &ThreeBody, reason: String) -> Self {
-        ThreeBodySweepPoint::unanswered(point, PointNotes::Refused(reason))
-    }
-
-    fn missing(point: &ThreeBody) -> Self {
-        ThreeBodySweepPoint::unanswered(point, PointNotes::Missing)
+    fn unanswered(system: &ThreeBody, notes: PointNotes) -> Self {
+        ThreeBodySweepPoint {
+            operating: operating_canonical(system.operating),
+            velocity: system.velocity,
+            mean_diameter: system.diameters.mean,
+            status: notes.status(),
+            result: None,
+            notes,
+            verification: None,
+            operating_point: system.operating,
+        }
     }
 
     fn notes(&self) -> &PointNotes {

@@ -199,6 +199,25 @@ pub struct RollingSolution {
     pub verification: Verification,
 }
 
+impl RollingSolution {
+    /// The integral quantities an answer reports, in the order of the struct: δ, A,
+    /// half-width, x_c, x_p, μ_r, μ, and the static companion's δ, A, μ.
+    pub fn quantities(&self) -> [f64; 10] {
+        [
+            self.penetration,
+            self.contact_area,
+            self.half_width,
+            self.centroid_shift,
+            self.pressure_centre_shift,
+            self.rolling_resistance_coefficient,
+            self.friction_coefficient,
+            self.static_contact.penetration,
+            self.static_contact.contact_area,
+            self.static_contact.friction_coefficient,
+        ]
+    }
+}
+
 /// Solves the rolling contact of `rolling` (docs/model.md §3).
 ///
 /// Fails, never panics nor returns a non-finite number, on parameters outside their ranges,
@@ -343,20 +362,11 @@ fn quadrature_error(
 
 /// Refuses to hand out a non-finite number (serde_json would write it as a silent `null`).
 fn ensure_finite(s: &RollingSolution) -> Result<(), ModelError> {
-    let scalars = [
-        s.penetration,
-        s.contact_area,
-        s.half_width,
-        s.centroid_shift,
-        s.pressure_centre_shift,
-        s.rolling_resistance_coefficient,
-        s.friction_coefficient,
-        s.static_contact.penetration,
-        s.static_contact.contact_area,
-        s.static_contact.friction_coefficient,
+    let verification = [
         s.verification.load_residual,
         s.verification.quadrature_error_estimate,
     ];
+    let scalars = s.quantities().into_iter().chain(verification);
     let boundary = s.boundary.iter().flat_map(|p| [p.y, p.exit, p.entry]);
     let pressure = s.pressure.iter().flat_map(|g| {
         g.x.iter()
@@ -364,12 +374,7 @@ fn ensure_finite(s: &RollingSolution) -> Result<(), ModelError> {
             .chain(g.values.iter().flatten())
             .copied()
     });
-    if scalars
-        .into_iter()
-        .chain(boundary)
-        .chain(pressure)
-        .all(f64::is_finite)
-    {
+    if scalars.chain(boundary).chain(pressure).all(f64::is_finite) {
         Ok(())
     } else {
         Err(ModelError::NotRepresentable {

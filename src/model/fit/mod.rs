@@ -461,15 +461,14 @@ mod tests {
             .collect()
     }
 
-    #[test]
-    fn a_fit_stopped_after_its_first_minimisation_answers_with_the_best_it_finished() {
-        let truth = Layer::default();
-        let problem = Problem {
+    /// Both times free, from a start off the truth, on `truth`'s friction against speed.
+    fn two_times(truth: &Layer) -> Problem {
+        Problem {
             parameterization: Parameterization {
                 base: Layer {
                     relaxation_time: 0.05,
                     retardation_time: 0.2,
-                    ..truth
+                    ..*truth
                 },
                 free: vec![FitParameter::RelaxationTime, FitParameter::RetardationTime],
             },
@@ -485,8 +484,13 @@ mod tests {
                     max: 100.0,
                 },
             ],
-            data: friction_at(&[0.0, 1.0, 2.0, 4.0, 8.0, 16.0, 32.0], &truth),
-        };
+            data: friction_at(&[0.0, 1.0, 2.0, 4.0, 8.0, 16.0, 32.0], truth),
+        }
+    }
+
+    #[test]
+    fn a_fit_stopped_after_its_first_minimisation_answers_with_the_best_it_finished() {
+        let problem = two_times(&Layer::default());
         let calls = std::sync::atomic::AtomicUsize::new(0);
         let counting = || {
             calls.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
@@ -519,29 +523,7 @@ mod tests {
     #[test]
     fn noiseless_data_give_back_the_layer_they_came_from() {
         let truth = Layer::default();
-        let problem = Problem {
-            parameterization: Parameterization {
-                base: Layer {
-                    relaxation_time: 0.05,
-                    retardation_time: 0.2,
-                    ..truth
-                },
-                free: vec![FitParameter::RelaxationTime, FitParameter::RetardationTime],
-            },
-            bounds: vec![
-                Bounds {
-                    start: 0.05,
-                    min: 1e-3,
-                    max: 10.0,
-                },
-                Bounds {
-                    start: 0.2,
-                    min: 1e-3,
-                    max: 100.0,
-                },
-            ],
-            data: friction_at(&[0.0, 1.0, 2.0, 4.0, 8.0, 16.0, 32.0], &truth),
-        };
+        let problem = two_times(&truth);
         let (fitted, _) = fit(&problem, &|| Ok::<(), ()>(())).unwrap();
         assert!(
             (fitted.values[0] / 0.1 - 1.0).abs() < 1e-6,
