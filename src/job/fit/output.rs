@@ -275,6 +275,7 @@ impl Output for FitOutput {
         ("search.candidates", ""),
         ("search.starts", ""),
         ("search.steps", ""),
+        ("search.finished", ""),
     ]];
 
     /// One row per measured point: measured, fitted and residual in the unit of `quantity`
