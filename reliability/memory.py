@@ -4,6 +4,7 @@ sampled every second, with a small memory budget (8 MiB) so that growth beyond i
 Prints the RSS at the start, its maximum and at the end. Usage: reliability/memory.py [s]"""
 
 import collections
+import json
 import sys
 import threading
 import time
@@ -17,6 +18,19 @@ stop = threading.Event()
 statuses = collections.Counter()
 
 
+def outcome(answer):
+    """The status of an answer, with the problem's name for a refusal (`503 results-full`:
+    no room to keep the job's result, an honest no rather than a fault)."""
+    status, body = answer[0], answer[1]
+    if status >= 400:
+        try:
+            name = json.loads(body)["type"].rsplit("/", 1)[-1]
+            return f"{status} {name}"
+        except (ValueError, KeyError, AttributeError):
+            pass
+    return str(status)
+
+
 def distinct(n):
     i = 0
     while not stop.is_set():
@@ -24,7 +38,7 @@ def distinct(n):
         loads = [f"{1 + ((n * 7919 + i) * 104729 + k) % 1_000_000 / 1e6} nN" for k in range(20)]
         job = {"kind": "sweep", "input": {"vary": {"load": loads}}}
         try:
-            statuses[f"distinct {request(port, 'POST', '/v1/jobs', job)[0]}"] += 1
+            statuses[f"distinct {outcome(request(port, 'POST', '/v1/jobs', job))}"] += 1
         except OSError as e:
             statuses[f"distinct error {type(e).__name__}"] += 1
 
@@ -33,7 +47,7 @@ def same():
     job = {"kind": "rolling"}
     while not stop.is_set():
         try:
-            statuses[f"cached {request(port, 'POST', '/v1/jobs', job)[0]}"] += 1
+            statuses[f"cached {outcome(request(port, 'POST', '/v1/jobs', job))}"] += 1
         except OSError as e:
             statuses[f"cached error {type(e).__name__}"] += 1
 
