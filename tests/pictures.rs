@@ -125,6 +125,24 @@ fn a_sweep_has_a_curve_per_other_value_and_marks_points_at_rest() {
 }
 
 #[test]
+fn a_sweep_draws_the_points_it_answered_and_counts_those_it_did_not() {
+    let (_, svg) = solve(json!({"kind": "sweep", "input": {"vary": {
+        "load": ["1 nN", "1 mN", "2 nN"]}}}));
+    let (series, _) = parts(&svg);
+    assert_eq!(series, ["sweep"]);
+    let doc = roxmltree::Document::parse(&svg).unwrap();
+    let notes: Vec<&str> = doc
+        .descendants()
+        .filter(|n| n.attribute("class") == Some("notes"))
+        .flat_map(|n| n.children().filter_map(|t| t.text()))
+        .collect();
+    assert_eq!(
+        notes,
+        ["1 of 3 points not drawn:", "refused, or not solved"]
+    );
+}
+
+#[test]
 fn a_three_body_system_shades_the_particles_in_contact_and_splits_the_area() {
     let (answer, svg) = solve(json!({"kind": "three_body",
         "input": {"operating": {"total_load": "1 mN"}}}));

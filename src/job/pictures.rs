@@ -223,12 +223,13 @@ pub fn sweep(answer: &Value) -> Result<Chart, PictureError> {
     } else {
         "friction coefficient"
     };
+    // Short lines: they stand under the legend.
     let notes = match unanswered {
         0 => Vec::new(),
-        n => vec![format!(
-            "{n} of {} points not drawn: refused by the model, or not solved (see their status)",
-            points.len()
-        )],
+        n => vec![
+            format!("{n} of {} points not drawn:", points.len()),
+            "refused, or not solved".to_string(),
+        ],
     };
     Ok(Chart {
         title: format!("Sweep: {y_name} against {}", along.0.replace('_', " ")),
