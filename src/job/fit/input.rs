@@ -345,9 +345,20 @@ fn read_parameters(
         free: free.clone(),
     };
     if starts.iter().all(|x| x.is_finite()) && base.violations().is_empty() {
+        // The starts as a person reads them: each parameter's name and value with its unit.
+        let shown: serde_json::Map<String, serde_json::Value> = free
+            .iter()
+            .zip(&starts)
+            .map(|(p, &x)| {
+                (
+                    p.name().to_string(),
+                    quantity(x, p.parameter().unit()).into(),
+                )
+            })
+            .collect();
         for e in parameterization.layer(&starts).violations() {
             let allowed = format!("starts that make a valid layer, but at them {e}");
-            checker.invalid("", json!(starts), &allowed);
+            checker.invalid("", serde_json::Value::Object(shown.clone()), &allowed);
         }
     }
     (free, all)
