@@ -382,6 +382,19 @@ impl Engine {
         job: Job,
         meta: Meta,
     ) -> Result<(Arc<Solved>, CacheStatus), EngineError> {
+        let deadline = Instant::now() + self.config.solve_deadline;
+        self.solve_by(job, meta, deadline).await
+    }
+
+    /// [`Engine::solve`] with a deadline of the caller's (shared by several solves, as a
+    /// checks suite's), never later than the solve deadline from now.
+    pub async fn solve_by(
+        self: &Arc<Self>,
+        job: Job,
+        meta: Meta,
+        deadline: Instant,
+    ) -> Result<(Arc<Solved>, CacheStatus), EngineError> {
+        let deadline = deadline.min(Instant::now() + self.config.solve_deadline);
         self.admit()?;
         let key = meta.input_hash.clone();
         if let Some(solved) = self.cache.get(&key).await {
@@ -392,7 +405,6 @@ impl Engine {
         let key_claimed = key.clone();
         let solve = move || {
             async move {
-                let deadline = Instant::now() + engine.config.solve_deadline;
                 if let Claim::Solved(solved) =
                     engine.cache.claim(&meta.input_hash, deadline).await?
                 {

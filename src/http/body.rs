@@ -3,12 +3,12 @@
 //! solver threads, so that no body holds an async worker (and with it `/healthz`) for long.
 
 use axum::extract::{FromRequest, Request};
-use axum::http::{header, HeaderMap};
+use axum::http::{header, HeaderMap, StatusCode};
 use bytes::Bytes;
 use serde_json::Value;
 
 use super::error::ApiError;
-use super::AppState;
+use super::{server, AppState};
 use crate::engine::EngineError;
 use crate::job::input;
 
@@ -37,7 +37,10 @@ impl FromRequest<AppState> for JsonBody {
         Bytes::from_request(request, state)
             .await
             .map(JsonBody)
-            .map_err(|rejection| ApiError::unreadable_body(&rejection, state.config().body_limit))
+            .map_err(|rejection| match server::slow_body_in(&rejection) {
+                Some(slow) => ApiError::from_status(StatusCode::REQUEST_TIMEOUT, slow.to_string()),
+                None => ApiError::unreadable_body(&rejection, state.config().body_limit),
+            })
     }
 }
 

@@ -10,7 +10,7 @@ use std::time::Duration;
 use axum::http::HeaderValue;
 use clap::{Parser, ValueEnum};
 
-use super::server::ConnectionLimits;
+use super::server::{BodyPace, ConnectionLimits};
 use crate::engine::fleet::FleetConfig;
 use crate::engine::EngineConfig;
 use crate::job::Limits;
@@ -83,10 +83,33 @@ pub struct ServeArgs {
     #[arg(long, env = "THIRDBODY_MAX_CONNECTIONS", default_value_t = 512)]
     pub max_connections: usize,
 
-    /// Longest a client may take to send a request's headers; also how long an idle
-    /// keep-alive connection stays open.
+    /// Longest a client may take to send a request's headers.
     #[arg(long, env = "THIRDBODY_HEADER_TIMEOUT", default_value = "10s", value_parser = duration)]
     pub header_timeout: Duration,
+
+    /// How long an idle keep-alive connection stays open between requests.
+    #[arg(long, env = "THIRDBODY_KEEP_ALIVE_TIMEOUT", default_value = "5s", value_parser = duration)]
+    pub keep_alive_timeout: Duration,
+
+    /// Longest a write of an answer may wait for the client to read (the time between two
+    /// successive writes, not the whole answer); then the connection is closed.
+    #[arg(long, env = "THIRDBODY_SEND_TIMEOUT", default_value = "10s", value_parser = duration)]
+    pub send_timeout: Duration,
+
+    /// Longest wait for the next piece of a request body; also the grace period before
+    /// --body-min-rate applies. A body slower than either is answered 408.
+    #[arg(long, env = "THIRDBODY_BODY_TIMEOUT", default_value = "10s", value_parser = duration)]
+    pub body_timeout: Duration,
+
+    /// Bytes per second a request body must average once --body-timeout has passed.
+    #[arg(long, env = "THIRDBODY_BODY_MIN_RATE", default_value_t = 240)]
+    pub body_min_rate: u64,
+
+    /// Event streams (GET /v1/jobs/{id}/events) open at once, a share of --max-connections
+    /// (default: an eighth of them); more are refused with 429 (polling GET /v1/jobs/{id}
+    /// still works).
+    #[arg(long, env = "THIRDBODY_MAX_EVENT_STREAMS")]
+    pub max_event_streams: Option<usize>,
 
     /// Origins allowed to call the API from a browser, comma-separated (`*` for any);
     /// none by default.
@@ -205,6 +228,8 @@ pub struct Config {
     /// The fleet on Redis, if any.
     pub fleet: Option<FleetConfig>,
     pub connections: ConnectionLimits,
+    /// Event streams open at once.
+    pub max_event_streams: usize,
     pub engine: EngineConfig,
     pub limits: Limits,
     pub body_limit: usize,
@@ -231,6 +256,16 @@ impl std::error::Error for ConfigError {}
 const MAX_POOL_SIZE: usize = 1024;
 /// Smallest body limit that still fits a sweep of a few lists.
 const MIN_BODY_LIMIT: usize = 1024;
+/// Largest body limit: a body is held in memory whole, and parsed at ~40 times its size.
+const MAX_BODY_LIMIT: usize = 1 << 30;
+/// Most connections: far above any process's limit on open files.
+const MAX_CONNECTIONS: usize = 1 << 20;
+/// Most of any other count (points, jobs): beyond this a number is a typo.
+const MAX_COUNT: usize = 100_000_000;
+/// Largest minimum body rate: 1 GB/s.
+const MAX_BODY_MIN_RATE: u64 = 1_000_000_000;
+/// Longest of any duration: a year (times are added to clocks, which must not overflow).
+const MAX_DURATION: Duration = Duration::from_secs(365 * 24 * 3600);
 
 fn duration(text: &str) -> Result<Duration, String> {
     humantime::parse_duration(text).map_err(|e| format!("{e} (write e.g. 30s, 500ms, 10m)"))
@@ -259,11 +294,36 @@ impl ServeArgs {
         if self.max_jobs == 0 {
             return fail("--max-jobs 0: allowed at least 1".to_string());
         }
-        if self.max_connections == 0 {
-            return fail("--max-connections 0: allowed at least 1".to_string());
+        let max_event_streams = self
+            .max_event_streams
+            .unwrap_or((self.max_connections / 8).max(1));
+        for (flag, value, most) in [
+            ("--max-connections", self.max_connections, MAX_CONNECTIONS),
+            (
+                "--max-event-streams",
+                max_event_streams,
+                self.max_connections,
+            ),
+            ("--max-sweep-points", self.max_sweep_points, MAX_COUNT),
+            ("--max-queued-jobs", self.max_queued_jobs, MAX_COUNT),
+            ("--max-jobs", self.max_jobs, MAX_COUNT),
+            ("--body-limit", self.body_limit, MAX_BODY_LIMIT),
+        ] {
+            if !(1..=most).contains(&value) {
+                return fail(format!("{flag} {value}: allowed 1 to {most}"));
+            }
+        }
+        if self.body_min_rate > MAX_BODY_MIN_RATE {
+            return fail(format!(
+                "--body-min-rate {}: allowed 0 to {MAX_BODY_MIN_RATE} bytes/s",
+                self.body_min_rate
+            ));
         }
         for (flag, value) in [
             ("--header-timeout", self.header_timeout),
+            ("--keep-alive-timeout", self.keep_alive_timeout),
+            ("--send-timeout", self.send_timeout),
+            ("--body-timeout", self.body_timeout),
             ("--request-timeout", self.request_timeout),
             ("--solve-deadline", self.solve_deadline),
             ("--job-deadline", self.job_deadline),
@@ -271,9 +331,20 @@ impl ServeArgs {
             ("--job-retention", self.job_retention),
             ("--shutdown-timeout", self.shutdown_timeout),
         ] {
-            if value.is_zero() {
-                return fail(format!("{flag} 0s: allowed more than 0"));
+            if value.is_zero() || value > MAX_DURATION {
+                return fail(format!(
+                    "{flag} {}: allowed more than 0s and at most {}",
+                    humantime::format_duration(value),
+                    humantime::format_duration(MAX_DURATION)
+                ));
             }
+        }
+        if self.drain_delay > MAX_DURATION {
+            return fail(format!(
+                "--drain-delay {}: allowed at most {}",
+                humantime::format_duration(self.drain_delay),
+                humantime::format_duration(MAX_DURATION)
+            ));
         }
         if self.solve_deadline >= self.request_timeout {
             return fail(format!(
@@ -303,7 +374,14 @@ impl ServeArgs {
             connections: ConnectionLimits {
                 max_connections: self.max_connections,
                 header_timeout: self.header_timeout,
+                keep_alive_timeout: self.keep_alive_timeout,
+                send_timeout: self.send_timeout,
+                body: BodyPace {
+                    timeout: self.body_timeout,
+                    min_rate: self.body_min_rate,
+                },
             },
+            max_event_streams,
             engine: EngineConfig {
                 pool_size,
                 solve_deadline: self.solve_deadline,
@@ -394,6 +472,30 @@ mod tests {
             (&["--cors-origin", "dashboard.example"], "dashboard.example"),
             (&["--cors-origin", "https://a.example/path"], "no path"),
             (&["--log-format", "xml"], "xml"),
+            (
+                &["--max-connections", "18446744073709551615"],
+                "--max-connections 18446744073709551615: allowed 1 to 1048576",
+            ),
+            (
+                &["--max-connections", "0"],
+                "--max-connections 0: allowed 1 to",
+            ),
+            (
+                &["--max-event-streams", "600"],
+                "--max-event-streams 600: allowed 1 to 512",
+            ),
+            (
+                &["--max-queued-jobs", "18446744073709551615"],
+                "--max-queued-jobs",
+            ),
+            (&["--max-jobs", "0"], "--max-jobs 0"),
+            (&["--job-deadline", "500000000y"], "--job-deadline"),
+            (
+                &["--send-timeout", "0s"],
+                "--send-timeout 0s: allowed more than 0s",
+            ),
+            (&["--drain-delay", "2y"], "--drain-delay"),
+            (&["--body-min-rate", "-1"], "--body-min-rate"),
         ] {
             let error = config(args).unwrap_err();
             assert!(error.contains(needle), "{args:?}: {error}");

@@ -35,7 +35,8 @@ pub struct Problem {
     /// `not-acceptable` (406: the `Accept` header names no form the resource offers),
     /// `payload-too-large` (413), `not-found` (404), `interrupted` (410: the service stopped
     /// before the job finished), `not-ready` (409: the job has no result yet), `cancelled`
-    /// (409), `overloaded` (429),
+    /// (409), `overloaded` (429), `too-many-streams` (429: every event stream the service
+    /// follows at once is open; poll the job instead),
     /// `draining` (503), `unavailable` (503: the shared job store cannot be reached),
     /// `results-full` (503: no room to keep the job's result now; retry after `Retry-After`),
     /// `result-too-large` (422: the job's result would not fit even in an empty store),
@@ -76,6 +77,7 @@ enum Kind {
     NotReady,
     Cancelled,
     Overloaded,
+    TooManyStreams,
     Draining,
     Unavailable,
     ResultsFull,
@@ -103,7 +105,7 @@ impl Kind {
             Kind::NotFound => StatusCode::NOT_FOUND,
             Kind::Interrupted => StatusCode::GONE,
             Kind::Cancelled | Kind::NotReady => StatusCode::CONFLICT,
-            Kind::Overloaded => StatusCode::TOO_MANY_REQUESTS,
+            Kind::Overloaded | Kind::TooManyStreams => StatusCode::TOO_MANY_REQUESTS,
             Kind::Draining | Kind::Unavailable | Kind::ResultsFull => {
                 StatusCode::SERVICE_UNAVAILABLE
             }
@@ -129,6 +131,7 @@ impl Kind {
             Kind::NotReady => ("not-ready", "The job has no result yet"),
             Kind::Cancelled => ("cancelled", "The job was cancelled"),
             Kind::Overloaded => ("overloaded", "Every solver thread is busy"),
+            Kind::TooManyStreams => ("too-many-streams", "Too many event streams are open"),
             Kind::Draining => ("draining", "The service is shutting down"),
             Kind::Unavailable => ("unavailable", "The shared job store cannot be reached"),
             Kind::ResultsFull => ("results-full", "No room to keep the job's result now"),
@@ -144,8 +147,8 @@ impl Kind {
         match self {
             // Solves take microseconds to seconds: a permit is soon free.
             Kind::Overloaded | Kind::NotReady => Some(1),
-            // Another instance should have taken over by then.
-            Kind::Draining => Some(5),
+            // Another instance should have taken over by then; streams end as jobs do.
+            Kind::Draining | Kind::TooManyStreams => Some(5),
             // Redis reconnects by itself within a second or two.
             Kind::Unavailable => Some(2),
             _ => None,
@@ -219,6 +222,18 @@ impl ApiError {
 
     pub fn internal(detail: impl Into<String>) -> Self {
         ApiError::new(Kind::Internal, detail)
+    }
+
+    /// Every event stream this service follows at once (`limit`) is open.
+    pub fn too_many_streams(limit: usize) -> Self {
+        ApiError::new(
+            Kind::TooManyStreams,
+            format!(
+                "{limit} event streams are open, the most this service follows at once \
+                 (--max-event-streams): poll GET /v1/jobs/{{id}} instead, or follow the job \
+                 again later"
+            ),
+        )
     }
 
     pub fn draining() -> Self {

@@ -60,6 +60,8 @@ struct Inner {
     prometheus: PrometheusHandle,
     /// Large request bodies read at once (see `body::offload`).
     readers: Arc<tokio::sync::Semaphore>,
+    /// Event streams open at once (`--max-event-streams`).
+    streams: Arc<tokio::sync::Semaphore>,
 }
 
 impl AppState {
@@ -90,12 +92,14 @@ impl AppState {
         observe::describe(&metrics);
         let engine = Engine::with_storage(config.engine.clone(), metrics, storage);
         let readers = Arc::new(tokio::sync::Semaphore::new(config.engine.pool_size));
+        let streams = Arc::new(tokio::sync::Semaphore::new(config.max_event_streams));
         AppState {
             inner: Arc::new(Inner {
                 config,
                 engine,
                 prometheus,
                 readers,
+                streams,
             }),
         }
     }
@@ -111,6 +115,14 @@ impl AppState {
     /// A place to read a large request body, if one is free.
     fn reader_permit(&self) -> Option<tokio::sync::OwnedSemaphorePermit> {
         self.inner.readers.clone().try_acquire_owned().ok()
+    }
+
+    /// A place for an event stream, if one is free; held as long as the stream.
+    fn stream_permit(&self) -> Result<tokio::sync::OwnedSemaphorePermit, ApiError> {
+        let streams = self.inner.streams.clone();
+        streams
+            .try_acquire_owned()
+            .map_err(|_| ApiError::too_many_streams(self.inner.config.max_event_streams))
     }
 
     /// The metrics in the Prometheus text format.

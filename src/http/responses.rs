@@ -167,3 +167,11 @@ problems!(
             earlier run of the service); submit it again", false),
     }
 );
+
+problems!(
+    /// Every event stream the service follows at once is open.
+    TooManyStreams {
+        (429, "too-many-streams: every event stream this service follows at once is open \
+            (--max-event-streams); poll the job instead", true),
+    }
+);

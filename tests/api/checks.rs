@@ -228,3 +228,33 @@ async fn curl_fails_the_pipeline_on_failed_checks_and_prints_the_report() {
     let junit = String::from_utf8(out.stdout).unwrap();
     assert!(junit.contains("tests=\"4\" failures=\"0\""), "{junit}");
 }
+
+#[tokio::test]
+async fn a_suite_runs_within_one_solve_deadline_however_many_checks_it_holds() {
+    let app = spawn_app(&["--solve-deadline", "1s", "--request-timeout", "30s"]).await;
+    // Five sweeps that each take longer than the deadline: one deadline each would hold the
+    // request (and a solver thread) five seconds.
+    let checks: Vec<Value> = (0..5)
+        .map(|i| {
+            json!({"name": format!("slow {i}"), "job": crate::helpers::long_sweep(36 + i),
+                   "expect": {"points[].friction_coefficient": {"min": 0}}})
+        })
+        .collect();
+    let start = std::time::Instant::now();
+    let response = within(app.post("/v1/checks", &json!({ "checks": checks }))).await;
+    let elapsed = start.elapsed();
+    let report = problem(response, 422).await;
+    assert!(elapsed < std::time::Duration::from_secs(4), "{elapsed:?}");
+    let errors: Vec<&str> = report["checks"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| c["error"].as_str().unwrap_or(""))
+        .collect();
+    assert!(
+        errors[1..]
+            .iter()
+            .all(|e| e.starts_with("not run: the suite ran past its deadline of 1s")),
+        "{errors:?}"
+    );
+}

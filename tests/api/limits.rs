@@ -83,6 +83,207 @@ async fn at_the_connection_cap_a_silent_connection_makes_room_for_a_new_client()
 }
 
 #[tokio::test]
+async fn at_the_connection_cap_an_idle_keep_alive_connection_makes_room() {
+    let app = spawn_app(&[
+        "--max-connections",
+        "2",
+        "--header-timeout",
+        "60s",
+        "--keep-alive-timeout",
+        "60s",
+    ])
+    .await;
+    let base = app.base.clone();
+    // Two clients that each had an answer and keep their connection open, idle...
+    let held = tokio::task::spawn_blocking(move || {
+        (0..2)
+            .map(|_| {
+                let mut stream = connect(&base);
+                stream
+                    .write_all(b"GET /healthz HTTP/1.1\r\nHost: x\r\n\r\n")
+                    .unwrap();
+                let mut answer = [0u8; 12];
+                stream.read_exact(&mut answer).unwrap();
+                assert_eq!(&answer, b"HTTP/1.1 200");
+                stream
+            })
+            .collect::<Vec<TcpStream>>()
+    })
+    .await
+    .unwrap();
+    // ...do not keep a new client waiting: the one idle longest is closed for it.
+    let start = Instant::now();
+    assert_eq!(within(app.get("/healthz")).await.status(), 200);
+    assert!(
+        start.elapsed() < Duration::from_secs(5),
+        "{:?}",
+        start.elapsed()
+    );
+    let closed = tokio::task::spawn_blocking(move || {
+        let first = held.into_iter().next().unwrap();
+        read_until_closed(first, Duration::from_secs(5)).0
+    })
+    .await
+    .unwrap();
+    assert!(closed, "the connection idle longest was closed");
+}
+
+#[tokio::test]
+async fn an_idle_keep_alive_connection_is_closed_after_the_keep_alive_timeout() {
+    let app = spawn_app(&["--keep-alive-timeout", "500ms"]).await;
+    let base = app.base.clone();
+    let after = tokio::task::spawn_blocking(move || {
+        let mut idle = connect(&base);
+        idle.write_all(b"GET /healthz HTTP/1.1\r\nHost: x\r\n\r\n")
+            .unwrap();
+        let start = Instant::now();
+        let (closed, text) = read_until_closed(idle, Duration::from_secs(20));
+        assert!(closed && text.starts_with("HTTP/1.1 200"), "{text}");
+        start.elapsed()
+    })
+    .await
+    .unwrap();
+    // The header timeout (10 s) would have closed it later.
+    assert!(after < Duration::from_secs(4), "{after:?}");
+}
+
+#[tokio::test]
+async fn a_client_that_stops_reading_its_answers_is_disconnected_after_the_send_timeout() {
+    let app = spawn_app(&["--send-timeout", "1s"]).await;
+    let sweep =
+        json!({"vary": {"load": (0..5000).map(|i| 1e-9 + i as f64 * 1e-13).collect::<Vec<_>>()}});
+    let body = sweep.to_string();
+    assert_eq!(
+        app.post("/v1/sweeps", &sweep).await.status(),
+        200,
+        "solved and cached"
+    );
+    let base = app.base.clone();
+    let (closed, after) = tokio::task::spawn_blocking(move || {
+        let mut stream = connect(&base);
+        // Pipelined requests for ~100 MB of answers, more than the kernel's buffers hold,
+        // none of which is read: the server's writes wait, then time out.
+        let request = format!(
+            "POST /v1/sweeps HTTP/1.1\r\nHost: x\r\nContent-Type: application/json\r\n\
+             Content-Length: {}\r\n\r\n{body}",
+            body.len()
+        );
+        for _ in 0..30 {
+            stream.write_all(request.as_bytes()).unwrap();
+        }
+        let start = Instant::now();
+        std::thread::sleep(Duration::from_secs(6));
+        // Reads what the kernel kept, then learns whether the server closed the connection
+        // (a reset: it closed with requests unread).
+        stream
+            .set_read_timeout(Some(Duration::from_secs(20)))
+            .unwrap();
+        let closed = match std::io::copy(&mut stream, &mut std::io::sink()) {
+            Ok(_) => true,
+            Err(e) => e.kind() == std::io::ErrorKind::ConnectionReset,
+        };
+        (closed, start.elapsed())
+    })
+    .await
+    .unwrap();
+    assert!(closed, "closed after {after:?}");
+    assert_eq!(within(app.get("/healthz")).await.status(), 200);
+}
+
+#[tokio::test]
+async fn a_body_that_crawls_is_answered_408_naming_the_knobs() {
+    let app = spawn_app(&["--body-timeout", "1s"]).await;
+    let base = app.base.clone();
+    let (text, after) = tokio::task::spawn_blocking(move || {
+        let mut stream = connect(&base);
+        let head = "POST /v1/rolling HTTP/1.1\r\nHost: x\r\nContent-Type: application/json\r\n\
+                    Content-Length: 100\r\n\r\n{";
+        stream.write_all(head.as_bytes()).unwrap();
+        let start = Instant::now();
+        // A byte every 300 ms: each within the body timeout, far below 240 bytes/s.
+        stream
+            .set_read_timeout(Some(Duration::from_millis(300)))
+            .unwrap();
+        let mut text = Vec::new();
+        for _ in 0..40 {
+            if stream.write_all(b" ").is_err() {
+                break;
+            }
+            let mut chunk = [0u8; 4096];
+            match stream.read(&mut chunk) {
+                Ok(0) => break,
+                Ok(n) => text.extend_from_slice(&chunk[..n]),
+                Err(_) => {}
+            }
+            if text.windows(4).any(|w| w == b"\r\n\r\n") && text.ends_with(b"}") {
+                break;
+            }
+        }
+        (String::from_utf8_lossy(&text).into_owned(), start.elapsed())
+    })
+    .await
+    .unwrap();
+    assert!(text.starts_with("HTTP/1.1 408"), "{text}");
+    assert!(
+        text.contains("--body-timeout") && text.contains("--body-min-rate"),
+        "{text}"
+    );
+    assert!(after < Duration::from_secs(6), "{after:?}");
+}
+
+#[tokio::test]
+async fn event_streams_beyond_their_allowance_are_refused_and_polling_still_works() {
+    let app = spawn_app(&["--max-event-streams", "1"]).await;
+    let running = app.submit(&long_sweep(40)).await;
+    let first = app
+        .send(
+            Method::GET,
+            &format!("{running}/events"),
+            &[("accept", "text/event-stream")],
+            None,
+        )
+        .await;
+    assert_eq!(first.status(), 200);
+    let second = app
+        .send(
+            Method::GET,
+            &format!("{running}/events"),
+            &[("accept", "text/event-stream")],
+            None,
+        )
+        .await;
+    assert!(second.headers().contains_key("retry-after"));
+    let refused = problem(second, 429).await;
+    assert_eq!(refused["type"], problem_type("too-many-streams"));
+    assert!(refused["detail"]
+        .as_str()
+        .unwrap()
+        .contains("--max-event-streams"));
+    assert_eq!(app.get(&running).await.status(), 200, "polling works");
+    // A stream that ends gives its place back.
+    drop(first);
+    app.cancel(&running).await;
+    let again = within(async {
+        loop {
+            let response = app
+                .send(
+                    Method::GET,
+                    &format!("{running}/events"),
+                    &[("accept", "text/event-stream")],
+                    None,
+                )
+                .await;
+            if response.status() == 200 {
+                return response;
+            }
+            tokio::time::sleep(Duration::from_millis(50)).await;
+        }
+    })
+    .await;
+    Events::new(again);
+}
+
+#[tokio::test]
 async fn a_body_declared_too_large_is_refused_before_it_is_read() {
     let app = spawn_app(&[]).await;
     let base = app.base.clone();

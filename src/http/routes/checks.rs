@@ -5,7 +5,9 @@ use axum::http::{header, HeaderMap};
 use axum::response::{IntoResponse, Response};
 use serde_json::Value;
 
-use crate::check::{ChecksInput, Report, Suite};
+use std::time::Instant;
+
+use crate::check::{CheckReport, ChecksInput, Report, Suite};
 use crate::engine::EngineError;
 use crate::http::accept::Accept;
 use crate::http::body::JsonBody;
@@ -21,7 +23,8 @@ const FORMS: [&str; 2] = ["application/json", "application/xml"];
 ///
 /// The body is a checks document, as `thirdbody check` takes (golden answers inline, as
 /// `golden.answer`): each check a job and expectations on its answer. Every job is solved
-/// through the cache like a synchronous request. The answer is the report, as JSON or, with
+/// through the cache like a synchronous request, all of them within one solve deadline
+/// (checks not reached by then fail, saying so). The answer is the report, as JSON or, with
 /// `Accept: application/xml`, as JUnit XML: 200 when every check passed, 422 when one
 /// failed (as JSON, the problem `checks-failed` with the report's fields as members), so
 /// that `curl --fail-with-body` fails a pipeline and still prints the report.
@@ -65,16 +68,37 @@ pub async fn run(
         }
         .into());
     }
-    let mut reports = Vec::new();
+    // One deadline for the whole suite, so that its cost is that of one solve at most,
+    // however many checks it holds; each answer is judged and let go before the next.
+    let deadline = Instant::now() + state.config().engine.solve_deadline;
+    let mut reports = Vec::with_capacity(suite.checks.len());
     for spec in &suite.checks {
+        if Instant::now() >= deadline {
+            let mut report = CheckReport::new(&spec.name, spec.job.kind());
+            report.fail_with(format!(
+                "not run: the suite ran past its deadline of {} (--solve-deadline, one for \
+                 the whole suite); split the suite, or run it with `thirdbody check`",
+                humantime::format_duration(state.config().engine.solve_deadline)
+            ));
+            report.settle();
+            reports.push(report);
+            continue;
+        }
         let meta = spec.job.meta();
-        let answer = match state.engine().solve(spec.job.clone(), meta).await {
+        let answer = match state
+            .engine()
+            .solve_by(spec.job.clone(), meta, deadline)
+            .await
+        {
             Ok((solved, _)) => serde_json::from_slice::<Value>(solved.json())
                 .map_err(|e| JobError::Internal(e.to_string())),
             Err(EngineError::Job(e)) => Err(e),
             Err(refusal) => return Err(refusal.into()),
         };
-        reports.push(spec.judge(answer));
+        let mut report = spec.judge(answer);
+        // The answer is kept for `thirdbody check --update` only.
+        report.answer = None;
+        reports.push(report);
     }
     let report = Report::new(reports);
     let failed = (!report.passed).then(|| ApiError::checks_failed(&report));

@@ -23,7 +23,8 @@ use crate::http::accept::{Accept, AcceptsJson};
 use crate::http::body::JsonBody;
 use crate::http::error::{ApiError, Problem};
 use crate::http::responses::{
-    BadBody, Busy, Gone, JobFailure, NotAcceptable, NotFound, NotModified, Unfinished,
+    BadBody, Busy, Gone, JobFailure, NotAcceptable, NotFound, NotModified, TooManyStreams,
+    Unfinished,
 };
 use crate::http::AppState;
 use crate::job::registry::{AnyOutput, Envelope, KindName};
@@ -318,7 +319,7 @@ impl JobEvent {
         (status = 200, description = "A text/event-stream of `progress` events and one \
             `completion` event, each with a JobView as data",
             content_type = "text/event-stream", body = JobEvent),
-        NotFound, Gone, NotAcceptable,
+        NotFound, Gone, NotAcceptable, TooManyStreams,
     )
 )]
 pub async fn events(
@@ -327,7 +328,9 @@ pub async fn events(
     FoundJob(record): FoundJob,
 ) -> Result<Sse<impl Stream<Item = Result<Event, axum::Error>>>, ApiError> {
     accept.require("text/event-stream")?;
+    let permit = state.stream_permit()?;
     let watcher = Watcher {
+        _permit: permit,
         engine: state.engine().clone(),
         changes: state.engine().watch(record.id),
         record,
@@ -343,6 +346,8 @@ pub async fn events(
 
 /// Turns a job's changes into events.
 struct Watcher {
+    /// The stream's place among `--max-event-streams`, given back when the stream ends.
+    _permit: tokio::sync::OwnedSemaphorePermit,
     engine: Arc<Engine>,
     /// The job as last read.
     record: JobRecord,
