@@ -495,7 +495,10 @@ mod tests {
                 "--send-timeout 0s: allowed more than 0s",
             ),
             (&["--drain-delay", "2y"], "--drain-delay"),
-            (&["--body-min-rate", "-1"], "--body-min-rate"),
+            (
+                &["--body-min-rate", "2000000000"],
+                "--body-min-rate 2000000000: allowed 0 to",
+            ),
         ] {
             let error = config(args).unwrap_err();
             assert!(error.contains(needle), "{args:?}: {error}");
