@@ -96,3 +96,14 @@ def latency_line(name, seconds):
         f"{name}: {len(ms)} requests, p50 {percentile(ms, 50):.1f} ms, "
         f"p99 {percentile(ms, 99):.1f} ms, max {max(ms) if ms else float('nan'):.1f} ms"
     )
+
+
+def probe_health(port, stop, latencies, failures, every=0.1):
+    """Asks /healthz every `every` seconds on a new connection until `stop` is set, adding
+    each answer's seconds to `latencies` and each failure's error name to `failures`."""
+    while not stop.is_set():
+        try:
+            latencies.append(request(port, "GET", "/healthz", timeout=5)[2])
+        except OSError as e:
+            failures.append(type(e).__name__)
+        time.sleep(every)

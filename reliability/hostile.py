@@ -22,7 +22,7 @@ import sys
 import threading
 import time
 
-from common import Server, latency_line, request
+from common import Server, latency_line, probe_health, request
 
 MODES = ["slow-readers", "keep-alive", "slow-bodies", "sse"]
 HOSTILE = 511
@@ -177,13 +177,6 @@ def run(mode, seconds):
         attack = multiprocessing.Process(
             target=attacker, args=(port, mode, job_id, attacking, results)
         )
-        def prober():
-            while not stop.is_set():
-                try:
-                    health.append(request(port, "GET", "/healthz", timeout=5)[2])
-                except OSError as e:
-                    health_failed.append(type(e).__name__)
-                time.sleep(0.1)
 
         def client():
             i = 0
@@ -198,7 +191,10 @@ def run(mode, seconds):
                     solves["failed"] += 1
                 time.sleep(0.05)
 
-        threads = [threading.Thread(target=t) for t in (prober, client)]
+        threads = [
+            threading.Thread(target=probe_health, args=(port, stop, health, health_failed)),
+            threading.Thread(target=client),
+        ]
         if mode == "sse":
             threads.append(threading.Thread(target=feed_jobs))
             deadline = time.time() + 10

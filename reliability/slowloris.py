@@ -9,7 +9,7 @@ import sys
 import threading
 import time
 
-from common import Server, latency_line, request
+from common import Server, latency_line, probe_health
 
 SECONDS = float(sys.argv[1]) if len(sys.argv) > 1 else 40
 SLOW = 1100
@@ -58,15 +58,10 @@ with Server(preexec=limit_files) as server:
             held.append(time.time() - opened)
             s.close()
 
-    def prober():
-        while not stop.is_set():
-            try:
-                health.append(request(port, "GET", "/healthz", timeout=5)[2])
-            except OSError as e:
-                failures.append(type(e).__name__)
-            time.sleep(0.1)
-
-    threads = [threading.Thread(target=slow_client), threading.Thread(target=prober)]
+    threads = [
+        threading.Thread(target=slow_client),
+        threading.Thread(target=probe_health, args=(port, stop, health, failures)),
+    ]
     for t in threads:
         t.start()
     time.sleep(SECONDS)

@@ -263,7 +263,7 @@ const MAX_CONNECTIONS: usize = 1 << 20;
 /// Most of any other count (points, jobs): beyond this a number is a typo.
 const MAX_COUNT: usize = 100_000_000;
 /// Largest minimum body rate: 1 GB/s.
-const MAX_BODY_MIN_RATE: u64 = 1_000_000_000;
+const MAX_BODY_MIN_RATE: usize = 1_000_000_000;
 /// Longest of any duration: a year (times are added to clocks, which must not overflow).
 const MAX_DURATION: Duration = Duration::from_secs(365 * 24 * 3600);
 
@@ -277,74 +277,62 @@ impl ServeArgs {
         let fail = |message: String| Err(ConfigError(message));
         let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
         let pool_size = self.pool_size.unwrap_or(cores);
-        if !(1..=MAX_POOL_SIZE).contains(&pool_size) {
-            return fail(format!(
-                "--pool-size {pool_size}: allowed 1 to {MAX_POOL_SIZE}"
-            ));
-        }
-        if self.body_limit < MIN_BODY_LIMIT {
-            return fail(format!(
-                "--body-limit {}: allowed at least {MIN_BODY_LIMIT} bytes",
-                self.body_limit
-            ));
-        }
-        if self.max_sweep_points == 0 {
-            return fail("--max-sweep-points 0: allowed at least 1".to_string());
-        }
-        if self.max_jobs == 0 {
-            return fail("--max-jobs 0: allowed at least 1".to_string());
-        }
         let max_event_streams = self
             .max_event_streams
             .unwrap_or((self.max_connections / 8).max(1));
-        for (flag, value, most) in [
-            ("--max-connections", self.max_connections, MAX_CONNECTIONS),
+        let body_min_rate = usize::try_from(self.body_min_rate).unwrap_or(usize::MAX);
+        for (flag, value, allowed) in [
+            ("--pool-size", pool_size, 1..=MAX_POOL_SIZE),
+            (
+                "--body-limit",
+                self.body_limit,
+                MIN_BODY_LIMIT..=MAX_BODY_LIMIT,
+            ),
+            ("--body-min-rate", body_min_rate, 0..=MAX_BODY_MIN_RATE),
+            ("--max-sweep-points", self.max_sweep_points, 1..=MAX_COUNT),
+            ("--max-queued-jobs", self.max_queued_jobs, 0..=MAX_COUNT),
+            ("--max-jobs", self.max_jobs, 1..=MAX_COUNT),
+            (
+                "--max-connections",
+                self.max_connections,
+                1..=MAX_CONNECTIONS,
+            ),
             (
                 "--max-event-streams",
                 max_event_streams,
-                self.max_connections,
+                1..=self.max_connections,
             ),
-            ("--max-sweep-points", self.max_sweep_points, MAX_COUNT),
-            ("--max-queued-jobs", self.max_queued_jobs, MAX_COUNT),
-            ("--max-jobs", self.max_jobs, MAX_COUNT),
-            ("--body-limit", self.body_limit, MAX_BODY_LIMIT),
         ] {
-            if !(1..=most).contains(&value) {
-                return fail(format!("{flag} {value}: allowed 1 to {most}"));
+            if !allowed.contains(&value) {
+                return fail(format!(
+                    "{flag} {value}: allowed {} to {}",
+                    allowed.start(),
+                    allowed.end()
+                ));
             }
         }
-        if self.body_min_rate > MAX_BODY_MIN_RATE {
-            return fail(format!(
-                "--body-min-rate {}: allowed 0 to {MAX_BODY_MIN_RATE} bytes/s",
-                self.body_min_rate
-            ));
-        }
-        for (flag, value) in [
-            ("--header-timeout", self.header_timeout),
-            ("--keep-alive-timeout", self.keep_alive_timeout),
-            ("--send-timeout", self.send_timeout),
-            ("--body-timeout", self.body_timeout),
-            ("--request-timeout", self.request_timeout),
-            ("--solve-deadline", self.solve_deadline),
-            ("--job-deadline", self.job_deadline),
-            ("--cache-ttl", self.cache_ttl),
-            ("--job-retention", self.job_retention),
-            ("--shutdown-timeout", self.shutdown_timeout),
+        // (flag, value, whether 0 is allowed)
+        for (flag, value, zero) in [
+            ("--header-timeout", self.header_timeout, false),
+            ("--keep-alive-timeout", self.keep_alive_timeout, false),
+            ("--send-timeout", self.send_timeout, false),
+            ("--body-timeout", self.body_timeout, false),
+            ("--request-timeout", self.request_timeout, false),
+            ("--solve-deadline", self.solve_deadline, false),
+            ("--job-deadline", self.job_deadline, false),
+            ("--cache-ttl", self.cache_ttl, false),
+            ("--job-retention", self.job_retention, false),
+            ("--shutdown-timeout", self.shutdown_timeout, false),
+            ("--drain-delay", self.drain_delay, true),
         ] {
-            if value.is_zero() || value > MAX_DURATION {
+            if (value.is_zero() && !zero) || value > MAX_DURATION {
+                let least = if zero { "0s" } else { "more than 0s" };
                 return fail(format!(
-                    "{flag} {}: allowed more than 0s and at most {}",
+                    "{flag} {}: allowed {least} and at most {}",
                     humantime::format_duration(value),
                     humantime::format_duration(MAX_DURATION)
                 ));
             }
-        }
-        if self.drain_delay > MAX_DURATION {
-            return fail(format!(
-                "--drain-delay {}: allowed at most {}",
-                humantime::format_duration(self.drain_delay),
-                humantime::format_duration(MAX_DURATION)
-            ));
         }
         if self.solve_deadline >= self.request_timeout {
             return fail(format!(

@@ -235,23 +235,10 @@ async fn a_body_that_crawls_is_answered_408_naming_the_knobs() {
 async fn event_streams_beyond_their_allowance_are_refused_and_polling_still_works() {
     let app = spawn_app(&["--max-event-streams", "1"]).await;
     let running = app.submit(&long_sweep(40)).await;
-    let first = app
-        .send(
-            Method::GET,
-            &format!("{running}/events"),
-            &[("accept", "text/event-stream")],
-            None,
-        )
-        .await;
+    let events = format!("{running}/events");
+    let first = app.get(&events).await;
     assert_eq!(first.status(), 200);
-    let second = app
-        .send(
-            Method::GET,
-            &format!("{running}/events"),
-            &[("accept", "text/event-stream")],
-            None,
-        )
-        .await;
+    let second = app.get(&events).await;
     assert!(second.headers().contains_key("retry-after"));
     let refused = problem(second, 429).await;
     assert_eq!(refused["type"], problem_type("too-many-streams"));
@@ -265,14 +252,7 @@ async fn event_streams_beyond_their_allowance_are_refused_and_polling_still_work
     app.cancel(&running).await;
     let again = within(async {
         loop {
-            let response = app
-                .send(
-                    Method::GET,
-                    &format!("{running}/events"),
-                    &[("accept", "text/event-stream")],
-                    None,
-                )
-                .await;
+            let response = app.get(&events).await;
             if response.status() == 200 {
                 return response;
             }

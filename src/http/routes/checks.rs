@@ -1,11 +1,11 @@
 //! `POST /v1/checks`: the checks `thirdbody check` runs, for a pipeline without the binary.
 
+use std::time::Instant;
+
 use axum::extract::State;
 use axum::http::{header, HeaderMap};
 use axum::response::{IntoResponse, Response};
 use serde_json::Value;
-
-use std::time::Instant;
 
 use crate::check::{CheckReport, ChecksInput, Report, Suite};
 use crate::engine::EngineError;

@@ -59,8 +59,9 @@ pub struct Paced {
     pace: BodyPace,
     started: Instant,
     received: u64,
-    /// When the body is too slow unless more of it arrives.
-    deadline: Pin<Box<Sleep>>,
+    /// When the body is too slow unless more of it arrives; armed at the first wait (most
+    /// bodies arrive whole with their head, and need no timer).
+    deadline: Option<Pin<Box<Sleep>>>,
 }
 
 impl Paced {
@@ -75,7 +76,7 @@ impl Paced {
             pace,
             started,
             received: 0,
-            deadline: Box::pin(tokio::time::sleep_until(started + pace.timeout)),
+            deadline: None,
         }
     }
 
@@ -112,21 +113,29 @@ impl HttpBody for Paced {
                 if let Some(data) = frame.data_ref() {
                     this.received += data.len() as u64;
                 }
-                let deadline = this.next_deadline();
-                this.deadline.as_mut().reset(deadline);
+                let next = this.next_deadline();
+                if let Some(deadline) = &mut this.deadline {
+                    deadline.as_mut().reset(next);
+                }
                 Poll::Ready(Some(Ok(frame)))
             }
             Poll::Ready(end) => {
                 this.activity.receiving(false);
                 Poll::Ready(end.map(|e| e.map_err(Into::into)))
             }
-            Poll::Pending => match this.deadline.as_mut().poll(cx) {
-                Poll::Ready(()) => {
-                    this.activity.receiving(false);
-                    Poll::Ready(Some(Err(this.too_slow().into())))
+            Poll::Pending => {
+                let next = this.next_deadline();
+                let deadline = this
+                    .deadline
+                    .get_or_insert_with(|| Box::pin(tokio::time::sleep_until(next)));
+                match deadline.as_mut().poll(cx) {
+                    Poll::Ready(()) => {
+                        this.activity.receiving(false);
+                        Poll::Ready(Some(Err(this.too_slow().into())))
+                    }
+                    Poll::Pending => Poll::Pending,
                 }
-                Poll::Pending => Poll::Pending,
-            },
+            }
         }
     }
 

@@ -60,7 +60,7 @@ pub async fn serve(
     stop: CancellationToken,
     close_within: impl Fn() -> Duration,
 ) -> std::io::Result<()> {
-    let slots = Arc::new(Semaphore::new(limits.max_connections.max(1)));
+    let slots = Arc::new(Semaphore::new(limits.max_connections));
     let clock = Clock::new();
     let connections = Connections::new(clock);
     let graceful = GracefulShutdown::new();
