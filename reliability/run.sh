@@ -22,6 +22,7 @@ python3 reliability/slowloris.py "${durations[2]}" | tee -a "$out"
 # Not yet in the bounded run: one /healthz probe of 79 timed out once under 8 s of slow
 # bodies, unexplained so far (issue 21 is open).
 $bounded || python3 reliability/hostile.py all "${durations[3]}" | tee -a "$out"
+python3 reliability/checks_memory.py | tee -a "$out"
 python3 reliability/sigterm.py | tee -a "$out"
 python3 reliability/sigkill.py | tee -a "$out"
 if $bounded; then
@@ -30,6 +31,10 @@ if $bounded; then
   grep -q "lost 0:" "$out" || { echo "BROKEN: an accepted job was lost"; broken=1; }
   if grep "failed (5 s timeout)" "$out" | grep -v ", 0 failed (5 s timeout)"; then
     echo "BROKEN: /healthz went unanswered"; broken=1
+  fi
+  # A checks suite near the body limit stays within the default memory budget (256 MiB).
+  if ! grep -qE "checks suite: .*status 200 .* -> ([0-9]|[0-9][0-9]|1[0-9][0-9]|2[0-4][0-9]|25[0-5]) MiB" "$out"; then
+    echo "BROKEN: a large checks suite was not answered within the memory budget"; broken=1
   fi
   # Under 511 hostile connections, a well-behaved client is served (RELIABILITY.md).
   if grep -E "well-behaved solves: .*\((9[0-8]|[0-8]?[0-9])\.[0-9] %\)" "$out"; then
