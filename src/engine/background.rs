@@ -36,6 +36,7 @@ impl Background {
         thread::Builder::new()
             .name("thirdbody-background".to_string())
             .spawn(move || {
+                super::heavy::lower_priority();
                 for (key, work) in pieces {
                     // A panic in one piece must not end the thread nor leave its key pending.
                     let _ = std::panic::catch_unwind(std::panic::AssertUnwindSafe(work));

@@ -12,6 +12,7 @@ pub mod cache;
 mod coalesce;
 mod doorkeeper;
 pub mod fleet;
+pub mod heavy;
 mod memo;
 pub mod metrics;
 pub mod pool;

@@ -37,7 +37,7 @@ impl Pool {
             .expect("the pool's semaphore is never closed")
     }
 
-    /// Runs `work` on a blocking thread that holds `permit` until it returns, inside the
+    /// Runs `work` on a blocking thread (below the async threads, [`super::heavy`]) that holds `permit` until it returns, inside the
     /// caller's tracing span. If the caller stops waiting (a client hung up, a request timed
     /// out), `control` is cancelled: the solver stops at its next check instead of burning a
     /// core for nobody.
@@ -52,7 +52,7 @@ impl Pool {
     {
         let guard = CancelOnDrop(Some(control.clone()));
         let span = tracing::Span::current();
-        let result = tokio::task::spawn_blocking(move || {
+        let result = super::heavy::run(move || {
             let _permit = permit;
             span.in_scope(|| work(&control))
         })

@@ -348,7 +348,7 @@ impl MemoryJobStore {
             return state;
         };
         let spill = spill.clone();
-        let written = tokio::task::spawn_blocking(move || spill.write(id, &solved))
+        let written = super::heavy::run(move || spill.write(id, &solved))
             .await
             .unwrap_or_else(|e| Err(std::io::Error::other(e)));
         match written {

@@ -9,7 +9,7 @@ use serde_json::Value;
 
 use super::error::ApiError;
 use super::{server, AppState};
-use crate::engine::EngineError;
+use crate::engine::{heavy, EngineError};
 use crate::job::input;
 
 /// Bodies up to this size are read where they arrive: parsing them takes microseconds.
@@ -69,7 +69,7 @@ pub async fn offload<T: Send + 'static>(
     let Some(permit) = state.reader_permit() else {
         return Err(EngineError::Overloaded.into());
     };
-    tokio::task::spawn_blocking(move || {
+    heavy::run(move || {
         let _permit = permit;
         work()
     })

@@ -191,6 +191,44 @@ async fn a_client_that_stops_reading_its_answers_is_disconnected_after_the_send_
 }
 
 #[tokio::test]
+async fn a_reader_cut_by_the_send_timeout_is_reset_so_its_answer_leaves_the_kernel() {
+    let app = spawn_app(&["--send-timeout", "1s"]).await;
+    let sweep =
+        json!({"vary": {"load": (0..5000).map(|i| 1e-9 + i as f64 * 1e-13).collect::<Vec<_>>()}});
+    let body = sweep.to_string();
+    assert_eq!(app.post("/v1/sweeps", &sweep).await.status(), 200, "cached");
+    // A client with a small receive buffer, as a reader that wants the server to queue its
+    // answer would have.
+    let socket = tokio::net::TcpSocket::new_v4().unwrap();
+    socket.set_recv_buffer_size(4096).unwrap();
+    let address = app.base.trim_start_matches("http://").parse().unwrap();
+    let stream = socket.connect(address).await.unwrap().into_std().unwrap();
+    let ended = tokio::task::spawn_blocking(move || {
+        let mut stream = stream;
+        stream.set_nonblocking(false).unwrap();
+        // One request for a 3.3 MB answer, not read until well past the send timeout.
+        write!(
+            stream,
+            "POST /v1/sweeps HTTP/1.1\r\nHost: x\r\nContent-Type: application/json\r\n\
+             Content-Length: {}\r\n\r\n{body}",
+            body.len()
+        )
+        .unwrap();
+        std::thread::sleep(Duration::from_secs(3));
+        stream
+            .set_read_timeout(Some(Duration::from_secs(20)))
+            .unwrap();
+        // Closed gracefully, the server's kernel would go on sending the megabytes it had
+        // queued, then the end; reset, the client gets what reached it, then the reset.
+        std::io::copy(&mut stream, &mut std::io::sink()).map_err(|e| e.kind())
+    })
+    .await
+    .unwrap();
+    assert_eq!(ended.map(|_| ()), Err(std::io::ErrorKind::ConnectionReset));
+    assert_eq!(within(app.get("/healthz")).await.status(), 200);
+}
+
+#[tokio::test]
 async fn a_body_that_crawls_is_answered_408_naming_the_knobs() {
     let app = spawn_app(&["--body-timeout", "1s"]).await;
     let base = app.base.clone();

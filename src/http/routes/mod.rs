@@ -26,7 +26,7 @@ use super::error::ApiError;
 use super::AppState;
 use crate::engine::cache::{picture, Solved};
 use crate::engine::spill::JobResult;
-use crate::engine::CacheStatus;
+use crate::engine::{heavy, CacheStatus};
 use crate::job::meta::{GIT_COMMIT, SOFTWARE_VERSION};
 use crate::job::{Job, Meta};
 use crate::model::MODEL_VERSION;
@@ -202,7 +202,7 @@ impl Answering {
             Format::Svg => {
                 let json = spilled.json().await.map_err(unreadable)?;
                 let kind = spilled.kind;
-                let svg = tokio::task::spawn_blocking(move || picture(kind, &json))
+                let svg = heavy::run(move || picture(kind, &json))
                     .await
                     .map_err(|e| ApiError::internal(e.to_string()))?
                     .map_err(|e| ApiError::internal(e.to_string()))?;

@@ -8,6 +8,7 @@ use std::sync::atomic::{AtomicBool, AtomicU32, AtomicU64, Ordering::Relaxed};
 use std::sync::{Arc, Mutex, MutexGuard};
 use std::time::Instant;
 
+use tokio::sync::OwnedSemaphorePermit;
 use tokio::task::AbortHandle;
 
 /// How long a write may wait, or a body crawl, before its connection counts as stalled for
@@ -151,6 +152,8 @@ struct Open {
     id: u64,
     activity: Arc<Activity>,
     task: AbortHandle,
+    /// Its place under the connection cap, given back when it leaves the registry.
+    slot: OwnedSemaphorePermit,
 }
 
 /// The open connections.
@@ -174,23 +177,39 @@ impl Connections {
         self.open.lock().unwrap_or_else(|p| p.into_inner())
     }
 
-    /// Registers a connection about to be served by the task `spawn` starts (given the id
-    /// to pass to [`Connections::closed`]), under the lock, so that its removal always
-    /// follows its entry.
-    pub fn add(&self, activity: Arc<Activity>, spawn: impl FnOnce(u64) -> AbortHandle) {
+    /// Registers a connection holding `slot`, about to be served by the task `spawn` starts
+    /// (given the id to pass to [`Connections::closed`]), under the lock, so that its removal
+    /// always follows its entry.
+    pub fn add(
+        &self,
+        activity: Arc<Activity>,
+        slot: OwnedSemaphorePermit,
+        spawn: impl FnOnce(u64) -> AbortHandle,
+    ) {
         let id = self.next.fetch_add(1, Relaxed);
         let mut open = self.open();
         let task = spawn(id);
-        open.push(Open { id, activity, task });
+        open.push(Open {
+            id,
+            activity,
+            task,
+            slot,
+        });
     }
 
     pub fn closed(&self, id: u64) {
         self.open().retain(|c| c.id != id);
     }
 
-    /// Closes the most dispensable connection (the one waiting longest among those); false
-    /// if every connection is serving a request.
-    pub fn evict(&self) -> bool {
+    /// Closes the most dispensable connection (the one waiting longest among those) and
+    /// hands its slot over at once; None if every connection is serving a request.
+    ///
+    /// The slot does not wait for the closed connection's task to be dropped: under a burst
+    /// of newcomers the accept loop would otherwise wait for a busy worker thread once per
+    /// newcomer (a /healthz probe queued behind 100 such newcomers waited 240 ms). The
+    /// aborted tasks' sockets close moments later, so the open sockets may briefly exceed
+    /// the cap by the evictions still in flight.
+    pub fn evict(&self) -> Option<OwnedSemaphorePermit> {
         let now = self.clock.now();
         let mut open = self.open();
         let chosen = open
@@ -198,11 +217,10 @@ impl Connections {
             .enumerate()
             .filter_map(|(i, c)| c.activity.dispensable(now).map(|key| (key, i)))
             .min();
-        let Some((_, index)) = chosen else {
-            return false;
-        };
-        open.swap_remove(index).task.abort();
-        true
+        let (_, index) = chosen?;
+        let evicted = open.swap_remove(index);
+        evicted.task.abort();
+        Some(evicted.slot)
     }
 
     /// Closes the connections that have been idle (no request, nothing heard) for at least

