@@ -4,7 +4,7 @@
 
 use serde_json::{json, Value};
 use thirdbody::job::{pictures, Control, Job, Limits};
-use thirdbody::render::svg::Layer;
+use thirdbody::render::svg::{Layer, HEATMAP_CELLS};
 use thirdbody::render::Format;
 
 /// The answer to `job` as JSON and as SVG.
@@ -99,6 +99,24 @@ fn a_pressure_grid_is_a_heat_map_with_a_colour_bar() {
     parts(&svg);
     assert!(svg.contains(r#"<g class="heatmap">"#) && svg.contains(r#"<g class="colourbar">"#));
     assert!(svg.contains("pressure [MPa]"));
+}
+
+#[test]
+fn the_finest_pressure_grid_draws_a_picture_of_bounded_size_that_says_so() {
+    let grid = 501; // the largest the options allow
+    let (answer, svg) =
+        solve(json!({"kind": "rolling", "input": {"options": {"pressure_grid": grid}}}));
+    parts(&svg);
+    assert_eq!(answer["pressure"]["values"].as_array().unwrap().len(), grid);
+    let cells = svg.matches("<rect ").count();
+    assert!(
+        cells <= HEATMAP_CELLS * HEATMAP_CELLS + 40,
+        "{cells} rectangles"
+    );
+    // A 71-byte request drew 12.1 MB when every value had its cell.
+    assert!(svg.len() < 1 << 20, "{} bytes", svg.len());
+    assert!(svg.contains("pressure drawn on 100 × 100 cells"));
+    assert!(svg.contains("(the answer has 501 × 501)"));
 }
 
 #[test]

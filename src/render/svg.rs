@@ -294,6 +294,7 @@ impl Chart {
         let mut legend = Vec::new();
         let mut colour = 0;
         let mut groups: Vec<&str> = Vec::new();
+        let mut notes = self.notes.clone();
         for layer in &self.layers {
             let mut c = PALETTE[colour % PALETTE.len()];
             if let Layer::Line { group, .. } = layer {
@@ -361,15 +362,23 @@ impl Chart {
                     colour += 1;
                 }
                 Layer::Heatmap {
-                    x, y, values, unit, ..
+                    name,
+                    x,
+                    y,
+                    values,
+                    unit,
                 } => {
-                    self.write_heatmap(
+                    let drawn = self.write_heatmap(
                         &mut svg,
                         (&sx, &sy),
                         (x_factor, y_factor),
                         (x, y, values),
                         unit,
                     );
+                    if drawn != (x.len(), y.len()) {
+                        notes.push(format!("{name} drawn on {} × {} cells", drawn.0, drawn.1));
+                        notes.push(format!("(the answer has {} × {})", x.len(), y.len()));
+                    }
                 }
             }
         }
@@ -377,7 +386,7 @@ impl Chart {
         let shown = write_legend(&mut svg, &legend);
         let mut y = TOP + 10.0 + 22.0 * shown as f64 + 10.0;
         svg.push_str(r#"<g class="notes">"#);
-        for note in &self.notes {
+        for note in &notes {
             let _ = write!(
                 svg,
                 r#"<text x="{}" y="{y}" font-size="11">{}</text>"#,
@@ -438,6 +447,7 @@ impl Chart {
         );
     }
 
+    /// Draws a heatmap and its colour bar; returns how many cells it drew along x and y.
     fn write_heatmap(
         &self,
         svg: &mut String,
@@ -445,34 +455,20 @@ impl Chart {
         (x_factor, y_factor): (f64, f64),
         (x, y, values): (&[f64], &[f64], &[Vec<f64>]),
         unit: &str,
-    ) {
+    ) -> (usize, usize) {
         let finite = values.iter().flatten().copied().filter(|v| v.is_finite());
         let top_value = finite.fold(0.0, f64::max);
         if x.len() < 2 || y.len() < 2 || top_value <= 0.0 {
-            return;
+            return (x.len(), y.len());
         }
         let (factor, unit) = prefixed(unit, top_value);
-        let half = |v: &[f64], i: usize| {
-            let lo = if i == 0 {
-                v[0]
-            } else {
-                (v[i - 1] + v[i]) / 2.0
-            };
-            let hi = if i + 1 == v.len() {
-                v[i]
-            } else {
-                (v[i] + v[i + 1]) / 2.0
-            };
-            (lo, hi)
-        };
+        let (columns, rows, means) = coarsened((x, y, values), HEATMAP_CELLS);
         svg.push_str(r#"<g class="heatmap">"#);
-        for (j, row) in values.iter().enumerate().take(y.len()) {
-            for (i, &value) in row.iter().enumerate().take(x.len()) {
-                if value.is_nan() || value <= 0.0 {
+        for (&(y0, y1), row) in rows.iter().zip(&means) {
+            for (&(x0, x1), &value) in columns.iter().zip(row) {
+                if value <= 0.0 {
                     continue;
                 }
-                let (x0, x1) = half(x, i);
-                let (y0, y1) = half(y, j);
                 let (px0, px1) = (sx.at(x0 * x_factor), sx.at(x1 * x_factor));
                 let (py0, py1) = (sy.at(y1 * y_factor), sy.at(y0 * y_factor));
                 let _ = write!(
@@ -514,7 +510,67 @@ impl Chart {
             by - 8.0,
             escape(&unit)
         );
+        (columns.len(), rows.len())
     }
+}
+
+/// The cells a heatmap draws at most along each axis: about 4 pixels each in the plot. A
+/// finer grid is drawn as blocks of its cells (each the mean of its cells), so that a
+/// picture's size does not grow with the grid asked for (a 501 × 501 pressure grid drew
+/// 12 MB of SVG cell by cell); the answer's JSON and CSV carry every value.
+pub const HEATMAP_CELLS: usize = 100;
+
+/// The cells of a heatmap with values `values[j][i]` at (x[i], y[j]), at most `most` along
+/// each axis: each cell's extent along x and y, and the mean of the fine cells it covers
+/// (a value that is not positive, or not a number, counts as no pressure).
+fn coarsened(
+    (x, y, values): (&[f64], &[f64], &[Vec<f64>]),
+    most: usize,
+) -> (Vec<(f64, f64)>, Vec<(f64, f64)>, Vec<Vec<f64>>) {
+    let columns = blocks(x, most);
+    let rows = blocks(y, most);
+    let value = |j: usize, i: usize| {
+        let v = values.get(j).and_then(|row| row.get(i)).copied();
+        v.filter(|v| *v > 0.0).unwrap_or(0.0)
+    };
+    let means = rows
+        .iter()
+        .map(|(_, js)| {
+            columns
+                .iter()
+                .map(|(_, is)| {
+                    let sum: f64 = js
+                        .clone()
+                        .flat_map(|j| is.clone().map(move |i| (j, i)))
+                        .map(|(j, i)| value(j, i))
+                        .sum();
+                    sum / (js.len() * is.len()) as f64
+                })
+                .collect()
+        })
+        .collect();
+    let extents = |cells: Vec<((f64, f64), std::ops::Range<usize>)>| {
+        cells.into_iter().map(|(extent, _)| extent).collect()
+    };
+    (extents(columns), extents(rows), means)
+}
+
+/// The points of `v` (a grid axis) grouped into at most `most` consecutive blocks of
+/// nearly equal size: each block's extent (from midway to the previous point to midway to
+/// the next, ending at the axis's ends) and its points' indices.
+fn blocks(v: &[f64], most: usize) -> Vec<((f64, f64), std::ops::Range<usize>)> {
+    let count = v.len().min(most.max(1));
+    let edge = |i: usize| match i {
+        0 => v[0],
+        i if i >= v.len() => v[v.len() - 1],
+        i => (v[i - 1] + v[i]) / 2.0,
+    };
+    (0..count)
+        .map(|k| {
+            let (start, end) = (k * v.len() / count, (k + 1) * v.len() / count);
+            ((edge(start), edge(end)), start..end)
+        })
+        .collect()
 }
 
 fn log_ticks(lo: f64, hi: f64) -> Vec<f64> {
@@ -605,6 +661,48 @@ const LEGEND_ROWS: usize = 14;
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_fine_heatmap_is_drawn_as_blocks_that_cover_it_and_keep_its_total() {
+        let x: Vec<f64> = (0..501).map(|i| f64::from(i) * 0.5).collect();
+        let y: Vec<f64> = (0..37).map(|j| f64::from(j) * 2.0 - 30.0).collect();
+        let values: Vec<Vec<f64>> = (0..37)
+            .map(|j| {
+                (0..501)
+                    .map(|i| {
+                        if (i + j) % 7 == 0 {
+                            -1.0
+                        } else {
+                            f64::from(i * j)
+                        }
+                    })
+                    .collect()
+            })
+            .collect();
+        let (columns, rows, means) = coarsened((&x, &y, &values), 100);
+        assert_eq!((columns.len(), rows.len()), (100, 37), "coarse in x only");
+        for (cells, axis) in [(&columns, &x), (&rows, &y)] {
+            assert_eq!(cells[0].0, axis[0]);
+            assert_eq!(cells[cells.len() - 1].1, axis[axis.len() - 1]);
+            assert!(cells.windows(2).all(|w| w[0].1 == w[1].0), "no gaps");
+        }
+        // Each block is the mean of its cells, so blocks weighted by their cells' widths in
+        // index space sum to the fine total (negative values count as no pressure).
+        let fine: f64 = values.iter().flatten().map(|v| v.max(0.0)).sum();
+        let blocks_x = blocks(&x, 100);
+        let coarse: f64 = means
+            .iter()
+            .flat_map(|row| {
+                row.iter()
+                    .zip(&blocks_x)
+                    .map(|(m, (_, is))| m * is.len() as f64)
+            })
+            .sum();
+        assert!(
+            (coarse / fine - 1.0).abs() < 1e-12,
+            "{coarse} against {fine}"
+        );
+    }
 
     #[test]
     fn ticks_are_round_and_cover_the_range() {
