@@ -520,13 +520,16 @@ impl Chart {
 /// 12 MB of SVG cell by cell); the answer's JSON and CSV carry every value.
 pub const HEATMAP_CELLS: usize = 100;
 
+/// Where a cell begins and ends along an axis.
+type Span = (f64, f64);
+
 /// The cells of a heatmap with values `values[j][i]` at (x[i], y[j]), at most `most` along
 /// each axis: each cell's extent along x and y, and the mean of the fine cells it covers
 /// (a value that is not positive, or not a number, counts as no pressure).
 fn coarsened(
     (x, y, values): (&[f64], &[f64], &[Vec<f64>]),
     most: usize,
-) -> (Vec<(f64, f64)>, Vec<(f64, f64)>, Vec<Vec<f64>>) {
+) -> (Vec<Span>, Vec<Span>, Vec<Vec<f64>>) {
     let columns = blocks(x, most);
     let rows = blocks(y, most);
     let value = |j: usize, i: usize| {
@@ -549,7 +552,7 @@ fn coarsened(
                 .collect()
         })
         .collect();
-    let extents = |cells: Vec<((f64, f64), std::ops::Range<usize>)>| {
+    let extents = |cells: Vec<(Span, std::ops::Range<usize>)>| {
         cells.into_iter().map(|(extent, _)| extent).collect()
     };
     (extents(columns), extents(rows), means)
@@ -558,7 +561,7 @@ fn coarsened(
 /// The points of `v` (a grid axis) grouped into at most `most` consecutive blocks of
 /// nearly equal size: each block's extent (from midway to the previous point to midway to
 /// the next, ending at the axis's ends) and its points' indices.
-fn blocks(v: &[f64], most: usize) -> Vec<((f64, f64), std::ops::Range<usize>)> {
+fn blocks(v: &[f64], most: usize) -> Vec<(Span, std::ops::Range<usize>)> {
     let count = v.len().min(most.max(1));
     let edge = |i: usize| match i {
         0 => v[0],
