@@ -432,3 +432,41 @@ async fn a_job_the_shutdown_bound_cannot_fit_ends_interrupted() {
     assert_eq!(completion["status"], "interrupted");
     within(&mut app.server).await.unwrap().unwrap();
 }
+
+#[tokio::test]
+async fn pollers_of_a_job_the_shutdown_interrupts_learn_it_before_the_port_closes() {
+    let mut app = spawn_app(&["--max-sweep-points", "1000000", "--shutdown-timeout", "3s"]).await;
+    let long = app.submit(&long_sweep(100)).await;
+    app.wait_for_job(&long, |j| j["status"] == "running").await;
+    let started = Instant::now();
+    app.shut_down();
+    // Five clients poll once a second (the pace the job's Retry-After asks), each from its
+    // own moment; each must read the job's end from this process.
+    let pollers = (0..5u64).map(|k| {
+        let (client, url) = (app.client.clone(), format!("{}{long}", app.base));
+        tokio::spawn(async move {
+            tokio::time::sleep(Duration::from_millis(200 * k)).await;
+            loop {
+                match client.get(&url).send().await {
+                    Ok(answer) => {
+                        let job: serde_json::Value = answer.json().await.unwrap();
+                        if job["status"] != "running" {
+                            return Ok(job["status"].clone());
+                        }
+                    }
+                    Err(e) => return Err(format!("after {:?}: {e}", started.elapsed())),
+                }
+                tokio::time::sleep(Duration::from_secs(1)).await;
+            }
+        })
+    });
+    for poller in pollers.collect::<Vec<_>>() {
+        assert_eq!(poller.await.unwrap(), Ok(json!("interrupted")));
+    }
+    within(&mut app.server).await.unwrap().unwrap();
+    assert!(
+        started.elapsed() < Duration::from_millis(3500),
+        "{:?}",
+        started.elapsed()
+    );
+}
