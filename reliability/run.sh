@@ -44,6 +44,8 @@ if $bounded; then
           END{exit !slow}' "$out"; then
     echo "BROKEN: /healthz p99 reached 50 ms under hostile connections"; broken=1
   fi
+  grep -q "sigterm past the timeout: 5 of 5 pollers read the job interrupted" "$out" \
+    || { echo "BROKEN: a poller of a job the shutdown interrupted was not told"; broken=1; }
   grep -q "answers 410 tag:thirdbody,2026:problems/interrupted" "$out" \
     || { echo "BROKEN: a restarted server does not say interrupted"; broken=1; }
   # 503 results-full is a refusal the service owes (no room to keep a job's result for its

@@ -1,7 +1,9 @@
 """SIGTERM with work in flight: a server with one solver thread takes a long job (running)
 and four short ones (queued behind it), then gets SIGTERM. Every job's client keeps polling
 it until it ends or the server is gone. Prints how many accepted jobs were answered and how
-many were lost. Usage: reliability/sigterm.py"""
+many were lost. Then a job the shutdown timeout cannot fit, polled by five clients once a
+second: prints how many read its fate (`interrupted`) before the port closed.
+Usage: reliability/sigterm.py"""
 
 import json
 import signal
@@ -50,3 +52,43 @@ with Server("--pool-size", "1", "--max-sweep-points", "1000000", "--shutdown-tim
     print(f"sigterm: {len(ids)} jobs accepted (1 running, {len(ids) - 1} queued), then SIGTERM")
     print(f"answered {answered}, lost {len(ids) - answered}: " + ", ".join(sorted(final.values())))
     print(f"the server exited {exited:.1f} s after SIGTERM, status {server.proc.returncode}")
+
+
+def pollers_of_an_interrupted_job():
+    with Server("--max-sweep-points", "1000000", "--shutdown-timeout", "6s") as server:
+        port = server.port
+        sweep = {"kind": "sweep", "input": {"base": {"options": {"strips": 128}}, "vary": {
+            "radius": [f"{25 + i} nm" for i in range(100)],
+            "load": [f"{1000 + i} pN" for i in range(100)],
+            "velocity": [f"{1 + i} nm/s" for i in range(30)]}}}
+        status, body, _ = request(port, "POST", "/v1/jobs", sweep)
+        job = json.loads(body)["id"]
+        time.sleep(0.3)
+        server.proc.send_signal(signal.SIGTERM)
+        seen = {}
+
+        def poll(k):
+            time.sleep(0.2 * k)
+            while True:
+                try:
+                    status, body, _ = request(port, "GET", f"/v1/jobs/{job}", timeout=5)
+                except OSError as e:
+                    seen[k] = f"refused ({type(e).__name__})"
+                    return
+                state = json.loads(body).get("status") if status == 200 else f"HTTP {status}"
+                if state not in ("queued", "running"):
+                    seen[k] = state
+                    return
+                time.sleep(1)
+
+        threads = [threading.Thread(target=poll, args=(k,)) for k in range(5)]
+        for t in threads:
+            t.start()
+        for t in threads:
+            t.join()
+        told = sum(1 for s in seen.values() if s == "interrupted")
+        print(f"sigterm past the timeout: {told} of 5 pollers read the job interrupted: "
+              + ", ".join(sorted(seen.values())))
+
+
+pollers_of_an_interrupted_job()

@@ -130,7 +130,7 @@ pub struct ServeArgs {
     pub drain_delay: Duration,
 
     /// On shutdown, how long the jobs accepted (queued and running) and the requests in
-    /// flight have to finish. A job still running 2 s before the end (half the timeout, if
+    /// flight have to finish. A job still running 5 s before the end (half the timeout, if
     /// shorter) is interrupted, and its clients have those last seconds to read that.
     #[arg(long, env = "THIRDBODY_SHUTDOWN_TIMEOUT", default_value = "30s", value_parser = duration)]
     pub shutdown_timeout: Duration,

@@ -243,9 +243,10 @@ fn cors(origins: &CorsOrigins) -> Option<CorsLayer> {
 /// then ends `interrupted`), the listener closes and the requests in flight finish within
 /// what remains of the timeout.
 /// The end of a drain kept for the clients of the jobs it interrupts to poll their fate:
-/// two polls at the pace a job's `Retry-After` asks (1 s). Without it, 4 of 5 pollers of
-/// an interrupted job found the port closed.
-const FATE_NOTICE: Duration = Duration::from_secs(2);
+/// time for a big job to stop and keep what it finished (0.5 s for 300,000 points), then
+/// several polls at the pace a job's `Retry-After` asks (1 s). Without it, 4 of 5 pollers
+/// of an interrupted job found the port closed.
+const FATE_NOTICE: Duration = Duration::from_secs(5);
 
 pub async fn run(
     listener: TcpListener,
