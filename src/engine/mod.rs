@@ -6,6 +6,7 @@
 //! the place of the in-process ones.
 
 mod background;
+mod backlog;
 mod bounded;
 mod budget;
 pub mod cache;
@@ -20,6 +21,7 @@ mod service;
 pub mod spill;
 pub mod store;
 
+pub use backlog::Backlogged;
 pub use service::{CacheStatus, Engine, EngineConfig, EngineError, Storage};
 
 use crate::job::{Control, Job, JobError};

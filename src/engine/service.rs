@@ -17,6 +17,7 @@ use tracing::Instrument;
 use uuid::Uuid;
 
 use super::background::Background;
+use super::backlog::{Backlog, Backlogged, Ticket};
 use super::bounded::Bounded;
 use super::budget::{self, Budget};
 use super::cache::{Claim, MemoryCache, ResultCache, Solved};
@@ -104,6 +105,9 @@ pub enum EngineError {
     /// The shared job store cannot be reached (why): asynchronous work is refused rather
     /// than accepted and possibly lost.
     Unavailable(String),
+    /// The work accepted before an asynchronous job and its own would not end within its
+    /// deadline ([`super::backlog`]).
+    Backlogged(Backlogged),
     /// The job store cannot hold the job's result now (what is full, and when room is
     /// next made): the job is refused before any work rather than its result dropped after.
     ResultsFull { what: String, retry_after: Duration },
@@ -278,6 +282,8 @@ pub struct Engine {
     draining: AtomicBool,
     /// Asynchronous jobs waiting for a permit.
     queued: AtomicUsize,
+    /// The estimated work of the asynchronous jobs accepted and not ended.
+    backlog: Arc<Backlog>,
     pub(super) metrics: Metrics,
     cache_hits: Counter,
     cache_misses: Counter,
@@ -299,6 +305,7 @@ impl Engine {
                 link.report_to(metrics.labelled_gauge(names::REDIS_UP, &[("role", link.role)]));
             }
         }
+        let job_threads = config.pool_size.saturating_sub(1).max(1);
         Arc::new(Engine {
             pool: Pool::new(config.pool_size),
             cache: storage.cache,
@@ -328,9 +335,8 @@ impl Engine {
             uncollected: Mutex::default(),
             owed: Mutex::default(),
             ids: JobIds::new(),
-            job_slots: Arc::new(tokio::sync::Semaphore::new(
-                config.pool_size.saturating_sub(1).max(1),
-            )),
+            job_slots: Arc::new(tokio::sync::Semaphore::new(job_threads)),
+            backlog: Backlog::new(job_threads, config.job_deadline),
             tracker: TaskTracker::new(),
             draining: AtomicBool::new(false),
             queued: AtomicUsize::new(0),
@@ -481,6 +487,17 @@ impl Engine {
         {
             return Err(self.refused(EngineError::Overloaded));
         }
+        let units = match job.work() {
+            Work::Known(units) => units,
+            Work::Unknown => 1,
+        };
+        let ticket = match self.backlog.admit(job.cost_class(), units) {
+            Ok(ticket) => ticket,
+            Err(backlogged) => {
+                self.queued.fetch_sub(1, Ordering::SeqCst);
+                return Err(self.refused(EngineError::Backlogged(backlogged)));
+            }
+        };
         let record = JobRecord::queued(self.ids.next(), job.kind(), job.work());
         let id = record.id;
         if let Err(refusal) = self.jobs.insert(record.clone(), job.result_bytes()).await {
@@ -501,7 +518,8 @@ impl Engine {
         self.tracker.spawn(
             async move {
                 let work = job.work();
-                let state = engine.run_job(&live, id, job, meta).await;
+                let state = engine.run_job(&live, id, job, meta, &ticket).await;
+                drop(ticket);
                 let status = state.status();
                 let done = match (status, work) {
                     (JobStatus::Succeeded, Work::Known(total)) => total,
@@ -730,7 +748,7 @@ impl Engine {
     /// Counts a refusal (a no to new work) and passes the error on.
     fn refused(&self, e: EngineError) -> EngineError {
         let reason = match e {
-            EngineError::Overloaded => "overloaded",
+            EngineError::Overloaded | EngineError::Backlogged(_) => "overloaded",
             EngineError::Draining => "draining",
             EngineError::Unavailable(_) => "unavailable",
             EngineError::ResultsFull { .. } | EngineError::ResultTooLarge { .. } => "results_full",
@@ -807,7 +825,15 @@ impl Engine {
     }
 
     /// The life of an asynchronous job after its submission; returns its final state.
-    async fn run_job(&self, live: &LiveJob, id: Uuid, job: Job, meta: Meta) -> JobState {
+    /// Runs an accepted job to its end state; its solve time teaches `ticket`'s class.
+    async fn run_job(
+        &self,
+        live: &LiveJob,
+        id: Uuid,
+        job: Job,
+        meta: Meta,
+        ticket: &Ticket,
+    ) -> JobState {
         let permit = match self.cache.get(&meta.input_hash).await {
             Some(hit) => {
                 self.cache_hits.increment(1);
@@ -830,9 +856,11 @@ impl Engine {
         self.jobs.update(id, JobState::Running, 0).await;
         live.status.send_replace(JobStatus::Running);
         self.jobs_running.increment(1.0);
+        let started = Instant::now();
         let result = self
             .execute(permit, job, meta, live.control.clone(), true)
             .await;
+        ticket.ran(live.control.done(), started.elapsed());
         self.jobs_running.decrement(1.0);
         match result {
             Ok(solved) => {

@@ -46,7 +46,8 @@ pub struct ServeArgs {
     #[arg(long, env = "THIRDBODY_MAX_SWEEP_POINTS", default_value_t = Limits::default().max_sweep_points)]
     pub max_sweep_points: usize,
 
-    /// Asynchronous jobs that may wait for a solver thread; more are refused with 429.
+    /// Asynchronous jobs that may wait for a solver thread; more are refused with 429 (as is
+    /// a job that could not end within --job-deadline behind the work already accepted).
     #[arg(long, env = "THIRDBODY_MAX_QUEUED_JOBS", default_value_t = 64)]
     pub max_queued_jobs: usize,
 

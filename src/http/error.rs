@@ -11,9 +11,9 @@ use serde_json::{Map, Value};
 use utoipa::ToSchema;
 
 use crate::check::Report;
-use crate::engine::EngineError;
+use crate::engine::{Backlogged, EngineError};
 use crate::job::{FieldError, JobError};
-use crate::model::text::count;
+use crate::model::text::{count, quantity};
 
 pub const PROBLEM_JSON: &str = "application/problem+json";
 
@@ -327,6 +327,29 @@ impl From<EngineError> for ApiError {
                 "every solver thread is busy and the job queue is full or not used: \
                  retry shortly, or submit big work to /v1/jobs",
             ),
+            EngineError::Backlogged(Backlogged {
+                ahead,
+                needs,
+                deadline,
+            }) => {
+                let ahead_s = ahead.as_secs_f64().ceil().max(1.0);
+                ApiError {
+                    retry_after: Some(ahead_s.min(f64::from(u32::MAX)) as u32),
+                    ..ApiError::new(
+                        Kind::Overloaded,
+                        format!(
+                            "the job was not accepted: the jobs accepted before it hold the \
+                             job threads for about {} and it needs about {} more (estimated \
+                             from the jobs of its kind solved here), past its deadline of {} \
+                             (--job-deadline). Retry in about {}, or split it",
+                            quantity(ahead.as_secs_f64(), "s"),
+                            quantity(needs.as_secs_f64(), "s"),
+                            quantity(deadline.as_secs_f64(), "s"),
+                            quantity(ahead_s, "s"),
+                        ),
+                    )
+                }
+            }
             EngineError::Draining => ApiError::new(
                 Kind::Draining,
                 "the service is shutting down and takes no new work",

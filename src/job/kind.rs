@@ -64,6 +64,12 @@ pub trait Kind: fmt::Debug + PartialEq + Send + Sync + Sized + 'static {
     /// The work the job takes.
     fn work(&self) -> Work;
 
+    /// The jobs whose solve times estimate this one's cost per unit of work (admission by
+    /// cost): the kind, unless its units cost differently within it.
+    fn cost_class(&self) -> &'static str {
+        Self::NAME
+    }
+
     /// Runs the job to its answer, whose `meta` is `meta`. A long job checks `control`
     /// between units of work, and counts them there.
     fn run(&self, meta: Meta, control: &Control) -> Result<Self::Output, JobError>;
@@ -153,6 +159,7 @@ trait Dispatch: fmt::Debug + Send + Sync {
     fn canonical(&self) -> Value;
     fn references(&self) -> &'static [Reference];
     fn work(&self) -> Work;
+    fn cost_class(&self) -> &'static str;
     fn small(&self) -> bool;
     fn result_bytes(&self) -> u64;
     fn run(&self, meta: Meta, control: &Control) -> Result<Answer, Unfinished>;
@@ -183,6 +190,10 @@ impl<K: Kind> Dispatch for K {
 
     fn work(&self) -> Work {
         Kind::work(self)
+    }
+
+    fn cost_class(&self) -> &'static str {
+        Kind::cost_class(self)
     }
 
     fn small(&self) -> bool {
@@ -252,6 +263,11 @@ impl Job {
     /// The kind's name on the wire.
     pub fn kind(&self) -> &'static str {
         self.kind.name()
+    }
+
+    /// What its cost per unit of work is estimated from ([`Kind::cost_class`]).
+    pub fn cost_class(&self) -> &'static str {
+        self.kind.cost_class()
     }
 
     /// The canonical input: every default filled in, every quantity an SI number.

@@ -196,6 +196,14 @@ impl Kind for SweepJob {
         self.size().map_or(Work::Unknown, Work::Known)
     }
 
+    /// A three-body point costs a hundred rolling points.
+    fn cost_class(&self) -> &'static str {
+        match self.points {
+            SweepOfPoints::Rolling(_) => "sweep of rolling",
+            SweepOfPoints::ThreeBody(_) => "sweep of three_body",
+        }
+    }
+
     fn run(&self, meta: Meta, control: &Control) -> Result<SweepOutput, JobError> {
         let all = 0..self.size().unwrap_or(0);
         self.run_points(meta, all, control)

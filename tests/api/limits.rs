@@ -470,3 +470,46 @@ async fn pollers_of_a_job_the_shutdown_interrupts_learn_it_before_the_port_close
         started.elapsed()
     );
 }
+
+#[tokio::test]
+async fn a_job_that_could_not_end_within_its_deadline_behind_the_queue_is_refused() {
+    let app = spawn_app(&[
+        "--pool-size",
+        "2",
+        "--job-deadline",
+        "3s",
+        "--max-sweep-points",
+        "100000",
+    ])
+    .await;
+    // A job of 1,000 points (~0.3 s) teaches the service what such points cost.
+    let first = app.submit(&long_sweep(20)).await;
+    app.wait_for_job(&first, |j| j["status"] == "succeeded")
+        .await;
+    // 27,000 points (~7 s on the one job thread) are accepted: nothing is ahead of them.
+    let big = app.submit(&long_sweep(60)).await;
+    // 1,331 more would wait for them past their own deadline: refused now, not failed later.
+    let answer = app.post("/v1/jobs", &long_sweep(22)).await;
+    let wait: u64 = answer.headers()["retry-after"]
+        .to_str()
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert!(wait >= 3, "Retry-After {wait}");
+    let refusal = problem(answer, 429).await;
+    assert_eq!(refusal["type"], problem_type("overloaded"));
+    let detail = refusal["detail"].as_str().unwrap();
+    assert!(
+        detail.contains("past its deadline of 3 s (--job-deadline)"),
+        "{detail}"
+    );
+    // A synchronous solve is not held up; once the big job ends, the next is accepted.
+    assert_eq!(app.post("/v1/rolling", &json!({})).await.status(), 200);
+    let cancel = app.post(&format!("{big}/cancel"), &json!({})).await;
+    assert!(cancel.status().is_success(), "{}", cancel.status());
+    app.wait_for_job(&big, |j| {
+        j["status"] != "running" && j["status"] != "queued"
+    })
+    .await;
+    assert_eq!(app.post("/v1/jobs", &long_sweep(22)).await.status(), 202);
+}
