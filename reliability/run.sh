@@ -21,6 +21,7 @@ python3 reliability/memory.py "${durations[1]}" | tee -a "$out"
 python3 reliability/slowloris.py "${durations[2]}" | tee -a "$out"
 python3 reliability/hostile.py all "${durations[3]}" | tee -a "$out"
 python3 reliability/checks_memory.py | tee -a "$out"
+python3 reliability/queue_cost.py | tee -a "$out"
 python3 reliability/sigterm.py | tee -a "$out"
 python3 reliability/sigkill.py | tee -a "$out"
 if $bounded; then
@@ -44,6 +45,8 @@ if $bounded; then
           END{exit !slow}' "$out"; then
     echo "BROKEN: /healthz p99 reached 50 ms under hostile connections"; broken=1
   fi
+  grep -q "queue cost: .* refused at once (429)" "$out" \
+    || { echo "BROKEN: a job that could not end within its deadline was accepted"; broken=1; }
   grep -q "sigterm past the timeout: 5 of 5 pollers read the job interrupted" "$out" \
     || { echo "BROKEN: a poller of a job the shutdown interrupted was not told"; broken=1; }
   grep -q "answers 410 tag:thirdbody,2026:problems/interrupted" "$out" \
