@@ -84,6 +84,7 @@ impl Backlog {
         Ok(Ticket {
             backlog: self.clone(),
             class,
+            units,
             estimate: needs,
         })
     }
@@ -94,11 +95,19 @@ impl Backlog {
 pub struct Ticket {
     backlog: Arc<Backlog>,
     class: &'static str,
+    /// Its units of work, as admitted.
+    units: usize,
     estimate: f64,
 }
 
 impl Ticket {
-    /// The job ran for `took` and did `units` of work: its class's rate learns from it.
+    /// Its units of work, as admitted: what a job that ended well did.
+    pub fn units(&self) -> usize {
+        self.units
+    }
+
+    /// The job ran for `took` and did `units` of work (counted as admitted: all of them if
+    /// it ended well): its class's rate learns from it.
     pub fn ran(&self, units: usize, took: Duration) {
         if units == 0 || took < TEACHES {
             return;

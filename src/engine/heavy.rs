@@ -58,7 +58,7 @@ mod tests {
 
     #[cfg(target_os = "linux")]
     fn own_niceness() -> i32 {
-        // SAFETY: as in set_niceness.
+        // SAFETY: as in lower_by.
         unsafe { libc::getpriority(libc::PRIO_PROCESS, libc::gettid() as libc::id_t) }
     }
 

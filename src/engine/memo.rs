@@ -41,3 +41,29 @@ impl Memo for PointMemo {
         self.points.insert(key, (value, bytes));
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::job::Control;
+    use std::sync::Arc;
+
+    #[test]
+    fn units_recalled_from_the_memo_are_counted_apart_from_those_solved() {
+        let memo = Arc::new(PointMemo::new(1 << 20, Duration::from_secs(60)));
+        let control = Control::new(None, 1).with_memo(memo);
+        let solved = std::sync::atomic::AtomicUsize::new(0);
+        let square = control.kept(
+            |x: &u32| x.to_string(),
+            |_| 8,
+            |x: &u32| {
+                solved.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                Ok::<u32, ()>(x * x)
+            },
+        );
+        assert_eq!([2, 3, 2, 2].map(|x| square(&x).unwrap()), [4, 9, 4, 4]);
+        drop(square);
+        assert_eq!(solved.into_inner(), 2);
+        assert_eq!(control.recalled(), 2);
+    }
+}

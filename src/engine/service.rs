@@ -856,11 +856,19 @@ impl Engine {
         self.jobs.update(id, JobState::Running, 0).await;
         live.status.send_replace(JobStatus::Running);
         self.jobs_running.increment(1.0);
-        let started = Instant::now();
+        let (started, work) = (Instant::now(), job.work());
         let result = self
             .execute(permit, job, meta, live.control.clone(), true)
             .await;
-        ticket.ran(live.control.done(), started.elapsed());
+        // A job of unknown work (a fit) is one unit, and teaches only when it ends well;
+        // units recalled from the memo (a retry's) cost nothing and teach nothing.
+        let done = match (&result, work) {
+            (Ok(_), _) => ticket.units(),
+            (Err(_), Work::Known(_)) => live.control.done(),
+            (Err(_), Work::Unknown) => 0,
+        };
+        let solved = done.saturating_sub(live.control.recalled());
+        ticket.ran(solved, started.elapsed());
         self.jobs_running.decrement(1.0);
         match result {
             Ok(solved) => {

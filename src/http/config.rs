@@ -80,7 +80,8 @@ pub struct ServeArgs {
     pub spill_bytes: u64,
 
     /// Connections open at once; more wait in the kernel's backlog (keep it below the
-    /// process's limit on open files).
+    /// process's limit on open files, with a margin: a connection closed to make room for a
+    /// newcomer may take a moment to release its socket).
     #[arg(long, env = "THIRDBODY_MAX_CONNECTIONS", default_value_t = 512)]
     pub max_connections: usize,
 

@@ -328,6 +328,20 @@ impl From<EngineError> for ApiError {
                  retry shortly, or submit big work to /v1/jobs",
             ),
             EngineError::Backlogged(Backlogged {
+                ahead: _,
+                needs,
+                deadline,
+            }) if needs > deadline => ApiError::new(
+                Kind::Overloaded,
+                format!(
+                    "the job was not accepted: it alone needs about {} (estimated from the \
+                     jobs of its kind solved here), more than its deadline of {} \
+                     (--job-deadline), and other work is queued ahead of it: split it",
+                    quantity(needs.as_secs_f64(), "s"),
+                    quantity(deadline.as_secs_f64(), "s"),
+                ),
+            ),
+            EngineError::Backlogged(Backlogged {
                 ahead,
                 needs,
                 deadline,

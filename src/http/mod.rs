@@ -236,18 +236,19 @@ fn cors(origins: &CorsOrigins) -> Option<CorsLayer> {
     )
 }
 
-/// Serves `state` on `listener` until `shutdown` resolves, then drains: new work is refused
-/// (503, `/readyz` fails) while the jobs already accepted, queued or running, go on and their
-/// clients can still poll and follow them; after the drain delay, once those jobs are done
-/// and their clients have read them, or the shutdown timeout is spent (a job still running
-/// then ends `interrupted`), the listener closes and the requests in flight finish within
-/// what remains of the timeout.
 /// The end of a drain kept for the clients of the jobs it interrupts to poll their fate:
 /// time for a big job to stop and keep what it finished (0.5 s for 300,000 points), then
 /// several polls at the pace a job's `Retry-After` asks (1 s). Without it, 4 of 5 pollers
 /// of an interrupted job found the port closed.
 const FATE_NOTICE: Duration = Duration::from_secs(5);
 
+/// Serves `state` on `listener` until `shutdown` resolves, then drains: new work is refused
+/// (503, `/readyz` fails) while the jobs already accepted, queued or running, go on and their
+/// clients can still poll and follow them. After the drain delay, once those jobs are done
+/// and their clients have read them, the listener closes; a job not finished
+/// [`FATE_NOTICE`] before the shutdown timeout (half the timeout, if shorter) ends
+/// `interrupted` and the listener closes at the timeout, so that its clients read that. The
+/// requests in flight finish within what remains of the timeout.
 pub async fn run(
     listener: TcpListener,
     state: AppState,

@@ -78,6 +78,8 @@ pub struct Control {
     cancelled: AtomicBool,
     deadline: Option<Instant>,
     done: AtomicUsize,
+    /// Units recalled from the memo rather than solved.
+    recalled: AtomicUsize,
     threads: usize,
     memo: Option<Arc<dyn Memo>>,
     later: Option<Arc<dyn Later>>,
@@ -97,6 +99,7 @@ impl Control {
             cancelled: AtomicBool::new(false),
             deadline,
             done: AtomicUsize::new(0),
+            recalled: AtomicUsize::new(0),
             threads: threads.max(1),
             memo: None,
             later: None,
@@ -131,6 +134,12 @@ impl Control {
     /// Units of work done so far (the job's [`super::Work`] counts in the same units).
     pub fn done(&self) -> usize {
         self.done.load(Ordering::Relaxed)
+    }
+
+    /// Units of work recalled from the memo ([`Control::kept`]) rather than solved: done, at
+    /// almost no cost.
+    pub fn recalled(&self) -> usize {
+        self.recalled.load(Ordering::Relaxed)
     }
 
     /// Records `units` more of work done.
@@ -174,6 +183,7 @@ impl Control {
             };
             let key = key(item);
             if let Some(kept) = memo.recall(&key).and_then(|k| k.downcast::<R>().ok()) {
+                self.recalled.fetch_add(1, Ordering::Relaxed);
                 return Ok((*kept).clone());
             }
             let solution = solve(item)?;

@@ -147,6 +147,15 @@ impl Drop for RequestGuard {
     }
 }
 
+/// Removes a connection from the registry when dropped ([`Connections::on_drop_close`]).
+pub struct Closing(Connections, u64);
+
+impl Drop for Closing {
+    fn drop(&mut self) {
+        self.0.closed(self.1);
+    }
+}
+
 /// An open connection, as the accept loop sees it.
 struct Open {
     id: u64,
@@ -199,6 +208,11 @@ impl Connections {
 
     pub fn closed(&self, id: u64) {
         self.open().retain(|c| c.id != id);
+    }
+
+    /// A guard that calls [`Connections::closed`] for `id` when dropped.
+    pub fn on_drop_close(&self, id: u64) -> Closing {
+        Closing(self.clone(), id)
     }
 
     /// Closes the most dispensable connection (the one waiting longest among those) and
@@ -276,6 +290,30 @@ mod tests {
             ]
         );
         assert!(ranked[0] < ranked[1] && ranked[1] < ranked[2] && ranked[2] < ranked[3]);
+    }
+
+    #[tokio::test]
+    async fn an_evicted_connection_hands_its_slot_over_at_once() {
+        let slots = Arc::new(tokio::sync::Semaphore::new(2));
+        let connections = Connections::new(Clock::new());
+        let open = |activity: Arc<Activity>| {
+            let slot = slots.clone().try_acquire_owned().expect("a free slot");
+            let task = tokio::spawn(std::future::pending::<()>());
+            connections.add(activity, slot, |_| task.abort_handle());
+            task
+        };
+        let idle = open(Arc::new(Activity::new(Clock::new())));
+        let busy = Arc::new(Activity::new(Clock::new()));
+        let _request = busy.request();
+        let _working = open(busy);
+        assert_eq!(slots.available_permits(), 0);
+        let handed = connections.evict().expect("the idle connection goes");
+        // The slot is the newcomer's now, before the closed connection's task has gone.
+        assert_eq!(slots.available_permits(), 0);
+        drop(handed);
+        assert_eq!(slots.available_permits(), 1);
+        assert!(idle.await.unwrap_err().is_cancelled());
+        assert!(connections.evict().is_none(), "the other serves a request");
     }
 
     #[test]

@@ -127,9 +127,11 @@ pub async fn serve(
         let registry = connections.clone();
         connections.add(activity, slot, move |id| {
             tokio::spawn(async move {
+                // Leaves the registry (giving its slot back) however the task ends, a
+                // panic included.
+                let _leave = registry.on_drop_close(id);
                 // A closed or timed-out connection is the client's business, not an error.
                 let _ = connection.await;
-                registry.closed(id);
             })
             .abort_handle()
         });
