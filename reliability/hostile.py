@@ -216,7 +216,8 @@ def run(mode, seconds):
     total = solves["ok"] + solves["failed"]
     share = 100 * solves["ok"] / total if total else float("nan")
     print(f"hostile {mode}: {HOSTILE} connections, {seconds:.0f} s, server alive at the end: {alive}")
-    print(latency_line("  /healthz", health) + f", {len(health_failed)} failed (5 s timeout)")
+    why = f": {', '.join(sorted(set(health_failed)))}" if health_failed else ""
+    print(latency_line("  /healthz", health) + f", {len(health_failed)} failed (5 s timeout){why}")
     print(f"  well-behaved solves: {solves['ok']} of {total} succeeded ({share:.1f} %)")
     print(
         f"  hostile connections opened {opened}, held median {median:.1f} s, "

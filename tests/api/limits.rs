@@ -83,6 +83,47 @@ async fn at_the_connection_cap_a_silent_connection_makes_room_for_a_new_client()
 }
 
 #[tokio::test]
+async fn at_the_connection_cap_a_fresh_connection_keeps_its_place_over_a_crawling_body() {
+    let app = spawn_app(&["--max-connections", "2", "--body-timeout", "60s"]).await;
+    let base = app.base.clone();
+    let (fresh, crawling) = tokio::task::spawn_blocking(move || {
+        // A body that crawls holds one place...
+        let mut crawling = connect(&base);
+        write!(
+            crawling,
+            "POST /v1/rolling HTTP/1.1\r\nHost: x\r\nContent-Type: application/json\r\n\
+             Content-Length: 1000\r\n\r\n{{"
+        )
+        .unwrap();
+        std::thread::sleep(Duration::from_millis(400));
+        // ...a client has just connected to the other and not yet sent its request...
+        let mut fresh = connect(&base);
+        // ...when a third arrives: the crawling body goes, not the client's new connection.
+        let mut third = connect(&base);
+        write!(
+            third,
+            "GET /healthz HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n"
+        )
+        .unwrap();
+        let (_, third_answer) = read_until_closed(third, Duration::from_secs(10));
+        assert!(third_answer.starts_with("HTTP/1.1 200"), "{third_answer}");
+        write!(
+            fresh,
+            "GET /healthz HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n"
+        )
+        .unwrap();
+        (
+            read_until_closed(fresh, Duration::from_secs(10)),
+            read_until_closed(crawling, Duration::from_secs(1)),
+        )
+    })
+    .await
+    .unwrap();
+    assert!(fresh.1.starts_with("HTTP/1.1 200"), "{fresh:?}");
+    assert!(crawling.0, "the crawling body was closed: {crawling:?}");
+}
+
+#[tokio::test]
 async fn at_the_connection_cap_an_idle_keep_alive_connection_makes_room() {
     let app = spawn_app(&[
         "--max-connections",

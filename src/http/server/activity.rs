@@ -115,6 +115,13 @@ impl Activity {
         }
         if self.requests.load(Relaxed) == 0 {
             let since = self.idle_since.load(Relaxed);
+            // A connection just opened (or just answered) has a moment to send its request:
+            // else a client's fresh connection, idle until its head arrives, was the first
+            // to go when another came at the cap, ahead of 511 crawling bodies (a /healthz
+            // probe failed so, once in a few hundred).
+            if !waited(since) {
+                return None;
+            }
             let why = if self.heard.load(Relaxed) {
                 Dispensable::HeadUnfinished
             } else {
@@ -295,14 +302,16 @@ mod tests {
     #[tokio::test]
     async fn an_evicted_connection_hands_its_slot_over_at_once() {
         let slots = Arc::new(tokio::sync::Semaphore::new(2));
-        let connections = Connections::new(Clock::new());
+        // A clock a second old, so that a connection idle since its start may go.
+        let clock = Clock(Instant::now() - std::time::Duration::from_secs(1));
+        let connections = Connections::new(clock);
         let open = |activity: Arc<Activity>| {
             let slot = slots.clone().try_acquire_owned().expect("a free slot");
             let task = tokio::spawn(std::future::pending::<()>());
             connections.add(activity, slot, |_| task.abort_handle());
             task
         };
-        let idle = open(Arc::new(Activity::new(Clock::new())));
+        let idle = open(Arc::new(at(1)));
         let busy = Arc::new(Activity::new(Clock::new()));
         let _request = busy.request();
         let _working = open(busy);
@@ -314,6 +323,26 @@ mod tests {
         assert_eq!(slots.available_permits(), 1);
         assert!(idle.await.unwrap_err().is_cancelled());
         assert!(connections.evict().is_none(), "the other serves a request");
+    }
+
+    #[test]
+    fn a_connection_just_opened_has_a_moment_to_send_its_request() {
+        let now = 100_000;
+        let fresh = Arc::new(at(now - 10));
+        assert_eq!(fresh.dispensable(now), None);
+        let body = Arc::new(at(1_000));
+        let _upload = body.request();
+        body.receiving_since.store(now - 50_000, Relaxed);
+        assert_eq!(
+            body.dispensable(now).map(|(why, _)| why),
+            Some(Dispensable::SlowBody),
+            "a crawling body goes before it"
+        );
+        assert_eq!(
+            fresh.dispensable(now + STALL_GRACE_MS).map(|(why, _)| why),
+            Some(Dispensable::Idle),
+            "then it is idle like any other"
+        );
     }
 
     #[test]
