@@ -525,7 +525,7 @@ impl Engine {
                     (JobStatus::Succeeded, Work::Known(total)) => total,
                     _ => live.control.done(),
                 };
-                tracing::info!(status = status.as_str(), "job finished");
+                state.log_end(id);
                 engine.jobs.update(id, state, done).await;
                 engine.uncollected().insert(id, engine.config.max_jobs);
                 engine.live().remove(&id);
@@ -544,7 +544,7 @@ impl Engine {
         job: Job,
         meta: Meta,
     ) -> Result<JobRecord, EngineError> {
-        let unavailable = |e: super::fleet::Failure| self.refused(EngineError::Unavailable(e.0));
+        let unavailable = |e: super::fleet::Failure| self.refused(EngineError::Unavailable(e.why));
         let backlog = shared.backlog().await.map_err(unavailable)?;
         if backlog >= self.config.max_queued_jobs.saturating_mul(64) {
             return Err(self.refused(EngineError::Overloaded));

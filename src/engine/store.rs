@@ -72,6 +72,18 @@ pub enum JobState {
 }
 
 impl JobState {
+    /// Logs that the job ended in this state: an internal failure as an error with its
+    /// cause, which its clients are not shown.
+    pub fn log_end(&self, id: impl std::fmt::Display) {
+        match self {
+            JobState::Failed {
+                error: error @ JobError::Internal(_),
+                ..
+            } => tracing::error!(%id, %error, "job failed inside the service"),
+            _ => tracing::info!(%id, status = self.status().as_str(), "job finished"),
+        }
+    }
+
     pub fn status(&self) -> JobStatus {
         match self {
             JobState::Queued => JobStatus::Queued,

@@ -170,7 +170,14 @@ pub struct ApiError {
     extensions: Map<String, Value>,
     /// Seconds to wait before trying again, when this case knows better than its kind.
     retry_after: Option<u32>,
+    /// What went wrong inside the service: logged when the answer is sent, never sent (it
+    /// may name files, threads or internals a client has no use for).
+    internal: Option<String>,
 }
+
+/// The detail of every internal error a client sees.
+const INTERNAL_DETAIL: &str = "the service failed to answer this request; the failure was \
+    logged with its x-request-id: quote it when reporting this";
 
 impl ApiError {
     fn new(kind: Kind, detail: impl Into<String>) -> Self {
@@ -180,6 +187,7 @@ impl ApiError {
             errors: Vec::new(),
             extensions: Map::new(),
             retry_after: None,
+            internal: None,
         }
     }
 
@@ -220,8 +228,12 @@ impl ApiError {
         ApiError::new(Kind::NotReady, detail)
     }
 
+    /// An internal failure: `detail` is logged, the client told only that it happened.
     pub fn internal(detail: impl Into<String>) -> Self {
-        ApiError::new(Kind::Internal, detail)
+        ApiError {
+            internal: Some(detail.into()),
+            ..ApiError::new(Kind::Internal, INTERNAL_DETAIL)
+        }
     }
 
     /// Every event stream this service follows at once (`limit`) is open.
@@ -313,7 +325,8 @@ impl From<JobError> for ApiError {
             JobError::OutOfDomain(_) => ApiError::new(Kind::OutOfDomain, detail),
             JobError::Cancelled => ApiError::new(Kind::Cancelled, detail),
             JobError::DeadlineExceeded => ApiError::new(Kind::DeadlineExceeded, detail),
-            JobError::Internal(_) => ApiError::new(Kind::Internal, detail),
+            JobError::Abandoned(_) => ApiError::new(Kind::Internal, detail),
+            JobError::Internal(_) => ApiError::internal(detail),
         }
     }
 }
@@ -437,6 +450,9 @@ pub fn too_large(declared: Option<u64>, limit: usize) -> String {
 
 impl IntoResponse for ApiError {
     fn into_response(self) -> Response {
+        if let Some(internal) = &self.internal {
+            tracing::error!(error = %internal, "internal error");
+        }
         let body = serde_json::to_vec(&self.problem()).unwrap_or_default();
         self.respond_as(PROBLEM_JSON, body)
     }
@@ -514,6 +530,20 @@ mod tests {
             (JobError::Internal("x".into()), 500, "internal"),
         ] {
             assert_eq!(kind_of(error), (status, t(name)));
+        }
+    }
+
+    #[test]
+    fn an_internal_failure_is_logged_not_sent() {
+        let why = "cannot write /var/lib/thirdbody/spill/17.json: permission denied";
+        for error in [
+            ApiError::internal(why),
+            JobError::Internal(why.to_string()).into(),
+        ] {
+            let problem = serde_json::to_value(error.problem()).unwrap();
+            assert_eq!(problem["detail"], INTERNAL_DETAIL);
+            assert!(!problem.to_string().contains("spill"), "{problem}");
+            assert!(error.internal.is_some_and(|logged| logged.ends_with(why)));
         }
     }
 

@@ -50,7 +50,10 @@ pub enum JobError {
     Cancelled,
     /// The job ran past its deadline.
     DeadlineExceeded,
-    /// A fault of the service, not of the job.
+    /// The service gave the job up (every worker that took a part of it stopped): its fate,
+    /// in words for the client.
+    Abandoned(String),
+    /// A fault of the service, not of the job: logged, not shown to clients.
     Internal(String),
 }
 
@@ -74,7 +77,9 @@ impl fmt::Display for JobError {
                     more => write!(f, "; and {more} more (see `errors`)"),
                 }
             }
-            JobError::Unsolvable(m) | JobError::OutOfDomain(m) => f.write_str(m),
+            JobError::Unsolvable(m) | JobError::OutOfDomain(m) | JobError::Abandoned(m) => {
+                f.write_str(m)
+            }
             JobError::Cancelled => f.write_str("the job was cancelled"),
             JobError::DeadlineExceeded => f.write_str("the job ran past its deadline"),
             JobError::Internal(m) => write!(f, "internal error: {m}"),

@@ -185,8 +185,8 @@ impl ToSchema for KindName {
     "vary": {"load": ["0.5 nN", "1 nN", "2 nN"], "velocity": ["0 nm/s", "4 nm/s"]}}}))]
 pub struct Envelope {
     pub kind: KindName,
-    /// The input of the job's kind: a `RollingInput`, `ThreeBodyInput`, `SweepInput` or
-    /// `FigureInput`.
+    /// The input of the job's kind: a `RollingInput`, `ThreeBodyInput`, `SweepInput`,
+    /// `FigureInput` or `FitInput`.
     /// Absent, every field takes its default.
     #[serde(default)]
     #[schema(value_type = Option<Object>)]

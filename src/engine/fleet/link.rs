@@ -16,13 +16,32 @@ const CALL_TIMEOUT: Duration = Duration::from_secs(1);
 /// How often an unreachable server is tried again.
 pub const RETRY_EVERY: Duration = Duration::from_millis(500);
 
-/// Why a call to Redis failed, in a sentence.
+/// Why a call to Redis failed, in a sentence, and the server's error code if it refused
+/// the command.
 #[derive(Clone, Debug, PartialEq, Eq)]
-pub struct Failure(pub String);
+pub struct Failure {
+    pub why: String,
+    /// The code a Redis error reply begins with (`NOGROUP`, `BUSYGROUP`...).
+    code: Option<String>,
+}
+
+impl Failure {
+    pub fn new(why: impl Into<String>) -> Self {
+        Failure {
+            why: why.into(),
+            code: None,
+        }
+    }
+
+    /// Whether Redis refused the command with error `code`.
+    pub fn is(&self, code: &str) -> bool {
+        self.code.as_deref() == Some(code)
+    }
+}
 
 impl std::fmt::Display for Failure {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(&self.0)
+        f.write_str(&self.why)
     }
 }
 
@@ -97,11 +116,14 @@ impl Link {
                 if lost {
                     self.set_up(false);
                 }
-                Err(Failure(format!("Redis ({}): {e}", self.role)))
+                Err(Failure {
+                    why: format!("Redis ({}): {e}", self.role),
+                    code: e.code().map(str::to_string),
+                })
             }
             Err(_) => {
                 self.set_up(false);
-                Err(Failure(format!(
+                Err(Failure::new(format!(
                     "Redis ({}) did not answer within {CALL_TIMEOUT:?}",
                     self.role
                 )))

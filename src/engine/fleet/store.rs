@@ -225,7 +225,7 @@ impl RedisJobStore {
             .into_iter()
             .map(|(_, text)| serde_json::from_str(&text))
             .collect::<Result<Vec<RenderedPart>, _>>()
-            .map_err(|e| Failure(format!("a stored part is unreadable: {e}")))?;
+            .map_err(|e| Failure::new(format!("a stored part is unreadable: {e}")))?;
         Ok(Some(parts))
     }
 
@@ -248,7 +248,7 @@ impl RedisJobStore {
             Some(result) => result
                 .bodies()
                 .await
-                .map_err(|e| Failure(format!("cannot render the result: {e}")))?,
+                .map_err(|e| Failure::new(format!("cannot render the result: {e}")))?,
             None => (Bytes::new(), Bytes::new()),
         };
         let status = state.status().as_str();
@@ -296,7 +296,7 @@ impl RedisJobStore {
         };
         let kind = registry::find(&text("kind"))
             .map(|k| k.name())
-            .map_err(|e| Failure(format!("a stored job is unreadable: {e}")))?;
+            .map_err(|e| Failure::new(format!("a stored job is unreadable: {e}")))?;
         let work = text("work").parse().map_or(Work::Unknown, Work::Known);
         // A result of a cancelled or failed job is what it finished before it stopped.
         let result = |complete: bool| match (&json, &csv) {

@@ -174,7 +174,7 @@ impl Engine {
                 1 => "once".to_string(),
                 n => format!("{n} times"),
             };
-            let error = JobError::Internal(format!(
+            let error = JobError::Abandoned(format!(
                 "part {} of the job was delivered {times} and every worker that took it stopped \
                  before finishing it (killed, or out of memory): the job is given up",
                 entry.part_name(),
@@ -318,7 +318,7 @@ impl Engine {
     /// Stores the job's final `state`, then acknowledges the entry (left for another worker
     /// if the state could not be stored).
     async fn finish(&self, shared: &Shared, entry: &Entry, state: JobState, done: Option<usize>) {
-        tracing::info!(id = %entry.job, status = state.status().as_str(), "job finished");
+        state.log_end(entry.job);
         if shared
             .store
             .set_state(entry.job, &state, done)
@@ -352,7 +352,7 @@ async fn next_entry(fleet: &Fleet, looked: &mut Instant) -> Result<Option<Entry>
                 }
                 *looked = Instant::now();
             }
-            Err(e) if e.0.contains("NOGROUP") => create_group(fleet).await?,
+            Err(e) if e.is("NOGROUP") => create_group(fleet).await?,
             Err(e) => return Err(e),
         }
     }
@@ -370,7 +370,7 @@ async fn next_entry(fleet: &Fleet, looked: &mut Instant) -> Result<Option<Entry>
         Ok(reply) => Ok(reply
             .and_then(|r| r.keys.into_iter().next())
             .and_then(|k| k.ids.first().and_then(Entry::read))),
-        Err(e) if e.0.contains("NOGROUP") => create_group(fleet).await.map(|()| None),
+        Err(e) if e.is("NOGROUP") => create_group(fleet).await.map(|()| None),
         Err(e) => Err(e),
     }
 }
@@ -385,7 +385,7 @@ async fn create_group(fleet: &Fleet) -> Result<(), Failure> {
         .arg("MKSTREAM")
         .clone();
     match fleet.jobs.query::<()>(&create).await {
-        Err(e) if !e.0.contains("BUSYGROUP") => Err(e),
+        Err(e) if !e.is("BUSYGROUP") => Err(e),
         _ => Ok(()),
     }
 }

@@ -1,13 +1,13 @@
 //! The model's value at one measured point, and its sensitivities to the layer.
 //!
-//! For one particle, MODEL.md §3 gives the structure: A = A₀ · α(ξ, κ) with
+//! For one particle, docs/model.md §3 gives the structure: A = A₀ · α(ξ, κ) with
 //! A₀ = 2√(πRP H/E_L), ξ = V T_σ / r₀ and r₀ ∝ (H/E_L)^{1/4}; μ = τ_a A / P with
 //! τ_a = E_L/(2000(1 + ν)). So every sensitivity in logarithms follows from two:
 //! g = ∂ ln α/∂ ln ξ (one solve at a slightly higher speed) and ∂ ln α/∂κ (one solve at a
 //! slightly larger κ). Such a point costs at most three solves, whatever the number of
 //! parameters; a point at rest costs one.
 //!
-//! A three-body system (MODEL.md §4) mixes particles of every size and the upper surface's
+//! A three-body system (docs/model.md §4) mixes particles of every size and the upper surface's
 //! contacts, so it has no such structure: its sensitivities are forward differences in T_σ
 //! (at fixed κ), κ, E_L and H, four more solves (two at rest, where the times have no effect).
 

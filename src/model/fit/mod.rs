@@ -5,7 +5,7 @@
 //! intervals and an identifiability verdict.
 //!
 //! Parameters are fitted in logarithms: every one is positive, they span decades, and the
-//! model's own structure is multiplicative in them (MODEL.md §3: A = A₀(k, R, P) · α(ξ, κ)).
+//! model's own structure is multiplicative in them (docs/model.md §3: A = A₀(k, R, P) · α(ξ, κ)).
 
 pub mod forward;
 pub mod lm;
