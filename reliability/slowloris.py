@@ -71,5 +71,6 @@ with Server(preexec=limit_files) as server:
     held.sort()
     median = held[len(held) // 2] if held else float("nan")
     print(f"slowloris: {SLOW} slow connections, server limited to 1024 files, {SECONDS:.0f} s")
-    print(latency_line("/healthz", health) + f", {len(failures)} failed (5 s timeout)")
+    why = f": {', '.join(sorted(set(failures)))}" if failures else ""
+    print(latency_line("/healthz", health) + f", {len(failures)} failed (5 s timeout){why}")
     print(f"slow connections held: median {median:.0f} s, longest {max(held or [0]):.0f} s")

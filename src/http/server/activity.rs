@@ -12,9 +12,12 @@ use tokio::sync::OwnedSemaphorePermit;
 use tokio::task::AbortHandle;
 
 /// How long a write may wait, or a body crawl, before its connection counts as stalled for
-/// eviction (the send and body timeouts close it later anyway): a client on a slow link
-/// keeps its place through short waits.
-const STALL_GRACE_MS: u64 = 200;
+/// eviction (the send and body timeouts close it later anyway), and how long a connection
+/// just opened or answered has to begin its request: a client on a slow link keeps its place
+/// through short waits. Longer is not kinder: while a burst of newcomers is all within it,
+/// nothing may go, the accept loop waits and their SYNs queue (200 ms cost a /healthz probe
+/// a 1 s retransmit under 1,100 slowloris connections).
+const STALL_GRACE_MS: u64 = 50;
 
 /// A monotonic clock in milliseconds that atomics can hold; 0 means "never".
 #[derive(Clone, Copy, Debug)]
@@ -42,6 +45,8 @@ pub struct Activity {
     idle_since: AtomicU64,
     /// Whether bytes arrived since then: a request head has begun.
     heard: AtomicBool,
+    /// Whether a request has been answered on it (a keep-alive connection).
+    answered: AtomicBool,
     /// Since when a write has waited for the client to read; 0 while none waits.
     stalled_since: AtomicU64,
     /// Since when a request body has been arriving; 0 while none is.
@@ -51,9 +56,11 @@ pub struct Activity {
 /// Why a connection may be closed to make room, the most dispensable first.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
 enum Dispensable {
-    /// No request: an idle keep-alive connection, or one that has sent nothing yet.
+    /// No request since its last answer: an idle keep-alive connection.
     Idle,
-    /// A request head begun and not finished (slowloris).
+    /// A request head begun and not finished (slowloris), or none begun on a connection
+    /// that has not been answered yet: a silent newcomer is no more dispensable than a
+    /// slowloris that sent a byte (a /healthz probe whose request was late went first).
     HeadUnfinished,
     /// Its client has not read the answer for a while.
     NotReading,
@@ -68,6 +75,7 @@ impl Activity {
             requests: AtomicU32::new(0),
             idle_since: AtomicU64::new(clock.now()),
             heard: AtomicBool::new(false),
+            answered: AtomicBool::new(false),
             stalled_since: AtomicU64::new(0),
             receiving_since: AtomicU64::new(0),
         }
@@ -122,7 +130,7 @@ impl Activity {
             if !waited(since) {
                 return None;
             }
-            let why = if self.heard.load(Relaxed) {
+            let why = if self.heard.load(Relaxed) || !self.answered.load(Relaxed) {
                 Dispensable::HeadUnfinished
             } else {
                 Dispensable::Idle
@@ -150,6 +158,7 @@ impl Drop for RequestGuard {
     fn drop(&mut self) {
         let activity = &self.0;
         activity.idle_since.store(activity.clock.now(), Relaxed);
+        activity.answered.store(true, Relaxed);
         activity.requests.fetch_sub(1, Relaxed);
     }
 }
@@ -272,6 +281,7 @@ mod tests {
     fn idle_connections_go_first_then_unfinished_heads_then_stalled_readers_then_slow_bodies() {
         let now = 100_000;
         let idle = Arc::new(at(5_000));
+        drop(idle.request());
         let head = Arc::new(at(1_000));
         head.heard.store(true, Relaxed);
         let reader = Arc::new(at(1_000));
@@ -338,11 +348,24 @@ mod tests {
             Some(Dispensable::SlowBody),
             "a crawling body goes before it"
         );
+        // Then, silent, it ranks with unfinished heads, after those that have waited longer
+        // (a slowloris that sent a byte), and after idle keep-alive connections.
+        let later = now + STALL_GRACE_MS;
+        let slowloris = Arc::new(at(2_000));
+        slowloris.heard();
+        let keep_alive = Arc::new(at(1_000));
+        drop(keep_alive.request());
+        let mut ranked: Vec<_> = [&fresh, &slowloris, &keep_alive]
+            .iter()
+            .enumerate()
+            .filter_map(|(i, a)| a.dispensable(later).map(|key| (key, i)))
+            .collect();
+        ranked.sort();
         assert_eq!(
-            fresh.dispensable(now + STALL_GRACE_MS).map(|(why, _)| why),
-            Some(Dispensable::Idle),
-            "then it is idle like any other"
+            ranked.iter().map(|(_, i)| *i).collect::<Vec<_>>(),
+            [2, 1, 0]
         );
+        assert_eq!(ranked[2].0 .0, Dispensable::HeadUnfinished);
     }
 
     #[test]
