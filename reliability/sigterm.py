@@ -12,6 +12,20 @@ import time
 
 from common import Server, request
 
+def fate(port, job_id, every, gone):
+    """Polls the job every `every` seconds until it ends; its final status, or `gone`
+    (formatted with the error's name) once the server no longer answers."""
+    while True:
+        try:
+            status, body, _ = request(port, "GET", f"/v1/jobs/{job_id}", timeout=5)
+        except OSError as e:
+            return gone.format(type(e).__name__)
+        state = json.loads(body).get("status") if status == 200 else f"HTTP {status}"
+        if state not in ("queued", "running"):
+            return state
+        time.sleep(every)
+
+
 with Server("--pool-size", "1", "--max-sweep-points", "1000000", "--shutdown-timeout", "60s") as server:
     port = server.port
     # Its own rule keeps every point an exact strip solve (not a table look-up): long.
@@ -29,17 +43,7 @@ with Server("--pool-size", "1", "--max-sweep-points", "1000000", "--shutdown-tim
     final = {}
 
     def follow(job_id):
-        while True:
-            try:
-                status, body, _ = request(port, "GET", f"/v1/jobs/{job_id}", timeout=5)
-            except OSError:
-                final[job_id] = "lost (server gone before it answered)"
-                return
-            state = json.loads(body).get("status") if status == 200 else f"HTTP {status}"
-            if state not in ("queued", "running"):
-                final[job_id] = state
-                return
-            time.sleep(0.05)
+        final[job_id] = fate(port, job_id, every=0.05, gone="lost (server gone before it answered)")
 
     threads = [threading.Thread(target=follow, args=(i,)) for i in ids]
     for t in threads:
@@ -69,17 +73,7 @@ def pollers_of_an_interrupted_job():
 
         def poll(k):
             time.sleep(0.2 * k)
-            while True:
-                try:
-                    status, body, _ = request(port, "GET", f"/v1/jobs/{job}", timeout=5)
-                except OSError as e:
-                    seen[k] = f"refused ({type(e).__name__})"
-                    return
-                state = json.loads(body).get("status") if status == 200 else f"HTTP {status}"
-                if state not in ("queued", "running"):
-                    seen[k] = state
-                    return
-                time.sleep(1)
+            seen[k] = fate(port, job, every=1, gone="refused ({})")
 
         threads = [threading.Thread(target=poll, args=(k,)) for k in range(5)]
         for t in threads:
