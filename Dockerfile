@@ -11,6 +11,7 @@ ARG THIRDBODY_GIT_COMMIT=unknown
 ENV THIRDBODY_GIT_COMMIT=${THIRDBODY_GIT_COMMIT}
 WORKDIR /src
 COPY Cargo.toml Cargo.lock build.rs ./
+COPY model model
 COPY src src
 COPY benches benches
 COPY openapi openapi

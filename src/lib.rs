@@ -10,5 +10,5 @@ pub mod check;
 pub mod engine;
 pub mod http;
 pub mod job;
-pub mod model;
+pub use thirdbody_model as model;
 pub mod render;

@@ -3,7 +3,9 @@
 //! on a pool of permits sized to the cores ([`pool`]), a result cache ([`cache`]) in front
 //! of which identical misses share one solve ([`coalesce`]), and a store of asynchronous
 //! jobs ([`store`]). The cache and the store are traits, so that a shared backend can take
-//! the place of the in-process ones.
+//! the place of the in-process ones. Inside, the engine is two parts: the solve path
+//! ([`Solver`]) and the life of asynchronous jobs (`lifecycle`); the fleet's workers
+//! ([`fleet::Worker`]) solve through the same [`Solver`].
 
 mod background;
 mod backlog;
@@ -14,15 +16,18 @@ mod coalesce;
 mod doorkeeper;
 pub mod fleet;
 pub mod heavy;
+mod lifecycle;
 mod memo;
 pub mod metrics;
 pub mod pool;
 mod service;
+mod solver;
 pub mod spill;
 pub mod store;
 
 pub use backlog::Backlogged;
-pub use service::{CacheStatus, Engine, EngineConfig, EngineError, Storage};
+pub use service::{Engine, EngineConfig, EngineError, Storage};
+pub use solver::{CacheStatus, Solver};
 
 use crate::job::{Control, Job, JobError};
 use crate::render::Answer;

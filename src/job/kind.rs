@@ -351,6 +351,43 @@ impl Job {
     }
 }
 
+/// A validated job and its [`Meta`] (which holds its cache key), made together by
+/// [`Job::keyed`]: what the engine solves and caches, so that a job can never be paired with
+/// another's key.
+#[derive(Clone, Debug)]
+pub struct Keyed {
+    job: Job,
+    meta: Meta,
+}
+
+impl Keyed {
+    pub fn job(&self) -> &Job {
+        &self.job
+    }
+
+    pub fn meta(&self) -> &Meta {
+        &self.meta
+    }
+
+    /// The cache key: the hash of the canonical input and the model version.
+    pub fn key(&self) -> &str {
+        &self.meta.input_hash
+    }
+
+    /// The job and its meta, to run it ([`Job::run`]).
+    pub fn into_parts(self) -> (Job, Meta) {
+        (self.job, self.meta)
+    }
+}
+
+impl Job {
+    /// The job with its [`Meta`] (computing it costs a few µs: once per request).
+    pub fn keyed(self) -> Keyed {
+        let meta = self.meta();
+        Keyed { job: self, meta }
+    }
+}
+
 impl PartialEq for Job {
     fn eq(&self, other: &Job) -> bool {
         self.kind.same(other.kind.as_any()) && self.warnings == other.warnings

@@ -20,7 +20,7 @@ use std::time::Duration;
 pub use cache::TieredCache;
 pub use link::{Failure, Link};
 pub use store::RedisJobStore;
-pub use worker::Shared;
+pub use worker::{Shared, Worker};
 
 use super::cache::MemoryCache;
 use super::{EngineConfig, Storage};

@@ -15,14 +15,17 @@ use redis::streams::{StreamAutoClaimReply, StreamId, StreamReadReply};
 use redis::Value;
 use uuid::Uuid;
 
+use tokio::sync::Semaphore;
+use tokio_util::sync::CancellationToken;
+
 use super::store::RedisJobStore;
 use super::{keys, Failure, Fleet};
 use crate::engine::cache::Solved;
 use crate::engine::metrics as names;
 use crate::engine::pool::Pool;
+use crate::engine::solver::Solver;
 use crate::engine::spill::JobResult;
 use crate::engine::store::JobState;
-use crate::engine::Engine;
 use crate::job::parts::{self, RenderedPart};
 use crate::job::{Control, Job, JobError, Unfinished, Work};
 
@@ -113,35 +116,41 @@ enum Outcome {
     Part(RenderedPart),
 }
 
-impl Engine {
-    /// Starts `loops` workers on the fleet's stream (none without a fleet). With
-    /// `share_with_requests` (a process that also serves HTTP) they take the job slots, so
-    /// that a synchronous request always finds a solver thread. They stop when the engine
-    /// drains.
-    pub fn start_workers(self: &Arc<Self>, loops: usize, share_with_requests: bool) {
-        let Some(shared) = self.fleet.clone() else {
-            return;
-        };
-        let watcher = shared.fleet.clone();
-        tokio::spawn(async move { watcher.watch().await });
-        for _ in 0..loops.max(1) {
-            let (engine, shared) = (self.clone(), shared.clone());
-            self.tracker
-                .spawn(async move { engine.work(&shared, share_with_requests).await });
+/// One worker of the fleet's stream, built from the handles it needs: the solve path, the
+/// fleet, the job slots it shares with synchronous requests (if any), and the drain's
+/// signal, at which it stops taking entries.
+pub struct Worker {
+    solver: Arc<Solver>,
+    shared: Arc<Shared>,
+    slots: Option<Arc<Semaphore>>,
+    draining: CancellationToken,
+}
+
+impl Worker {
+    pub fn new(
+        solver: Arc<Solver>,
+        shared: Arc<Shared>,
+        slots: Option<Arc<Semaphore>>,
+        draining: CancellationToken,
+    ) -> Worker {
+        Worker {
+            solver,
+            shared,
+            slots,
+            draining,
         }
     }
 
-    /// One worker's loop.
-    async fn work(self: Arc<Self>, shared: &Shared, share_with_requests: bool) {
+    /// The worker's loop: one entry at a time until the drain begins.
+    pub async fn run(self) {
         let mut looked_for_orphans = Instant::now();
-        while !self.is_draining() {
-            let slot = if share_with_requests {
-                Some(self.job_slots.clone().acquire_owned().await)
-            } else {
-                None
+        while !self.draining.is_cancelled() {
+            let slot = match &self.slots {
+                Some(slots) => Some(slots.clone().acquire_owned().await),
+                None => None,
             };
-            match next_entry(&shared.fleet, &mut looked_for_orphans).await {
-                Ok(Some(entry)) => self.process(shared, entry).await,
+            match next_entry(&self.shared.fleet, &mut looked_for_orphans).await {
+                Ok(Some(entry)) => self.process(entry).await,
                 Ok(None) => tokio::time::sleep(IDLE).await,
                 Err(e) => {
                     tracing::debug!(error = %e, "no work from Redis");
@@ -153,7 +162,8 @@ impl Engine {
     }
 
     /// Solves `entry` and stores its result; acknowledges it unless it should run again.
-    async fn process(&self, shared: &Shared, entry: Entry) {
+    async fn process(&self, entry: Entry) {
+        let shared = &self.shared;
         let store = &shared.store;
         let id = entry.job;
         let deliveries = match store.delivered(id, &entry.part_name()).await {
@@ -161,7 +171,10 @@ impl Engine {
             Err(_) => return, // Redis is away: the entry stays ours, and is taken over later.
         };
         if deliveries > 1 {
-            self.metrics.counter(names::REDELIVERIES, &[]).increment(1);
+            self.solver
+                .metrics()
+                .counter(names::REDELIVERIES, &[])
+                .increment(1);
         }
         let runnable = match store.runnable(id).await {
             Ok(Some(r)) if !r.status.is_finished() => r,
@@ -179,24 +192,20 @@ impl Engine {
                  before finishing it (killed, or out of memory): the job is given up",
                 entry.part_name(),
             ));
-            return self
-                .finish(shared, &entry, JobState::failed(error), None)
-                .await;
+            return self.finish(&entry, JobState::failed(error), None).await;
         }
         let job = match Job::from_wire(&runnable.wire) {
             Ok(job) => job,
-            Err(e) => return self.finish(shared, &entry, JobState::failed(e), None).await,
+            Err(e) => return self.finish(&entry, JobState::failed(e), None).await,
         };
-        let meta = job.meta();
-        if meta.input_hash != runnable.key {
+        let keyed = job.clone().keyed();
+        if keyed.key() != runnable.key {
             let error = JobError::Internal(
                 "the job read back from the job store is not the job accepted".to_string(),
             );
-            return self
-                .finish(shared, &entry, JobState::failed(error), None)
-                .await;
+            return self.finish(&entry, JobState::failed(error), None).await;
         }
-        let control = Arc::new(self.control(runnable.deadline));
+        let control = Arc::new(self.solver.control(runnable.deadline));
         shared.running().insert(entry.id.clone(), control.clone());
         let heartbeat = tokio::spawn(heartbeat(
             shared.fleet.clone(),
@@ -208,11 +217,11 @@ impl Engine {
         ));
         tracing::info!(entry = entry.id, job = %id, part = entry.part_name(), deliveries, "solving a part");
         let _ = store.set_state(id, &JobState::Running, None).await;
-        let permit = self.pool.acquire().await;
-        self.jobs_running.increment(1.0);
+        let permit = self.solver.permit().await;
+        let running = self.solver.running();
         let key = runnable.key.clone();
         let part = entry.part.clone();
-        let solving = job.clone();
+        let (solving, meta) = keyed.into_parts();
         let result = Pool::run(permit, control.clone(), move |control| match part {
             None => match solving.run_keeping(meta, control) {
                 Ok(answer) => Ok(Outcome::Whole(Arc::new(Solved::new(
@@ -235,7 +244,7 @@ impl Engine {
             )?)),
         })
         .await;
-        self.jobs_running.decrement(1.0);
+        drop(running);
         heartbeat.abort();
         shared.running().remove(&entry.id);
         let outcome = match &result {
@@ -243,58 +252,48 @@ impl Engine {
             Err(JobError::Cancelled) => "cancelled",
             Err(_) => "failed",
         };
-        self.metrics
+        self.solver
+            .metrics()
             .counter(names::PARTS, &[("outcome", outcome)])
             .increment(1);
         match result {
             Ok(Outcome::Whole(solved)) => {
-                self.cache.insert(solved.clone()).await;
+                self.solver.keep(solved.clone()).await;
                 let total = match job.work() {
                     Work::Known(total) => total,
                     Work::Unknown => control.done(),
                 };
                 let state = JobState::Succeeded(JobResult::Ready(solved));
-                self.finish(shared, &entry, state, Some(total)).await;
+                self.finish(&entry, state, Some(total)).await;
             }
             Ok(Outcome::Stopped(error, partial)) => {
                 let state = JobState::Failed {
                     error,
                     partial: Some(JobResult::Ready(partial)),
                 };
-                self.finish(shared, &entry, state, Some(control.done()))
-                    .await;
+                self.finish(&entry, state, Some(control.done())).await;
             }
             Ok(Outcome::Part(rendered)) => {
                 let points = entry.part.as_ref().map_or(0, |(_, r)| r.len());
                 let index = entry.part.as_ref().map_or(0, |(i, _)| *i);
                 match store.part_done(id, index, &rendered, points).await {
-                    Ok(Some(all)) => {
-                        self.assemble(shared, &entry, &job, &runnable.key, &all)
-                            .await
-                    }
+                    Ok(Some(all)) => self.assemble(&entry, &job, &runnable.key, &all).await,
                     Ok(None) => acknowledge(&shared.fleet, &entry).await,
                     Err(_) => {} // taken over later
                 }
             }
             // Stopped by the drain: left to another process.
-            Err(JobError::Cancelled) if self.is_draining() => {}
+            Err(JobError::Cancelled) if self.draining.is_cancelled() => {}
             Err(JobError::Cancelled) => acknowledge(&shared.fleet, &entry).await,
             Err(e) => {
-                self.finish(shared, &entry, JobState::failed(e), Some(control.done()))
+                self.finish(&entry, JobState::failed(e), Some(control.done()))
                     .await;
             }
         }
     }
 
     /// Assembles the split `job` from all its parts and finishes it.
-    async fn assemble(
-        &self,
-        shared: &Shared,
-        entry: &Entry,
-        job: &Job,
-        key: &str,
-        all: &[RenderedPart],
-    ) {
+    async fn assemble(&self, entry: &Entry, job: &Job, key: &str, all: &[RenderedPart]) {
         let state = match parts::assemble(&job.meta(), all) {
             Ok(assembled) => {
                 let solved = Arc::new(Solved::rendered(
@@ -303,7 +302,7 @@ impl Engine {
                     Bytes::from(assembled.json),
                     Bytes::from(assembled.csv),
                 ));
-                self.cache.insert(solved.clone()).await;
+                self.solver.keep(solved.clone()).await;
                 JobState::Succeeded(JobResult::Ready(solved))
             }
             Err(e) => JobState::failed(e),
@@ -312,13 +311,14 @@ impl Engine {
             (JobState::Succeeded(_), Work::Known(n)) => Some(n),
             _ => None,
         };
-        self.finish(shared, entry, state, done).await;
+        self.finish(entry, state, done).await;
     }
 
     /// Stores the job's final `state`, then acknowledges the entry (left for another worker
     /// if the state could not be stored).
-    async fn finish(&self, shared: &Shared, entry: &Entry, state: JobState, done: Option<usize>) {
+    async fn finish(&self, entry: &Entry, state: JobState, done: Option<usize>) {
         state.log_end(entry.job);
+        let shared = &self.shared;
         if shared
             .store
             .set_state(entry.job, &state, done)

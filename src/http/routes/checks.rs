@@ -84,12 +84,8 @@ pub async fn run(
             reports.push(report);
             continue;
         }
-        let meta = spec.job.meta();
-        let answer = match state
-            .engine()
-            .solve_by(spec.job.clone(), meta, deadline)
-            .await
-        {
+        let keyed = spec.job.clone().keyed();
+        let answer = match state.engine().solve_by(keyed, deadline).await {
             Ok((solved, _)) => serde_json::from_slice::<Value>(solved.json())
                 .map_err(|e| JobError::Internal(e.to_string())),
             Err(EngineError::Job(e)) => Err(e),

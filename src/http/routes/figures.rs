@@ -41,7 +41,5 @@ pub async fn figure(
         .ok_or_else(|| {
             ApiError::not_found(format!("there is no figure {n}: figures are 3 to 9"))
         })?;
-    let job = Job::new(job);
-    let meta = job.meta();
-    answering.solve(&state, job, meta).await
+    answering.solve(&state, Job::new(job).keyed()).await
 }

@@ -154,12 +154,12 @@ pub async fn submit(
     body: JsonBody,
 ) -> Result<Response, ApiError> {
     let limits = state.config().limits;
-    let job = body
+    let keyed = body
         .read(&state, move |envelope| {
-            Ok(Job::from_value(envelope, &limits)?)
+            Ok(Job::from_value(envelope, &limits)?.keyed())
         })
         .await?;
-    let record = state.engine().submit(job).await?;
+    let record = state.engine().submit(keyed).await?;
     let location = format!("/v1/jobs/{}", record.id);
     let view = JobView::of(&record);
     let headers = [

@@ -28,7 +28,7 @@ use crate::engine::cache::{picture, Solved};
 use crate::engine::spill::JobResult;
 use crate::engine::{heavy, CacheStatus};
 use crate::job::meta::{GIT_COMMIT, SOFTWARE_VERSION};
-use crate::job::{Job, Meta};
+use crate::job::{Job, Keyed};
 use crate::model::MODEL_VERSION;
 use crate::render::Format;
 
@@ -260,15 +260,9 @@ impl Answering {
         Ok(response)
     }
 
-    /// Solves a validated job (whose [`Meta`], and so cache key, the caller computed) and
-    /// answers it.
-    pub async fn solve(
-        &self,
-        state: &AppState,
-        job: Job,
-        meta: Meta,
-    ) -> Result<Response, ApiError> {
-        let (solved, cache) = state.engine().solve(job, meta).await?;
+    /// Solves a validated job and answers it.
+    pub async fn solve(&self, state: &AppState, keyed: Keyed) -> Result<Response, ApiError> {
+        let (solved, cache) = state.engine().solve(keyed).await?;
         self.respond(&solved, Some(cache))
     }
 }
@@ -313,14 +307,12 @@ impl SolveRequest {
             return self.answering.respond(&solved, Some(CacheStatus::Hit));
         }
         let limits = state.config().limits;
-        let (job, meta) = offload(state, text.len(), move || {
-            let job = Job::from_input(kind, input, &limits)?;
-            let meta = job.meta();
-            Ok((job, meta))
+        let keyed = offload(state, text.len(), move || {
+            Ok(Job::from_input(kind, input, &limits)?.keyed())
         })
         .await?;
-        engine.remember_input(text, meta.input_hash.clone());
-        self.answering.solve(state, job, meta).await
+        engine.remember_input(text, keyed.key().to_string());
+        self.answering.solve(state, keyed).await
     }
 }
 

@@ -1,6 +1,6 @@
 //! docs/model.md §3 reference table, to every printed digit.
 
-use thirdbody::model::{solve, Layer, Rolling, SolveOptions};
+use thirdbody_model::{solve, Layer, Rolling, SolveOptions};
 
 /// One row: R nm, P nN, V nm/s, δ nm, a(0) nm, b(0) nm, A nm², x_c nm, x_p nm, μ; and the
 /// number of decimals printed for each of δ, a, b, A, x_c, x_p, μ.

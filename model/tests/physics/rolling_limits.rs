@@ -8,8 +8,8 @@
 
 use std::panic::{catch_unwind, AssertUnwindSafe};
 
-use thirdbody::model::limits::{instantaneous, relaxed, slow_rolling};
-use thirdbody::model::{
+use thirdbody_model::limits::{instantaneous, relaxed, slow_rolling};
+use thirdbody_model::{
     solve, Layer, ModelError, Parameter, Quadrature, Rolling, RollingSolution, SolveOption,
     SolveOptions,
 };
@@ -838,7 +838,7 @@ fn extreme_scales_give_finite_results_or_errors_not_panics() {
 
 /// (P̂, Â, ∬x dA, ∬x p dA) in units of r₀ for a contact of half-width r̂ (units of r₀).
 fn graded_integrals(half_width: f64, xi: f64, kappa: f64) -> [f64; 4] {
-    let (x16, w16) = thirdbody::model::quadrature::gauss_legendre_16();
+    let (x16, w16) = thirdbody_model::quadrature::gauss_legendre_16();
     // φ = π/2 − θ, y = r cos φ, b = r sin φ, dy = r sin φ dφ. Panels [φ/2, φ] down to
     // φ ~ 1e-4 min(ξ/r, 1), then one panel [0, φ_min].
     let mut edges = vec![std::f64::consts::FRAC_PI_2];
@@ -854,7 +854,7 @@ fn graded_integrals(half_width: f64, xi: f64, kappa: f64) -> [f64; 4] {
         for (t, w) in x16.iter().zip(w16) {
             let phi = 0.5 * (lo + hi) + 0.5 * (hi - lo) * t;
             let weight = 0.5 * (hi - lo) * w * phi.sin();
-            let strip = thirdbody::model::strip::Strip {
+            let strip = thirdbody_model::strip::Strip {
                 entry: half_width * phi.sin(),
                 relaxation_length: xi,
                 kappa,

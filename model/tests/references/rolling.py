@@ -1,10 +1,10 @@
 #!/usr/bin/env python3
-"""High-precision references for tests/honest_edges.rs: the rolling contact of MODEL.md §3 at
+"""High-precision references for model/tests/physics/honest_edges.rs: the rolling contact of MODEL.md §3 at
 the edges of its range (small κ = (T_ε − T_σ)/T_σ, slow rolling), computed from the exact
 closed forms with mpmath at 80 working digits, independently of the Rust solver.
 
     pip install mpmath
-    python3 tests/references/rolling.py          # prints the Rust constants (about 3 min)
+    python3 model/tests/references/rolling.py          # prints the Rust constants (about 3 min)
 
 Every input is the IEEE double the Rust test builds (printed with repr, which round-trips);
 the reference is the exact answer for those doubles: k = E_L/H, κ = (T_ε − T_σ)/T_σ and so

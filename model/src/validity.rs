@@ -200,7 +200,7 @@ pub fn three_body(system: &ThreeBody, s: &ThreeBodySolution) -> Vec<Check> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::{solve, SolveOptions};
+    use crate::{solve, SolveOptions};
 
     #[test]
     fn the_thresholds_are_those_of_model_section_7() {

@@ -2,7 +2,7 @@
 //! bounds the true error of every reported quantity for every rule offered, and the
 //! quantities that vanish with the viscosity keep their relative precision as it does.
 
-use thirdbody::model::{solve, Layer, Quadrature, Rolling, RollingSolution, SolveOptions};
+use thirdbody_model::{solve, Layer, Quadrature, Rolling, RollingSolution, SolveOptions};
 
 fn at(radius: f64, load: f64, velocity: f64, kappa: f64) -> Rolling {
     let layer = Layer::default();
@@ -126,7 +126,7 @@ fn the_shifts_keep_their_relative_precision_as_the_viscosity_vanishes() {
 
 #[test]
 fn a_vanishing_spread_of_diameters_joins_the_single_size_answer() {
-    use thirdbody::model::three_body::{
+    use thirdbody_model::three_body::{
         solve, Diameters, OperatingPoint, ThreeBody, ThreeBodyOptions,
     };
     let at = |std: f64| {
@@ -154,7 +154,7 @@ fn a_vanishing_spread_of_diameters_joins_the_single_size_answer() {
 
 #[test]
 fn a_finite_particle_modulus_softens_the_hertz_layer_contact_as_model_section_4_says() {
-    use thirdbody::model::three_body::{
+    use thirdbody_model::three_body::{
         solve, Diameters, LayerContact, OperatingPoint, Particle, ThreeBody, ThreeBodyOptions,
     };
     // Particles of one size at a given separation: each is squeezed by ω = x − d, split so

@@ -14,7 +14,7 @@ use super::{ModelError, OptionError, SolveOption};
 
 /// Gauss nodes used when a job does not ask for a number. Against a 1024-node rule, 64 nodes
 /// err by at most 6.7e-15 (relative, in δ, A, x_c and x_p) over 1e-6 ≤ V T_σ/r₀ ≤ 20 and
-/// 0.01 ≤ κ ≤ 1e4 (5e-11 before [`Spacing::Tips`]); `tests/rolling_limits.rs` holds that
+/// 0.01 ≤ κ ≤ 1e4 (5e-11 before [`Spacing::Tips`]); `tests/physics/rolling_limits.rs` holds that
 /// to 1e-9.
 pub const DEFAULT_GAUSS_NODES: usize = 64;
 /// Midpoint strips used when a job asks for the paper's method without a number.

@@ -292,7 +292,7 @@ mod tests {
     /// edge (where slow strips have a boundary layer of width V T_σ), against the closed forms.
     #[test]
     fn exact_strip_load_and_moment_equal_a_quadrature_of_the_pressure() {
-        let (x16, w16) = crate::model::quadrature::gauss_legendre_16();
+        let (x16, w16) = crate::quadrature::gauss_legendre_16();
         for &beta in &[0.1, 1.0, 10.0, 100.0] {
             let s = strip(beta, 4.0);
             let rho = s.exit_root(None).unwrap().rho;

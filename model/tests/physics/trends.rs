@@ -16,8 +16,8 @@
 
 use proptest::prelude::*;
 use proptest::test_runner::Config as ProptestConfig;
-use thirdbody::model::limits::relaxed;
-use thirdbody::model::{solve, Layer, Quadrature, Rolling, RollingSolution, SolveOptions};
+use thirdbody_model::limits::relaxed;
+use thirdbody_model::{solve, Layer, Quadrature, Rolling, RollingSolution, SolveOptions};
 
 fn config() -> ProptestConfig {
     ProptestConfig {

@@ -87,7 +87,7 @@ impl Use {
 }
 
 /// The largest certified error ([`SimilarityTable::error`]) with which a table answers a
-/// rolling job: a table is good to ≈ 1e-13 for κ ≤ 1e4 (tests/similarity.rs) but less for
+/// rolling job: a table is good to ≈ 1e-13 for κ ≤ 1e4 (tests/physics/similarity.rs) but less for
 /// stronger viscosity, where the exact solve answers instead.
 const ACCEPTED_TABLE_ERROR: f64 = 1e-10;
 

@@ -4,7 +4,7 @@
 
 use std::f64::consts::{FRAC_1_SQRT_2, PI};
 
-use crate::model::quadrature::gauss_legendre;
+use crate::quadrature::gauss_legendre;
 
 /// Heights are integrated to this many standard deviations above the separation.
 const HEIGHT_RANGE: f64 = 12.0;

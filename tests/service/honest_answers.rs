@@ -237,7 +237,7 @@ fn every_numeric_field_of_every_answer_has_a_unit() {
         json!({"kind": "sweep", "input": {"kind": "three_body",
             "vary": {"separation": ["50 nm"]}}}),
         json!({"kind": "figure", "input": {"number": 3}}),
-        serde_json::from_str(include_str!("../examples/fit.json")).unwrap(),
+        serde_json::from_str(include_str!("../../examples/fit.json")).unwrap(),
         json!({"kind": "fit", "input": {"series": [{"quantity": "contact_area", "points": [
             {"load": "1 nN", "value": "90 nm^2"}, {"load": "1.4 nN", "value": "101 nm^2"},
             {"load": "1.2 nN", "value": "95 nm^2"}]}],

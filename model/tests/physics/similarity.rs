@@ -1,12 +1,12 @@
-//! Rolling answers through the similarity tables (src/model/similarity.rs) against the exact
+//! Rolling answers through the similarity tables (src/similarity.rs) against the exact
 //! strip solver over the whole range the service promises: ξ = V T_σ/r₀ ∈ [0, ∞) and
 //! κ ∈ [0, 1e4], every integral quantity within 1e-9 (relative) and within the bound each
 //! answer reports in `verification.table_error`.
 
-use thirdbody::model::limits;
-use thirdbody::model::rolling::penetration_contact;
-use thirdbody::model::tables::{self, Use};
-use thirdbody::model::{self, Layer, Quadrature, Rolling, RollingSolution, SolveOptions};
+use thirdbody_model::limits;
+use thirdbody_model::rolling::penetration_contact;
+use thirdbody_model::tables::{self, Use};
+use thirdbody_model::{self as model, Layer, Quadrature, Rolling, RollingSolution, SolveOptions};
 
 /// A rolling contact on the default layer with viscosity strength κ at ξ = V T_σ/r₀.
 fn contact(kappa: f64, xi: f64) -> Rolling {

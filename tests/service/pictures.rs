@@ -1,6 +1,6 @@
 //! Every answer has a picture: SVG that parses, with axes, one path per series and a legend
 //! naming each, drawn from the answer's own numbers; Figures 3 and 6 are snapshot-tested
-//! (`UPDATE_SNAPSHOTS=1 cargo test --test pictures` rewrites them after a deliberate change).
+//! (`UPDATE_SNAPSHOTS=1 cargo test --test service pictures` rewrites them after a deliberate change).
 
 use serde_json::{json, Value};
 use thirdbody::job::{pictures, Control, Job, Limits};
@@ -183,7 +183,7 @@ fn a_three_body_system_shades_the_particles_in_contact_and_splits_the_area() {
 
 #[test]
 fn a_fit_draws_each_series_measured_and_fitted_with_its_residuals() {
-    let text = include_str!("../examples/fit.json");
+    let text = include_str!("../../examples/fit.json");
     let (answer, svg) = solve(serde_json::from_str(text).unwrap());
     let (series, legend) = parts(&svg);
     assert_eq!(

@@ -93,7 +93,7 @@ mod tests {
     #[test]
     fn the_truncated_density_integrates_to_one_and_matches_its_fractions() {
         let dist = Diameters::with_default_bounds(50e-9, 5e-9);
-        let rule = crate::model::quadrature::gauss_legendre(64);
+        let rule = crate::quadrature::gauss_legendre(64);
         let (x, w) = &*rule;
         let integral = |lo: f64, hi: f64| -> f64 {
             x.iter()

@@ -5,9 +5,9 @@
 use std::f64::consts::PI;
 use std::sync::Arc;
 
-use crate::model::roots::brent;
-use crate::model::similarity::SimilarityTable;
-use crate::model::ModelError;
+use crate::roots::brent;
+use crate::similarity::SimilarityTable;
+use crate::ModelError;
 
 /// How the upper surface takes a particle of radius R = x/2.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -331,7 +331,7 @@ fn quadrature_error(
     load_residual: f64,
 ) -> f64 {
     /// The bound never claims less than the rounding of the strip sums, the roots and the
-    /// scaling to SI units: against 40-digit references (tests/honest_edges.rs) exact
+    /// scaling to SI units: against 40-digit references (model/tests/physics/honest_edges.rs) exact
     /// answers whose quadrature and load residual leave next to nothing err by up to 1.3e-15
     /// (μ, which also rounds τ_a and P); 16 ε ≈ 3.6e-15 bounds that with a margin of 2.7
     /// (4 ε, 8.9e-16, did not).

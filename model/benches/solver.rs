@@ -1,0 +1,104 @@
+//! Speed of the physics core: one rolling solve at 1e-9 relative accuracy (target: < 100 µs
+//! median), through the similarity tables, and a `kelvin_layer` three-body system with a given
+//! total load (target: < 20 ms median). The service's own benchmarks (sweeps, figures, the work
+//! a request adds, fits) are the service crate's `service` bench. Results and method:
+//! BENCHMARKS.md. Run with `cargo bench --bench solver`.
+
+use std::hint::black_box;
+
+use criterion::{criterion_group, criterion_main, Criterion};
+use thirdbody_model::rolling::penetration_contact;
+use thirdbody_model::similarity::SimilarityTable;
+use thirdbody_model::tables::{self, Use};
+use thirdbody_model::three_body::{
+    self, Asperities, LayerContact, OperatingPoint, ThreeBody, ThreeBodyOptions,
+};
+use thirdbody_model::{solve, Quadrature, Rolling, SolveOptions};
+
+fn rolling(c: &mut Criterion) {
+    let mut group = c.benchmark_group("rolling");
+    let default = Rolling::default();
+    // The default job: V = 4 nm/s, 64 Gauss nodes, 41 boundary points.
+    group.bench_function("default_job", |b| {
+        b.iter(|| solve(black_box(&default), &SolveOptions::default()).unwrap())
+    });
+    // As in sweeps: no boundary.
+    group.bench_function("integrals_only", |b| {
+        let options = SolveOptions::integrals_only(Quadrature::default());
+        b.iter(|| solve(black_box(&default), &options).unwrap())
+    });
+    for velocity in [0.0, 1e-10, 1e-8, 1e-6] {
+        let point = Rolling {
+            velocity,
+            ..default
+        };
+        let options = SolveOptions::integrals_only(Quadrature::default());
+        group.bench_function(format!("integrals_only_V={velocity:e}"), |b| {
+            b.iter(|| solve(black_box(&point), &options).unwrap())
+        });
+    }
+    group.bench_function("midpoint_40_strips", |b| {
+        let options = SolveOptions::integrals_only(Quadrature::Midpoint { strips: 40 });
+        b.iter(|| solve(black_box(&default), &options).unwrap())
+    });
+    // Through the layer's similarity table, once built (as every answer after the first
+    // on a layer is in the service).
+    tables::get_or_build(default.layer.kappa(), Quadrature::default()).unwrap();
+    group.bench_function("tabulated_default_job", |b| {
+        let options = SolveOptions::default();
+        b.iter(|| tables::solve(black_box(&default), &options, Use::IfBuilt).unwrap())
+    });
+    group.bench_function("tabulated_integrals_only", |b| {
+        let options = SolveOptions::integrals_only(Quadrature::default());
+        b.iter(|| tables::solve(black_box(&default), &options, Use::IfBuilt).unwrap())
+    });
+    group.finish();
+}
+
+fn three_body(c: &mut Criterion) {
+    let mut group = c.benchmark_group("three_body");
+    let options = ThreeBodyOptions::default();
+    // The default system of docs/model.md §5 carrying W = 1 mN (target: < 20 ms median).
+    let kelvin = ThreeBody::with_defaults(OperatingPoint::TotalLoad(1e-3));
+    group.bench_function("kelvin_layer_total_load", |b| {
+        b.iter(|| three_body::solve(black_box(&kelvin), &options).unwrap())
+    });
+    group.bench_function("kelvin_layer_separation", |b| {
+        let at = ThreeBody {
+            operating: OperatingPoint::Separation(58e-9),
+            ..kelvin
+        };
+        b.iter(|| three_body::solve(black_box(&at), &options).unwrap())
+    });
+    group.bench_function("kelvin_layer_asperities", |b| {
+        let rough = ThreeBody {
+            asperities: Some(Asperities {
+                density: 1e11,
+                tip_radius: 1e-6,
+                height_std: 5e-9,
+                hardness: 1e9,
+            }),
+            ..kelvin
+        };
+        b.iter(|| three_body::solve(black_box(&rough), &options).unwrap())
+    });
+    group.bench_function("hertz_total_load", |b| {
+        let hertz = ThreeBody {
+            layer_contact: LayerContact::Hertz,
+            ..kelvin
+        };
+        b.iter(|| three_body::solve(black_box(&hertz), &options).unwrap())
+    });
+    group.bench_function("similarity_table_build", |b| {
+        b.iter(|| {
+            SimilarityTable::build(black_box(4.0), |xi| {
+                penetration_contact(xi, 4.0, Quadrature::default())
+            })
+            .unwrap()
+        })
+    });
+    group.finish();
+}
+
+criterion_group!(benches, rolling, three_body);
+criterion_main!(benches);

@@ -1,0 +1,9 @@
+//! The physics core against its closed forms, the reference table and its stated trends:
+//! one test binary, a module per concern.
+
+mod honest_edges;
+mod numerical_honesty;
+mod reference_table;
+mod rolling_limits;
+mod similarity;
+mod trends;

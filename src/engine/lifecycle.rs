@@ -1,0 +1,523 @@
+//! The life of asynchronous jobs: their records, the handles of those this process runs,
+//! their ids, the drain that waits for them, and the fleet's work stream when the engine
+//! works in one. Their solving goes through the [`Solver`], the one solve path.
+
+use std::collections::{HashMap, HashSet, VecDeque};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::{Arc, Mutex, MutexGuard};
+use std::time::{Duration, Instant};
+
+use metrics::Gauge;
+use tokio::sync::{watch, Semaphore};
+use tokio_util::sync::CancellationToken;
+use tokio_util::task::TaskTracker;
+use tracing::Instrument;
+use uuid::Uuid;
+
+use super::backlog::{Backlog, Ticket};
+use super::fleet::{Shared, Worker};
+use super::metrics::{self as names, Metrics};
+use super::solver::{Solver, Stopped};
+use super::spill::JobResult;
+use super::store::{JobRecord, JobState, JobStatus, JobStore};
+use super::{EngineConfig, EngineError};
+use crate::job::{Control, JobError, Keyed, Work};
+
+/// How long a cancel waits for the job to stop (it checks between units of work, which take
+/// microseconds to milliseconds).
+const CANCEL_WAIT: Duration = Duration::from_secs(5);
+
+/// The handles of an asynchronous job this process runs: what its record cannot hold.
+struct LiveJob {
+    control: Arc<Control>,
+    /// Wakes a job still waiting for a permit when it is cancelled (the solver itself
+    /// watches `control`).
+    cancel: CancellationToken,
+    /// Whether the job is being stopped by the shutdown rather than by its client.
+    interrupted: AtomicBool,
+    /// The job's status, for those who wait for a change.
+    status: watch::Sender<JobStatus>,
+}
+
+impl LiveJob {
+    /// Asks the job to stop: at once if it is queued, at the solver's next check if it runs.
+    fn cancel(&self) {
+        self.cancel.cancel();
+        self.control.cancel();
+    }
+
+    /// The state of a job that stopped on a cancel: interrupted if the shutdown asked.
+    fn stopped(&self, partial: Option<JobResult>) -> JobState {
+        if self.interrupted.load(Ordering::SeqCst) {
+            JobState::Interrupted
+        } else {
+            JobState::Cancelled { partial }
+        }
+    }
+}
+
+/// Finished jobs no client has read finished yet, oldest first.
+#[derive(Debug, Default)]
+struct Uncollected {
+    ids: HashSet<Uuid>,
+    order: VecDeque<Uuid>,
+}
+
+impl Uncollected {
+    /// Adds `id`, giving up the oldest beyond `max` (their clients are long gone).
+    fn insert(&mut self, id: Uuid, max: usize) {
+        self.ids.insert(id);
+        self.order.push_back(id);
+        while self.ids.len() > max {
+            match self.order.pop_front() {
+                Some(old) => {
+                    self.ids.remove(&old);
+                }
+                None => break,
+            }
+        }
+        // Ids read since are still in `order`: drop them when they outnumber the rest.
+        if self.order.len() > 2 * self.ids.len() + 16 {
+            let ids = &self.ids;
+            self.order.retain(|id| ids.contains(id));
+        }
+    }
+}
+
+/// Ids of asynchronous jobs: a tag of the process that accepted the job, then random bits.
+/// A process that does not know an id can tell whether it is its own (expired, or never
+/// given) or another run's (whose unfinished jobs a shutdown interrupted).
+#[derive(Clone, Copy, Debug)]
+struct JobIds {
+    instance: [u8; 4],
+}
+
+impl JobIds {
+    fn new() -> Self {
+        let tag = Uuid::new_v4();
+        let mut instance = [0; 4];
+        instance.copy_from_slice(&tag.as_bytes()[..4]);
+        JobIds { instance }
+    }
+
+    fn next(&self) -> Uuid {
+        let mut bytes = *Uuid::new_v4().as_bytes();
+        bytes[..4].copy_from_slice(&self.instance);
+        // Keep the version (4) and variant bits of the random UUID.
+        Uuid::from_bytes(bytes)
+    }
+
+    fn issued(&self, id: Uuid) -> bool {
+        id.as_bytes()[..4] == self.instance
+    }
+}
+
+/// The asynchronous jobs of an engine.
+pub(super) struct Lifecycle {
+    config: EngineConfig,
+    solver: Arc<Solver>,
+    jobs: Arc<dyn JobStore>,
+    /// The fleet, when the engine works in one: jobs then run on its work stream.
+    fleet: Option<Arc<Shared>>,
+    /// The jobs this process runs, by id.
+    live: Mutex<HashMap<Uuid, Arc<LiveJob>>>,
+    /// Jobs finished that no client has read finished yet (at most `max_jobs`, the oldest
+    /// given up first).
+    uncollected: Mutex<Uncollected>,
+    /// The jobs unfinished or uncollected when the drain began, whose clients have not yet
+    /// read them finished: the drain waits for them (see [`Lifecycle::jobs_collected`]).
+    owed: Mutex<HashSet<Uuid>>,
+    ids: JobIds,
+    /// Solver threads asynchronous jobs may hold at once: all but one, so that synchronous
+    /// requests always find one that no job holds.
+    job_slots: Arc<Semaphore>,
+    /// The tasks of asynchronous jobs (and the fleet's workers), waited for on shutdown.
+    tracker: TaskTracker,
+    /// Cancelled when the drain begins: no new work is taken from then on.
+    draining: CancellationToken,
+    /// Asynchronous jobs waiting for a permit.
+    queued: AtomicUsize,
+    /// The estimated work of the asynchronous jobs accepted and not ended.
+    backlog: Arc<Backlog>,
+    jobs_queued: Gauge,
+}
+
+impl Lifecycle {
+    pub(super) fn new(
+        config: EngineConfig,
+        metrics: &Metrics,
+        solver: Arc<Solver>,
+        jobs: Arc<dyn JobStore>,
+        fleet: Option<Arc<Shared>>,
+    ) -> Lifecycle {
+        let job_threads = config.pool_size.saturating_sub(1).max(1);
+        Lifecycle {
+            solver,
+            jobs,
+            fleet,
+            live: Mutex::default(),
+            uncollected: Mutex::default(),
+            owed: Mutex::default(),
+            ids: JobIds::new(),
+            job_slots: Arc::new(Semaphore::new(job_threads)),
+            backlog: Backlog::new(job_threads, config.job_deadline),
+            tracker: TaskTracker::new(),
+            draining: CancellationToken::new(),
+            queued: AtomicUsize::new(0),
+            jobs_queued: metrics.gauge(names::JOBS_QUEUED),
+            config,
+        }
+    }
+
+    fn live(&self) -> MutexGuard<'_, HashMap<Uuid, Arc<LiveJob>>> {
+        self.live.lock().unwrap_or_else(|p| p.into_inner())
+    }
+
+    /// Starts `loops` workers on the fleet's stream (none without a fleet). With
+    /// `share_with_requests` (a process that also serves HTTP) they take the job slots, so
+    /// that a synchronous request always finds a solver thread. They stop when the drain
+    /// begins.
+    pub(super) fn start_workers(&self, loops: usize, share_with_requests: bool) {
+        let Some(shared) = self.fleet.clone() else {
+            return;
+        };
+        let watcher = shared.fleet.clone();
+        tokio::spawn(async move { watcher.watch().await });
+        let slots = share_with_requests.then(|| self.job_slots.clone());
+        for _ in 0..loops.max(1) {
+            let worker = Worker::new(
+                self.solver.clone(),
+                shared.clone(),
+                slots.clone(),
+                self.draining.clone(),
+            );
+            self.tracker.spawn(worker.run());
+        }
+    }
+
+    /// Queues `job` to run in the background; returns its record. Refused when the queue
+    /// is full, the service is draining, or there is no room to keep the job's result.
+    pub(super) async fn submit(self: &Arc<Self>, keyed: Keyed) -> Result<JobRecord, EngineError> {
+        self.store_reachable()?;
+        let job = keyed.job().clone();
+        // A job whose answer is cached is answered at once: it takes no place in the queue.
+        if let Some(solved) = self.solver.cached(keyed.key()).await {
+            let mut record = JobRecord::queued(self.ids.next(), job.kind(), job.work());
+            let done = match job.work() {
+                Work::Known(total) => total,
+                Work::Unknown => 0,
+            };
+            self.jobs
+                .insert(record.clone(), solved.weight())
+                .await
+                .map_err(EngineError::from)?;
+            let state = JobState::Succeeded(JobResult::Ready(solved));
+            self.jobs.update(record.id, state.clone(), done).await;
+            self.uncollected().insert(record.id, self.config.max_jobs);
+            record.state = state;
+            record.done = done;
+            return Ok(record);
+        }
+        if let Some(shared) = &self.fleet {
+            return self.enqueue(shared, keyed).await;
+        }
+        let max = self.config.max_queued_jobs;
+        if self
+            .queued
+            .fetch_update(Ordering::SeqCst, Ordering::SeqCst, |n| {
+                (n < max).then_some(n + 1)
+            })
+            .is_err()
+        {
+            return Err(EngineError::Overloaded);
+        }
+        let units = match job.work() {
+            Work::Known(units) => units,
+            Work::Unknown => 1,
+        };
+        let ticket = match self.backlog.admit(job.cost_class(), units) {
+            Ok(ticket) => ticket,
+            Err(backlogged) => {
+                self.queued.fetch_sub(1, Ordering::SeqCst);
+                return Err(EngineError::Backlogged(backlogged));
+            }
+        };
+        let record = JobRecord::queued(self.ids.next(), job.kind(), job.work());
+        let id = record.id;
+        if let Err(refusal) = self.jobs.insert(record.clone(), job.result_bytes()).await {
+            self.queued.fetch_sub(1, Ordering::SeqCst);
+            return Err(refusal.into());
+        }
+        self.jobs_queued.increment(1.0);
+        let deadline = Instant::now() + self.config.job_deadline;
+        let live = Arc::new(LiveJob {
+            control: Arc::new(self.solver.control(deadline)),
+            cancel: CancellationToken::new(),
+            interrupted: AtomicBool::new(false),
+            status: watch::Sender::new(JobStatus::Queued),
+        });
+        self.live().insert(id, live.clone());
+        let span = tracing::info_span!("job", id = %id, kind = job.kind());
+        let lifecycle = self.clone();
+        self.tracker.spawn(
+            async move {
+                let work = job.work();
+                let state = lifecycle.run_job(&live, id, keyed, &ticket).await;
+                drop(ticket);
+                let status = state.status();
+                let done = match (status, work) {
+                    (JobStatus::Succeeded, Work::Known(total)) => total,
+                    _ => live.control.done(),
+                };
+                state.log_end(id);
+                lifecycle.jobs.update(id, state, done).await;
+                lifecycle
+                    .uncollected()
+                    .insert(id, lifecycle.config.max_jobs);
+                lifecycle.live().remove(&id);
+                live.status.send_replace(status);
+            }
+            .instrument(span),
+        );
+        Ok(record)
+    }
+
+    /// Puts `job` on the fleet's work stream (in parts, if it splits into more than a part's
+    /// points); refused when the stream holds more than 64 entries per queued job allowed.
+    async fn enqueue(&self, shared: &Shared, keyed: Keyed) -> Result<JobRecord, EngineError> {
+        let unavailable = |e: super::fleet::Failure| EngineError::Unavailable(e.why);
+        let backlog = shared.backlog().await.map_err(unavailable)?;
+        if backlog >= self.config.max_queued_jobs.saturating_mul(64) {
+            return Err(EngineError::Overloaded);
+        }
+        let job = keyed.job();
+        let per_part = shared.fleet.config.part_points;
+        let parts = job
+            .points()
+            .filter(|&n| n > per_part)
+            .map(|n| crate::job::parts::ranges(n, per_part))
+            .unwrap_or_default();
+        let record = JobRecord::queued(self.ids.next(), job.kind(), job.work());
+        let deadline = std::time::SystemTime::now() + self.config.job_deadline;
+        shared
+            .store
+            .enqueue(&record, &job.to_wire(), keyed.key(), deadline, &parts)
+            .await
+            .map_err(unavailable)?;
+        Ok(record)
+    }
+
+    /// `Unavailable` while the fleet's job store cannot be reached.
+    pub(super) fn store_reachable(&self) -> Result<(), EngineError> {
+        match &self.fleet {
+            Some(shared) if !shared.fleet.jobs.is_up() => Err(EngineError::Unavailable(
+                "no answer from it at the last try".to_string(),
+            )),
+            _ => Ok(()),
+        }
+    }
+
+    /// The reachability of each Redis role, when the engine works in a fleet.
+    pub(super) fn fleet_health(&self) -> Option<[(&'static str, bool); 2]> {
+        self.fleet.as_ref().map(|shared| shared.fleet.health())
+    }
+
+    /// The asynchronous job `id`, unless unknown or expired; a job this process runs has
+    /// its progress counted up to now.
+    pub(super) async fn job(&self, id: Uuid) -> Option<JobRecord> {
+        let mut record = self.jobs.get(id).await?;
+        if record.state.status().is_finished() {
+            self.collected(id);
+        }
+        if let Some(live) = self.live().get(&id) {
+            if !record.state.status().is_finished() {
+                record.done = live.control.done();
+            }
+        }
+        Some(record)
+    }
+
+    /// Whether `id` is the id of a job this process accepted (known or forgotten since).
+    pub(super) fn issued(&self, id: Uuid) -> bool {
+        self.jobs.shared() || self.ids.issued(id)
+    }
+
+    /// A receiver of the status changes of the job `id`, if this process runs it.
+    pub(super) fn watch(&self, id: Uuid) -> Option<watch::Receiver<JobStatus>> {
+        self.live().get(&id).map(|live| live.status.subscribe())
+    }
+
+    /// Cancels the job `id`: a queued job at once, a running one at the solver's next check;
+    /// waits a little for it to stop and returns it then. A finished job is left as it is.
+    pub(super) async fn cancel(&self, id: Uuid) -> Option<JobRecord> {
+        let before = self.job(id).await?;
+        let live = self.live().get(&id).cloned();
+        if live.is_none() && self.jobs.shared() && !before.state.status().is_finished() {
+            // Run by a worker of the fleet: it sees the cancel at its next heartbeat.
+            let state = JobState::Cancelled { partial: None };
+            self.jobs.update(id, state, before.done).await;
+        }
+        if let Some(live) = live {
+            live.cancel();
+            let mut status = live.status.subscribe();
+            // Still running after the wait: the answer says so, and the job stops soon after.
+            let _ = tokio::time::timeout(CANCEL_WAIT, status.wait_for(|s| s.is_finished())).await;
+        }
+        Some(self.job(id).await.unwrap_or(before))
+    }
+
+    /// Cancels the job `id` if it has not finished (see [`Lifecycle::cancel`]) and forgets it;
+    /// returns it as it ended.
+    pub(super) async fn delete(&self, id: Uuid) -> Option<JobRecord> {
+        let record = self.cancel(id).await?;
+        self.jobs.remove(id).await;
+        Some(record)
+    }
+
+    /// Forgets the finished jobs past their retention.
+    pub(super) async fn purge_expired_jobs(&self) -> usize {
+        self.jobs.purge_expired().await
+    }
+
+    /// Stops taking work: new solves and jobs are refused. The jobs accepted, queued or
+    /// running, go on; [`Lifecycle::jobs_finished`] waits for them to finish and
+    /// [`Lifecycle::jobs_collected`] for their clients to read them.
+    pub(super) fn begin_drain(&self) {
+        self.draining.cancel();
+        let unfinished: Vec<Uuid> = self.live().keys().copied().collect();
+        let uncollected: Vec<Uuid> = self.uncollected().ids.iter().copied().collect();
+        self.owed()
+            .extend(unfinished.into_iter().chain(uncollected));
+    }
+
+    fn owed(&self) -> MutexGuard<'_, HashSet<Uuid>> {
+        self.owed.lock().unwrap_or_else(|p| p.into_inner())
+    }
+
+    fn uncollected(&self) -> MutexGuard<'_, Uncollected> {
+        self.uncollected.lock().unwrap_or_else(|p| p.into_inner())
+    }
+
+    /// A client read the job `id` finished: it owes its client nothing more.
+    fn collected(&self, id: Uuid) {
+        self.uncollected().ids.remove(&id);
+        self.owed().remove(&id);
+    }
+
+    /// Resolves when every job unfinished at the start of the drain has been read finished
+    /// by its client (polled, or followed to its completion event), so that none of their
+    /// answers is lost with the process.
+    pub(super) async fn jobs_collected(&self) {
+        /// How often the drain looks.
+        const LOOK: Duration = Duration::from_millis(20);
+        while !self.owed().is_empty() {
+            tokio::time::sleep(LOOK).await;
+        }
+    }
+
+    /// Asynchronous jobs of this process queued or running: those a drain waits to finish.
+    pub(super) fn unfinished_jobs(&self) -> usize {
+        self.live().len()
+    }
+
+    /// Jobs finished that no client has read yet: those a drain waits for clients to read
+    /// (once it has begun, the jobs it owes that are finished; before, every one unread).
+    pub(super) fn unread_jobs(&self) -> usize {
+        if self.is_draining() {
+            let live: HashSet<Uuid> = self.live().keys().copied().collect();
+            self.owed().iter().filter(|id| !live.contains(id)).count()
+        } else {
+            self.uncollected().ids.len()
+        }
+    }
+
+    pub(super) fn is_draining(&self) -> bool {
+        self.draining.is_cancelled()
+    }
+
+    /// Resolves when every asynchronous job has finished (call after `begin_drain`).
+    pub(super) async fn jobs_finished(&self) {
+        self.tracker.close();
+        self.tracker.wait().await;
+    }
+
+    /// Waits (after `begin_drain`) for the jobs to finish until `end`; what is still running
+    /// then is interrupted ([`Lifecycle::interrupt_unfinished_jobs`]) and given a second to stop.
+    /// Returns whether every job finished in time.
+    pub(super) async fn finish_jobs(&self, end: tokio::time::Instant) -> bool {
+        if tokio::time::timeout_at(end, self.jobs_finished())
+            .await
+            .is_ok()
+        {
+            return true;
+        }
+        self.interrupt_unfinished_jobs();
+        // They stop at their next check, microseconds to milliseconds away.
+        let _ = tokio::time::timeout(Duration::from_secs(1), self.jobs_finished()).await;
+        false
+    }
+
+    /// Stops every job not finished yet (the drain ran out of time): they end
+    /// `interrupted`.
+    pub(super) fn interrupt_unfinished_jobs(&self) {
+        if let Some(shared) = &self.fleet {
+            shared.interrupt();
+        }
+        for live in self.live().values() {
+            live.interrupted.store(true, Ordering::SeqCst);
+            live.cancel();
+        }
+    }
+
+    /// The life of an asynchronous job after its submission; returns its final state.
+    /// Runs an accepted job to its end state; its solve time teaches `ticket`'s class.
+    async fn run_job(&self, live: &LiveJob, id: Uuid, keyed: Keyed, ticket: &Ticket) -> JobState {
+        let permit = match self.solver.cached(keyed.key()).await {
+            Some(hit) => Err(JobState::Succeeded(JobResult::Ready(hit))),
+            None => tokio::select! {
+                () = live.cancel.cancelled() => Err(live.stopped(None)),
+                permits = async {
+                    let slot = self.job_slots.clone().acquire_owned().await;
+                    (slot, self.solver.permit().await)
+                } => Ok(permits),
+            },
+        };
+        self.queued.fetch_sub(1, Ordering::SeqCst);
+        self.jobs_queued.decrement(1.0);
+        let (_slot, permit) = match permit {
+            Ok(permits) => permits,
+            Err(state) => return state,
+        };
+        self.jobs.update(id, JobState::Running, 0).await;
+        live.status.send_replace(JobStatus::Running);
+        let running = self.solver.running();
+        let (started, work) = (Instant::now(), keyed.job().work());
+        let result = self
+            .solver
+            .execute(permit, keyed, live.control.clone(), true)
+            .await;
+        // A job of unknown work (a fit) is one unit, and teaches only when it ends well;
+        // units recalled from the memo (a retry's) cost nothing and teach nothing.
+        let done = match (&result, work) {
+            (Ok(_), _) => ticket.units(),
+            (Err(_), Work::Known(_)) => live.control.done(),
+            (Err(_), Work::Unknown) => 0,
+        };
+        let solved = done.saturating_sub(live.control.recalled());
+        ticket.ran(solved, started.elapsed());
+        drop(running);
+        match result {
+            Ok(solved) => {
+                self.solver.keep(solved.clone()).await;
+                JobState::Succeeded(JobResult::Ready(solved))
+            }
+            Err(Stopped { error, partial }) => {
+                let partial = partial.map(JobResult::Ready);
+                match error {
+                    JobError::Cancelled => live.stopped(partial),
+                    error => JobState::Failed { error, partial },
+                }
+            }
+        }
+    }
+}

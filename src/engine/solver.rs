@@ -1,0 +1,318 @@
+//! The solve path: keyed job → cache → one solve per key in flight → a permit (or a refusal)
+//! → a blocking thread with a deadline and a cancel flag → the answer rendered and kept.
+//! Synchronous solves, asynchronous jobs ([`super::lifecycle`]) and the fleet's workers
+//! ([`super::fleet::Worker`]) all solve through it; it knows nothing of job records.
+
+use std::sync::Arc;
+use std::time::Instant;
+
+use futures_util::FutureExt;
+use metrics::{Counter, Gauge};
+use tokio::sync::OwnedSemaphorePermit;
+
+use super::background::Background;
+use super::bounded::Bounded;
+use super::budget::{self, Budget};
+use super::cache::{Claim, ResultCache, Solved};
+use super::coalesce::Coalescer;
+use super::doorkeeper::Doorkeeper;
+use super::memo::PointMemo;
+use super::metrics::{self as names, Metrics};
+use super::pool::Pool;
+use super::{EngineConfig, EngineError};
+use crate::job::{Control, JobError, Keyed, Unfinished};
+
+/// Whether an answer came from the cache or was solved for this call.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CacheStatus {
+    Hit,
+    Miss,
+}
+
+impl CacheStatus {
+    pub fn as_str(self) -> &'static str {
+        match self {
+            CacheStatus::Hit => "hit",
+            CacheStatus::Miss => "miss",
+        }
+    }
+}
+
+/// A solve that did not answer: why, and the partial answer of a job that keeps what it
+/// finished ([`crate::job::Unfinished`]).
+pub(super) struct Stopped {
+    pub error: JobError,
+    pub partial: Option<Arc<Solved>>,
+}
+
+impl From<JobError> for Stopped {
+    fn from(error: JobError) -> Self {
+        Stopped {
+            error,
+            partial: None,
+        }
+    }
+}
+
+/// The solver threads, the answers and what is remembered between requests.
+pub struct Solver {
+    pool: Pool,
+    cache: Arc<dyn ResultCache>,
+    coalescer: Coalescer,
+    /// The text of valid inputs (their kind and compact JSON with sorted keys) → their
+    /// cache key, so that a repeated request is answered without being validated again.
+    input_keys: Bounded<Arc<str>>,
+    /// Which inputs were seen once: the memo takes an input on its second sighting.
+    doorkeeper: Doorkeeper,
+    /// Solved points of sweeps, for a retry after a deadline.
+    points: Arc<PointMemo>,
+    /// Work jobs leave for later (tables to build); `None` if its thread could not start.
+    background: Option<Arc<Background>>,
+    metrics: Metrics,
+    cache_hits: Counter,
+    cache_misses: Counter,
+    jobs_running: Gauge,
+}
+
+impl Solver {
+    /// A solve path of `config.pool_size` threads whose answers are kept in `cache`.
+    pub(super) fn new(
+        config: &EngineConfig,
+        metrics: Metrics,
+        cache: Arc<dyn ResultCache>,
+    ) -> Self {
+        let budget = Budget::split(config.memory_budget);
+        Solver {
+            pool: Pool::new(config.pool_size),
+            cache,
+            coalescer: Coalescer::default(),
+            // An input and its key weigh about 100 bytes, and the entry's overhead more.
+            input_keys: Bounded::new(
+                budget.inputs,
+                config.cache_ttl,
+                budget::ENTRY_OVERHEAD,
+                |key: &Arc<str>| key.len() as u64,
+            ),
+            doorkeeper: Doorkeeper::new(budget.inputs / budget::ENTRY_OVERHEAD),
+            points: Arc::new(PointMemo::new(budget.points, config.cache_ttl)),
+            background: Background::start()
+                .inspect_err(|e| {
+                    tracing::warn!("no background thread ({e}): no tables built later")
+                })
+                .ok(),
+            cache_hits: metrics.counter(names::CACHE_HITS, &[]),
+            cache_misses: metrics.counter(names::CACHE_MISSES, &[]),
+            jobs_running: metrics.gauge(names::JOBS_RUNNING),
+            metrics,
+        }
+    }
+
+    pub fn metrics(&self) -> &Metrics {
+        &self.metrics
+    }
+
+    /// The cached answer to an input seen before (`text`: its kind and compact JSON), found
+    /// without validating the input again; `None` if it was not seen or its answer expired.
+    pub async fn cached_input(&self, text: &str) -> Option<Arc<Solved>> {
+        let key = self.input_keys.get(text)?;
+        self.cached(&key).await
+    }
+
+    /// Remembers that the input `text` (as for [`Solver::cached_input`]) is a valid job
+    /// with cache key `key`, if it was seen before ([`Doorkeeper`]).
+    pub fn remember_input(&self, text: String, key: String) {
+        if self.doorkeeper.seen_before(&text) {
+            self.input_keys.insert(text, key.into());
+        }
+    }
+
+    /// The cached answer under `key`, counted as a hit.
+    pub async fn cached(&self, key: &str) -> Option<Arc<Solved>> {
+        let solved = self.cache.get(key).await;
+        if solved.is_some() {
+            self.cache_hits.increment(1);
+        }
+        solved
+    }
+
+    /// Keeps `solved` in the cache.
+    pub async fn keep(&self, solved: Arc<Solved>) {
+        self.cache.insert(solved).await;
+    }
+
+    /// Solves `keyed` by `deadline`, or takes its answer from the cache. Identical
+    /// concurrent calls share one solve (in a fleet, one across processes). With no solver
+    /// thread free the call is refused at once.
+    pub async fn solve_by(
+        self: &Arc<Self>,
+        keyed: Keyed,
+        deadline: Instant,
+    ) -> Result<(Arc<Solved>, CacheStatus), EngineError> {
+        let key = keyed.key().to_string();
+        if let Some(solved) = self.cached(&key).await {
+            return Ok((solved, CacheStatus::Hit));
+        }
+        let solver = self.clone();
+        let key_claimed = key.clone();
+        let solve = move || {
+            async move {
+                if let Claim::Solved(solved) = solver.cache.claim(&key_claimed, deadline).await? {
+                    return Ok(solved);
+                }
+                let solved = solver.solve_claimed(keyed, deadline).await;
+                solver.cache.release(&key_claimed).await;
+                solved
+            }
+            .boxed()
+        };
+        let (solved, started) = self.coalescer.run(&key, solve).await;
+        let solved = solved?;
+        if started {
+            Ok((solved, CacheStatus::Miss))
+        } else {
+            self.cache_hits.increment(1);
+            Ok((solved, CacheStatus::Hit))
+        }
+    }
+
+    /// Solves `keyed` now, this process holding the fleet's claim on it, and keeps the
+    /// answer.
+    async fn solve_claimed(
+        &self,
+        keyed: Keyed,
+        deadline: Instant,
+    ) -> Result<Arc<Solved>, EngineError> {
+        let permit = self.pool.try_acquire().ok_or(EngineError::Overloaded)?;
+        let control = Arc::new(self.control(deadline));
+        let solved = self
+            .execute(permit, keyed, control, false)
+            .await
+            .map_err(|stopped| stopped.error)?;
+        self.keep(solved.clone()).await;
+        Ok(solved)
+    }
+
+    /// Waits for a solver thread's permit (first come, first served).
+    pub async fn permit(&self) -> OwnedSemaphorePermit {
+        self.pool.acquire().await
+    }
+
+    /// The control of a job run by this engine: one thread, `deadline`, the point memo and
+    /// the background thread.
+    pub fn control(&self, deadline: Instant) -> Control {
+        let control = Control::new(Some(deadline), 1).with_memo(self.points.clone());
+        match &self.background {
+            Some(background) => control.with_later(background.clone()),
+            None => control,
+        }
+    }
+
+    /// Counts a job as running (the `jobs_running` gauge) until the guard is dropped.
+    pub fn running(&self) -> Running {
+        self.jobs_running.increment(1.0);
+        Running(self.jobs_running.clone())
+    }
+
+    /// Solves `keyed` holding `permit` (on a blocking thread, or here if it is small),
+    /// renders its answer, and records the solve. With `keep` (an asynchronous job's
+    /// result, kept for its retention) the answer is rendered in every form now
+    /// ([`Solved::kept`]), and a job stopped before its end keeps what it finished.
+    pub(super) async fn execute(
+        &self,
+        permit: OwnedSemaphorePermit,
+        keyed: Keyed,
+        control: Arc<Control>,
+        keep: bool,
+    ) -> Result<Arc<Solved>, Stopped> {
+        self.cache_misses.increment(1);
+        let (job, meta) = keyed.into_parts();
+        let (kind, small) = (job.kind(), job.is_small());
+        let start = Instant::now();
+        let solve = move |control: &Control| {
+            let key = meta.input_hash.clone();
+            let kept = |solved: Solved| match keep {
+                true => solved.kept().map_err(|e| JobError::Internal(e.to_string())),
+                false => Ok(solved),
+            };
+            Ok(match job.run_keeping(meta, control) {
+                Ok(answer) => Solved::new(key, job.kind(), answer)
+                    .and_then(kept)
+                    .map(Arc::new)
+                    .map_err(Stopped::from),
+                Err(Unfinished { error, partial }) => Err(Stopped {
+                    error,
+                    partial: partial
+                        .filter(|_| keep)
+                        .and_then(|a| Solved::partial(key, job.kind(), a).and_then(kept).ok())
+                        .map(Arc::new),
+                }),
+            })
+        };
+        let result = if small {
+            // Tens of microseconds: less than the two thread hand-offs of `Pool::run`.
+            let _permit = permit;
+            solve(&control)
+        } else {
+            Pool::run(permit, control, solve).await
+        }
+        .unwrap_or_else(|e| Err(Stopped::from(e)));
+        let outcome = match &result {
+            Ok(_) => "succeeded",
+            Err(Stopped {
+                error: JobError::Cancelled,
+                ..
+            }) => "cancelled",
+            Err(Stopped {
+                error: JobError::DeadlineExceeded,
+                ..
+            }) => "deadline_exceeded",
+            Err(_) => "failed",
+        };
+        self.metrics
+            .fixed_histogram(
+                names::SOLVE_DURATION,
+                &[("kind", kind), ("outcome", outcome)],
+            )
+            .record(start.elapsed());
+        result
+    }
+}
+
+/// A job counted as running ([`Solver::running`]) until dropped.
+pub struct Running(Gauge);
+
+impl Drop for Running {
+    fn drop(&mut self) {
+        self.0.decrement(1.0);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::time::Duration;
+
+    use super::*;
+    use crate::engine::cache::MemoryCache;
+
+    #[tokio::test]
+    async fn the_input_memo_takes_an_input_on_its_second_sighting() {
+        let config = EngineConfig {
+            pool_size: 1,
+            solve_deadline: Duration::from_secs(1),
+            job_deadline: Duration::from_secs(1),
+            max_queued_jobs: 1,
+            memory_budget: 1 << 20,
+            max_jobs: 1,
+            cache_ttl: Duration::from_secs(60),
+            job_retention: Duration::from_secs(60),
+            spill: None,
+        };
+        let cache = Arc::new(MemoryCache::for_engine(&config));
+        let solver = Solver::new(&config, Metrics::noop(), cache);
+        let input = "rolling\n{\"load\":1e-9}";
+        solver.remember_input(input.into(), "key".into());
+        assert_eq!(solver.input_keys.get(input), None);
+        solver.remember_input(input.into(), "key".into());
+        assert_eq!(solver.input_keys.get(input).as_deref(), Some("key"));
+    }
+}

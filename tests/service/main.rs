@@ -1,0 +1,13 @@
+//! The service without HTTP: the command line, the job kinds through the library, pictures,
+//! the fleet's processes on a real Redis, and the deployment files. One test binary, a
+//! module per concern (the HTTP service end to end is the `api` binary).
+
+mod cli;
+mod deploy;
+mod fit;
+mod fleet;
+mod honest_answers;
+mod jobs;
+mod kinds;
+mod pictures;
+mod three_body;
