@@ -8,7 +8,7 @@ use std::time::{Duration, Instant};
 
 use async_trait::async_trait;
 use bytes::Bytes;
-use redis::Script;
+use redis::{Cmd, ExistenceCheck, Script, SetExpiry, SetOptions};
 
 use super::{keys, Fleet};
 use crate::engine::cache::{Claim, MemoryCache, ResultCache, Solved};
@@ -50,12 +50,7 @@ impl TieredCache {
         if !link.is_up() {
             return None;
         }
-        let cmd = redis::cmd("HMGET")
-            .arg(keys::answer(key))
-            .arg("json")
-            .arg("csv")
-            .arg("kind")
-            .clone();
+        let cmd = Cmd::hmget(keys::answer(key), &["json", "csv", "kind"][..]);
         type Fields = (Option<Vec<u8>>, Option<Vec<u8>>, Option<String>);
         let (json, csv, kind): Fields = link.query(&cmd).await.ok()?;
         let kind = registry::find(&kind?).ok()?.name();
@@ -90,19 +85,15 @@ impl ResultCache for TieredCache {
         };
         let key = keys::answer(&solved.key);
         let mut pipe = redis::pipe();
+        let fields: [(&str, &[u8]); 3] = [
+            ("json", solved.json()),
+            ("csv", &csv),
+            ("kind", solved.kind.as_bytes()),
+        ];
         pipe.atomic()
-            .cmd("HSET")
-            .arg(&key)
-            .arg("json")
-            .arg(solved.json().as_ref())
-            .arg("csv")
-            .arg(csv.as_ref())
-            .arg("kind")
-            .arg(solved.kind)
+            .hset_multiple(&key, &fields)
             .ignore()
-            .cmd("PEXPIRE")
-            .arg(&key)
-            .arg(millis(self.ttl))
+            .pexpire(&key, i64::try_from(millis(self.ttl)).unwrap_or(i64::MAX))
             .ignore();
         if let Err(e) = link.pipe::<()>(&pipe).await {
             tracing::warn!(error = %e, "an answer was not shared");
@@ -118,13 +109,10 @@ impl ResultCache for TieredCache {
                 return Ok(Claim::Mine);
             }
             let lapse = deadline.saturating_duration_since(Instant::now()) + Duration::from_secs(1);
-            let taken = redis::cmd("SET")
-                .arg(&claim)
-                .arg(&self.fleet.consumer)
-                .arg("NX")
-                .arg("PX")
-                .arg(millis(lapse))
-                .clone();
+            let only_new = SetOptions::default()
+                .conditional_set(ExistenceCheck::NX)
+                .with_expiration(SetExpiry::PX(millis(lapse)));
+            let taken = Cmd::set_options(&claim, &self.fleet.consumer, only_new);
             if let Ok(Some(_)) = link.query::<Option<String>>(&taken).await {
                 // Solved by another between the lookup and the claim?
                 if let Some(solved) = self.shared(key).await {

@@ -184,7 +184,7 @@ impl Link {
     pub async fn watch(&self) {
         loop {
             tokio::time::sleep(RETRY_EVERY).await;
-            let _ = self.query::<String>(&redis::cmd("PING")).await;
+            let _ = self.query::<String>(&Cmd::ping()).await;
         }
     }
 }

@@ -10,7 +10,7 @@ use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
 
 use async_trait::async_trait;
 use bytes::Bytes;
-use redis::Script;
+use redis::{Cmd, Script};
 use uuid::Uuid;
 
 use super::cache::millis;
@@ -97,49 +97,29 @@ impl RedisJobStore {
         let job = keys::job(record.id);
         let id = record.id.to_string();
         let mut pipe = redis::pipe();
-        pipe.atomic()
-            .cmd("HSET")
-            .arg(&job.record)
-            .arg("kind")
-            .arg(record.kind)
-            .arg("work")
-            .arg(work_text(record.work))
-            .arg("status")
-            .arg(JobStatus::Queued.as_str())
-            .arg("done")
-            .arg(0)
-            .arg("job")
-            .arg(wire)
-            .arg("key")
-            .arg(key)
-            .arg("deadline")
-            .arg(unix_millis(deadline))
-            .arg("parts")
-            .arg(parts.len().max(1))
-            .arg("parts_done")
-            .arg(0)
-            .ignore();
+        let fields = [
+            ("kind", record.kind.to_string()),
+            ("work", work_text(record.work)),
+            ("status", JobStatus::Queued.as_str().to_string()),
+            ("done", "0".to_string()),
+            ("job", wire.to_string()),
+            ("key", key.to_string()),
+            ("deadline", unix_millis(deadline).to_string()),
+            ("parts", parts.len().max(1).to_string()),
+            ("parts_done", "0".to_string()),
+        ];
+        pipe.atomic().hset_multiple(&job.record, &fields).ignore();
         if parts.is_empty() {
-            pipe.cmd("XADD")
-                .arg(keys::STREAM)
-                .arg("*")
-                .arg("job")
-                .arg(&id)
-                .ignore();
+            pipe.xadd(keys::STREAM, "*", &[("job", &id)]).ignore();
         }
         for (index, range) in parts.iter().enumerate() {
-            pipe.cmd("XADD")
-                .arg(keys::STREAM)
-                .arg("*")
-                .arg("job")
-                .arg(&id)
-                .arg("part")
-                .arg(index)
-                .arg("start")
-                .arg(range.start)
-                .arg("end")
-                .arg(range.end)
-                .ignore();
+            let entry = [
+                ("job", id.clone()),
+                ("part", index.to_string()),
+                ("start", range.start.to_string()),
+                ("end", range.end.to_string()),
+            ];
+            pipe.xadd(keys::STREAM, "*", &entry).ignore();
         }
         self.fleet.jobs.pipe::<()>(&pipe).await
     }
@@ -147,20 +127,15 @@ impl RedisJobStore {
     /// The status of job `id`; `None` if it is gone (deleted or expired). A running part's
     /// heartbeat asks it five times a second, so it reads that one field only.
     pub async fn status(&self, id: Uuid) -> Result<Option<JobStatus>, Failure> {
-        let cmd = redis::cmd("HGET")
-            .arg(keys::job(id).record)
-            .arg("status")
-            .clone();
+        let cmd = Cmd::hget(keys::job(id).record, "status");
         let status: Option<String> = self.fleet.jobs.query(&cmd).await?;
         Ok(status.as_deref().map(parse_status))
     }
 
     /// The job `id` as a worker runs it; `None` if it is gone (deleted or expired).
     pub async fn runnable(&self, id: Uuid) -> Result<Option<Runnable>, Failure> {
-        let cmd = redis::cmd("HMGET")
-            .arg(keys::job(id).record)
-            .arg(&["status", "job", "key", "deadline", "parts"][..])
-            .clone();
+        let fields = ["status", "job", "key", "deadline", "parts"];
+        let cmd = Cmd::hmget(keys::job(id).record, &fields[..]);
         type Fields = (
             Option<String>,
             Option<String>,
@@ -183,11 +158,7 @@ impl RedisJobStore {
 
     /// Counts a delivery of part `part` of job `id`; returns the deliveries so far.
     pub async fn delivered(&self, id: Uuid, part: &str) -> Result<u64, Failure> {
-        let cmd = redis::cmd("HINCRBY")
-            .arg(keys::job(id).deliveries)
-            .arg(part)
-            .arg(1)
-            .clone();
+        let cmd = Cmd::hincr(keys::job(id).deliveries, part, 1);
         self.fleet.jobs.query(&cmd).await
     }
 
@@ -278,11 +249,8 @@ impl RedisJobStore {
     pub async fn record(&self, id: Uuid) -> Result<Option<JobRecord>, Failure> {
         let job = keys::job(id);
         let mut pipe = redis::pipe();
-        pipe.cmd("HGETALL")
-            .arg(&job.record)
-            .cmd("HMGET")
-            .arg(&job.result)
-            .arg(&["json", "csv"][..]);
+        pipe.hgetall(&job.record)
+            .hmget(&job.result, &["json", "csv"][..]);
         type Fields = (HashMap<String, Vec<u8>>, (Option<Vec<u8>>, Option<Vec<u8>>));
         let (fields, (json, csv)): Fields = self.fleet.jobs.pipe(&pipe).await?;
         if fields.is_empty() {
@@ -350,21 +318,15 @@ impl JobStore for RedisJobStore {
     /// The results are kept in Redis, whose memory bounds them (its `maxmemory`): no room
     /// is made here.
     async fn insert(&self, record: JobRecord, _result_bytes: u64) -> Result<(), Refusal> {
-        let cmd = redis::cmd("HSET")
-            .arg(keys::job(record.id).record)
-            .arg("kind")
-            .arg(record.kind)
-            .arg("work")
-            .arg(work_text(record.work))
-            .arg("status")
-            .arg(record.state.status().as_str())
-            .arg("done")
-            .arg(record.done)
-            .arg("parts")
-            .arg(1)
-            .arg("parts_done")
-            .arg(0)
-            .clone();
+        let fields = [
+            ("kind", record.kind.to_string()),
+            ("work", work_text(record.work)),
+            ("status", record.state.status().as_str().to_string()),
+            ("done", record.done.to_string()),
+            ("parts", "1".to_string()),
+            ("parts_done", "0".to_string()),
+        ];
+        let cmd = Cmd::hset_multiple(keys::job(record.id).record, &fields);
         if let Err(e) = self.fleet.jobs.query::<()>(&cmd).await {
             tracing::warn!(error = %e, id = %record.id, "a job record was not stored");
         }
@@ -382,7 +344,7 @@ impl JobStore for RedisJobStore {
     }
 
     async fn remove(&self, id: Uuid) {
-        let cmd = redis::cmd("DEL").arg(&keys::job(id).all()[..]).clone();
+        let cmd = Cmd::del(&keys::job(id).all()[..]);
         let _ = self.fleet.jobs.query::<i64>(&cmd).await;
     }
 

@@ -11,8 +11,11 @@ use std::sync::{Arc, Mutex, MutexGuard};
 use std::time::{Duration, Instant};
 
 use bytes::Bytes;
-use redis::streams::{StreamAutoClaimReply, StreamId, StreamReadReply};
-use redis::Value;
+use redis::streams::{
+    StreamAutoClaimOptions, StreamAutoClaimReply, StreamClaimOptions, StreamId, StreamReadOptions,
+    StreamReadReply,
+};
+use redis::{Cmd, Value};
 use uuid::Uuid;
 
 use tokio::sync::Semaphore;
@@ -65,10 +68,7 @@ impl Shared {
 
     /// Entries on the stream not yet finished (waiting or being solved).
     pub async fn backlog(&self) -> Result<usize, Failure> {
-        self.fleet
-            .jobs
-            .query(redis::cmd("XLEN").arg(keys::STREAM))
-            .await
+        self.fleet.jobs.query(&Cmd::xlen(keys::STREAM)).await
     }
 }
 
@@ -335,15 +335,14 @@ impl Worker {
 async fn next_entry(fleet: &Fleet, looked: &mut Instant) -> Result<Option<Entry>, Failure> {
     let idle = fleet.config.claim_idle;
     if looked.elapsed() >= idle / 2 {
-        let claim = redis::cmd("XAUTOCLAIM")
-            .arg(keys::STREAM)
-            .arg(keys::GROUP)
-            .arg(&fleet.consumer)
-            .arg(super::cache::millis(idle))
-            .arg("0-0")
-            .arg("COUNT")
-            .arg(1)
-            .clone();
+        let claim = Cmd::xautoclaim_options(
+            keys::STREAM,
+            keys::GROUP,
+            &fleet.consumer,
+            super::cache::millis(idle),
+            "0-0",
+            StreamAutoClaimOptions::default().count(1),
+        );
         match fleet.jobs.query::<StreamAutoClaimReply>(&claim).await {
             Ok(reply) => {
                 if let Some(entry) = reply.claimed.first().and_then(Entry::read) {
@@ -356,16 +355,13 @@ async fn next_entry(fleet: &Fleet, looked: &mut Instant) -> Result<Option<Entry>
             Err(e) => return Err(e),
         }
     }
-    let read = redis::cmd("XREADGROUP")
-        .arg("GROUP")
-        .arg(keys::GROUP)
-        .arg(&fleet.consumer)
-        .arg("COUNT")
-        .arg(1)
-        .arg("STREAMS")
-        .arg(keys::STREAM)
-        .arg(">")
-        .clone();
+    let read = Cmd::xread_options(
+        &[keys::STREAM],
+        &[">"],
+        &StreamReadOptions::default()
+            .group(keys::GROUP, &fleet.consumer)
+            .count(1),
+    );
     match fleet.jobs.query::<Option<StreamReadReply>>(&read).await {
         Ok(reply) => Ok(reply
             .and_then(|r| r.keys.into_iter().next())
@@ -377,13 +373,7 @@ async fn next_entry(fleet: &Fleet, looked: &mut Instant) -> Result<Option<Entry>
 
 /// Creates the stream and its consumer group (once in the fleet; later calls find it).
 async fn create_group(fleet: &Fleet) -> Result<(), Failure> {
-    let create = redis::cmd("XGROUP")
-        .arg("CREATE")
-        .arg(keys::STREAM)
-        .arg(keys::GROUP)
-        .arg("0")
-        .arg("MKSTREAM")
-        .clone();
+    let create = Cmd::xgroup_create_mkstream(keys::STREAM, keys::GROUP, "0");
     match fleet.jobs.query::<()>(&create).await {
         Err(e) if !e.is("BUSYGROUP") => Err(e),
         _ => Ok(()),
@@ -393,14 +383,10 @@ async fn create_group(fleet: &Fleet) -> Result<(), Failure> {
 /// Acknowledges `entry` and deletes it from the stream (whose length is then the backlog).
 async fn acknowledge(fleet: &Fleet, entry: &Entry) {
     let mut pipe = redis::pipe();
-    pipe.cmd("XACK")
-        .arg(keys::STREAM)
-        .arg(keys::GROUP)
-        .arg(&entry.id)
+    let ids = [&entry.id];
+    pipe.xack(keys::STREAM, keys::GROUP, &ids)
         .ignore()
-        .cmd("XDEL")
-        .arg(keys::STREAM)
-        .arg(&entry.id)
+        .xdel(keys::STREAM, &ids)
         .ignore();
     if let Err(e) = fleet.jobs.pipe::<()>(&pipe).await {
         tracing::warn!(error = %e, "an entry was not acknowledged: it will run again");
@@ -433,14 +419,14 @@ async fn heartbeat(
                 .await;
         }
         if kept.elapsed() >= keep_every {
-            let keep = redis::cmd("XCLAIM")
-                .arg(keys::STREAM)
-                .arg(keys::GROUP)
-                .arg(&fleet.consumer)
-                .arg(0)
-                .arg(&entry)
-                .arg("JUSTID")
-                .clone();
+            let keep = Cmd::xclaim_options(
+                keys::STREAM,
+                keys::GROUP,
+                &fleet.consumer,
+                0,
+                &[&entry],
+                StreamClaimOptions::default().with_justid(),
+            );
             if fleet.jobs.query::<Value>(&keep).await.is_ok() {
                 kept = Instant::now();
             }
