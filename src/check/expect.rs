@@ -97,7 +97,7 @@ impl Expectation {
     fn holds(&self, x: f64) -> bool {
         match self.bound {
             Bound::Range { min, max } => {
-                min.map_or(true, |lo| lo <= x) && max.map_or(true, |hi| x <= hi)
+                min.is_none_or(|lo| lo <= x) && max.is_none_or(|hi| x <= hi)
             }
             Bound::Equals { value, rtol, atol } => within(x, value, rtol, atol),
         }

@@ -66,7 +66,7 @@ impl Drop for Forget<'_> {
         let mut in_flight = self.coalescer.in_flight();
         let done = in_flight
             .get(self.key)
-            .is_some_and(|weak| weak.upgrade().map_or(true, |s| Shared::peek(&s).is_some()));
+            .is_some_and(|weak| weak.upgrade().is_none_or(|s| Shared::peek(&s).is_some()));
         if done {
             in_flight.remove(self.key);
         }

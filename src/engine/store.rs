@@ -478,7 +478,7 @@ impl JobStore for MemoryJobStore {
 mod tests {
     use super::*;
     use crate::engine::cache::Solved;
-    use crate::render::{Answer, Column, Output, Table, Units};
+    use crate::render::{Answer, Column, Fixed, Output, Table, UnitGroups, UnitTable};
     use serde::Serialize;
 
     #[derive(Debug, PartialEq, Serialize)]
@@ -487,7 +487,10 @@ mod tests {
     }
 
     impl Output for Blob {
-        const UNITS: Units = &[];
+        const UNITS: &'static UnitTable = {
+            static UNITS: UnitTable = Fixed::new(UnitGroups(&[]));
+            &UNITS
+        };
         fn table(&self) -> Table {
             Table::new(&[Column::text("text", |b: &Blob| b.text.clone())], [self])
         }

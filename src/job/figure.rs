@@ -9,10 +9,10 @@ use utoipa::ToSchema;
 use super::input::{self, Checker};
 use super::kind::SMALL_ANSWER;
 use super::meta::ROLLING_REFERENCES;
-use super::{Control, JobError, Kind, Limits, Meta, Reference, Validated, Work};
+use super::{Control, JobError, Kind, Limits, Meta, References, Validated, Work};
 use crate::model::figures::{Axis, Figure, Plan, FIGURES};
 use crate::model::tables::{self, Use};
-use crate::render::{Column, Output, Table, Units};
+use crate::render::{Column, Fixed, Output, Table, UnitGroups, UnitTable};
 
 /// Input of a figure job.
 #[derive(Clone, Debug, PartialEq, Deserialize, Serialize, ToSchema)]
@@ -62,8 +62,8 @@ impl Kind for FigureJob {
         })
     }
 
-    fn references(&self) -> &'static [Reference] {
-        ROLLING_REFERENCES
+    fn references(&self) -> &'static References {
+        &ROLLING_REFERENCES
     }
 
     fn picture(answer: &Value) -> Result<Chart, PictureError> {
@@ -173,13 +173,16 @@ struct FigureRow<'a> {
 
 impl Output for FigureOutput {
     /// The points are in the units of the axes, which the answer names.
-    const UNITS: Units = &[&[
-        ("figure", ""),
-        ("series[].radius", "m"),
-        ("series[].load", "N"),
-        ("series[].velocity", "m/s"),
-        ("series[].points[][]", "x.unit, y.unit"),
-    ]];
+    const UNITS: &'static UnitTable = {
+        static UNITS: UnitTable = Fixed::new(UnitGroups(&[&[
+            ("figure", ""),
+            ("series[].radius", "m"),
+            ("series[].load", "N"),
+            ("series[].velocity", "m/s"),
+            ("series[].points[][]", "x.unit, y.unit"),
+        ]]));
+        &UNITS
+    };
 
     /// One row per point: the series' index and legend, then x and y in the axes' units.
     fn table(&self) -> Table {

@@ -12,7 +12,7 @@ use std::sync::Arc;
 use serde_json::Value;
 use utoipa::ToSchema;
 
-use super::meta::{InputWarning, Meta, Reference};
+use super::meta::{InputWarning, Meta, References};
 use super::pictures::PictureError;
 use super::{Control, JobError, Limits};
 use crate::render::svg::Chart;
@@ -59,7 +59,7 @@ pub trait Kind: fmt::Debug + PartialEq + Send + Sync + Sized + 'static {
     fn canonical(&self) -> Value;
 
     /// The papers behind the answer.
-    fn references(&self) -> &'static [Reference];
+    fn references(&self) -> &'static References;
 
     /// The work the job takes.
     fn work(&self) -> Work;
@@ -157,7 +157,7 @@ pub const SMALL_ANSWER: u64 = 24 << 10;
 trait Dispatch: fmt::Debug + Send + Sync {
     fn name(&self) -> &'static str;
     fn canonical(&self) -> Value;
-    fn references(&self) -> &'static [Reference];
+    fn references(&self) -> &'static References;
     fn work(&self) -> Work;
     fn cost_class(&self) -> &'static str;
     fn small(&self) -> bool;
@@ -170,7 +170,7 @@ trait Dispatch: fmt::Debug + Send + Sync {
         range: Range<usize>,
         control: &Control,
     ) -> Result<Answer, Unfinished>;
-    fn units(&self) -> crate::render::Units;
+    fn units(&self) -> &'static crate::render::UnitTable;
     fn as_any(&self) -> &dyn Any;
     fn same(&self, other: &dyn Any) -> bool;
 }
@@ -184,7 +184,7 @@ impl<K: Kind> Dispatch for K {
         Kind::canonical(self)
     }
 
-    fn references(&self) -> &'static [Reference] {
+    fn references(&self) -> &'static References {
         Kind::references(self)
     }
 
@@ -221,7 +221,7 @@ impl<K: Kind> Dispatch for K {
         answer::<K>(Kind::run_points(self, meta, range, control)?)
     }
 
-    fn units(&self) -> crate::render::Units {
+    fn units(&self) -> &'static crate::render::UnitTable {
         K::Output::UNITS
     }
 

@@ -1,9 +1,7 @@
 //! What every answer says about itself: the model version, the canonical input and its hash,
 //! and the papers behind the numbers.
 
-use serde::{Deserialize, Serialize, Serializer};
-use std::collections::HashMap;
-use std::sync::{Mutex, OnceLock};
+use serde::{Deserialize, Serialize};
 
 use serde_json::value::RawValue;
 use serde_json::Value;
@@ -11,7 +9,7 @@ use sha2::{Digest, Sha256};
 use utoipa::ToSchema;
 
 use crate::model::MODEL_VERSION;
-use crate::render::Units;
+use crate::render::{Fixed, UnitTable};
 
 /// A source of the model.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, ToSchema)]
@@ -25,9 +23,18 @@ pub struct Reference {
     pub doi: Option<&'static str>,
 }
 
+/// Papers behind the numbers, a fixed part of answers.
+pub type References = Fixed<&'static [Reference]>;
+
 /// The papers behind the numbers: [`ROLLING_REFERENCES`] behind every job, all of them behind
 /// three-body jobs.
-pub const REFERENCES: [Reference; 5] = [
+pub static REFERENCES: References = Fixed::new(&ALL_REFERENCES);
+
+/// The papers behind one particle rolling over the layer: the model, the strip method and
+/// the shear strength.
+pub static ROLLING_REFERENCES: References = Fixed::new(ALL_REFERENCES.split_at(3).0);
+
+const ALL_REFERENCES: [Reference; 5] = [
     Reference {
         role: "model: three-body contact with particles rolling over a Kelvin layer (eqs. 1–13)",
         citation: "Contact problem of a system of particles rolling over a viscoelastic layer \
@@ -61,10 +68,6 @@ pub const REFERENCES: [Reference; 5] = [
         doi: None,
     },
 ];
-
-/// The papers behind one particle rolling over the layer: the model, the strip method and
-/// the shear strength.
-pub const ROLLING_REFERENCES: &[Reference] = REFERENCES.split_at(3).0;
 
 /// The version of this software (the crate's).
 pub const SOFTWARE_VERSION: &str = env!("CARGO_PKG_VERSION");
@@ -112,16 +115,14 @@ pub struct Meta {
     #[schema(value_type = Object)]
     pub input: Canonical,
     /// The papers behind the numbers.
-    #[serde(serialize_with = "references_json")]
     #[schema(value_type = Vec<Reference>)]
-    pub references: &'static [Reference],
+    pub references: &'static References,
     /// Values of the input that are valid but implausible as sent.
     pub warnings: Vec<InputWarning>,
     /// The unit of every numeric field of the answer, by its path (`boundary[].exit`);
     /// those of `meta.input` are the SI units of the input's fields.
-    #[serde(serialize_with = "units_map")]
     #[schema(value_type = std::collections::BTreeMap<String, String>)]
-    pub units: Units,
+    pub units: &'static UnitTable,
 }
 
 /// A canonical input as its JSON text (keys sorted, no `null`), the text its hash is taken
@@ -152,72 +153,15 @@ impl PartialEq for Canonical {
     }
 }
 
-/// The groups of units as one object (groups may share entries, as the two kinds of sweep
-/// points do).
-fn units_map<S: Serializer>(units: &Units, s: S) -> Result<S::Ok, S::Error> {
-    static_json((units.as_ptr() as usize, units.len()), s, || {
-        let map: std::collections::BTreeMap<_, _> = units
-            .iter()
-            .flat_map(|group| group.iter().copied())
-            .collect();
-        serde_json::value::to_raw_value(&map)
-    })
-}
-
-fn references_json<S: Serializer>(references: &&[Reference], s: S) -> Result<S::Ok, S::Error> {
-    let key = (references.as_ptr() as usize, references.len());
-    static_json(key, s, || serde_json::value::to_raw_value(references))
-}
-
-/// A long fixed text of an answer (an assumption in words, its rule), escaped once.
-pub(crate) fn static_text<S: Serializer>(text: &&'static str, s: S) -> Result<S::Ok, S::Error> {
-    static_json((text.as_ptr() as usize, text.len()), s, || {
-        serde_json::value::to_raw_value(text)
-    })
-}
-
-/// Writes a static part of an answer (its references, its units, its fixed texts), rendered
-/// as JSON once per process and then copied: they are the same for every answer of a kind,
-/// and building and escaping them again made up about a quarter of rendering an answer.
-/// `key` tells the static parts apart (their address and length); there are a few dozen, so
-/// the rendered texts are kept for good (two threads meeting a new one at once may both
-/// render it; one copy then goes unused, once).
-fn static_json<S: Serializer>(
-    key: (usize, usize),
-    s: S,
-    render: impl FnOnce() -> serde_json::Result<Box<RawValue>>,
-) -> Result<S::Ok, S::Error> {
-    type Rendered = Mutex<HashMap<(usize, usize), &'static RawValue>>;
-    static RENDERED: OnceLock<Rendered> = OnceLock::new();
-    let rendered = RENDERED.get_or_init(Rendered::default);
-    let known = rendered
-        .lock()
-        .unwrap_or_else(|poisoned| poisoned.into_inner())
-        .get(&key)
-        .copied();
-    let json = match known {
-        Some(json) => json,
-        None => {
-            let json: &'static RawValue = Box::leak(render().map_err(serde::ser::Error::custom)?);
-            rendered
-                .lock()
-                .unwrap_or_else(|poisoned| poisoned.into_inner())
-                .insert(key, json);
-            json
-        }
-    };
-    json.serialize(s)
-}
-
 impl Meta {
     /// The meta block of a job of `kind` whose canonical input is `canonical`, with the
     /// `warnings` its input raised and the `units` of its answer.
     pub fn new(
         kind: &str,
         canonical: Value,
-        references: &'static [Reference],
+        references: &'static References,
         warnings: Vec<InputWarning>,
-        units: Units,
+        units: &'static UnitTable,
     ) -> Self {
         let input = Canonical::new(&canonical);
         Meta {
@@ -270,26 +214,4 @@ pub fn input_hash(kind: &str, canonical: &str, warnings: &[InputWarning]) -> Str
         hex.push(char::from(HEX[usize::from(byte & 15)]));
     }
     hex
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[derive(Serialize)]
-    struct Refs(#[serde(serialize_with = "references_json")] &'static [Reference]);
-
-    /// The rolling references are the first three of all five, at the same address: the
-    /// texts rendered once must still tell them apart, and match a direct rendering.
-    #[test]
-    fn static_parts_rendered_once_match_a_direct_rendering_and_tell_prefixes_apart() {
-        for _ in 0..2 {
-            for references in [ROLLING_REFERENCES, &REFERENCES[..]] {
-                assert_eq!(
-                    serde_json::to_string(&Refs(references)).unwrap(),
-                    serde_json::to_string(references).unwrap()
-                );
-            }
-        }
-    }
 }

@@ -31,7 +31,9 @@ pub use figure::FigureJob;
 pub use fit::FitJob;
 pub use input::Quantity;
 pub use kind::{Job, Keyed, Kind, Unfinished, Validated, Work};
-pub use meta::{InputWarning, Meta, Reference, Software, REFERENCES, ROLLING_REFERENCES, SOFTWARE};
+pub use meta::{
+    InputWarning, Meta, Reference, References, Software, REFERENCES, ROLLING_REFERENCES, SOFTWARE,
+};
 pub use rolling::RollingJob;
 pub use sweep::SweepJob;
 pub use three_body::ThreeBodyJob;

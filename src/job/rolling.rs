@@ -11,11 +11,11 @@ use super::kind::SMALL_ANSWER;
 use super::meta::ROLLING_REFERENCES;
 use super::points::{PointNotes, PointNotesFields, PointStatus, Row, SweepVerification};
 use super::validity::{self, validity_units, PointValidity, Subject, ValidityOutput};
-use super::{Control, JobError, Kind, Limits, Meta, Reference, Validated, Work};
+use super::{Control, JobError, Kind, Limits, Meta, References, Validated, Work};
 use crate::model::rolling::{BoundaryPoint, PressureGrid, Verification};
 use crate::model::tables::{self, Use};
 use crate::model::{self, Parameter, Rolling, RollingSolution, SolveOption, SolveOptions};
-use crate::render::{Column, Output, Table, Units};
+use crate::render::{Column, Fixed, Output, Table, UnitGroups, UnitTable};
 
 /// Input of a rolling job; every field optional (docs/model.md §5 defaults).
 #[derive(Clone, Debug, Default, PartialEq, Deserialize, Serialize, ToSchema)]
@@ -124,8 +124,8 @@ impl Kind for RollingJob {
         input::canonical(&self.input())
     }
 
-    fn references(&self) -> &'static [Reference] {
-        ROLLING_REFERENCES
+    fn references(&self) -> &'static References {
+        &ROLLING_REFERENCES
     }
 
     fn picture(answer: &Value) -> Result<Chart, PictureError> {
@@ -531,19 +531,22 @@ impl RollingOutput {
 }
 
 impl Output for RollingOutput {
-    const UNITS: Units = &[
-        contact_units!(""),
-        &[
-            ("boundary[].y", "m"),
-            ("boundary[].exit", "m"),
-            ("boundary[].entry", "m"),
-            ("pressure.x[]", "m"),
-            ("pressure.y[]", "m"),
-            ("pressure.values[][]", "Pa"),
-        ],
-        verification_units!("meta.verification."),
-        validity_units!("meta.validity."),
-    ];
+    const UNITS: &'static UnitTable = {
+        static UNITS: UnitTable = Fixed::new(UnitGroups(&[
+            contact_units!(""),
+            &[
+                ("boundary[].y", "m"),
+                ("boundary[].exit", "m"),
+                ("boundary[].entry", "m"),
+                ("pressure.x[]", "m"),
+                ("pressure.y[]", "m"),
+                ("pressure.values[][]", "Pa"),
+            ],
+            verification_units!("meta.verification."),
+            validity_units!("meta.validity."),
+        ]));
+        &UNITS
+    };
 
     /// One row: the contact's conditions and integrals, as a sweep's row.
     fn table(&self) -> Table {

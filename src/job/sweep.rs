@@ -19,11 +19,11 @@ use super::three_body::{
     result_units, three_body_verification_units, ThreeBodyInput, ThreeBodyJob,
 };
 use super::validity::Subject;
-use super::{Control, JobError, Kind, Limits, Meta, OnRefusal, Reference, Swept, Validated, Work};
+use super::{Control, JobError, Kind, Limits, Meta, OnRefusal, References, Swept, Validated, Work};
 use crate::model::tables::{self, Use};
 use crate::model::three_body::{self, Diameters, OperatingPoint, ThreeBody, ThreeBodySolution};
 use crate::model::{Parameter, Rolling, RollingSolution, SolveOptions, MODEL_VERSION};
-use crate::render::{Output, Table, Units};
+use crate::render::{Fixed, Output, Table, UnitGroups, UnitTable};
 
 pub use super::rolling::SweepPoint;
 pub use super::three_body::ThreeBodySweepPoint;
@@ -157,7 +157,7 @@ impl Kind for SweepJob {
             on_refusal: input.on_refusal.unwrap_or_default(),
         };
         let max = limits.max_sweep_points;
-        if job.size().map_or(true, |n| n > max) {
+        if job.size().is_none_or(|n| n > max) {
             let points = job
                 .size()
                 .map_or_else(|| Value::from("more than 2^64"), Value::from);
@@ -181,9 +181,9 @@ impl Kind for SweepJob {
         })
     }
 
-    fn references(&self) -> &'static [Reference] {
+    fn references(&self) -> &'static References {
         match self.points {
-            SweepOfPoints::Rolling(_) => ROLLING_REFERENCES,
+            SweepOfPoints::Rolling(_) => &ROLLING_REFERENCES,
             SweepOfPoints::ThreeBody(_) => &REFERENCES,
         }
     }
@@ -597,37 +597,40 @@ pub struct SweepMeta {
 
 impl Output for SweepOutput {
     /// The points of a rolling sweep or of a three-body sweep.
-    const UNITS: Units = &[
-        &[
-            ("points[].radius", "m"),
-            ("points[].load", "N"),
-            ("points[].velocity", "m/s"),
-            ("points[].mean_diameter", "m"),
-            ("points[].operating.separation", "m"),
-            ("points[].operating.total_load", "N"),
-            ("points[].operating.particle_load", "N"),
-        ],
-        contact_units!("points[]."),
-        result_units!("points[]."),
-        &[
-            ("points[].validity.inside_layer", ""),
-            ("points[].validity.parabolic_sphere", ""),
-            ("points[].validity.local_layer", ""),
-            ("points[].validity.adhesive_friction", ""),
-            ("points[].validity.surfaces_apart", ""),
-            ("points[].validity.asperity_gap", ""),
-            ("points[].validity.particles_in_contact", ""),
-            ("meta.counts.total", ""),
-            ("meta.counts.ok", ""),
-            ("meta.counts.warn", ""),
-            ("meta.counts.refused", ""),
-            ("meta.counts.missing", ""),
-            ("meta.validity.assumptions[].warned", ""),
-            ("meta.validity.assumptions[].first_warned", ""),
-        ],
-        verification_units!("meta.verification."),
-        three_body_verification_units!("meta.verification."),
-    ];
+    const UNITS: &'static UnitTable = {
+        static UNITS: UnitTable = Fixed::new(UnitGroups(&[
+            &[
+                ("points[].radius", "m"),
+                ("points[].load", "N"),
+                ("points[].velocity", "m/s"),
+                ("points[].mean_diameter", "m"),
+                ("points[].operating.separation", "m"),
+                ("points[].operating.total_load", "N"),
+                ("points[].operating.particle_load", "N"),
+            ],
+            contact_units!("points[]."),
+            result_units!("points[]."),
+            &[
+                ("points[].validity.inside_layer", ""),
+                ("points[].validity.parabolic_sphere", ""),
+                ("points[].validity.local_layer", ""),
+                ("points[].validity.adhesive_friction", ""),
+                ("points[].validity.surfaces_apart", ""),
+                ("points[].validity.asperity_gap", ""),
+                ("points[].validity.particles_in_contact", ""),
+                ("meta.counts.total", ""),
+                ("meta.counts.ok", ""),
+                ("meta.counts.warn", ""),
+                ("meta.counts.refused", ""),
+                ("meta.counts.missing", ""),
+                ("meta.validity.assumptions[].warned", ""),
+                ("meta.validity.assumptions[].first_warned", ""),
+            ],
+            verification_units!("meta.verification."),
+            three_body_verification_units!("meta.verification."),
+        ]));
+        &UNITS
+    };
 
     /// One row per point.
     fn table(&self) -> Table {

@@ -12,13 +12,13 @@ use super::input::{self, field, Checker, LayerInput, QuadratureKind, Quantity};
 use super::meta::REFERENCES;
 use super::points::{PointNotes, PointNotesFields, PointStatus, Row, SweepVerification};
 use super::validity::{self, validity_units, PointValidity, Subject, ValidityOutput};
-use super::{Control, JobError, Kind, Limits, Meta, Reference, Validated, Work};
+use super::{Control, JobError, Kind, Limits, Meta, References, Validated, Work};
 use crate::model::three_body::{
     self, Asperities, ContactState, Diameters, LayerContact, OperatingPoint, Particle, ThreeBody,
     ThreeBodyOptions, ThreeBodySolution, UpperContact, UpperSurface, DEFAULT_DIAMETER_NODES,
 };
 use crate::model::{Parameter, SolveOption};
-use crate::render::{Column, Output, Table, Units};
+use crate::render::{Column, Fixed, Output, Table, UnitGroups, UnitTable};
 
 /// Input of a three-body job; every field optional but the operating point.
 #[derive(Clone, Debug, Default, PartialEq, Deserialize, Serialize, ToSchema)]
@@ -413,7 +413,7 @@ impl Kind for ThreeBodyJob {
         input::canonical(&self.input())
     }
 
-    fn references(&self) -> &'static [Reference] {
+    fn references(&self) -> &'static References {
         &REFERENCES
     }
 
@@ -701,11 +701,14 @@ impl ThreeBodyOutput {
 }
 
 impl Output for ThreeBodyOutput {
-    const UNITS: Units = &[
-        result_units!(""),
-        three_body_verification_units!("meta.verification."),
-        validity_units!("meta.validity."),
-    ];
+    const UNITS: &'static UnitTable = {
+        static UNITS: UnitTable = Fixed::new(UnitGroups(&[
+            result_units!(""),
+            three_body_verification_units!("meta.verification."),
+            validity_units!("meta.validity."),
+        ]));
+        &UNITS
+    };
 
     /// One row: the system's operating point, speed and mean diameter and its results, as a
     /// sweep's row.

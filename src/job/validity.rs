@@ -8,6 +8,7 @@ use utoipa::ToSchema;
 use super::JobError;
 use crate::model::text::{count, quantity};
 use crate::model::validity::{Assumption, Check, Status};
+use crate::render::{Fixed, Text};
 
 /// The units of a validity block's fields, under `$prefix` (a string literal).
 macro_rules! validity_units {
@@ -38,8 +39,8 @@ pub struct AssumptionOutput {
     /// `surfaces_apart`, `asperity_gap` or `particles_in_contact`.
     pub name: &'static str,
     /// The assumption in words.
-    #[serde(serialize_with = "super::meta::static_text")]
-    pub assumption: &'static str,
+    #[schema(value_type = String)]
+    pub assumption: &'static Text,
     /// What the ratio measures, e.g. `penetration / thickness`.
     pub ratio: &'static str,
     /// The ratio at the job's speed (dimensionless).
@@ -49,8 +50,8 @@ pub struct AssumptionOutput {
     /// The worse of the two.
     pub status: ValidityStatus,
     /// When the ratio warns and when it refuses the answer.
-    #[serde(serialize_with = "super::meta::static_text")]
-    pub rule: &'static str,
+    #[schema(value_type = String)]
+    pub rule: &'static Text,
     /// Why it warns, in words (with `warn` only).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub note: Option<String>,
@@ -153,7 +154,7 @@ impl PointValidity {
 
     /// The names of the assumptions that warn.
     pub fn warned(&self) -> impl Iterator<Item = &'static str> + '_ {
-        self.warning().map(|c| names(c.assumption).0)
+        self.warning().map(|c| described(c.assumption).name)
     }
 
     /// The names of the assumptions that warn, as a CSV cell: space-separated.
@@ -168,7 +169,7 @@ impl Serialize for PointValidity {
         use serde::ser::SerializeMap;
         let mut map = s.serialize_map(Some(self.checks.len()))?;
         for check in &self.checks {
-            map.serialize_entry(names(check.assumption).0, &check.ratio())?;
+            map.serialize_entry(described(check.assumption).name, &check.ratio())?;
         }
         map.end()
     }
@@ -195,7 +196,7 @@ struct Tally {
 impl Tally {
     /// Point `index` warns: its note is kept if it comes before the first one seen.
     fn offer(&mut self, index: usize, note: impl FnOnce() -> String) {
-        if self.first.as_ref().map_or(true, |(i, _)| index < *i) {
+        if self.first.as_ref().is_none_or(|(i, _)| index < *i) {
             self.first = Some((index, note()));
         }
     }
@@ -260,14 +261,16 @@ pub struct AssumptionTallyOutput {
     /// As in a rolling answer's `meta.validity`: `inside_layer`, `local_layer`, ...
     name: String,
     /// The assumption in words.
-    #[serde(skip_deserializing, serialize_with = "super::meta::static_text")]
-    assumption: &'static str,
+    #[serde(skip_deserializing, default = "no_text")]
+    #[schema(value_type = String)]
+    assumption: &'static Text,
     /// What the ratio of each point's `validity` measures.
     #[serde(skip_deserializing)]
     ratio: &'static str,
     /// When the ratio warns and when it refuses a point.
-    #[serde(skip_deserializing, serialize_with = "super::meta::static_text")]
-    rule: &'static str,
+    #[serde(skip_deserializing, default = "no_text")]
+    #[schema(value_type = String)]
+    rule: &'static Text,
     /// Answered points on which it warns (count).
     warned: usize,
     /// The index of the first of them.
@@ -276,6 +279,12 @@ pub struct AssumptionTallyOutput {
     /// Why it warns there, in words.
     #[serde(skip_serializing_if = "Option::is_none")]
     note: Option<String>,
+}
+
+/// The text of a tally read back from another process (which reads only its counts).
+fn no_text() -> &'static Text {
+    static NONE: Text = Fixed::new("");
+    &NONE
 }
 
 /// The model's assumptions over the answered points of a sweep (docs/model.md §7): each in
@@ -303,12 +312,12 @@ impl ValidityTally {
                 .assumptions
                 .iter()
                 .map(|t| {
-                    let (name, assumption, ratio, rule) = names(t.assumption);
+                    let described = described(t.assumption);
                     AssumptionTallyOutput {
-                        name: name.to_string(),
-                        assumption,
-                        ratio,
-                        rule,
+                        name: described.name.to_string(),
+                        assumption: &described.assumption,
+                        ratio: described.ratio,
+                        rule: &described.rule,
                         warned: t.warned,
                         first_warned: t.first.as_ref().map(|(i, _)| *i),
                         note: t.first.as_ref().map(|(_, note)| note.clone()),
@@ -329,7 +338,7 @@ impl<'de> Deserialize<'de> for ValidityTally {
             .map(|t| {
                 let assumption = Assumption::ALL
                     .into_iter()
-                    .find(|a| names(*a).0 == t.name)
+                    .find(|a| described(*a).name == t.name)
                     .ok_or_else(|| {
                         serde::de::Error::custom(format!("no assumption is named {}", t.name))
                     })?;
@@ -354,68 +363,92 @@ fn significant(x: f64) -> String {
     quantity(x, "")
 }
 
-fn names(assumption: Assumption) -> (&'static str, &'static str, &'static str, &'static str) {
+/// An assumption as answers describe it: its name, what its ratio measures, and the
+/// assumption and its rule in words (fixed texts, their JSON rendered once).
+struct Described {
+    name: &'static str,
+    assumption: Text,
+    ratio: &'static str,
+    rule: Text,
+}
+
+fn described(assumption: Assumption) -> &'static Described {
     use Assumption::*;
-    match assumption {
-        InsideLayer => (
-            "inside_layer",
+    static INSIDE_LAYER: Described = Described {
+        name: "inside_layer",
+        assumption: Fixed::new(
             "the sphere stays inside the layer: the rigid base is never reached",
-            "penetration / thickness",
+        ),
+        ratio: "penetration / thickness",
+        rule: Fixed::new(
             "warn above 0.1 (the linear layer law assumes small strain); refused at 1",
         ),
-        Parabolic => (
-            "parabolic_sphere",
+    };
+    static PARABOLIC: Described = Described {
+        name: "parabolic_sphere",
+        assumption: Fixed::new(
             "the sphere is a paraboloid near the contact (contact an order smaller than R)",
-            "contact extent / radius",
-            "warn when (ratio)²/4, the profile's error, passes 0.05; refused at 1",
         ),
-        LocalLayer => (
-            "local_layer",
+        ratio: "contact extent / radius",
+        rule: Fixed::new("warn when (ratio)²/4, the profile's error, passes 0.05; refused at 1"),
+    };
+    static LOCAL_LAYER: Described = Described {
+        name: "local_layer",
+        assumption: Fixed::new(
             "the layer is local (Winkler): the contact is wide compared with the layer",
-            "contact half-width / thickness",
-            "warn below 1",
         ),
-        AdhesiveFriction => (
-            "adhesive_friction",
-            "adhesive friction τ_a A / P (eq. 12) is meaningful",
-            "friction coefficient",
-            "warn above 1",
-        ),
-        SurfacesApart => (
-            "surfaces_apart",
-            "the surfaces stay apart (the paper's always-a-gap regime)",
-            "separation / largest diameter",
-            "refused at or below 0",
-        ),
-        AsperityGap => (
-            "asperity_gap",
-            "the asperities of the surfaces stay apart",
-            "separation / asperity height standard deviation",
-            "warn below 3",
-        ),
-        ParticlesInContact => (
-            "particles_in_contact",
-            "at least one particle is in contact",
-            "particles in contact",
-            "warn below 1",
-        ),
+        ratio: "contact half-width / thickness",
+        rule: Fixed::new("warn below 1"),
+    };
+    static ADHESIVE_FRICTION: Described = Described {
+        name: "adhesive_friction",
+        assumption: Fixed::new("adhesive friction τ_a A / P (eq. 12) is meaningful"),
+        ratio: "friction coefficient",
+        rule: Fixed::new("warn above 1"),
+    };
+    static SURFACES_APART: Described = Described {
+        name: "surfaces_apart",
+        assumption: Fixed::new("the surfaces stay apart (the paper's always-a-gap regime)"),
+        ratio: "separation / largest diameter",
+        rule: Fixed::new("refused at or below 0"),
+    };
+    static ASPERITY_GAP: Described = Described {
+        name: "asperity_gap",
+        assumption: Fixed::new("the asperities of the surfaces stay apart"),
+        ratio: "separation / asperity height standard deviation",
+        rule: Fixed::new("warn below 3"),
+    };
+    static PARTICLES_IN_CONTACT: Described = Described {
+        name: "particles_in_contact",
+        assumption: Fixed::new("at least one particle is in contact"),
+        ratio: "particles in contact",
+        rule: Fixed::new("warn below 1"),
+    };
+    match assumption {
+        InsideLayer => &INSIDE_LAYER,
+        Parabolic => &PARABOLIC,
+        LocalLayer => &LOCAL_LAYER,
+        AdhesiveFriction => &ADHESIVE_FRICTION,
+        SurfacesApart => &SURFACES_APART,
+        AsperityGap => &ASPERITY_GAP,
+        ParticlesInContact => &PARTICLES_IN_CONTACT,
     }
 }
 
 fn output(check: &Check, subject: Subject) -> AssumptionOutput {
-    let (name, assumption, ratio, rule) = names(check.assumption);
+    let described = described(check.assumption);
     let status = match check.status() {
         Status::Ok => ValidityStatus::Ok,
         _ => ValidityStatus::Warn,
     };
     AssumptionOutput {
-        name,
-        assumption,
-        ratio,
+        name: described.name,
+        assumption: &described.assumption,
+        ratio: described.ratio,
         value: check.ratio(),
         at_rest: check.ratio_at_rest(),
         status,
-        rule,
+        rule: &described.rule,
         note: (status == ValidityStatus::Warn).then(|| note(check, subject)),
     }
 }

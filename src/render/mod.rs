@@ -3,6 +3,7 @@
 //! and the command line choose a [`Format`] ([`negotiate`] for HTTP) and render an
 //! [`Answer`] into bytes.
 
+pub mod fixed;
 mod negotiate;
 mod number;
 pub mod svg;
@@ -15,6 +16,7 @@ use std::fmt;
 use serde::{Serialize, Serializer};
 use serde_json::value::RawValue;
 
+pub use fixed::{Fixed, Text, UnitGroups, UnitTable, Units};
 pub use negotiate::negotiate;
 pub use number::format_number;
 pub use table::{Cell, Column, Heading, Table};
@@ -123,14 +125,11 @@ impl RenderError {
     }
 }
 
-/// The unit of each numeric field of an answer, by path (`a.b`, `list[].c`): SI, `""` for
-/// plain numbers and counts; in groups, so that the parts answers share are declared once.
-pub type Units = &'static [&'static [(&'static str, &'static str)]];
-
 /// The answer of a job kind: JSON through serde, and one table for CSV.
 pub trait Output: Serialize + fmt::Debug + PartialEq + Send + Sync + 'static {
-    /// The unit of every numeric field of the JSON answer (outside `meta.input`).
-    const UNITS: Units;
+    /// The unit of every numeric field of the JSON answer (outside `meta.input`): a
+    /// `static` ([`Fixed`]), so that its JSON is rendered once.
+    const UNITS: &'static UnitTable;
 
     /// The answer as one table, its columns declared once by the output.
     fn table(&self) -> Table;
@@ -506,7 +505,10 @@ mod tests {
     }
 
     impl Output for Point {
-        const UNITS: Units = &[&[("x", "m")]];
+        const UNITS: &'static UnitTable = {
+            static UNITS: UnitTable = Fixed::new(UnitGroups(&[&[("x", "m")]]));
+            &UNITS
+        };
 
         fn table(&self) -> Table {
             const COLUMNS: [Column<Point>; 1] = [Column::number("x", "m", |p| p.x)];
@@ -536,7 +538,10 @@ mod tests {
     }
 
     impl Output for Holder {
-        const UNITS: Units = &[];
+        const UNITS: &'static UnitTable = {
+            static UNITS: UnitTable = Fixed::new(UnitGroups(&[]));
+            &UNITS
+        };
 
         fn table(&self) -> Table {
             const COLUMNS: [Column<f64>; 1] = [Column::number("x", "m", |x| *x)];

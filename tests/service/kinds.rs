@@ -11,10 +11,10 @@ use thirdbody::engine::metrics::Metrics;
 use thirdbody::engine::store::JobStatus;
 use thirdbody::engine::{self, Engine, EngineConfig};
 use thirdbody::job::{
-    Control, Job, JobError, Kind, Limits, Meta, Reference, Validated, Work, ROLLING_REFERENCES,
+    Control, Job, JobError, Kind, Limits, Meta, References, Validated, Work, ROLLING_REFERENCES,
 };
 use thirdbody::render::svg::{Axis, Chart, Layer};
-use thirdbody::render::{Column, Format, Output, Table, Units};
+use thirdbody::render::{Column, Fixed, Format, Output, Table, UnitGroups, UnitTable};
 use utoipa::ToSchema;
 
 /// A scratch kind that cannot tell its work in advance (as an iterative fit): it counts
@@ -31,7 +31,10 @@ struct CountdownOutput {
 }
 
 impl Output for CountdownOutput {
-    const UNITS: Units = &[&[("steps", "")]];
+    const UNITS: &'static UnitTable = {
+        static UNITS: UnitTable = Fixed::new(UnitGroups(&[&[("steps", "")]]));
+        &UNITS
+    };
 
     fn table(&self) -> Table {
         Table::new(
@@ -55,8 +58,8 @@ impl Kind for Countdown {
         json!({ "steps": self.steps })
     }
 
-    fn references(&self) -> &'static [Reference] {
-        ROLLING_REFERENCES
+    fn references(&self) -> &'static References {
+        &ROLLING_REFERENCES
     }
 
     fn work(&self) -> Work {

@@ -26,7 +26,7 @@ use super::input as wire;
 use super::kind::SMALL_ANSWER;
 use super::meta::ROLLING_REFERENCES;
 use super::pictures::PictureError;
-use super::{Control, FieldError, JobError, Kind, Limits, Meta, Reference, Validated, Work};
+use super::{Control, FieldError, JobError, Kind, Limits, Meta, References, Validated, Work};
 use crate::model::fit::stats;
 use crate::model::fit::{self, Datum, FitError, Fitted, Point, Problem, Setting};
 use crate::model::Layer;
@@ -63,8 +63,8 @@ impl Kind for FitJob {
         wire::canonical(&FitInput::of(&self.problem, &self.series))
     }
 
-    fn references(&self) -> &'static [Reference] {
-        ROLLING_REFERENCES
+    fn references(&self) -> &'static References {
+        &ROLLING_REFERENCES
     }
 
     fn work(&self) -> Work {
