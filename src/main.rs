@@ -7,11 +7,12 @@ use std::process::ExitCode;
 use std::sync::Arc;
 use std::time::Duration;
 
-use clap::{Args, Parser, Subcommand, ValueEnum};
+use clap::{Args, CommandFactory, FromArgMatches, Parser, Subcommand, ValueEnum};
 
 use thirdbody::check;
 use thirdbody::engine::Engine;
 use thirdbody::http::{self, AppState, Config, LogFormat, ServeArgs};
+use thirdbody::job::registry;
 use thirdbody::job::sweep::SweepOutput;
 use thirdbody::job::{Control, FigureJob, Job, JobError, Limits};
 use thirdbody::model::text::{count, quantity};
@@ -30,7 +31,7 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Solve a job {"kind": "rolling" | "three_body" | "sweep" | "figure" | "fit", "input": {...}} and print the result as JSON.
+    /// Solve a job {"kind": ..., "input": {...}} and print the result as JSON.
     ///
     /// Exits 0 with an answer, 1 when a valid job cannot be solved, 2 when the job cannot be
     /// used (the file cannot be read, is not JSON, or is not a valid job).
@@ -111,8 +112,31 @@ impl OutputFormat {
 /// `serve` setting that is not valid.
 const INVALID_JOB: u8 = 2;
 
+/// The command line, its help naming the job kinds from the registry (the one list of
+/// kinds).
+fn cli_with_kinds() -> clap::Command {
+    let kinds: Vec<String> = registry::NAMES.iter().map(|n| format!("\"{n}\"")).collect();
+    let about = format!(
+        "Solve a job {{\"kind\": {}, \"input\": {{...}}}} and print the result as JSON.",
+        kinds.join(" | ")
+    );
+    Cli::command().mut_subcommand("solve", |solve| {
+        // The doc comment's first paragraph is replaced, the rest (exit codes) kept.
+        let long = solve.get_long_about().map(|l| l.to_string());
+        let rest = long
+            .as_deref()
+            .and_then(|l| l.split_once("\n\n"))
+            .map(|(_, r)| r);
+        let long_about = match rest {
+            Some(rest) => format!("{about}\n\n{rest}"),
+            None => about.clone(),
+        };
+        solve.about(about).long_about(long_about)
+    })
+}
+
 fn main() -> ExitCode {
-    let cli = Cli::parse();
+    let cli = Cli::from_arg_matches(&cli_with_kinds().get_matches()).unwrap_or_else(|e| e.exit());
     let (job, output) = match cli.command {
         Command::Solve { job, output } => match read_input(&job) {
             Ok(text) => (Job::from_json(&text, &Limits::default()), output),

@@ -158,7 +158,7 @@ impl Suite {
 impl CheckSpec {
     /// Judges the job's answer (its JSON as clients see it), or the error it failed with.
     pub fn judge(&self, answer: Result<Value, JobError>) -> CheckReport {
-        let mut report = CheckReport::new(&self.name, self.job.kind());
+        let mut report = CheckReport::new(&self.name, self.job.kind().name());
         match answer {
             Err(e) => report.fail_with(e.to_string()),
             Ok(answer) => {

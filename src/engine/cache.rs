@@ -7,7 +7,7 @@ use std::time::{Duration, Instant};
 
 use super::bounded::Bounded;
 use super::budget;
-use crate::job::registry;
+use crate::job::registry::KindName;
 use crate::job::JobError;
 use crate::render::{draw_svg, Answer, Format, RenderError};
 use async_trait::async_trait;
@@ -22,7 +22,7 @@ pub struct Solved {
     /// The job's cache key.
     pub key: String,
     /// The job's kind (which draws its picture).
-    pub kind: &'static str,
+    pub kind: KindName,
     /// Whether the answer is whole: a partial one (what a stopped job finished, marked so in
     /// its `meta`) is never cached, and has no `ETag`.
     pub complete: bool,
@@ -37,7 +37,7 @@ pub struct Solved {
 impl Solved {
     /// Renders `answer` as JSON; an answer that cannot be rendered (a non-finite number)
     /// is an internal error, never a silent `null` for the client.
-    pub fn new(key: String, kind: &'static str, answer: Answer) -> Result<Solved, JobError> {
+    pub fn new(key: String, kind: KindName, answer: Answer) -> Result<Solved, JobError> {
         let json = answer.render(Format::Json).map_err(internal)?;
         Ok(Solved {
             key,
@@ -52,7 +52,7 @@ impl Solved {
 
     /// An answer of `kind` already rendered as JSON and CSV (its picture is drawn from the
     /// JSON).
-    pub fn rendered(key: String, kind: &'static str, json: Bytes, csv: Bytes) -> Solved {
+    pub fn rendered(key: String, kind: KindName, json: Bytes, csv: Bytes) -> Solved {
         Solved {
             key,
             kind,
@@ -65,7 +65,7 @@ impl Solved {
     }
 
     /// The partial answer of a stopped job (see [`Solved::complete`]).
-    pub fn partial(key: String, kind: &'static str, answer: Answer) -> Result<Solved, JobError> {
+    pub fn partial(key: String, kind: KindName, answer: Answer) -> Result<Solved, JobError> {
         Ok(Solved {
             complete: false,
             ..Solved::new(key, kind, answer)?
@@ -127,11 +127,8 @@ impl Solved {
 }
 
 /// The picture of an answer of `kind` from its JSON.
-pub fn picture(kind: &str, json: &[u8]) -> Result<Bytes, RenderError> {
-    let draw = registry::find(kind)
-        .map_err(|e| RenderError::new(e.to_string()))?
-        .picture();
-    draw_svg(draw, json).map(Bytes::from)
+pub fn picture(kind: KindName, json: &[u8]) -> Result<Bytes, RenderError> {
+    draw_svg(kind.picture(), json).map(Bytes::from)
 }
 
 fn internal(e: RenderError) -> JobError {

@@ -257,7 +257,7 @@ impl Lifecycle {
             status: watch::Sender::new(JobStatus::Queued),
         });
         self.live().insert(id, live.clone());
-        let span = tracing::info_span!("job", id = %id, kind = job.kind());
+        let span = tracing::info_span!("job", id = %id, kind = %job.kind());
         let lifecycle = self.clone();
         self.tracker.spawn(
             async move {

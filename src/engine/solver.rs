@@ -271,7 +271,7 @@ impl Solver {
         self.metrics
             .fixed_histogram(
                 names::SOLVE_DURATION,
-                &[("kind", kind), ("outcome", outcome)],
+                &[("kind", kind.name()), ("outcome", outcome)],
             )
             .record(start.elapsed());
         result

@@ -13,6 +13,7 @@ use bytes::Bytes;
 use uuid::Uuid;
 
 use super::cache::Solved;
+use crate::job::registry::KindName;
 use crate::render::Format;
 
 /// The directory results are spilled to.
@@ -67,7 +68,7 @@ pub struct Spilled {
     /// The job's cache key.
     pub key: String,
     /// The job's kind (which draws its picture).
-    pub kind: &'static str,
+    pub kind: KindName,
     /// Whether the answer is whole (see [`Solved::complete`]).
     pub complete: bool,
     json: PathBuf,

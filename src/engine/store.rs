@@ -13,6 +13,7 @@ use utoipa::ToSchema;
 use uuid::Uuid;
 
 use super::spill::{JobResult, SpillDir};
+use crate::job::registry::KindName;
 use crate::job::{JobError, Work};
 
 /// Where a job is in its life.
@@ -133,7 +134,7 @@ impl JobState {
 pub struct JobRecord {
     pub id: Uuid,
     /// The job's kind, by its name on the wire.
-    pub kind: &'static str,
+    pub kind: KindName,
     /// The work the job takes.
     pub work: Work,
     pub state: JobState,
@@ -146,7 +147,7 @@ pub struct JobRecord {
 
 impl JobRecord {
     /// A job just accepted, whose id is `id`.
-    pub fn queued(id: Uuid, kind: &'static str, work: Work) -> JobRecord {
+    pub fn queued(id: Uuid, kind: KindName, work: Work) -> JobRecord {
         JobRecord {
             id,
             kind,
@@ -501,12 +502,21 @@ mod tests {
         let blob = Blob {
             text: "x".repeat(bytes / 2),
         };
-        let solved = Solved::new(key.to_string(), "rolling", Answer::new(blob)).unwrap();
+        let solved = Solved::new(
+            key.to_string(),
+            KindName::of::<crate::job::RollingJob>(),
+            Answer::new(blob),
+        )
+        .unwrap();
         JobResult::Ready(Arc::new(solved.kept().unwrap()))
     }
 
     fn record() -> JobRecord {
-        JobRecord::queued(Uuid::new_v4(), "rolling", Work::Known(1))
+        JobRecord::queued(
+            Uuid::new_v4(),
+            KindName::of::<crate::job::RollingJob>(),
+            Work::Known(1),
+        )
     }
 
     /// Finishes job `id` with a result of `bytes`.

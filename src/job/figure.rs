@@ -49,6 +49,7 @@ impl FigureJob {
 
 impl Kind for FigureJob {
     const NAME: &'static str = "figure";
+    type Input = FigureInput;
     type Output = FigureOutput;
 
     fn validate(input: Value, _limits: &Limits) -> Result<Validated<Self>, JobError> {

@@ -14,6 +14,7 @@ use utoipa::ToSchema;
 
 use super::meta::{InputWarning, Meta, References};
 use super::pictures::PictureError;
+use super::registry::KindName;
 use super::{Control, JobError, Limits};
 use crate::render::svg::Chart;
 use crate::render::{Answer, Output};
@@ -48,6 +49,8 @@ impl<K> From<K> for Validated<K> {
 pub trait Kind: fmt::Debug + PartialEq + Send + Sync + Sized + 'static {
     /// The kind's name on the wire: the `kind` of a job envelope and of a job's status.
     const NAME: &'static str;
+    /// The input as the wire has it (its OpenAPI schema).
+    type Input: ToSchema;
     /// The answer.
     type Output: Output + ToSchema;
 
@@ -155,7 +158,7 @@ pub const SMALL_ANSWER: u64 = 24 << 10;
 
 /// What [`Job`] needs of a kind, object-safe.
 trait Dispatch: fmt::Debug + Send + Sync {
-    fn name(&self) -> &'static str;
+    fn kind(&self) -> KindName;
     fn canonical(&self) -> Value;
     fn references(&self) -> &'static References;
     fn work(&self) -> Work;
@@ -176,8 +179,8 @@ trait Dispatch: fmt::Debug + Send + Sync {
 }
 
 impl<K: Kind> Dispatch for K {
-    fn name(&self) -> &'static str {
-        K::NAME
+    fn kind(&self) -> KindName {
+        KindName::of::<K>()
     }
 
     fn canonical(&self) -> Value {
@@ -260,9 +263,9 @@ impl Job {
         &self.warnings
     }
 
-    /// The kind's name on the wire.
-    pub fn kind(&self) -> &'static str {
-        self.kind.name()
+    /// The job's kind.
+    pub fn kind(&self) -> KindName {
+        self.kind.kind()
     }
 
     /// What its cost per unit of work is estimated from ([`Kind::cost_class`]).
@@ -281,7 +284,7 @@ impl Job {
     pub fn meta(&self) -> Meta {
         let kind = &self.kind;
         Meta::new(
-            kind.name(),
+            kind.kind().name(),
             kind.canonical(),
             kind.references(),
             self.warnings.clone(),

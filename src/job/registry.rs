@@ -3,10 +3,11 @@
 //! `JobKind` and `Output` follow from here.
 
 use std::borrow::Cow;
+use std::fmt;
 
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 use serde_json::Value;
-use utoipa::openapi::schema::{ObjectBuilder, OneOfBuilder, Schema, Type};
+use utoipa::openapi::schema::{Object, ObjectBuilder, OneOfBuilder, Schema, SchemaType, Type};
 use utoipa::openapi::{Ref, RefOr};
 use utoipa::{PartialSchema, ToSchema};
 
@@ -28,6 +29,7 @@ pub struct Registered {
     name: &'static str,
     validate: fn(Value, &Limits) -> Result<Job, JobError>,
     picture: Draw,
+    input_schema: fn() -> Cow<'static, str>,
     output_schema: fn(&mut Schemas) -> RefOr<Schema>,
 }
 
@@ -37,16 +39,12 @@ impl Registered {
         self.name
     }
 
-    /// How an answer of this kind is drawn ([`Kind::picture`]).
-    pub fn picture(&self) -> Draw {
-        self.picture
-    }
-
     const fn of<K: Kind>() -> Registered {
         Registered {
             name: K::NAME,
             validate: validate::<K>,
             picture: K::picture,
+            input_schema: <K::Input as ToSchema>::name,
             output_schema: output_schema::<K>,
         }
     }
@@ -81,8 +79,9 @@ const LIST: &[Registered] = &[
 
 static KINDS: &[Registered] = LIST;
 
-/// The kinds' names, in the order of [`LIST`].
-const NAMES: [&str; LIST.len()] = {
+/// The kinds' names, in the order of [`LIST`] (for the CLI's help, the OpenAPI enum, and
+/// errors naming the known kinds).
+pub const NAMES: [&str; LIST.len()] = {
     let mut names = [""; LIST.len()];
     let mut i = 0;
     while i < names.len() {
@@ -133,32 +132,68 @@ impl Job {
     }
 }
 
-/// The name of a registered kind, as the wire has it.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct KindName(&'static str);
+/// A registered kind, as answers, records and pictures carry it: its name on the wire and
+/// what the registry knows of it, without a look-up by name.
+#[derive(Clone, Copy)]
+pub struct KindName(&'static Registered);
 
 impl KindName {
-    pub fn of(kind: &'static str) -> KindName {
-        KindName(kind)
+    /// Kind `K`.
+    pub const fn of<K: Kind>() -> KindName {
+        KindName(const { &Registered::of::<K>() })
+    }
+
+    /// The kind named `name`, or the error naming the known ones.
+    pub fn find(name: &str) -> Result<KindName, JobError> {
+        find(name).map(KindName)
     }
 
     pub fn name(self) -> &'static str {
-        self.0
+        self.0.name
+    }
+
+    /// How an answer of this kind is drawn ([`Kind::picture`]).
+    pub fn picture(self) -> Draw {
+        self.0.picture
+    }
+}
+
+impl PartialEq for KindName {
+    fn eq(&self, other: &KindName) -> bool {
+        self.name() == other.name()
+    }
+}
+
+impl Eq for KindName {}
+
+impl PartialEq<&str> for KindName {
+    fn eq(&self, other: &&str) -> bool {
+        self.name() == *other
+    }
+}
+
+impl fmt::Debug for KindName {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl fmt::Display for KindName {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
     }
 }
 
 impl Serialize for KindName {
     fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
-        s.serialize_str(self.0)
+        s.serialize_str(self.name())
     }
 }
 
 impl<'de> Deserialize<'de> for KindName {
     fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
         let name = Cow::<str>::deserialize(d)?;
-        find(&name)
-            .map(|k| KindName(k.name))
-            .map_err(|_| serde::de::Error::custom(unknown_kind(&name)))
+        KindName::find(&name).map_err(|_| serde::de::Error::custom(unknown_kind(&name)))
     }
 }
 
@@ -185,12 +220,26 @@ impl ToSchema for KindName {
     "vary": {"load": ["0.5 nN", "1 nN", "2 nN"], "velocity": ["0 nm/s", "4 nm/s"]}}}))]
 pub struct Envelope {
     pub kind: KindName,
-    /// The input of the job's kind: a `RollingInput`, `ThreeBodyInput`, `SweepInput`,
-    /// `FigureInput` or `FitInput`.
-    /// Absent, every field takes its default.
     #[serde(default)]
-    #[schema(value_type = Option<Object>)]
+    #[schema(schema_with = any_input)]
     pub input: Option<Value>,
+}
+
+/// The envelope's `input`: an object (or absent), whose schema is its kind's.
+fn any_input() -> Object {
+    let names: Vec<String> = KINDS
+        .iter()
+        .map(|k| format!("`{}`", (k.input_schema)()))
+        .collect();
+    let (last, rest) = names.split_last().expect("there are kinds");
+    ObjectBuilder::new()
+        .schema_type(SchemaType::from_iter([Type::Object, Type::Null]))
+        .description(Some(format!(
+            "The input of the job's kind: a {} or {last}. Absent, every field takes its \
+             default.",
+            rest.join(", ")
+        )))
+        .build()
 }
 
 /// The answer to any job, for the OpenAPI description: one of the kinds' outputs.

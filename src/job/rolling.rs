@@ -113,6 +113,7 @@ impl RollingJob {
 
 impl Kind for RollingJob {
     const NAME: &'static str = "rolling";
+    type Input = RollingInput;
     type Output = RollingOutput;
 
     fn validate(input: Value, _limits: &Limits) -> Result<Validated<Self>, JobError> {

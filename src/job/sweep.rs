@@ -138,6 +138,7 @@ impl SweepJob {
 
 impl Kind for SweepJob {
     const NAME: &'static str = "sweep";
+    type Input = SweepInput;
     type Output = SweepOutput;
 
     fn validate(value: Value, limits: &Limits) -> Result<Validated<Self>, JobError> {

@@ -402,6 +402,7 @@ impl ThreeBodyJob {
 
 impl Kind for ThreeBodyJob {
     const NAME: &'static str = "three_body";
+    type Input = ThreeBodyInput;
     type Output = ThreeBodyOutput;
 
     fn validate(input: Value, _limits: &Limits) -> Result<Validated<Self>, JobError> {

@@ -600,3 +600,32 @@ fn a_check_s_misspelt_path_names_the_nearest_fields_of_the_answer() {
         "{report}"
     );
 }
+
+/// The kinds are listed once, in the registry: the help of `solve` and README's job line
+/// name each of them, and no other.
+#[test]
+fn the_help_and_the_readme_name_every_kind_of_the_registry() {
+    let out = thirdbody(&["solve", "--help"], None);
+    assert!(out.status.success());
+    let help = String::from_utf8(out.stdout).unwrap();
+    let readme =
+        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/README.md")).unwrap();
+    let job_line = readme
+        .lines()
+        .find(|l| l.starts_with("A job is `{\"kind\": "))
+        .expect("README says what a job is");
+    let listed = |text: &str| -> Vec<String> {
+        let kinds = text.split("{\"kind\": ").nth(1).unwrap();
+        let kinds = kinds.split(", \"input\"").next().unwrap();
+        kinds
+            .split(" | ")
+            .map(|k| k.trim_matches('"').to_string())
+            .collect()
+    };
+    let registry: Vec<String> = thirdbody::job::registry::NAMES
+        .iter()
+        .map(|n| n.to_string())
+        .collect();
+    assert_eq!(listed(&help), registry, "{help}");
+    assert_eq!(listed(job_line), registry, "{job_line}");
+}

@@ -12,7 +12,8 @@ use redis::{Cmd, ExistenceCheck, Script, SetExpiry, SetOptions};
 
 use super::{keys, Fleet};
 use crate::engine::cache::{Claim, MemoryCache, ResultCache, Solved};
-use crate::job::{registry, JobError};
+use crate::job::registry::KindName;
+use crate::job::JobError;
 use crate::render::Format;
 
 /// How often a process waiting for another's solve looks for the answer.
@@ -53,7 +54,7 @@ impl TieredCache {
         let cmd = Cmd::hmget(keys::answer(key), &["json", "csv", "kind"][..]);
         type Fields = (Option<Vec<u8>>, Option<Vec<u8>>, Option<String>);
         let (json, csv, kind): Fields = link.query(&cmd).await.ok()?;
-        let kind = registry::find(&kind?).ok()?.name();
+        let kind = KindName::find(&kind?).ok()?;
         let solved = Arc::new(Solved::rendered(
             key.to_string(),
             kind,
@@ -88,7 +89,7 @@ impl ResultCache for TieredCache {
         let fields: [(&str, &[u8]); 3] = [
             ("json", solved.json()),
             ("csv", &csv),
-            ("kind", solved.kind.as_bytes()),
+            ("kind", solved.kind.name().as_bytes()),
         ];
         pipe.atomic()
             .hset_multiple(&key, &fields)

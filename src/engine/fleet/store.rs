@@ -19,7 +19,8 @@ use crate::engine::cache::Solved;
 use crate::engine::spill::JobResult;
 use crate::engine::store::{JobRecord, JobState, JobStatus, JobStore, Refusal};
 use crate::job::parts::RenderedPart;
-use crate::job::{registry, JobError, Work};
+use crate::job::registry::KindName;
+use crate::job::{JobError, Work};
 use std::sync::Arc;
 
 /// Moves a job to a new state unless it has finished; a finished state keeps the result,
@@ -98,7 +99,7 @@ impl RedisJobStore {
         let id = record.id.to_string();
         let mut pipe = redis::pipe();
         let fields = [
-            ("kind", record.kind.to_string()),
+            ("kind", record.kind.name().to_string()),
             ("work", work_text(record.work)),
             ("status", JobStatus::Queued.as_str().to_string()),
             ("done", "0".to_string()),
@@ -262,8 +263,7 @@ impl RedisJobStore {
                 .map(|v| String::from_utf8_lossy(v).into_owned())
                 .unwrap_or_default()
         };
-        let kind = registry::find(&text("kind"))
-            .map(|k| k.name())
+        let kind = KindName::find(&text("kind"))
             .map_err(|e| Failure::new(format!("a stored job is unreadable: {e}")))?;
         let work = text("work").parse().map_or(Work::Unknown, Work::Known);
         // A result of a cancelled or failed job is what it finished before it stopped.
@@ -319,7 +319,7 @@ impl JobStore for RedisJobStore {
     /// is made here.
     async fn insert(&self, record: JobRecord, _result_bytes: u64) -> Result<(), Refusal> {
         let fields = [
-            ("kind", record.kind.to_string()),
+            ("kind", record.kind.name().to_string()),
             ("work", work_text(record.work)),
             ("status", record.state.status().as_str().to_string()),
             ("done", record.done.to_string()),

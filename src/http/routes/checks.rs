@@ -74,7 +74,7 @@ pub async fn run(
     let mut reports = Vec::with_capacity(suite.checks.len());
     for spec in &suite.checks {
         if Instant::now() >= deadline {
-            let mut report = CheckReport::new(&spec.name, spec.job.kind());
+            let mut report = CheckReport::new(&spec.name, spec.job.kind().name());
             report.fail_with(format!(
                 "not run: the suite ran past its deadline of {} (--solve-deadline, one for \
                  the whole suite); split the suite, or run it with `thirdbody check`",

@@ -71,7 +71,7 @@ impl JobView {
         let result = record.state.result();
         JobView {
             id: record.id,
-            kind: KindName::of(record.kind),
+            kind: record.kind,
             status: record.state.status(),
             progress: Progress {
                 done: record.done,

@@ -42,6 +42,7 @@ pub struct FitJob {
 
 impl Kind for FitJob {
     const NAME: &'static str = "fit";
+    type Input = FitInput;
     type Output = FitOutput;
 
     fn validate(value: Value, limits: &Limits) -> Result<Validated<Self>, JobError> {
