@@ -4,6 +4,7 @@
 //! ids, the drain, the fleet's stream). The engine admits or refuses new work (and counts
 //! refusals) and hands each call to its part.
 
+use std::future::Future;
 use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -157,18 +158,23 @@ impl Engine {
         self.solver.metrics()
     }
 
-    /// The cached answer to an input seen before (`text`: its kind and compact JSON), found
-    /// without validating the input again; `None` if it was not seen or its answer expired.
-    /// Refused while draining, like every other call for an answer.
-    pub async fn cached_input(&self, text: &str) -> Result<Option<Arc<Solved>>, EngineError> {
+    /// Answers the input `text` (its kind and compact JSON, as the client sent it): an input
+    /// seen before whose answer is cached is answered at once, without validating it again
+    /// (validation and the cache key cost more than the look-up); otherwise `validate` makes
+    /// its job, which is solved ([`Engine::solve`]). The caller decides where `validate`
+    /// runs (a large input is read on a blocking thread).
+    pub async fn answer<E: From<EngineError>>(
+        self: &Arc<Self>,
+        text: String,
+        validate: impl Future<Output = Result<Keyed, E>>,
+    ) -> Result<(Arc<Solved>, CacheStatus), E> {
         self.admit()?;
-        Ok(self.solver.cached_input(text).await)
-    }
-
-    /// Remembers that the input `text` (as for [`Engine::cached_input`]) is a valid job
-    /// with cache key `key`, if it was seen before.
-    pub fn remember_input(&self, text: String, key: String) {
-        self.solver.remember_input(text, key)
+        if let Some(solved) = self.solver.cached_input(&text).await {
+            return Ok((solved, CacheStatus::Hit));
+        }
+        let keyed = validate.await?;
+        self.solver.remember_input(text, keyed.key().to_string());
+        Ok(self.solve(keyed).await?)
     }
 
     /// Solves `keyed` now, or takes its answer from the cache. Identical concurrent calls

@@ -290,12 +290,11 @@ impl FromRequest<AppState> for SolveRequest {
 }
 
 impl SolveRequest {
-    /// Validates the input as a job of the kind named `kind`, solves it and answers it. An
-    /// input seen before (the same JSON up to key order and spacing) whose answer is cached
-    /// is answered at once: validation and the cache key cost more than the lookup.
+    /// Answers the input as a job of the kind named `kind` ([`crate::engine::Engine::answer`]:
+    /// an input seen before, the same JSON up to key order and spacing, is answered from the
+    /// cache without being validated again).
     pub async fn solve(self, kind: &'static str) -> Result<Response, ApiError> {
         let state = &self.state;
-        let engine = state.engine();
         let (input, text) = self
             .body
             .read(state, move |input: Value| {
@@ -303,16 +302,12 @@ impl SolveRequest {
                 Ok((input, text))
             })
             .await?;
-        if let Some(solved) = engine.cached_input(&text).await? {
-            return self.answering.respond(&solved, Some(CacheStatus::Hit));
-        }
         let limits = state.config().limits;
-        let keyed = offload(state, text.len(), move || {
+        let validate = offload(state, text.len(), move || {
             Ok(Job::from_input(kind, input, &limits)?.keyed())
-        })
-        .await?;
-        engine.remember_input(text, keyed.key().to_string());
-        self.answering.solve(state, keyed).await
+        });
+        let (solved, cache) = state.engine().answer(text, validate).await?;
+        self.answering.respond(&solved, Some(cache))
     }
 }
 
