@@ -16,7 +16,8 @@ use super::meta::{REFERENCES, ROLLING_REFERENCES};
 use super::points::{self, SweepSummary};
 use super::rolling::{contact_units, verification_units, RollingInput, RollingJob};
 use super::three_body::{
-    result_units, three_body_verification_units, ThreeBodyInput, ThreeBodyJob,
+    operating_fields, result_units, slot, three_body_verification_units, ThreeBodyInput,
+    ThreeBodyJob,
 };
 use super::validity::Subject;
 use super::{Control, JobError, Kind, Limits, Meta, OnRefusal, References, Swept, Validated, Work};
@@ -383,13 +384,6 @@ impl RollingSweep {
     }
 }
 
-/// The operating-point lists of a three-body sweep: each with the parameter it gives.
-type OperatingList<'a> = (
-    Field<'a, Vec<Quantity>>,
-    Parameter,
-    fn(f64) -> OperatingPoint,
-);
-
 impl ThreeBodySweep {
     fn read(
         base: Field<Value>,
@@ -401,24 +395,10 @@ impl ThreeBodySweep {
         let mut base_input: ThreeBodyInput = read_object(base)?;
         let vary_input: ThreeBodyVary = read_object(vary)?;
         let v = &vary_input;
-        let lists: [OperatingList; 3] = [
-            (
-                field!(v.separation),
-                Parameter::Separation,
-                OperatingPoint::Separation,
-            ),
-            (
-                field!(v.total_load),
-                Parameter::TotalLoad,
-                OperatingPoint::TotalLoad,
-            ),
-            (
-                field!(v.particle_load),
-                Parameter::ParticleLoad,
-                OperatingPoint::ParticleLoad,
-            ),
-        ];
-        let varied: Vec<&OperatingList> = lists.iter().filter(|l| l.0.value.is_some()).collect();
+        let lists = operating_fields!(field!(v))
+            .into_iter()
+            .zip(OperatingPoint::KINDS);
+        let varied: Vec<_> = lists.filter(|(list, _)| list.value.is_some()).collect();
         // A varied operating point replaces the base's, which then only has to be readable.
         if !varied.is_empty() {
             let placeholder = OperatingPoint::Separation(0.0);
@@ -442,7 +422,7 @@ impl ThreeBodySweep {
         };
         let sweep = checker.nested(vary_field, |c, vary| {
             if varied.len() > 1 {
-                let names: Vec<&str> = varied.iter().map(|l| l.0.name).collect();
+                let names: Vec<&str> = varied.iter().map(|(list, _)| list.name).collect();
                 c.invalid(
                     "",
                     json!(names),
@@ -450,7 +430,7 @@ impl ThreeBodySweep {
                 );
             }
             let operating = match varied.first() {
-                Some(&&(list, parameter, point)) => c
+                Some(&(list, (parameter, point))) => c
                     .list(list, parameter, f64::NAN, max)
                     .into_iter()
                     .map(point)
@@ -512,11 +492,9 @@ impl ThreeBodySweep {
         };
         if self.varies_operating {
             let values: Vec<f64> = self.operating.iter().map(|o| o.value()).collect();
-            let list = quantities(&values);
-            match self.operating.first() {
-                Some(OperatingPoint::Separation(_)) => vary.separation = list,
-                Some(OperatingPoint::TotalLoad(_)) => vary.total_load = list,
-                Some(OperatingPoint::ParticleLoad(_)) | None => vary.particle_load = list,
+            if let Some(first) = self.operating.first() {
+                let slots = operating_fields!(slot!(vary));
+                *slots[first.kind()] = quantities(&values);
             }
         }
         input::canonical(&vary)

@@ -261,31 +261,44 @@ impl AsperitiesInput {
     }
 }
 
+/// The operating-point fields of `$input`, an input or a sweep's lists (which name them
+/// alike), in the order of [`OperatingPoint::KINDS`], each as `$field!` makes it
+/// ([`field!`] to read, [`slot!`] to write): the one place naming them.
+macro_rules! operating_fields {
+    ($field:ident!($input:ident)) => {
+        [
+            $field!($input.separation),
+            $field!($input.total_load),
+            $field!($input.particle_load),
+        ]
+    };
+}
+pub(crate) use operating_fields;
+
+/// A field of `$input` to write.
+macro_rules! slot {
+    ($input:ident . $name:ident) => {
+        &mut $input.$name
+    };
+}
+pub(crate) use slot;
+
 impl OperatingInput {
     /// Every operating point given (a valid input gives exactly one).
     fn read(&self, checker: &mut Checker) -> Vec<OperatingPoint> {
         let input = self;
-        let mut given = Vec::new();
-        if let Some(d) = checker.optional(field!(input.separation), Parameter::Separation) {
-            given.push(OperatingPoint::Separation(d));
-        }
-        if let Some(w) = checker.optional(field!(input.total_load), Parameter::TotalLoad) {
-            given.push(OperatingPoint::TotalLoad(w));
-        }
-        if let Some(p) = checker.optional(field!(input.particle_load), Parameter::ParticleLoad) {
-            given.push(OperatingPoint::ParticleLoad(p));
-        }
-        given
+        operating_fields!(field!(input))
+            .into_iter()
+            .zip(OperatingPoint::KINDS)
+            .filter_map(|(field, (parameter, point))| checker.optional(field, parameter).map(point))
+            .collect()
     }
 
     /// The input of one operating point.
     pub fn of(operating: OperatingPoint) -> OperatingInput {
         let mut input = OperatingInput::default();
-        match operating {
-            OperatingPoint::Separation(d) => input.separation = Quantity::si(d),
-            OperatingPoint::TotalLoad(w) => input.total_load = Quantity::si(w),
-            OperatingPoint::ParticleLoad(p) => input.particle_load = Quantity::si(p),
-        }
+        let slots = operating_fields!(slot!(input));
+        *slots[operating.kind()] = Quantity::si(operating.value());
         input
     }
 }
@@ -791,22 +804,13 @@ impl ThreeBodySweepPoint {
             .map(read)
     }
 
-    /// The model parameter the operating point gives.
-    fn operating_parameter(&self) -> Parameter {
-        match self.operating_point {
-            OperatingPoint::Separation(_) => Parameter::Separation,
-            OperatingPoint::TotalLoad(_) => Parameter::TotalLoad,
-            OperatingPoint::ParticleLoad(_) => Parameter::ParticleLoad,
-        }
-    }
-
     /// The table of `points`, whose operating points are all of one kind: the first column
     /// is named after it (`separation`, `total_load` or `particle_load`) and takes its unit.
     pub fn table(points: &[ThreeBodySweepPoint]) -> Table {
         let mut table = Table::new(&Self::COLUMNS, points);
         if let Some(point) = points.first() {
             let name = point.operating.as_object().and_then(|o| o.keys().next());
-            let unit = point.operating_parameter().unit();
+            let unit = point.operating_point.parameter().unit();
             table.rename(0, name.map_or("operating", String::as_str), unit);
         }
         table

@@ -102,7 +102,32 @@ pub enum OperatingPoint {
     ParticleLoad(f64),
 }
 
+/// A kind of operating point: the parameter that bounds its value, and the point of a value.
+pub type OperatingKind = (Parameter, fn(f64) -> OperatingPoint);
+
 impl OperatingPoint {
+    /// The kinds of operating point, each with the parameter that bounds its value, in the
+    /// order inputs list them (separation, total load, particle load).
+    pub const KINDS: [OperatingKind; 3] = [
+        (Parameter::Separation, OperatingPoint::Separation),
+        (Parameter::TotalLoad, OperatingPoint::TotalLoad),
+        (Parameter::ParticleLoad, OperatingPoint::ParticleLoad),
+    ];
+
+    /// The position of the operating point's kind in [`OperatingPoint::KINDS`].
+    pub fn kind(self) -> usize {
+        match self {
+            OperatingPoint::Separation(_) => 0,
+            OperatingPoint::TotalLoad(_) => 1,
+            OperatingPoint::ParticleLoad(_) => 2,
+        }
+    }
+
+    /// The parameter whose value the operating point gives.
+    pub fn parameter(self) -> Parameter {
+        OperatingPoint::KINDS[self.kind()].0
+    }
+
     /// The separation, total load or mean particle load given.
     pub fn value(self) -> f64 {
         match self {
@@ -656,5 +681,21 @@ impl<'a> Model<'a> {
             root.iterations,
             (carried(&state) / target - 1.0).abs(),
         ))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `kind` and `parameter` agree with the table inputs read operating points by.
+    #[test]
+    fn each_operating_point_finds_its_own_kind_in_the_table() {
+        for (i, (parameter, point)) in OperatingPoint::KINDS.into_iter().enumerate() {
+            let point = point(2.5);
+            assert_eq!(point.kind(), i);
+            assert_eq!(point.parameter(), parameter);
+            assert_eq!(point.value(), 2.5);
+        }
     }
 }
