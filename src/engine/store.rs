@@ -479,7 +479,8 @@ impl JobStore for MemoryJobStore {
 mod tests {
     use super::*;
     use crate::engine::cache::Solved;
-    use crate::render::{Answer, Column, Fixed, Output, Table, UnitGroups, UnitTable};
+    use crate::render::{Answer, Column, Output, Table, UnitTable};
+    use crate::unit_table;
     use serde::Serialize;
 
     #[derive(Debug, PartialEq, Serialize)]
@@ -488,10 +489,7 @@ mod tests {
     }
 
     impl Output for Blob {
-        const UNITS: &'static UnitTable = {
-            static UNITS: UnitTable = Fixed::new(UnitGroups(&[]));
-            &UNITS
-        };
+        const UNITS: &'static UnitTable = unit_table![];
         fn table(&self) -> Table {
             Table::new(&[Column::text("text", |b: &Blob| b.text.clone())], [self])
         }

@@ -12,7 +12,8 @@ use super::meta::ROLLING_REFERENCES;
 use super::{Control, JobError, Kind, Limits, Meta, References, Validated, Work};
 use crate::model::figures::{Axis, Figure, Plan, FIGURES};
 use crate::model::tables::{self, Use};
-use crate::render::{Column, Fixed, Output, Table, UnitGroups, UnitTable};
+use crate::render::{Column, Output, Table, UnitTable};
+use crate::unit_table;
 
 /// Input of a figure job.
 #[derive(Clone, Debug, PartialEq, Deserialize, Serialize, ToSchema)]
@@ -174,16 +175,13 @@ struct FigureRow<'a> {
 
 impl Output for FigureOutput {
     /// The points are in the units of the axes, which the answer names.
-    const UNITS: &'static UnitTable = {
-        static UNITS: UnitTable = Fixed::new(UnitGroups(&[&[
-            ("figure", ""),
-            ("series[].radius", "m"),
-            ("series[].load", "N"),
-            ("series[].velocity", "m/s"),
-            ("series[].points[][]", "x.unit, y.unit"),
-        ]]));
-        &UNITS
-    };
+    const UNITS: &'static UnitTable = unit_table![&[
+        ("figure", ""),
+        ("series[].radius", "m"),
+        ("series[].load", "N"),
+        ("series[].velocity", "m/s"),
+        ("series[].points[][]", "x.unit, y.unit"),
+    ]];
 
     /// One row per point: the series' index and legend, then x and y in the axes' units.
     fn table(&self) -> Table {

@@ -15,7 +15,8 @@ use super::{Control, JobError, Kind, Limits, Meta, References, Validated, Work};
 use crate::model::rolling::{BoundaryPoint, PressureGrid, Verification};
 use crate::model::tables::{self, Use};
 use crate::model::{self, Parameter, Rolling, RollingSolution, SolveOption, SolveOptions};
-use crate::render::{Column, Fixed, Output, Table, UnitGroups, UnitTable};
+use crate::render::{Column, Output, Table, UnitTable};
+use crate::unit_table;
 
 /// Input of a rolling job; every field optional (docs/model.md §5 defaults).
 #[derive(Clone, Debug, Default, PartialEq, Deserialize, Serialize, ToSchema)]
@@ -532,22 +533,19 @@ impl RollingOutput {
 }
 
 impl Output for RollingOutput {
-    const UNITS: &'static UnitTable = {
-        static UNITS: UnitTable = Fixed::new(UnitGroups(&[
-            contact_units!(""),
-            &[
-                ("boundary[].y", "m"),
-                ("boundary[].exit", "m"),
-                ("boundary[].entry", "m"),
-                ("pressure.x[]", "m"),
-                ("pressure.y[]", "m"),
-                ("pressure.values[][]", "Pa"),
-            ],
-            verification_units!("meta.verification."),
-            validity_units!("meta.validity."),
-        ]));
-        &UNITS
-    };
+    const UNITS: &'static UnitTable = unit_table![
+        contact_units!(""),
+        &[
+            ("boundary[].y", "m"),
+            ("boundary[].exit", "m"),
+            ("boundary[].entry", "m"),
+            ("pressure.x[]", "m"),
+            ("pressure.y[]", "m"),
+            ("pressure.values[][]", "Pa"),
+        ],
+        verification_units!("meta.verification."),
+        validity_units!("meta.validity."),
+    ];
 
     /// One row: the contact's conditions and integrals, as a sweep's row.
     fn table(&self) -> Table {

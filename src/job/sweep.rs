@@ -24,7 +24,8 @@ use super::{Control, JobError, Kind, Limits, Meta, OnRefusal, References, Swept,
 use crate::model::tables::{self, Use};
 use crate::model::three_body::{self, Diameters, OperatingPoint, ThreeBody, ThreeBodySolution};
 use crate::model::{Parameter, Rolling, RollingSolution, SolveOptions, MODEL_VERSION};
-use crate::render::{Fixed, Output, Table, UnitGroups, UnitTable};
+use crate::render::{Output, Table, UnitTable};
+use crate::unit_table;
 
 pub use super::rolling::SweepPoint;
 pub use super::three_body::ThreeBodySweepPoint;
@@ -576,40 +577,37 @@ pub struct SweepMeta {
 
 impl Output for SweepOutput {
     /// The points of a rolling sweep or of a three-body sweep.
-    const UNITS: &'static UnitTable = {
-        static UNITS: UnitTable = Fixed::new(UnitGroups(&[
-            &[
-                ("points[].radius", "m"),
-                ("points[].load", "N"),
-                ("points[].velocity", "m/s"),
-                ("points[].mean_diameter", "m"),
-                ("points[].operating.separation", "m"),
-                ("points[].operating.total_load", "N"),
-                ("points[].operating.particle_load", "N"),
-            ],
-            contact_units!("points[]."),
-            result_units!("points[]."),
-            &[
-                ("points[].validity.inside_layer", ""),
-                ("points[].validity.parabolic_sphere", ""),
-                ("points[].validity.local_layer", ""),
-                ("points[].validity.adhesive_friction", ""),
-                ("points[].validity.surfaces_apart", ""),
-                ("points[].validity.asperity_gap", ""),
-                ("points[].validity.particles_in_contact", ""),
-                ("meta.counts.total", ""),
-                ("meta.counts.ok", ""),
-                ("meta.counts.warn", ""),
-                ("meta.counts.refused", ""),
-                ("meta.counts.missing", ""),
-                ("meta.validity.assumptions[].warned", ""),
-                ("meta.validity.assumptions[].first_warned", ""),
-            ],
-            verification_units!("meta.verification."),
-            three_body_verification_units!("meta.verification."),
-        ]));
-        &UNITS
-    };
+    const UNITS: &'static UnitTable = unit_table![
+        &[
+            ("points[].radius", "m"),
+            ("points[].load", "N"),
+            ("points[].velocity", "m/s"),
+            ("points[].mean_diameter", "m"),
+            ("points[].operating.separation", "m"),
+            ("points[].operating.total_load", "N"),
+            ("points[].operating.particle_load", "N"),
+        ],
+        contact_units!("points[]."),
+        result_units!("points[]."),
+        &[
+            ("points[].validity.inside_layer", ""),
+            ("points[].validity.parabolic_sphere", ""),
+            ("points[].validity.local_layer", ""),
+            ("points[].validity.adhesive_friction", ""),
+            ("points[].validity.surfaces_apart", ""),
+            ("points[].validity.asperity_gap", ""),
+            ("points[].validity.particles_in_contact", ""),
+            ("meta.counts.total", ""),
+            ("meta.counts.ok", ""),
+            ("meta.counts.warn", ""),
+            ("meta.counts.refused", ""),
+            ("meta.counts.missing", ""),
+            ("meta.validity.assumptions[].warned", ""),
+            ("meta.validity.assumptions[].first_warned", ""),
+        ],
+        verification_units!("meta.verification."),
+        three_body_verification_units!("meta.verification."),
+    ];
 
     /// One row per point.
     fn table(&self) -> Table {

@@ -18,7 +18,8 @@ use crate::model::three_body::{
     ThreeBodyOptions, ThreeBodySolution, UpperContact, UpperSurface, DEFAULT_DIAMETER_NODES,
 };
 use crate::model::{Parameter, SolveOption};
-use crate::render::{Column, Fixed, Output, Table, UnitGroups, UnitTable};
+use crate::render::{Column, Output, Table, UnitTable};
+use crate::unit_table;
 
 /// Input of a three-body job; every field optional but the operating point.
 #[derive(Clone, Debug, Default, PartialEq, Deserialize, Serialize, ToSchema)]
@@ -715,14 +716,11 @@ impl ThreeBodyOutput {
 }
 
 impl Output for ThreeBodyOutput {
-    const UNITS: &'static UnitTable = {
-        static UNITS: UnitTable = Fixed::new(UnitGroups(&[
-            result_units!(""),
-            three_body_verification_units!("meta.verification."),
-            validity_units!("meta.validity."),
-        ]));
-        &UNITS
-    };
+    const UNITS: &'static UnitTable = unit_table![
+        result_units!(""),
+        three_body_verification_units!("meta.verification."),
+        validity_units!("meta.validity."),
+    ];
 
     /// One row: the system's operating point, speed and mean diameter and its results, as a
     /// sweep's row.

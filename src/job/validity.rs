@@ -372,67 +372,71 @@ struct Described {
     rule: Text,
 }
 
-fn described(assumption: Assumption) -> &'static Described {
-    use Assumption::*;
-    static INSIDE_LAYER: Described = Described {
-        name: "inside_layer",
-        assumption: Fixed::new(
-            "the sphere stays inside the layer: the rigid base is never reached",
-        ),
-        ratio: "penetration / thickness",
-        rule: Fixed::new(
-            "warn above 0.1 (the linear layer law assumes small strain); refused at 1",
-        ),
-    };
-    static PARABOLIC: Described = Described {
-        name: "parabolic_sphere",
-        assumption: Fixed::new(
-            "the sphere is a paraboloid near the contact (contact an order smaller than R)",
-        ),
-        ratio: "contact extent / radius",
-        rule: Fixed::new("warn when (ratio)²/4, the profile's error, passes 0.05; refused at 1"),
-    };
-    static LOCAL_LAYER: Described = Described {
-        name: "local_layer",
-        assumption: Fixed::new(
-            "the layer is local (Winkler): the contact is wide compared with the layer",
-        ),
-        ratio: "contact half-width / thickness",
-        rule: Fixed::new("warn below 1"),
-    };
-    static ADHESIVE_FRICTION: Described = Described {
-        name: "adhesive_friction",
-        assumption: Fixed::new("adhesive friction τ_a A / P (eq. 12) is meaningful"),
-        ratio: "friction coefficient",
-        rule: Fixed::new("warn above 1"),
-    };
-    static SURFACES_APART: Described = Described {
-        name: "surfaces_apart",
-        assumption: Fixed::new("the surfaces stay apart (the paper's always-a-gap regime)"),
-        ratio: "separation / largest diameter",
-        rule: Fixed::new("refused at or below 0"),
-    };
-    static ASPERITY_GAP: Described = Described {
-        name: "asperity_gap",
-        assumption: Fixed::new("the asperities of the surfaces stay apart"),
-        ratio: "separation / asperity height standard deviation",
-        rule: Fixed::new("warn below 3"),
-    };
-    static PARTICLES_IN_CONTACT: Described = Described {
-        name: "particles_in_contact",
-        assumption: Fixed::new("at least one particle is in contact"),
-        ratio: "particles in contact",
-        rule: Fixed::new("warn below 1"),
-    };
-    match assumption {
-        InsideLayer => &INSIDE_LAYER,
-        Parabolic => &PARABOLIC,
-        LocalLayer => &LOCAL_LAYER,
-        AdhesiveFriction => &ADHESIVE_FRICTION,
-        SurfacesApart => &SURFACES_APART,
-        AsperityGap => &ASPERITY_GAP,
-        ParticlesInContact => &PARTICLES_IN_CONTACT,
+impl Described {
+    const fn new(
+        name: &'static str,
+        assumption: &'static str,
+        ratio: &'static str,
+        rule: &'static str,
+    ) -> Described {
+        Described {
+            name,
+            assumption: Fixed::new(assumption),
+            ratio,
+            rule: Fixed::new(rule),
+        }
     }
+}
+
+/// Each assumption described, in the order of [`Assumption::ALL`].
+static DESCRIBED: [Described; 7] = [
+    Described::new(
+        "inside_layer",
+        "the sphere stays inside the layer: the rigid base is never reached",
+        "penetration / thickness",
+        "warn above 0.1 (the linear layer law assumes small strain); refused at 1",
+    ),
+    Described::new(
+        "parabolic_sphere",
+        "the sphere is a paraboloid near the contact (contact an order smaller than R)",
+        "contact extent / radius",
+        "warn when (ratio)²/4, the profile's error, passes 0.05; refused at 1",
+    ),
+    Described::new(
+        "local_layer",
+        "the layer is local (Winkler): the contact is wide compared with the layer",
+        "contact half-width / thickness",
+        "warn below 1",
+    ),
+    Described::new(
+        "adhesive_friction",
+        "adhesive friction τ_a A / P (eq. 12) is meaningful",
+        "friction coefficient",
+        "warn above 1",
+    ),
+    Described::new(
+        "surfaces_apart",
+        "the surfaces stay apart (the paper's always-a-gap regime)",
+        "separation / largest diameter",
+        "refused at or below 0",
+    ),
+    Described::new(
+        "asperity_gap",
+        "the asperities of the surfaces stay apart",
+        "separation / asperity height standard deviation",
+        "warn below 3",
+    ),
+    Described::new(
+        "particles_in_contact",
+        "at least one particle is in contact",
+        "particles in contact",
+        "warn below 1",
+    ),
+];
+
+fn described(assumption: Assumption) -> &'static Described {
+    let index = Assumption::ALL.iter().position(|a| *a == assumption);
+    &DESCRIBED[index.expect("Assumption::ALL lists every assumption")]
 }
 
 fn output(check: &Check, subject: Subject) -> AssumptionOutput {

@@ -87,6 +87,18 @@ impl Serialize for UnitGroups {
 /// The unit table of an output kind ([`super::Output::UNITS`]).
 pub type UnitTable = Fixed<UnitGroups>;
 
+/// An output's unit table ([`super::Output::UNITS`]) from its groups of (path, unit), as a
+/// `static` of its own, so that its JSON is rendered once:
+/// `const UNITS: &'static UnitTable = unit_table![&[("x", "m")]];`.
+#[macro_export]
+macro_rules! unit_table {
+    ($($group:expr),* $(,)?) => {{
+        static UNITS: $crate::render::UnitTable =
+            $crate::render::Fixed::new($crate::render::UnitGroups(&[$($group),*]));
+        &UNITS
+    }};
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

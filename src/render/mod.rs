@@ -465,6 +465,7 @@ fn has_null(json: &[u8]) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::unit_table;
 
     #[test]
     fn a_null_value_is_found_and_a_null_inside_a_string_is_not() {
@@ -505,10 +506,7 @@ mod tests {
     }
 
     impl Output for Point {
-        const UNITS: &'static UnitTable = {
-            static UNITS: UnitTable = Fixed::new(UnitGroups(&[&[("x", "m")]]));
-            &UNITS
-        };
+        const UNITS: &'static UnitTable = unit_table![&[("x", "m")]];
 
         fn table(&self) -> Table {
             const COLUMNS: [Column<Point>; 1] = [Column::number("x", "m", |p| p.x)];
@@ -538,10 +536,7 @@ mod tests {
     }
 
     impl Output for Holder {
-        const UNITS: &'static UnitTable = {
-            static UNITS: UnitTable = Fixed::new(UnitGroups(&[]));
-            &UNITS
-        };
+        const UNITS: &'static UnitTable = unit_table![];
 
         fn table(&self) -> Table {
             const COLUMNS: [Column<f64>; 1] = [Column::number("x", "m", |x| *x)];

@@ -14,7 +14,8 @@ use thirdbody::job::{
     Control, Job, JobError, Kind, Limits, Meta, References, Validated, Work, ROLLING_REFERENCES,
 };
 use thirdbody::render::svg::{Axis, Chart, Layer};
-use thirdbody::render::{Column, Fixed, Format, Output, Table, UnitGroups, UnitTable};
+use thirdbody::render::{Column, Format, Output, Table, UnitTable};
+use thirdbody::unit_table;
 use utoipa::ToSchema;
 
 /// A scratch kind that cannot tell its work in advance (as an iterative fit): it counts
@@ -31,10 +32,7 @@ struct CountdownOutput {
 }
 
 impl Output for CountdownOutput {
-    const UNITS: &'static UnitTable = {
-        static UNITS: UnitTable = Fixed::new(UnitGroups(&[&[("steps", "")]]));
-        &UNITS
-    };
+    const UNITS: &'static UnitTable = unit_table![&[("steps", "")]];
 
     fn table(&self) -> Table {
         Table::new(
