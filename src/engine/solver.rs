@@ -76,7 +76,7 @@ pub struct Solver {
 
 impl Solver {
     /// A solve path of `config.pool_size` threads whose answers are kept in `cache`.
-    pub(super) fn new(
+    pub fn new(
         config: &EngineConfig,
         metrics: Metrics,
         cache: Arc<dyn ResultCache>,

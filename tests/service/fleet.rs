@@ -424,3 +424,104 @@ async fn a_part_whose_worker_keeps_dying_fails_its_job_saying_so() {
         "{detail}"
     );
 }
+
+/// A worker on its own, built from its handles (a solve path, the fleet, the drain's
+/// token), with no engine and no HTTP: it takes a job from the stream of a real Redis, stores
+/// its answer, and stops once the drain begins.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_worker_on_its_own_takes_a_job_from_the_stream_and_stores_its_answer() {
+    use thirdbody::engine::cache::MemoryCache;
+    use thirdbody::engine::fleet::{
+        Fleet, FleetConfig, RedisJobStore, Shared, TieredCache, Worker,
+    };
+    use thirdbody::engine::metrics::Metrics;
+    use thirdbody::engine::store::{JobRecord, JobStatus};
+    use thirdbody::engine::{EngineConfig, Solver};
+    use thirdbody::job::{Control, Job, Limits};
+    use tokio_util::sync::CancellationToken;
+
+    let Some((redis_port, _redis)) = fresh_redis() else {
+        return;
+    };
+    let url = format!("redis://127.0.0.1:{redis_port}");
+    let minute = Duration::from_secs(60);
+    let config = EngineConfig {
+        pool_size: 1,
+        solve_deadline: minute,
+        job_deadline: minute,
+        max_queued_jobs: 1,
+        memory_budget: 1 << 24,
+        max_jobs: 1,
+        cache_ttl: minute,
+        job_retention: minute,
+        spill: None,
+    };
+    let fleet = Arc::new(
+        Fleet::open(FleetConfig {
+            cache_url: url.clone(),
+            jobs_url: url,
+            claim_idle: Duration::from_secs(30),
+            max_deliveries: 3,
+            part_points: 250,
+        })
+        .unwrap(),
+    );
+    let store = Arc::new(RedisJobStore::new(fleet.clone(), minute));
+    let cache = TieredCache::new(MemoryCache::new(1 << 24, minute), fleet.clone(), minute);
+    let solver = Arc::new(Solver::new(&config, Metrics::noop(), Arc::new(cache)));
+
+    let keyed = Job::from_value(
+        json!({"kind": "rolling", "input": {"load": "1.2 nN"}}),
+        &Limits::default(),
+    )
+    .unwrap()
+    .keyed();
+    let job = keyed.job();
+    let record = JobRecord::queued(uuid::Uuid::new_v4(), job.kind(), job.work());
+    let deadline = std::time::SystemTime::now() + minute;
+    store
+        .enqueue(&record, &job.to_wire(), keyed.key(), deadline, &[])
+        .await
+        .unwrap();
+
+    let draining = CancellationToken::new();
+    let shared = Arc::new(Shared::new(fleet, store.clone()));
+    let worker = tokio::spawn(Worker::new(solver, shared, None, draining.clone()).run());
+    let start = Instant::now();
+    let answered = loop {
+        let now = store
+            .record(record.id)
+            .await
+            .unwrap()
+            .expect("the record is kept");
+        if now.state.status().is_finished() {
+            break now;
+        }
+        assert!(
+            start.elapsed() < Duration::from_secs(20),
+            "not answered: {now:?}"
+        );
+        tokio::time::sleep(Duration::from_millis(20)).await;
+    };
+    assert_eq!(answered.state.status(), JobStatus::Succeeded);
+    let (json, _) = answered.state.result().unwrap().bodies().await.unwrap();
+    let stored: Value = serde_json::from_slice(&json).unwrap();
+    let direct = thirdbody::engine::run(job, &Control::default()).unwrap();
+    let direct: Value = serde_json::from_str(&direct.to_pretty_json().unwrap()).unwrap();
+    assert_eq!(stored["meta"]["input_hash"], json!(keyed.key()));
+    // Through the layer's table or exactly, whichever this process has built by then: the
+    // two agree to the table's error, 1e-9 (tests/service/jobs.rs).
+    for quantity in ["contact_area", "friction_coefficient", "penetration"] {
+        let (a, b) = (
+            stored[quantity].as_f64().unwrap(),
+            direct[quantity].as_f64().unwrap(),
+        );
+        assert!((a / b - 1.0).abs() < 1e-9, "{quantity}: {a:e} vs {b:e}");
+    }
+
+    draining.cancel();
+    tokio::time::timeout(Duration::from_secs(5), worker)
+        .await
+        .expect("the worker stops when the drain begins")
+        .unwrap();
+}
