@@ -76,11 +76,7 @@ pub struct Solver {
 
 impl Solver {
     /// A solve path of `config.pool_size` threads whose answers are kept in `cache`.
-    pub fn new(
-        config: &EngineConfig,
-        metrics: Metrics,
-        cache: Arc<dyn ResultCache>,
-    ) -> Self {
+    pub fn new(config: &EngineConfig, metrics: Metrics, cache: Arc<dyn ResultCache>) -> Self {
         let budget = Budget::split(config.memory_budget);
         Solver {
             pool: Pool::new(config.pool_size),
