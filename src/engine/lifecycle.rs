@@ -17,7 +17,7 @@ use uuid::Uuid;
 use super::backlog::{Backlog, Ticket};
 use super::fleet::{Shared, Worker};
 use super::metrics::{self as names, Metrics};
-use super::solver::{Solver, Stopped};
+use super::solver::Solver;
 use super::spill::JobResult;
 use super::store::{JobRecord, JobState, JobStatus, JobStore};
 use super::{EngineConfig, EngineError};
@@ -511,7 +511,8 @@ impl Lifecycle {
                 self.solver.keep(solved.clone()).await;
                 JobState::Succeeded(JobResult::Ready(solved))
             }
-            Err(Stopped { error, partial }) => {
+            Err(stopped) => {
+                let (error, partial) = stopped.into_parts();
                 let partial = partial.map(JobResult::Ready);
                 match error {
                     JobError::Cancelled => live.stopped(partial),

@@ -41,8 +41,15 @@ impl CacheStatus {
 /// A solve that did not answer: why, and the partial answer of a job that keeps what it
 /// finished ([`crate::job::Unfinished`]).
 pub(super) struct Stopped {
-    pub error: JobError,
-    pub partial: Option<Arc<Solved>>,
+    error: JobError,
+    partial: Option<Arc<Solved>>,
+}
+
+impl Stopped {
+    /// Why the solve stopped, and what it finished (kept for an asynchronous job only).
+    pub(super) fn into_parts(self) -> (JobError, Option<Arc<Solved>>) {
+        (self.error, self.partial)
+    }
 }
 
 impl From<JobError> for Stopped {
@@ -183,7 +190,7 @@ impl Solver {
         let solved = self
             .execute(permit, keyed, control, false)
             .await
-            .map_err(|stopped| stopped.error)?;
+            .map_err(|stopped| stopped.into_parts().0)?;
         self.keep(solved.clone()).await;
         Ok(solved)
     }
