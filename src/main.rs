@@ -31,10 +31,8 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Solve a job {"kind": ..., "input": {...}} and print the result as JSON.
-    ///
-    /// Exits 0 with an answer, 1 when a valid job cannot be solved, 2 when the job cannot be
-    /// used (the file cannot be read, is not JSON, or is not a valid job).
+    /// Solve a job and print the result as JSON (the help naming the kinds is made from the
+    /// registry, in `cli_with_kinds`).
     Solve {
         /// The job file, or - for standard input.
         job: String,
@@ -112,27 +110,20 @@ impl OutputFormat {
 /// `serve` setting that is not valid.
 const INVALID_JOB: u8 = 2;
 
+/// What `thirdbody solve` exits with, under its first line in `solve --help`.
+const SOLVE_EXITS: &str = "Exits 0 with an answer, 1 when a valid job cannot be solved, 2 when \
+                           the job cannot be used (the file cannot be read, is not JSON, or is \
+                           not a valid job).";
+
 /// The command line, its help naming the job kinds from the registry (the one list of
 /// kinds).
 fn cli_with_kinds() -> clap::Command {
-    let kinds: Vec<String> = registry::NAMES.iter().map(|n| format!("\"{n}\"")).collect();
     let about = format!(
         "Solve a job {{\"kind\": {}, \"input\": {{...}}}} and print the result as JSON.",
-        kinds.join(" | ")
+        registry::quoted_names(" | ")
     );
-    Cli::command().mut_subcommand("solve", |solve| {
-        // The doc comment's first paragraph is replaced, the rest (exit codes) kept.
-        let long = solve.get_long_about().map(|l| l.to_string());
-        let rest = long
-            .as_deref()
-            .and_then(|l| l.split_once("\n\n"))
-            .map(|(_, r)| r);
-        let long_about = match rest {
-            Some(rest) => format!("{about}\n\n{rest}"),
-            None => about.clone(),
-        };
-        solve.about(about).long_about(long_about)
-    })
+    let long_about = format!("{about}\n\n{SOLVE_EXITS}");
+    Cli::command().mut_subcommand("solve", |solve| solve.about(about).long_about(long_about))
 }
 
 fn main() -> ExitCode {

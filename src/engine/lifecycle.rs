@@ -195,7 +195,7 @@ impl Lifecycle {
         }
     }
 
-    /// Queues `job` to run in the background; returns its record. Refused when the queue
+    /// Queues `keyed` to run in the background; returns its record. Refused when the queue
     /// is full, the service is draining, or there is no room to keep the job's result.
     pub(super) async fn submit(self: &Arc<Self>, keyed: Keyed) -> Result<JobRecord, EngineError> {
         self.store_reachable()?;

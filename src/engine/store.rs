@@ -133,7 +133,7 @@ impl JobState {
 #[derive(Clone, Debug)]
 pub struct JobRecord {
     pub id: Uuid,
-    /// The job's kind, by its name on the wire.
+    /// The job's kind (its name on the wire, and what draws its answer).
     pub kind: KindName,
     /// The work the job takes.
     pub work: Work,

@@ -103,11 +103,16 @@ pub fn find(name: &str) -> Result<&'static Registered, JobError> {
 }
 
 fn unknown_kind(name: &str) -> String {
-    let known: Vec<String> = NAMES.iter().map(|n| format!("\"{n}\"")).collect();
     format!(
         "unknown kind \"{name}\": expected one of {}",
-        known.join(", ")
+        quoted_names(", ")
     )
+}
+
+/// The kinds' names as JSON strings, in the order of [`LIST`], joined by `separator`.
+pub fn quoted_names(separator: &str) -> String {
+    let quoted: Vec<String> = NAMES.iter().map(|n| format!("\"{n}\"")).collect();
+    quoted.join(separator)
 }
 
 impl Job {

@@ -25,10 +25,6 @@ impl<T> Fixed<T> {
             json: OnceLock::new(),
         }
     }
-
-    pub fn get(&self) -> &T {
-        &self.value
-    }
 }
 
 impl<T: Serialize> Fixed<T> {

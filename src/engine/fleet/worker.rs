@@ -30,7 +30,7 @@ use crate::engine::solver::Solver;
 use crate::engine::spill::JobResult;
 use crate::engine::store::JobState;
 use crate::job::parts::{self, RenderedPart};
-use crate::job::{Control, Job, JobError, Unfinished, Work};
+use crate::job::{Control, Job, JobError, Keyed, Unfinished, Work};
 
 /// How long an idle worker waits before looking at the stream again.
 const IDLE: Duration = Duration::from_millis(20);
@@ -198,7 +198,7 @@ impl Worker {
             Ok(job) => job,
             Err(e) => return self.finish(&entry, JobState::failed(e), None).await,
         };
-        let keyed = job.clone().keyed();
+        let keyed = job.keyed();
         if keyed.key() != runnable.key {
             let error = JobError::Internal(
                 "the job read back from the job store is not the job accepted".to_string(),
@@ -221,7 +221,7 @@ impl Worker {
         let running = self.solver.running();
         let key = runnable.key.clone();
         let part = entry.part.clone();
-        let (solving, meta) = keyed.into_parts();
+        let (solving, meta) = keyed.clone().into_parts();
         let result = Pool::run(permit, control.clone(), move |control| match part {
             None => match solving.run_keeping(meta, control) {
                 Ok(answer) => Ok(Outcome::Whole(Arc::new(Solved::new(
@@ -259,7 +259,7 @@ impl Worker {
         match result {
             Ok(Outcome::Whole(solved)) => {
                 self.solver.keep(solved.clone()).await;
-                let total = match job.work() {
+                let total = match keyed.job().work() {
                     Work::Known(total) => total,
                     Work::Unknown => control.done(),
                 };
@@ -277,7 +277,7 @@ impl Worker {
                 let points = entry.part.as_ref().map_or(0, |(_, r)| r.len());
                 let index = entry.part.as_ref().map_or(0, |(i, _)| *i);
                 match store.part_done(id, index, &rendered, points).await {
-                    Ok(Some(all)) => self.assemble(&entry, &job, &runnable.key, &all).await,
+                    Ok(Some(all)) => self.assemble(&entry, &keyed, &all).await,
                     Ok(None) => acknowledge(&shared.fleet, &entry).await,
                     Err(_) => {} // taken over later
                 }
@@ -293,11 +293,12 @@ impl Worker {
     }
 
     /// Assembles the split `job` from all its parts and finishes it.
-    async fn assemble(&self, entry: &Entry, job: &Job, key: &str, all: &[RenderedPart]) {
-        let state = match parts::assemble(&job.meta(), all) {
+    async fn assemble(&self, entry: &Entry, keyed: &Keyed, all: &[RenderedPart]) {
+        let job = keyed.job();
+        let state = match parts::assemble(keyed.meta(), all) {
             Ok(assembled) => {
                 let solved = Arc::new(Solved::rendered(
-                    key.to_string(),
+                    keyed.key().to_string(),
                     job.kind(),
                     Bytes::from(assembled.json),
                     Bytes::from(assembled.csv),
