@@ -13,7 +13,6 @@ use thirdbody::check;
 use thirdbody::engine::Engine;
 use thirdbody::http::{self, AppState, Config, LogFormat, ServeArgs};
 use thirdbody::job::registry;
-use thirdbody::job::sweep::SweepOutput;
 use thirdbody::job::{Control, FigureJob, Job, JobError, Limits};
 use thirdbody::model::text::{count, quantity};
 use thirdbody::render::{Answer, Format};
@@ -154,7 +153,9 @@ fn main() -> ExitCode {
         let meta = job.meta();
         let provenance = output.provenance.then(|| meta.provenance());
         let answer = job.run(meta, &Control::default())?;
-        warn_of_refusals(&answer);
+        if let Some(notice) = answer.notice() {
+            eprintln!("thirdbody: warning: {notice}");
+        }
         let format = output.format.format();
         let text = render(&answer, format)?;
         Ok(match provenance {
@@ -197,21 +198,6 @@ fn check(path: &Path, junit: Option<&Path>, update: bool) -> ExitCode {
         printed
     } else {
         ExitCode::FAILURE
-    }
-}
-
-/// Says on standard error how many points of a sweep the model refused (their rows say why),
-/// as it says the input's warnings: the answer is given, but not for every point.
-fn warn_of_refusals(answer: &Answer) {
-    if let Some(sweep) = answer.downcast_ref::<SweepOutput>() {
-        let counts = sweep.meta.summary.counts;
-        if counts.refused > 0 {
-            eprintln!(
-                "thirdbody: warning: the model refused {} of {} points; their rows say why \
-                 (\"on_refusal\": \"fail\" fails the sweep instead)",
-                counts.refused, counts.total
-            );
-        }
     }
 }
 

@@ -480,16 +480,18 @@ mod tests {
     use super::*;
     use crate::engine::cache::Solved;
     use crate::render::{Answer, Column, Output, Table, UnitTable};
-    use crate::unit_table;
+    use crate::{described, unit_table};
     use serde::Serialize;
 
-    #[derive(Debug, PartialEq, Serialize)]
-    struct Blob {
-        text: String,
+    described! {
+        #[derive(Debug, PartialEq, Serialize)]
+        struct Blob {
+            text: String => [],
+        }
     }
 
     impl Output for Blob {
-        const UNITS: &'static UnitTable = unit_table![];
+        const UNITS: &'static UnitTable = unit_table!(Blob);
         fn table(&self) -> Table {
             Table::new(&[Column::text("text", |b: &Blob| b.text.clone())], [self])
         }

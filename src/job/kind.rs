@@ -13,10 +13,9 @@ use serde_json::Value;
 use utoipa::ToSchema;
 
 use super::meta::{InputWarning, Meta, References};
-use super::pictures::PictureError;
+use super::picture::{draw, Picture};
 use super::registry::KindName;
 use super::{Control, JobError, Limits};
-use crate::render::svg::Chart;
 use crate::render::{Answer, Output};
 
 /// How much work a job takes, in the units its [`Control`] counts (rolling solves for the
@@ -77,9 +76,9 @@ pub trait Kind: fmt::Debug + PartialEq + Send + Sync + Sized + 'static {
     /// between units of work, and counts them there.
     fn run(&self, meta: Meta, control: &Control) -> Result<Self::Output, JobError>;
 
-    /// The picture of an answer of this kind, drawn from its JSON (so that an answer made
-    /// in another process is drawn the same).
-    fn picture(answer: &Value) -> Result<Chart, PictureError>;
+    /// What the picture of an answer of this kind is drawn from, read back from the
+    /// answer's JSON (so that an answer made in another process is drawn the same).
+    type Picture: Picture;
 
     /// The number of points the job splits into, for a job whose answer is one row per
     /// point, `{"points": [...], "meta": {...}}` (a sweep): parts of it can then be solved
@@ -144,10 +143,10 @@ impl From<JobError> for Unfinished {
 /// The answer of `output`, or the partial answer of an unfinished run.
 fn answer<K: Kind>(output: K::Output) -> Result<Answer, Unfinished> {
     match K::unfinished(&output) {
-        None => Ok(Answer::new(output).drawn_by(K::picture)),
+        None => Ok(Answer::new(output).drawn_by(draw::<K::Picture>)),
         Some(error) => Err(Unfinished {
             error,
-            partial: Some(Answer::new(output).drawn_by(K::picture)),
+            partial: Some(Answer::new(output).drawn_by(draw::<K::Picture>)),
         }),
     }
 }

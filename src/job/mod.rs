@@ -16,7 +16,7 @@ pub mod input;
 mod kind;
 pub mod meta;
 pub mod parts;
-pub mod pictures;
+pub mod picture;
 pub mod points;
 pub mod registry;
 pub mod rolling;

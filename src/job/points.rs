@@ -17,6 +17,8 @@ use super::rolling::VerificationOutput;
 use super::three_body::ThreeBodyVerificationOutput;
 use super::validity::{PointValidity, Subject, SweepValidityOutput, ValidityStatus, ValidityTally};
 use super::{JobError, Swept};
+use crate::described;
+use crate::render::{fields, Column, Field, Fields};
 
 /// What became of a point of a sweep.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, ToSchema)]
@@ -78,6 +80,16 @@ impl PointNotes {
     }
 }
 
+impl PointNotes {
+    /// The path and unit of each number the notes put in a row (its `validity`).
+    pub fn units() -> Vec<(String, &'static str)> {
+        let ratios = PointValidity::units().into_iter();
+        ratios
+            .map(|(name, unit)| (format!("validity.{name}"), unit))
+            .collect()
+    }
+}
+
 /// Flattened into a row: `validity` (each assumption's ratio at the point's speed, by name)
 /// and `warn` (the names of those that warn, at speed or at rest) for an answered point,
 /// `reason` for a refused one, nothing for a missing one.
@@ -119,6 +131,16 @@ pub struct PointNotesFields {
     warn: Option<Vec<String>>,
     /// Refused points: why, with the values named.
     reason: Option<String>,
+}
+
+/// The CSV columns of a kind of row: `fields`, the columns of its numbers, then its status
+/// and the note beside it.
+pub fn columns<R: Row>(mut fields: Vec<Column<R>>) -> Vec<Column<R>> {
+    fields.push(Column::text("status", |r| {
+        r.notes().status().as_str().to_string()
+    }));
+    fields.push(Column::text("note", |r| r.notes().note()));
+    fields
 }
 
 /// A row of a sweep, of either kind.
@@ -170,19 +192,21 @@ fn reason(e: JobError) -> String {
     }
 }
 
-/// How many points of a sweep are in each state.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, ToSchema)]
-pub struct PointCounts {
-    /// Points of the sweep (count).
-    pub total: usize,
-    /// Answered, every assumption holding (count).
-    pub ok: usize,
-    /// Answered with a warning (count).
-    pub warn: usize,
-    /// Refused by the model (count).
-    pub refused: usize,
-    /// Not solved: the job stopped before them (count).
-    pub missing: usize,
+described! {
+    /// How many points of a sweep are in each state.
+    #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, ToSchema)]
+    pub struct PointCounts {
+        /// Points of the sweep (count).
+        pub total: usize => [unit ""],
+        /// Answered, every assumption holding (count).
+        pub ok: usize => [unit ""],
+        /// Answered with a warning (count).
+        pub warn: usize => [unit ""],
+        /// Refused by the model (count).
+        pub refused: usize => [unit ""],
+        /// Not solved: the job stopped before them (count).
+        pub missing: usize => [unit ""],
+    }
 }
 
 impl PointCounts {
@@ -203,6 +227,19 @@ pub enum SweepVerification {
     ThreeBody(ThreeBodyVerificationOutput),
 }
 
+/// The fields of either kind's verification (the union: a sweep's is one of them).
+impl Fields for SweepVerification {
+    fn fields() -> Vec<Field<Self>> {
+        let mut fields = Field::nested::<VerificationOutput>("", None, |_| None);
+        fields.extend(Field::nested::<ThreeBodyVerificationOutput>(
+            "",
+            None,
+            |_| None,
+        ));
+        fields
+    }
+}
+
 impl SweepVerification {
     /// The worse of the two, field by field.
     fn worst(self, other: SweepVerification) -> SweepVerification {
@@ -219,23 +256,25 @@ impl SweepVerification {
     }
 }
 
-/// What a sweep's `meta` says of its rows.
-#[derive(Clone, Debug, PartialEq, Deserialize, ToSchema)]
-pub struct SweepSummary {
-    /// How many points are in each state.
-    pub counts: PointCounts,
-    /// Whether every point was reached (false: the job stopped; see `stopped`).
-    pub complete: bool,
-    /// Why the sweep stopped before its end (a cancel, the deadline): its unsolved points
-    /// are `missing`. Absent for a whole sweep.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub stopped: Option<String>,
-    /// The worst numerical error over the answered points, field by field (each point's
-    /// own is not repeated on its row). Absent when no point was answered.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub verification: Option<SweepVerification>,
-    #[schema(value_type = SweepValidityOutput)]
-    pub validity: ValidityTally,
+described! {
+    /// What a sweep's `meta` says of its rows.
+    #[derive(Clone, Debug, PartialEq, Deserialize, ToSchema)]
+    pub struct SweepSummary {
+        /// How many points are in each state.
+        pub counts: PointCounts => [nested],
+        /// Whether every point was reached (false: the job stopped; see `stopped`).
+        pub complete: bool => [],
+        /// Why the sweep stopped before its end (a cancel, the deadline): its unsolved points
+        /// are `missing`. Absent for a whole sweep.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        pub stopped: Option<String> => [],
+        /// The worst numerical error over the answered points, field by field (each point's
+        /// own is not repeated on its row). Absent when no point was answered.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        pub verification: Option<SweepVerification> => [optional nested],
+        #[schema(value_type = SweepValidityOutput)]
+        pub validity: ValidityTally => [by fields::units::<SweepValidityOutput>()],
+    }
 }
 
 /// Written as derived, but for the validity's status, which refused points make `warn`.

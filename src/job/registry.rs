@@ -14,6 +14,7 @@ use utoipa::{PartialSchema, ToSchema};
 use super::figure::FigureJob;
 use super::fit::FitJob;
 use super::kind::{Job, Kind};
+use super::picture::draw;
 use super::rolling::RollingJob;
 use super::sweep::SweepJob;
 use super::three_body::ThreeBodyJob;
@@ -43,7 +44,7 @@ impl Registered {
         Registered {
             name: K::NAME,
             validate: validate::<K>,
-            picture: K::picture,
+            picture: draw::<K::Picture>,
             input_schema: <K::Input as ToSchema>::name,
             output_schema: output_schema::<K>,
         }

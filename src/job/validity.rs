@@ -6,20 +6,10 @@ use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
 use super::JobError;
+use crate::described;
 use crate::model::text::{count, quantity};
 use crate::model::validity::{Assumption, Check, Status};
 use crate::render::{Fixed, Text};
-
-/// The units of a validity block's fields, under `$prefix` (a string literal).
-macro_rules! validity_units {
-    ($prefix:literal) => {
-        &[
-            (concat!($prefix, "assumptions[].value"), ""),
-            (concat!($prefix, "assumptions[].at_rest"), ""),
-        ]
-    };
-}
-pub(crate) use validity_units;
 
 /// `ok`, or `warn`: the answer is given, and a note says why it may be off.
 #[derive(
@@ -32,38 +22,42 @@ pub enum ValidityStatus {
     Warn,
 }
 
-/// One assumption of the model, measured on this answer.
-#[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
-pub struct AssumptionOutput {
-    /// `inside_layer`, `parabolic_sphere`, `local_layer`, `adhesive_friction`,
-    /// `surfaces_apart`, `asperity_gap` or `particles_in_contact`.
-    pub name: &'static str,
-    /// The assumption in words.
-    #[schema(value_type = String)]
-    pub assumption: &'static Text,
-    /// What the ratio measures, e.g. `penetration / thickness`.
-    pub ratio: &'static str,
-    /// The ratio at the job's speed (dimensionless).
-    pub value: f64,
-    /// The ratio of the V = 0 companion the answer also gives (dimensionless).
-    pub at_rest: f64,
-    /// The worse of the two.
-    pub status: ValidityStatus,
-    /// When the ratio warns and when it refuses the answer.
-    #[schema(value_type = String)]
-    pub rule: &'static Text,
-    /// Why it warns, in words (with `warn` only).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub note: Option<String>,
+described! {
+    /// One assumption of the model, measured on this answer.
+    #[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
+    pub struct AssumptionOutput {
+        /// `inside_layer`, `parabolic_sphere`, `local_layer`, `adhesive_friction`,
+        /// `surfaces_apart`, `asperity_gap` or `particles_in_contact`.
+        pub name: &'static str => [],
+        /// The assumption in words.
+        #[schema(value_type = String)]
+        pub assumption: &'static Text => [],
+        /// What the ratio measures, e.g. `penetration / thickness`.
+        pub ratio: &'static str => [],
+        /// The ratio at the job's speed (dimensionless).
+        pub value: f64 => [unit ""],
+        /// The ratio of the V = 0 companion the answer also gives (dimensionless).
+        pub at_rest: f64 => [unit ""],
+        /// The worse of the two.
+        pub status: ValidityStatus => [],
+        /// When the ratio warns and when it refuses the answer.
+        #[schema(value_type = String)]
+        pub rule: &'static Text => [],
+        /// Why it warns, in words (with `warn` only).
+        #[serde(skip_serializing_if = "Option::is_none")]
+        pub note: Option<String> => [],
+    }
 }
 
-/// The model's own error on this answer (the `verification` block gives the numerical
-/// error).
-#[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
-pub struct ValidityOutput {
-    /// The worst status of the assumptions.
-    pub status: ValidityStatus,
-    pub assumptions: Vec<AssumptionOutput>,
+described! {
+    /// The model's own error on this answer (the `verification` block gives the numerical
+    /// error).
+    #[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
+    pub struct ValidityOutput {
+        /// The worst status of the assumptions.
+        pub status: ValidityStatus => [],
+        pub assumptions: Vec<AssumptionOutput> => [each],
+    }
 }
 
 /// What the checks are measured on, for their words.
@@ -163,6 +157,13 @@ impl PointValidity {
     }
 }
 
+impl PointValidity {
+    /// The path and unit of each ratio a point may give (the serialization below).
+    pub fn units() -> Vec<(String, &'static str)> {
+        DESCRIBED.iter().map(|d| (d.name.to_string(), "")).collect()
+    }
+}
+
 /// `{"inside_layer": 0.0062, ...}`: each ratio at the point's speed.
 impl Serialize for PointValidity {
     fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
@@ -255,30 +256,32 @@ impl ValidityTally {
     }
 }
 
-/// One assumption of a sweep's `meta.validity`.
-#[derive(Serialize, Deserialize, ToSchema)]
-pub struct AssumptionTallyOutput {
-    /// As in a rolling answer's `meta.validity`: `inside_layer`, `local_layer`, ...
-    name: String,
-    /// The assumption in words.
-    #[serde(skip_deserializing, default = "no_text")]
-    #[schema(value_type = String)]
-    assumption: &'static Text,
-    /// What the ratio of each point's `validity` measures.
-    #[serde(skip_deserializing)]
-    ratio: &'static str,
-    /// When the ratio warns and when it refuses a point.
-    #[serde(skip_deserializing, default = "no_text")]
-    #[schema(value_type = String)]
-    rule: &'static Text,
-    /// Answered points on which it warns (count).
-    warned: usize,
-    /// The index of the first of them.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    first_warned: Option<usize>,
-    /// Why it warns there, in words.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    note: Option<String>,
+described! {
+    /// One assumption of a sweep's `meta.validity`.
+    #[derive(Serialize, Deserialize, ToSchema)]
+    pub struct AssumptionTallyOutput {
+        /// As in a rolling answer's `meta.validity`: `inside_layer`, `local_layer`, ...
+        name: String => [],
+        /// The assumption in words.
+        #[serde(skip_deserializing, default = "no_text")]
+        #[schema(value_type = String)]
+        assumption: &'static Text => [],
+        /// What the ratio of each point's `validity` measures.
+        #[serde(skip_deserializing)]
+        ratio: &'static str => [],
+        /// When the ratio warns and when it refuses a point.
+        #[serde(skip_deserializing, default = "no_text")]
+        #[schema(value_type = String)]
+        rule: &'static Text => [],
+        /// Answered points on which it warns (count).
+        warned: usize => [unit ""],
+        /// The index of the first of them.
+        #[serde(skip_serializing_if = "Option::is_none")]
+        first_warned: Option<usize> => [unit ""],
+        /// Why it warns there, in words.
+        #[serde(skip_serializing_if = "Option::is_none")]
+        note: Option<String> => [],
+    }
 }
 
 /// The text of a tally read back from another process (which reads only its counts).
@@ -287,14 +290,16 @@ fn no_text() -> &'static Text {
     &NONE
 }
 
-/// The model's assumptions over the answered points of a sweep (docs/model.md §7): each in
-/// words once, how many points it warns on, and why it warns on the first of them.
-#[derive(Serialize, Deserialize, ToSchema)]
-pub struct SweepValidityOutput {
-    /// `warn` if any answered point warns, or the model refused a point.
-    #[serde(skip_deserializing)]
-    status: ValidityStatus,
-    assumptions: Vec<AssumptionTallyOutput>,
+described! {
+    /// The model's assumptions over the answered points of a sweep (docs/model.md §7): each in
+    /// words once, how many points it warns on, and why it warns on the first of them.
+    #[derive(Serialize, Deserialize, ToSchema)]
+    pub struct SweepValidityOutput {
+        /// `warn` if any answered point warns, or the model refused a point.
+        #[serde(skip_deserializing)]
+        status: ValidityStatus => [],
+        assumptions: Vec<AssumptionTallyOutput> => [each],
+    }
 }
 
 impl ValidityTally {

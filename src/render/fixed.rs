@@ -3,7 +3,6 @@
 //! rendered once on first use. Building and escaping them again for every answer made up
 //! about a quarter of rendering one.
 
-use std::collections::BTreeMap;
 use std::fmt;
 use std::sync::OnceLock;
 
@@ -60,37 +59,18 @@ impl<T: PartialEq> PartialEq for Fixed<T> {
 /// A fixed text of answers (an assumption in words, its rule).
 pub type Text = Fixed<&'static str>;
 
-/// The unit of each numeric field of an answer, by path (`a.b`, `list[].c`): SI, `""` for
-/// plain numbers and counts; in groups, so that the parts answers share are declared once.
-pub type Units = &'static [&'static [(&'static str, &'static str)]];
-
-/// The units of an answer as one JSON object, path → unit (groups may share entries, as
-/// the two kinds of sweep points do).
-#[derive(Debug, PartialEq)]
-pub struct UnitGroups(pub Units);
-
-impl Serialize for UnitGroups {
-    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
-        let map: BTreeMap<_, _> = self
-            .0
-            .iter()
-            .flat_map(|group| group.iter().copied())
-            .collect();
-        map.serialize(s)
-    }
-}
-
 /// The unit table of an output kind ([`super::Output::UNITS`]).
-pub type UnitTable = Fixed<UnitGroups>;
+pub type UnitTable = Fixed<super::UnitGroups>;
 
-/// An output's unit table ([`super::Output::UNITS`]) from its groups of (path, unit), as a
-/// `static` of its own, so that its JSON is rendered once:
-/// `const UNITS: &'static UnitTable = unit_table![&[("x", "m")]];`.
+/// The unit table of output type `$output` ([`super::Output::UNITS`]), made from its
+/// [`super::Fields`] on first use, as a `static` of its own, so that its JSON is rendered
+/// once: `const UNITS: &'static UnitTable = unit_table!(RollingOutput);`.
 #[macro_export]
 macro_rules! unit_table {
-    ($($group:expr),* $(,)?) => {{
-        static UNITS: $crate::render::UnitTable =
-            $crate::render::Fixed::new($crate::render::UnitGroups(&[$($group),*]));
+    ($output:ty) => {{
+        static UNITS: $crate::render::UnitTable = $crate::render::Fixed::new(
+            $crate::render::UnitGroups::new($crate::render::fields::units::<$output>),
+        );
         &UNITS
     }};
 }
@@ -98,10 +78,19 @@ macro_rules! unit_table {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::render::UnitGroups;
+    use std::collections::BTreeMap;
+
+    fn units() -> BTreeMap<String, &'static str> {
+        [("b", "m"), ("a", "")]
+            .into_iter()
+            .map(|(path, unit)| (path.to_string(), unit))
+            .collect()
+    }
 
     static SHORT: Fixed<&[u32]> = Fixed::new(&[1, 2]);
     static LONG: Fixed<&[u32]> = Fixed::new(&[1, 2, 3]);
-    static UNITS: UnitTable = Fixed::new(UnitGroups(&[&[("b", "m")], &[("a", ""), ("b", "m")]]));
+    static UNITS: UnitTable = Fixed::new(UnitGroups::new(units));
 
     /// Rendered once, a fixed part still matches a direct rendering on every later use, and
     /// two statics whose values share a prefix stay apart.

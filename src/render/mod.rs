@@ -3,6 +3,7 @@
 //! and the command line choose a [`Format`] ([`negotiate`] for HTTP) and render an
 //! [`Answer`] into bytes.
 
+pub mod fields;
 pub mod fixed;
 mod negotiate;
 mod number;
@@ -16,7 +17,8 @@ use std::fmt;
 use serde::{Serialize, Serializer};
 use serde_json::value::RawValue;
 
-pub use fixed::{Fixed, Text, UnitGroups, UnitTable, Units};
+pub use fields::{Field, Fields, UnitGroups};
+pub use fixed::{Fixed, Text, UnitTable};
 pub use negotiate::negotiate;
 pub use number::format_number;
 pub use table::{Cell, Column, Heading, Table};
@@ -133,12 +135,19 @@ pub trait Output: Serialize + fmt::Debug + PartialEq + Send + Sync + 'static {
 
     /// The answer as one table, its columns declared once by the output.
     fn table(&self) -> Table;
+
+    /// What a person reading the answer should be told beside it, if anything (a sweep
+    /// whose points the model refused in part): the command line says it on stderr.
+    fn notice(&self) -> Option<String> {
+        None
+    }
 }
 
 /// What [`Answer`] needs of an output, object-safe.
 trait Render: fmt::Debug + Send + Sync {
     fn json(&self, pretty: bool) -> serde_json::Result<Vec<u8>>;
     fn table(&self) -> Table;
+    fn notice(&self) -> Option<String>;
     fn as_any(&self) -> &dyn Any;
     fn into_any(self: Box<Self>) -> Box<dyn Any>;
     fn same(&self, other: &dyn Any) -> bool;
@@ -160,6 +169,10 @@ impl<T: Output> Render for T {
 
     fn table(&self) -> Table {
         Output::table(self)
+    }
+
+    fn notice(&self) -> Option<String> {
+        Output::notice(self)
     }
 
     fn as_any(&self) -> &dyn Any {
@@ -322,7 +335,7 @@ fn scratch(
 }
 
 /// Draws an answer from its JSON (each job kind has its own).
-pub type Draw = fn(&serde_json::Value) -> Result<svg::Chart, String>;
+pub type Draw = fn(&[u8]) -> Result<svg::Chart, String>;
 
 /// The answer to any job, whatever its kind, and how to draw it.
 #[derive(Debug)]
@@ -389,6 +402,11 @@ impl Answer {
         self.0.table()
     }
 
+    /// What to tell a person beside the answer ([`Output::notice`]).
+    pub fn notice(&self) -> Option<String> {
+        self.0.notice()
+    }
+
     /// The output, if it is a `T`.
     pub fn downcast_ref<T: Output>(&self) -> Option<&T> {
         self.0.as_any().downcast_ref()
@@ -425,9 +443,7 @@ impl Serialize for Answer {
 
 /// The picture `draw` makes of the answer whose JSON is `json`, as SVG.
 pub fn draw_svg(draw: Draw, json: &[u8]) -> Result<String, RenderError> {
-    let value: serde_json::Value =
-        serde_json::from_slice(json).map_err(|e| RenderError(e.to_string()))?;
-    draw(&value)
+    draw(json)
         .map(|chart| chart.to_svg())
         .map_err(|e| RenderError(format!("cannot draw the answer: {e}")))
 }
@@ -500,17 +516,19 @@ mod tests {
         );
     }
 
-    #[derive(Debug, PartialEq, Serialize)]
-    struct Point {
-        x: f64,
+    crate::described! {
+        #[derive(Debug, PartialEq, Serialize)]
+        struct Point {
+            x: f64 => [number "m"],
+        }
     }
 
     impl Output for Point {
-        const UNITS: &'static UnitTable = unit_table![&[("x", "m")]];
+        const UNITS: &'static UnitTable = unit_table!(Point);
 
+        /// The columns its fields declare.
         fn table(&self) -> Table {
-            const COLUMNS: [Column<Point>; 1] = [Column::number("x", "m", |p| p.x)];
-            Table::new(&COLUMNS, [self])
+            Table::new(&fields::columns::<Point>(), [self])
         }
     }
 
@@ -528,15 +546,17 @@ mod tests {
         assert!(bad.to_pretty_json().is_err());
     }
 
-    /// An answer holding another.
-    #[derive(Debug, PartialEq, Serialize)]
-    struct Holder {
-        inner: Answer,
-        points: Vec<f64>,
+    crate::described! {
+        /// An answer holding another.
+        #[derive(Debug, PartialEq, Serialize)]
+        struct Holder {
+            inner: Answer => [],
+            points: Vec<f64> => [list "m"],
+        }
     }
 
     impl Output for Holder {
-        const UNITS: &'static UnitTable = unit_table![];
+        const UNITS: &'static UnitTable = unit_table!(Holder);
 
         fn table(&self) -> Table {
             const COLUMNS: [Column<f64>; 1] = [Column::number("x", "m", |x| *x)];

@@ -2,6 +2,9 @@
 //! cell), and the header and every row are written from that one declaration, so a CSV
 //! header cannot drift from its rows.
 
+use std::borrow::Cow;
+
+use super::fields::Reader;
 use super::number::format_number;
 
 /// One cell of a table.
@@ -23,11 +26,13 @@ enum Read<R> {
     Optional(fn(&R) -> Option<f64>),
     Count(fn(&R) -> usize),
     Text(fn(&R) -> String),
+    /// A number read through a field's declaration ([`super::fields::columns`]).
+    Field(Reader<R>),
 }
 
 /// A column of a table whose rows are `R`s.
 pub struct Column<R> {
-    pub name: &'static str,
+    pub name: Cow<'static, str>,
     /// SI unit of the column ("" for plain numbers, counts and text).
     pub unit: &'static str,
     read: Read<R>,
@@ -37,7 +42,7 @@ impl<R> Column<R> {
     /// A column of quantities in `unit` (SI; "" for a plain number).
     pub const fn number(name: &'static str, unit: &'static str, read: fn(&R) -> f64) -> Self {
         Column {
-            name,
+            name: Cow::Borrowed(name),
             unit,
             read: Read::Number(read),
         }
@@ -50,7 +55,7 @@ impl<R> Column<R> {
         read: fn(&R) -> Option<f64>,
     ) -> Self {
         Column {
-            name,
+            name: Cow::Borrowed(name),
             unit,
             read: Read::Optional(read),
         }
@@ -59,7 +64,7 @@ impl<R> Column<R> {
     /// A column of counts or indices.
     pub const fn count(name: &'static str, read: fn(&R) -> usize) -> Self {
         Column {
-            name,
+            name: Cow::Borrowed(name),
             unit: "",
             read: Read::Count(read),
         }
@@ -68,19 +73,38 @@ impl<R> Column<R> {
     /// A column of text.
     pub const fn text(name: &'static str, read: fn(&R) -> String) -> Self {
         Column {
-            name,
+            name: Cow::Borrowed(name),
             unit: "",
             read: Read::Text(read),
         }
     }
 
+    /// A column of numbers named `name`, in `unit`, that `read` gives (empty where `None`).
+    pub fn read(name: String, unit: &'static str, read: Reader<R>) -> Self {
+        Column {
+            name: Cow::Owned(name),
+            unit,
+            read: Read::Field(read),
+        }
+    }
+
+    /// The cell of `row` as a number, if it is one (a quantity present, or a count).
+    pub fn value(&self, row: &R) -> Option<f64> {
+        match self.cell(row) {
+            Cell::Number(x) => Some(x),
+            Cell::Count(n) => Some(n as f64),
+            Cell::Text(_) | Cell::Empty => None,
+        }
+    }
+
     /// The cell of `row`.
     pub fn cell(&self, row: &R) -> Cell {
-        match self.read {
+        match &self.read {
             Read::Number(read) => Cell::Number(read(row)),
             Read::Optional(read) => read(row).map_or(Cell::Empty, Cell::Number),
             Read::Count(read) => Cell::Count(read(row)),
             Read::Text(read) => Cell::Text(read(row)),
+            Read::Field(read) => read(row).map_or(Cell::Empty, Cell::Number),
         }
     }
 }
@@ -89,7 +113,7 @@ impl<R> Column<R> {
 #[derive(Clone, Debug, PartialEq)]
 pub struct Heading {
     pub name: String,
-    pub unit: &'static str,
+    pub unit: Cow<'static, str>,
 }
 
 impl Heading {
@@ -118,7 +142,7 @@ impl Table {
                 .iter()
                 .map(|c| Heading {
                     name: c.name.to_string(),
-                    unit: c.unit,
+                    unit: Cow::Borrowed(c.unit),
                 })
                 .collect(),
             rows: rows
@@ -130,10 +154,10 @@ impl Table {
 
     /// Renames column `index` and gives it `unit` (a column whose quantity depends on the
     /// rows, such as the operating point a sweep varies).
-    pub fn rename(&mut self, index: usize, name: &str, unit: &'static str) {
+    pub fn rename(&mut self, index: usize, name: &str, unit: &str) {
         if let Some(heading) = self.headings.get_mut(index) {
             heading.name = name.to_string();
-            heading.unit = unit;
+            heading.unit = Cow::Owned(unit.to_string());
         }
     }
 

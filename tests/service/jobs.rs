@@ -212,7 +212,7 @@ fn a_rolling_answer_carries_the_model_numbers_and_its_own_verification() {
     assert_eq!(out.contact.contact_area, s.contact_area);
     assert_eq!(out.contact.friction_coefficient, s.friction_coefficient);
     assert_eq!(
-        out.contact.static_contact.contact_area,
+        out.contact.r#static.contact_area,
         s.static_contact.contact_area
     );
     assert_eq!(out.boundary.len(), 41);

@@ -5,11 +5,12 @@
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use serde_json::{json, Value};
 use thirdbody::engine::metrics::Metrics;
 use thirdbody::engine::store::JobStatus;
 use thirdbody::engine::{self, Engine, EngineConfig};
+use thirdbody::job::picture::Picture;
 use thirdbody::job::{
     Control, Job, JobError, Kind, Limits, Meta, References, Validated, Work, ROLLING_REFERENCES,
 };
@@ -25,20 +26,48 @@ struct Countdown {
     steps: usize,
 }
 
-#[derive(Debug, PartialEq, Serialize, ToSchema)]
-struct CountdownOutput {
-    steps: usize,
-    meta: Meta,
+thirdbody::described! {
+    #[derive(Debug, PartialEq, Serialize, ToSchema)]
+    struct CountdownOutput {
+        steps: usize => [unit ""],
+        meta: Meta => [],
+    }
 }
 
 impl Output for CountdownOutput {
-    const UNITS: &'static UnitTable = unit_table![&[("steps", "")]];
+    const UNITS: &'static UnitTable = unit_table!(CountdownOutput);
 
     fn table(&self) -> Table {
         Table::new(
             &[Column::count("steps", |o: &CountdownOutput| o.steps)],
             [self],
         )
+    }
+}
+
+/// What the picture of a countdown shows: its steps.
+#[derive(Deserialize)]
+struct CountdownPicture {
+    steps: f64,
+}
+
+impl Picture for CountdownPicture {
+    /// The steps as one bar.
+    fn chart(self) -> Result<Chart, String> {
+        let steps = self.steps;
+        Ok(Chart {
+            title: "countdown".to_string(),
+            x: Axis::new("step", ""),
+            y: Axis::new("steps", ""),
+            layers: vec![Layer::Line {
+                name: "steps".to_string(),
+                group: "steps".to_string(),
+                points: vec![(0.0, 0.0), (steps, steps)],
+                dashed: false,
+            }],
+            equal_aspect: false,
+            notes: Vec::new(),
+        })
     }
 }
 
@@ -53,6 +82,7 @@ impl Kind for Countdown {
     const NAME: &'static str = "countdown";
     type Input = CountdownInput;
     type Output = CountdownOutput;
+    type Picture = CountdownPicture;
 
     fn validate(input: Value, _limits: &Limits) -> Result<Validated<Self>, JobError> {
         let steps = input["steps"].as_u64().unwrap_or(1);
@@ -70,24 +100,6 @@ impl Kind for Countdown {
 
     fn work(&self) -> Work {
         Work::Unknown
-    }
-
-    /// The steps as one bar.
-    fn picture(answer: &Value) -> Result<Chart, String> {
-        let steps = answer["steps"].as_f64().ok_or("no steps")?;
-        Ok(Chart {
-            title: "countdown".to_string(),
-            x: Axis::new("step", ""),
-            y: Axis::new("steps", ""),
-            layers: vec![Layer::Line {
-                name: "steps".to_string(),
-                group: "steps".to_string(),
-                points: vec![(0.0, 0.0), (steps, steps)],
-                dashed: false,
-            }],
-            equal_aspect: false,
-            notes: Vec::new(),
-        })
     }
 
     fn run(&self, meta: Meta, control: &Control) -> Result<CountdownOutput, JobError> {

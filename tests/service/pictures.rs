@@ -3,7 +3,14 @@
 //! (`UPDATE_SNAPSHOTS=1 cargo test --test service pictures` rewrites them after a deliberate change).
 
 use serde_json::{json, Value};
-use thirdbody::job::{pictures, Control, Job, Limits};
+use thirdbody::job::figure::FigurePicture;
+use thirdbody::job::fit::FitPicture;
+use thirdbody::job::picture::{draw, Picture};
+use thirdbody::job::rolling::RollingPicture;
+use thirdbody::job::sweep::SweepPicture;
+use thirdbody::job::three_body::ThreeBodyPicture;
+use thirdbody::job::{Control, Job, Limits};
+use thirdbody::render::svg::Chart;
 use thirdbody::render::svg::{Layer, HEATMAP_CELLS};
 use thirdbody::render::Format;
 
@@ -14,6 +21,11 @@ fn solve(job: Value) -> (Value, String) {
     let json = serde_json::from_slice(&answer.render(Format::Json).unwrap()).unwrap();
     let svg = String::from_utf8(answer.render(Format::Svg).unwrap()).unwrap();
     (json, svg)
+}
+
+/// The chart a kind's picture `P` draws of `answer`.
+fn chart<P: Picture>(answer: &Value) -> Chart {
+    draw::<P>(&serde_json::to_vec(answer).unwrap()).unwrap()
 }
 
 /// Checks the SVG's structure; returns the names of its series and its legend entries.
@@ -70,7 +82,7 @@ fn a_rolling_contact_is_its_contact_region_at_its_size() {
         ]
     );
     assert_eq!(legend, series);
-    let chart = pictures::rolling(&answer).unwrap();
+    let chart = chart::<RollingPicture>(&answer);
     let Layer::Area { outline, .. } = &chart.layers[0] else {
         panic!("the contact region comes first");
     };
@@ -129,7 +141,7 @@ fn a_sweep_has_a_curve_per_other_value_and_marks_points_at_rest() {
         ["P = 500 pN", "P = 1 nN", "P = 2 nN", "at rest, V = 0"]
     );
     assert_eq!(legend, series);
-    let chart = pictures::sweep(&answer).unwrap();
+    let chart = chart::<SweepPicture>(&answer);
     let Layer::Line { points, .. } = &chart.layers[1] else {
         panic!()
     };
@@ -167,7 +179,7 @@ fn a_three_body_system_shades_the_particles_in_contact_and_splits_the_area() {
     let (series, _) = parts(&svg);
     assert_eq!(series[0], "diameters");
     assert_eq!(series[1], "in contact (x > d)");
-    let chart = pictures::three_body(&answer).unwrap();
+    let chart = chart::<ThreeBodyPicture>(&answer);
     let Layer::Area { outline, .. } = &chart.layers[1] else {
         panic!()
     };
@@ -197,7 +209,7 @@ fn a_fit_draws_each_series_measured_and_fitted_with_its_residuals() {
     );
     // Per series: its markers, its curve, one residual segment per point.
     assert_eq!(series.len(), 2 * 2 + 30);
-    let chart = pictures::fit(&answer).unwrap();
+    let chart = chart::<FitPicture>(&answer);
     let Layer::Line { points, .. } = &chart.layers[1] else {
         panic!("the fitted curve")
     };
@@ -230,7 +242,7 @@ fn each_figure_draws_every_series_of_its_answer() {
                 "Fig. {number}"
             );
         }
-        let chart = pictures::figure(&answer).unwrap();
+        let chart = chart::<FigurePicture>(&answer);
         for (layer, curve) in chart.layers.iter().zip(expected) {
             let Layer::Line { points, dashed, .. } = layer else {
                 panic!()

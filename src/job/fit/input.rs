@@ -71,6 +71,20 @@ pub enum MeasuredQuantity {
 }
 
 impl MeasuredQuantity {
+    /// Both, in the order a residual names them.
+    pub const ALL: [MeasuredQuantity; 2] = [
+        MeasuredQuantity::FrictionCoefficient,
+        MeasuredQuantity::ContactArea,
+    ];
+
+    /// The name on the wire (as serde writes it).
+    pub fn name(self) -> &'static str {
+        match self {
+            MeasuredQuantity::FrictionCoefficient => "friction_coefficient",
+            MeasuredQuantity::ContactArea => "contact_area",
+        }
+    }
+
     pub fn model(self) -> Measured {
         match self {
             MeasuredQuantity::FrictionCoefficient => Measured::FrictionCoefficient,
@@ -85,7 +99,7 @@ impl MeasuredQuantity {
         }
     }
 
-    fn parameter(self) -> Parameter {
+    pub fn parameter(self) -> Parameter {
         match self {
             MeasuredQuantity::FrictionCoefficient => Parameter::FrictionCoefficient,
             MeasuredQuantity::ContactArea => Parameter::ContactArea,

@@ -6,6 +6,9 @@
 //! checks its control before each one (a particle's point takes tens of microseconds, a
 //! system's a few milliseconds, so a cancel stops it at once), and reports `Work::Unknown`.
 
+mod picture;
+pub use picture::FitPicture;
+
 mod input;
 mod output;
 
@@ -25,12 +28,10 @@ pub use output::{
 use super::input as wire;
 use super::kind::SMALL_ANSWER;
 use super::meta::ROLLING_REFERENCES;
-use super::pictures::PictureError;
 use super::{Control, FieldError, JobError, Kind, Limits, Meta, References, Validated, Work};
 use crate::model::fit::stats;
 use crate::model::fit::{self, Datum, FitError, Fitted, Point, Problem, Setting};
 use crate::model::Layer;
-use crate::render::svg::Chart;
 
 /// A validated fit.
 #[derive(Clone, Debug, PartialEq)]
@@ -43,6 +44,7 @@ pub struct FitJob {
 impl Kind for FitJob {
     const NAME: &'static str = "fit";
     type Input = FitInput;
+    type Picture = FitPicture;
     type Output = FitOutput;
 
     fn validate(value: Value, limits: &Limits) -> Result<Validated<Self>, JobError> {
@@ -133,10 +135,6 @@ impl Kind for FitJob {
 
     fn unfinished(output: &FitOutput) -> Option<JobError> {
         output.stop.clone()
-    }
-
-    fn picture(answer: &Value) -> Result<Chart, PictureError> {
-        super::pictures::fit(answer)
     }
 }
 
@@ -462,7 +460,7 @@ fn curve(
     Ok(Curve {
         series,
         quantity: MeasuredQuantity::of(first.measured),
-        along,
+        along: along.into(),
         points: curve_points,
     })
 }

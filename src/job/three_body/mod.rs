@@ -1,8 +1,11 @@
 //! The three-body job: a population of particles between the upper surface and the layer
 //! (docs/model.md §4).
 
-use super::pictures::PictureError;
-use crate::render::svg::Chart;
+mod picture;
+pub use picture::ThreeBodyPicture;
+
+use std::sync::LazyLock;
+
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
 use utoipa::ToSchema;
@@ -10,16 +13,16 @@ use utoipa::ToSchema;
 use super::input::units::Dimension;
 use super::input::{self, field, Checker, LayerInput, QuadratureKind, Quantity};
 use super::meta::REFERENCES;
-use super::points::{PointNotes, PointNotesFields, PointStatus, Row, SweepVerification};
-use super::validity::{self, validity_units, PointValidity, Subject, ValidityOutput};
+use super::points::{self, PointNotes, PointNotesFields, PointStatus, Row, SweepVerification};
+use super::validity::{self, PointValidity, Subject, ValidityOutput};
 use super::{Control, JobError, Kind, Limits, Meta, References, Validated, Work};
 use crate::model::three_body::{
     self, Asperities, ContactState, Diameters, LayerContact, OperatingPoint, Particle, ThreeBody,
     ThreeBodyOptions, ThreeBodySolution, UpperContact, UpperSurface, DEFAULT_DIAMETER_NODES,
 };
 use crate::model::{Parameter, SolveOption};
-use crate::render::{Column, Output, Table, UnitTable};
-use crate::unit_table;
+use crate::render::{fields, Column, Output, Table, UnitTable};
+use crate::{described, unit_table};
 
 /// Input of a three-body job; every field optional but the operating point.
 #[derive(Clone, Debug, Default, PartialEq, Deserialize, Serialize, ToSchema)]
@@ -417,6 +420,7 @@ impl ThreeBodyJob {
 impl Kind for ThreeBodyJob {
     const NAME: &'static str = "three_body";
     type Input = ThreeBodyInput;
+    type Picture = ThreeBodyPicture;
     type Output = ThreeBodyOutput;
 
     fn validate(input: Value, _limits: &Limits) -> Result<Validated<Self>, JobError> {
@@ -430,10 +434,6 @@ impl Kind for ThreeBodyJob {
 
     fn references(&self) -> &'static References {
         &REFERENCES
-    }
-
-    fn picture(answer: &Value) -> Result<Chart, PictureError> {
-        super::pictures::three_body(answer)
     }
 
     fn work(&self) -> Work {
@@ -451,99 +451,42 @@ pub fn operating_canonical(operating: OperatingPoint) -> Value {
     input::canonical(&OperatingInput::of(operating))
 }
 
-/// The units of a three-body result's fields (`ThreeBodyResult`), under `$prefix`.
-macro_rules! result_units {
-    ($prefix:literal) => {
-        &[
-            (concat!($prefix, "separation"), "m"),
-            (concat!($prefix, "particles_in_contact"), ""),
-            (concat!($prefix, "areas.surface_surface"), "m²"),
-            (concat!($prefix, "areas.particle_upper"), "m²"),
-            (concat!($prefix, "areas.particle_layer"), "m²"),
-            (concat!($prefix, "areas.total"), "m²"),
-            (concat!($prefix, "loads.asperities"), "N"),
-            (concat!($prefix, "loads.particles"), "N"),
-            (concat!($prefix, "loads.total"), "N"),
-            (concat!($prefix, "friction_coefficient.static"), ""),
-            (concat!($prefix, "friction_coefficient.rolling"), ""),
-            (concat!($prefix, "per_particle.mean_area"), "m²"),
-            (concat!($prefix, "per_particle.mean_load"), "N"),
-            (concat!($prefix, "static_operating_point.separation"), "m"),
-            (
-                concat!($prefix, "static_operating_point.particles_in_contact"),
-                "",
-            ),
-            (
-                concat!($prefix, "static_operating_point.areas.surface_surface"),
-                "m²",
-            ),
-            (
-                concat!($prefix, "static_operating_point.areas.particle_upper"),
-                "m²",
-            ),
-            (
-                concat!($prefix, "static_operating_point.areas.particle_layer"),
-                "m²",
-            ),
-            (concat!($prefix, "static_operating_point.areas.total"), "m²"),
-            (
-                concat!($prefix, "static_operating_point.loads.asperities"),
-                "N",
-            ),
-            (
-                concat!($prefix, "static_operating_point.loads.particles"),
-                "N",
-            ),
-            (concat!($prefix, "static_operating_point.loads.total"), "N"),
-        ]
-    };
-}
-pub(crate) use result_units;
-
-/// The units of a three-body verification block, under `$prefix`.
-macro_rules! three_body_verification_units {
-    ($prefix:literal) => {
-        &[
-            (concat!($prefix, "diameter_nodes"), ""),
-            (concat!($prefix, "separation_iterations"), ""),
-            (concat!($prefix, "relative_load_residual"), ""),
-            (concat!($prefix, "quadrature_error_estimate"), ""),
-            (concat!($prefix, "layer_table_error"), ""),
-        ]
-    };
-}
-pub(crate) use three_body_verification_units;
-
-/// Real contact areas (m²).
-#[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
-pub struct AreasOutput {
-    /// A_s1s2, asperity contact of the two surfaces.
-    pub surface_surface: f64,
-    /// A_s1a, particles on the upper surface.
-    pub particle_upper: f64,
-    /// A_s2a, particles on the layer.
-    pub particle_layer: f64,
-    /// A_total = A_s1s2 + A_s1a (eq. 6).
-    pub total: f64,
+described! {
+    /// Real contact areas (m²).
+    #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, ToSchema)]
+    pub struct AreasOutput {
+        /// A_s1s2, asperity contact of the two surfaces.
+        pub surface_surface: f64 => [number "m²"],
+        /// A_s1a, particles on the upper surface.
+        pub particle_upper: f64 => [number "m²"],
+        /// A_s2a, particles on the layer.
+        pub particle_layer: f64 => [number "m²"],
+        /// A_total = A_s1s2 + A_s1a (eq. 6).
+        pub total: f64 => [number "m²"],
+    }
 }
 
-/// Loads (N).
-#[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
-pub struct LoadsOutput {
-    pub asperities: f64,
-    pub particles: f64,
-    pub total: f64,
+described! {
+    /// Loads (N).
+    #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, ToSchema)]
+    pub struct LoadsOutput {
+        pub asperities: f64 => [number "N"],
+        pub particles: f64 => [number "N"],
+        pub total: f64 => [number "N"],
+    }
 }
 
-/// The system at one separation.
-#[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
-pub struct StateOutput {
-    /// d (m).
-    pub separation: f64,
-    /// n_a (eq. 7).
-    pub particles_in_contact: f64,
-    pub areas: AreasOutput,
-    pub loads: LoadsOutput,
+described! {
+    /// The system at one separation.
+    #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, ToSchema)]
+    pub struct StateOutput {
+        /// d (m).
+        pub separation: f64 => [number "m"],
+        /// n_a (eq. 7).
+        pub particles_in_contact: f64 => [number ""],
+        pub areas: AreasOutput => [nested "area_"],
+        pub loads: LoadsOutput => [nested "load_"],
+    }
 }
 
 impl From<&ContactState> for StateOutput {
@@ -566,38 +509,43 @@ impl From<&ContactState> for StateOutput {
     }
 }
 
-/// μ = (τ_a A_s2a + τ_s A_s1s2)/W without and with rolling.
-#[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
-pub struct FrictionOutput {
-    /// V = 0 (the job's separation, or its load re-solved at V = 0).
-    #[serde(rename = "static")]
-    pub static_: f64,
-    /// At the job's V.
-    pub rolling: f64,
+described! {
+    /// μ = (τ_a A_s2a + τ_s A_s1s2)/W without and with rolling.
+    #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, ToSchema)]
+    pub struct FrictionOutput {
+        /// V = 0 (the job's separation, or its load re-solved at V = 0).
+        pub r#static: f64 => [number ""],
+        /// At the job's V.
+        pub rolling: f64 => [number ""],
+    }
 }
 
-/// Per particle in contact.
-#[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
-pub struct PerParticleOutput {
-    /// A_total/n_a (m², eq. 8).
-    pub mean_area: f64,
-    /// W/n_a (N).
-    pub mean_load: f64,
+described! {
+    /// Per particle in contact.
+    #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, ToSchema)]
+    pub struct PerParticleOutput {
+        /// A_total/n_a (m², eq. 8).
+        pub mean_area: f64 => [number "m²"],
+        /// W/n_a (N).
+        pub mean_load: f64 => [number "N"],
+    }
 }
 
-/// How far the answer can be trusted.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, ToSchema)]
-pub struct ThreeBodyVerificationOutput {
-    pub diameter_nodes: usize,
-    pub separation_iterations: u32,
-    /// Relative residual of the operating load at the returned separation.
-    pub relative_load_residual: f64,
-    /// Largest relative change of areas and loads with half the diameter nodes.
-    pub quadrature_error_estimate: f64,
-    /// Relative error of the kelvin_layer table against direct solves (when used).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub layer_table_error: Option<f64>,
-    pub converged: bool,
+described! {
+    /// How far the answer can be trusted.
+    #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, ToSchema)]
+    pub struct ThreeBodyVerificationOutput {
+        pub diameter_nodes: usize => [unit ""],
+        pub separation_iterations: u32 => [unit ""],
+        /// Relative residual of the operating load at the returned separation.
+        pub relative_load_residual: f64 => [unit ""],
+        /// Largest relative change of areas and loads with half the diameter nodes.
+        pub quadrature_error_estimate: f64 => [unit ""],
+        /// Relative error of the kelvin_layer table against direct solves (when used).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        pub layer_table_error: Option<f64> => [unit ""],
+        pub converged: bool => [],
+    }
 }
 
 impl ThreeBodyVerificationOutput {
@@ -621,18 +569,20 @@ impl ThreeBodyVerificationOutput {
     }
 }
 
-/// The results of a three-body solve, shared by answers and sweep points.
-#[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
-pub struct ThreeBodyResult {
-    #[serde(flatten)]
-    pub state: StateOutput,
-    pub friction_coefficient: FrictionOutput,
-    /// Means per particle in contact; absent when no particle is in contact (the
-    /// asperities carry the load alone).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub per_particle: Option<PerParticleOutput>,
-    /// The same system at V = 0.
-    pub static_operating_point: StateOutput,
+described! {
+    /// The results of a three-body solve, shared by answers and sweep points.
+    #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, ToSchema)]
+    pub struct ThreeBodyResult {
+        #[serde(flatten)]
+        pub state: StateOutput => [flatten],
+        pub friction_coefficient: FrictionOutput => [nested "friction_"],
+        /// Means per particle in contact; absent when no particle is in contact (the
+        /// asperities carry the load alone).
+        #[serde(skip_serializing_if = "Option::is_none")]
+        pub per_particle: Option<PerParticleOutput> => [optional nested ""],
+        /// The same system at V = 0.
+        pub static_operating_point: StateOutput => [nested],
+    }
 }
 
 impl From<&ThreeBodySolution> for ThreeBodyResult {
@@ -640,7 +590,7 @@ impl From<&ThreeBodySolution> for ThreeBodyResult {
         ThreeBodyResult {
             state: (&s.rolling).into(),
             friction_coefficient: FrictionOutput {
-                static_: s.static_state.friction_coefficient,
+                r#static: s.static_state.friction_coefficient,
                 rolling: s.rolling.friction_coefficient,
             },
             per_particle: s.rolling.mean_area().zip(s.rolling.mean_load()).map(
@@ -668,29 +618,33 @@ impl From<&ThreeBodySolution> for ThreeBodyVerificationOutput {
     }
 }
 
-/// The `meta` block of a three-body answer.
-#[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
-pub struct ThreeBodyMeta {
-    #[serde(flatten)]
-    pub meta: Meta,
-    pub verification: ThreeBodyVerificationOutput,
-    /// How far the model can be trusted here (docs/model.md §7).
-    pub validity: ValidityOutput,
+described! {
+    /// The `meta` block of a three-body answer.
+    #[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
+    pub struct ThreeBodyMeta {
+        #[serde(flatten)]
+        pub meta: Meta => [],
+        pub verification: ThreeBodyVerificationOutput => [nested],
+        /// How far the model can be trusted here (docs/model.md §7).
+        pub validity: ValidityOutput => [nested],
+    }
 }
 
-/// The answer to a three-body job.
-#[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
-pub struct ThreeBodyOutput {
-    #[serde(flatten)]
-    pub result: ThreeBodyResult,
-    pub meta: ThreeBodyMeta,
-    /// The system solved (its operating point, speed and mean diameter are in `meta.input`
-    /// on the wire; the CSV row needs them).
-    #[serde(skip)]
-    system: ThreeBody,
-    /// The validity's checks, for the CSV row.
-    #[serde(skip)]
-    checks: PointValidity,
+described! {
+    /// The answer to a three-body job.
+    #[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
+    pub struct ThreeBodyOutput {
+        #[serde(flatten)]
+        pub result: ThreeBodyResult => [flatten],
+        pub meta: ThreeBodyMeta => [nested],
+        /// The system solved (its operating point, speed and mean diameter are in
+        /// `meta.input` on the wire; the CSV row needs them).
+        #[serde(skip)]
+        system: ThreeBody => [],
+        /// The validity's checks, for the CSV row.
+        #[serde(skip)]
+        checks: PointValidity => [],
+    }
 }
 
 impl ThreeBodyOutput {
@@ -716,11 +670,7 @@ impl ThreeBodyOutput {
 }
 
 impl Output for ThreeBodyOutput {
-    const UNITS: &'static UnitTable = unit_table![
-        result_units!(""),
-        three_body_verification_units!("meta.verification."),
-        validity_units!("meta.validity."),
-    ];
+    const UNITS: &'static UnitTable = unit_table!(ThreeBodyOutput);
 
     /// One row: the system's operating point, speed and mean diameter and its results, as a
     /// sweep's row.
@@ -735,33 +685,44 @@ impl Output for ThreeBodyOutput {
     }
 }
 
-/// One row of a three-body sweep: the point's conditions, its status, and (answered) its
-/// results and the ratios of the model's assumptions, or (refused) the reason.
-// Also the CSV row of a three-body answer: one declaration of the columns of systems.
-#[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
-pub struct ThreeBodySweepPoint {
-    /// The operating point as asked: `{"separation": d}`, `{"total_load": W}` or
-    /// `{"particle_load": P}` (SI).
-    #[schema(value_type = Object)]
-    pub operating: Value,
-    /// V (m/s).
-    pub velocity: f64,
-    /// x_a (m).
-    pub mean_diameter: f64,
-    pub status: PointStatus,
-    /// The system's results, when answered.
-    #[serde(flatten)]
-    pub result: Option<ThreeBodyResult>,
-    #[serde(flatten)]
-    #[schema(inline, value_type = PointNotesFields)]
-    pub notes: PointNotes,
-    /// The numerical error of an answered point (in the sweep's `meta.verification`, the
-    /// worst over its points).
-    #[serde(skip)]
-    pub verification: Option<ThreeBodyVerificationOutput>,
-    /// `operating`, typed (for the CSV).
-    #[serde(skip)]
-    operating_point: OperatingPoint,
+described! {
+    /// One row of a three-body sweep: the point's conditions, its status, and (answered) its
+    /// results and the ratios of the model's assumptions, or (refused) the reason.
+    // Also the CSV row of a three-body answer: one declaration of the columns of systems.
+    #[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
+    pub struct ThreeBodySweepPoint {
+        /// The operating point as asked: `{"separation": d}`, `{"total_load": W}` or
+        /// `{"particle_load": P}` (SI).
+        #[schema(value_type = Object)]
+        pub operating: Value => [by operating_units()],
+        /// V (m/s).
+        pub velocity: f64 => [number "m/s"],
+        /// x_a (m).
+        pub mean_diameter: f64 => [number "m"],
+        pub status: PointStatus => [],
+        /// The system's results, when answered.
+        #[serde(flatten)]
+        pub result: Option<ThreeBodyResult> => [optional flatten],
+        #[serde(flatten)]
+        #[schema(inline, value_type = PointNotesFields)]
+        pub notes: PointNotes => [flatten by PointNotes::units()],
+        /// The numerical error of an answered point (in the sweep's `meta.verification`, the
+        /// worst over its points).
+        #[serde(skip)]
+        pub verification: Option<ThreeBodyVerificationOutput> => [],
+        /// `operating`, typed (for the CSV).
+        #[serde(skip)]
+        operating_point: OperatingPoint => [],
+    }
+}
+
+/// The name and unit of each kind of operating point, in the order of
+/// [`OperatingPoint::KINDS`].
+pub(crate) fn operating_units() -> Vec<(String, &'static str)> {
+    let input = OperatingInput::default();
+    let names = operating_fields!(field!(input)).map(|f| f.name.to_string());
+    let units = OperatingPoint::KINDS.map(|(parameter, _)| parameter.unit());
+    names.into_iter().zip(units).collect()
 }
 
 impl ThreeBodySweepPoint {
@@ -789,68 +750,29 @@ impl ThreeBodySweepPoint {
         row
     }
 
-    /// A result, for a column.
-    fn number(&self, read: fn(&ThreeBodyResult) -> f64) -> Option<f64> {
-        self.result.as_ref().map(read)
-    }
-
-    /// A mean per particle, for a column.
-    fn mean(&self, read: fn(&PerParticleOutput) -> f64) -> Option<f64> {
-        self.result
-            .as_ref()
-            .and_then(|r| r.per_particle.as_ref())
-            .map(read)
-    }
-
     /// The table of `points`, whose operating points are all of one kind: the first column
     /// is named after it (`separation`, `total_load` or `particle_load`) and takes its unit.
     pub fn table(points: &[ThreeBodySweepPoint]) -> Table {
-        let mut table = Table::new(&Self::COLUMNS, points);
+        let mut table = Table::new(Self::columns(), points);
         if let Some(point) = points.first() {
-            let name = point.operating.as_object().and_then(|o| o.keys().next());
-            let unit = point.operating_point.parameter().unit();
-            table.rename(0, name.map_or("operating", String::as_str), unit);
+            let (name, unit) = &operating_units()[point.operating_point.kind()];
+            table.rename(0, name, unit);
         }
         table
     }
 
-    /// The CSV columns of three-body systems.
-    const COLUMNS: [Column<ThreeBodySweepPoint>; 18] = [
-        Column::number("operating", "", |p| p.operating_point.value()),
-        Column::number("velocity", "m/s", |p| p.velocity),
-        Column::number("mean_diameter", "m", |p| p.mean_diameter),
-        Column::optional("separation", "m", |p| p.number(|r| r.state.separation)),
-        Column::optional("particles_in_contact", "", |p| {
-            p.number(|r| r.state.particles_in_contact)
-        }),
-        Column::optional("area_surface_surface", "m²", |p| {
-            p.number(|r| r.state.areas.surface_surface)
-        }),
-        Column::optional("area_particle_upper", "m²", |p| {
-            p.number(|r| r.state.areas.particle_upper)
-        }),
-        Column::optional("area_particle_layer", "m²", |p| {
-            p.number(|r| r.state.areas.particle_layer)
-        }),
-        Column::optional("area_total", "m²", |p| p.number(|r| r.state.areas.total)),
-        Column::optional("load_asperities", "N", |p| {
-            p.number(|r| r.state.loads.asperities)
-        }),
-        Column::optional("load_particles", "N", |p| {
-            p.number(|r| r.state.loads.particles)
-        }),
-        Column::optional("load_total", "N", |p| p.number(|r| r.state.loads.total)),
-        Column::optional("friction_static", "", |p| {
-            p.number(|r| r.friction_coefficient.static_)
-        }),
-        Column::optional("friction_rolling", "", |p| {
-            p.number(|r| r.friction_coefficient.rolling)
-        }),
-        Column::optional("mean_area", "m²", |p| p.mean(|m| m.mean_area)),
-        Column::optional("mean_load", "N", |p| p.mean(|m| m.mean_load)),
-        Column::text("status", |p| p.status.as_str().to_string()),
-        Column::text("note", |p| p.notes.note()),
-    ];
+    /// The CSV columns of three-body systems: the operating point (named by
+    /// [`ThreeBodySweepPoint::table`]), then the fields', the status and the note.
+    fn columns() -> &'static [Column<ThreeBodySweepPoint>] {
+        static COLUMNS: LazyLock<Vec<Column<ThreeBodySweepPoint>>> = LazyLock::new(|| {
+            let operating = Column::number("operating", "", |p: &ThreeBodySweepPoint| {
+                p.operating_point.value()
+            });
+            let numbers = fields::columns::<ThreeBodySweepPoint>();
+            points::columns([operating].into_iter().chain(numbers).collect())
+        });
+        &COLUMNS
+    }
 }
 
 impl Row for ThreeBodySweepPoint {

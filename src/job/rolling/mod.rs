@@ -1,7 +1,10 @@
 //! The rolling job: one particle rolling over the layer (docs/model.md §3).
 
-use super::pictures::PictureError;
-use crate::render::svg::Chart;
+mod picture;
+pub use picture::RollingPicture;
+
+use std::sync::LazyLock;
+
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
 use utoipa::ToSchema;
@@ -9,14 +12,14 @@ use utoipa::ToSchema;
 use super::input::{self, field, Checker, LayerInput, QuadratureKind, Quantity};
 use super::kind::SMALL_ANSWER;
 use super::meta::ROLLING_REFERENCES;
-use super::points::{PointNotes, PointNotesFields, PointStatus, Row, SweepVerification};
-use super::validity::{self, validity_units, PointValidity, Subject, ValidityOutput};
+use super::points::{self, PointNotes, PointNotesFields, PointStatus, Row, SweepVerification};
+use super::validity::{self, PointValidity, Subject, ValidityOutput};
 use super::{Control, JobError, Kind, Limits, Meta, References, Validated, Work};
 use crate::model::rolling::{BoundaryPoint, PressureGrid, Verification};
 use crate::model::tables::{self, Use};
 use crate::model::{self, Parameter, Rolling, RollingSolution, SolveOption, SolveOptions};
-use crate::render::{Column, Output, Table, UnitTable};
-use crate::unit_table;
+use crate::render::{fields, Column, Output, Table, UnitTable};
+use crate::{described, unit_table};
 
 /// Input of a rolling job; every field optional (docs/model.md §5 defaults).
 #[derive(Clone, Debug, Default, PartialEq, Deserialize, Serialize, ToSchema)]
@@ -115,6 +118,7 @@ impl RollingJob {
 impl Kind for RollingJob {
     const NAME: &'static str = "rolling";
     type Input = RollingInput;
+    type Picture = RollingPicture;
     type Output = RollingOutput;
 
     fn validate(input: Value, _limits: &Limits) -> Result<Validated<Self>, JobError> {
@@ -128,10 +132,6 @@ impl Kind for RollingJob {
 
     fn references(&self) -> &'static References {
         &ROLLING_REFERENCES
-    }
-
-    fn picture(answer: &Value) -> Result<Chart, PictureError> {
-        super::pictures::rolling(answer)
     }
 
     fn work(&self) -> Work {
@@ -174,97 +174,68 @@ impl Kind for RollingJob {
     }
 }
 
-/// The units of a rolling contact's integral quantities (`ContactOutput`), under `$prefix`.
-macro_rules! contact_units {
-    ($prefix:literal) => {
-        &[
-            (concat!($prefix, "penetration"), "m"),
-            (concat!($prefix, "contact_area"), "m²"),
-            (concat!($prefix, "half_width"), "m"),
-            (concat!($prefix, "centroid_shift"), "m"),
-            (concat!($prefix, "pressure_centre_shift"), "m"),
-            (concat!($prefix, "rolling_resistance_coefficient"), ""),
-            (concat!($prefix, "friction_coefficient"), ""),
-            (concat!($prefix, "static.penetration"), "m"),
-            (concat!($prefix, "static.contact_area"), "m²"),
-            (concat!($prefix, "static.friction_coefficient"), ""),
-        ]
-    };
-}
-pub(crate) use contact_units;
-
-/// The units of a rolling contact's verification block, under `$prefix`.
-macro_rules! verification_units {
-    ($prefix:literal) => {
-        &[
-            (concat!($prefix, "relative_load_residual"), ""),
-            (concat!($prefix, "quadrature_error_estimate"), ""),
-            (concat!($prefix, "quadrature_nodes"), ""),
-            (concat!($prefix, "iterations"), ""),
-            (concat!($prefix, "exit_root_iterations"), ""),
-            (concat!($prefix, "table_error"), ""),
-        ]
-    };
-}
-pub(crate) use verification_units;
-
-/// The integral quantities of a rolling contact, shared by rolling answers and sweep points.
-#[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
-pub struct ContactOutput {
-    /// δ (m).
-    pub penetration: f64,
-    /// A (m²).
-    pub contact_area: f64,
-    /// √(2Rδ) (m).
-    pub half_width: f64,
-    /// x_c (m), area centroid ahead of the sphere centre.
-    pub centroid_shift: f64,
-    /// x_p (m), centre of pressure.
-    pub pressure_centre_shift: f64,
-    /// x_p/R (dimensionless).
-    pub rolling_resistance_coefficient: f64,
-    /// μ = τ_a A/P (eq. 12; dimensionless).
-    pub friction_coefficient: f64,
-    /// The same particle at V = 0.
-    #[serde(rename = "static")]
-    pub static_contact: StaticOutput,
+described! {
+    /// The integral quantities of a rolling contact, shared by rolling answers and sweep points.
+    #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, ToSchema)]
+    pub struct ContactOutput {
+        /// δ (m).
+        pub penetration: f64 => [number "m"],
+        /// A (m²).
+        pub contact_area: f64 => [number "m²"],
+        /// √(2Rδ) (m).
+        pub half_width: f64 => [number "m"],
+        /// x_c (m), area centroid ahead of the sphere centre.
+        pub centroid_shift: f64 => [number "m"],
+        /// x_p (m), centre of pressure.
+        pub pressure_centre_shift: f64 => [number "m"],
+        /// x_p/R (dimensionless).
+        pub rolling_resistance_coefficient: f64 => [number ""],
+        /// μ = τ_a A/P (eq. 12; dimensionless).
+        pub friction_coefficient: f64 => [number ""],
+        /// The same particle at V = 0.
+        pub r#static: StaticOutput => [nested "static_"],
+    }
 }
 
-/// The particle without rolling.
-#[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
-pub struct StaticOutput {
-    /// δ at V = 0 (m).
-    pub penetration: f64,
-    /// A at V = 0 (m²).
-    pub contact_area: f64,
-    /// μ at V = 0 (dimensionless).
-    pub friction_coefficient: f64,
+described! {
+    /// The particle without rolling.
+    #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, ToSchema)]
+    pub struct StaticOutput {
+        /// δ at V = 0 (m).
+        pub penetration: f64 => [number "m"],
+        /// A at V = 0 (m²).
+        pub contact_area: f64 => [number "m²"],
+        /// μ at V = 0 (dimensionless).
+        pub friction_coefficient: f64 => [number ""],
+    }
 }
 
-/// How far the answer can be trusted.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, ToSchema)]
-pub struct VerificationOutput {
-    /// |P(δ) − P|/P at the returned δ (dimensionless).
-    pub relative_load_residual: f64,
-    /// A bound on the relative error of every reported quantity: twice its change when the
-    /// quadrature is halved, with the load residual carried through, never below rounding
-    /// (dimensionless). For a table answer, add `table_error`.
-    pub quadrature_error_estimate: f64,
-    /// Nodes (or strips) of the y-quadrature (count).
-    pub quadrature_nodes: usize,
-    /// Iterations of the load equation: strip-sum passes under every rule of the solve,
-    /// coarsest first, or look-ups in the similarity table (count).
-    pub iterations: u32,
-    /// Newton steps of all exit-edge roots, under every rule (count).
-    pub exit_root_iterations: u32,
-    /// Whether every root finder converged.
-    pub converged: bool,
-    /// Present when the load equation was solved through the layer's similarity table
-    /// (built once per layer from the exact strip solver, then ≈ 1 µs per answer): a bound
-    /// on the relative difference of every integral quantity from the exact solve
-    /// (dimensionless). Absent for an exact solve.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub table_error: Option<f64>,
+described! {
+    /// How far the answer can be trusted.
+    #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, ToSchema)]
+    pub struct VerificationOutput {
+        /// |P(δ) − P|/P at the returned δ (dimensionless).
+        pub relative_load_residual: f64 => [unit ""],
+        /// A bound on the relative error of every reported quantity: twice its change when the
+        /// quadrature is halved, with the load residual carried through, never below rounding
+        /// (dimensionless). For a table answer, add `table_error`.
+        pub quadrature_error_estimate: f64 => [unit ""],
+        /// Nodes (or strips) of the y-quadrature (count).
+        pub quadrature_nodes: usize => [unit ""],
+        /// Iterations of the load equation: strip-sum passes under every rule of the solve,
+        /// coarsest first, or look-ups in the similarity table (count).
+        pub iterations: u32 => [unit ""],
+        /// Newton steps of all exit-edge roots, under every rule (count).
+        pub exit_root_iterations: u32 => [unit ""],
+        /// Whether every root finder converged.
+        pub converged: bool => [],
+        /// Present when the load equation was solved through the layer's similarity table
+        /// (built once per layer from the exact strip solver, then ≈ 1 µs per answer): a bound
+        /// on the relative difference of every integral quantity from the exact solve
+        /// (dimensionless). Absent for an exact solve.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        pub table_error: Option<f64> => [unit ""],
+    }
 }
 
 impl VerificationOutput {
@@ -313,7 +284,7 @@ impl From<&RollingSolution> for ContactOutput {
             pressure_centre_shift: s.pressure_centre_shift,
             rolling_resistance_coefficient: s.rolling_resistance_coefficient,
             friction_coefficient: s.friction_coefficient,
-            static_contact: StaticOutput {
+            r#static: StaticOutput {
                 penetration: s.static_contact.penetration,
                 contact_area: s.static_contact.contact_area,
                 friction_coefficient: s.static_contact.friction_coefficient,
@@ -322,28 +293,30 @@ impl From<&RollingSolution> for ContactOutput {
     }
 }
 
-/// One row of a rolling sweep: the point's conditions, its status, and (answered) its numbers
-/// and the ratios of the model's assumptions, or (refused) the reason.
-// Also the CSV row of a rolling answer: one declaration of the columns of rolling contacts.
-#[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
-pub struct SweepPoint {
-    /// R (m).
-    pub radius: f64,
-    /// P (N).
-    pub load: f64,
-    /// V (m/s).
-    pub velocity: f64,
-    pub status: PointStatus,
-    /// The contact, when answered.
-    #[serde(flatten)]
-    pub contact: Option<ContactOutput>,
-    #[serde(flatten)]
-    #[schema(inline, value_type = PointNotesFields)]
-    pub notes: PointNotes,
-    /// The numerical error of an answered point (in the sweep's `meta.verification`, the
-    /// worst over its points).
-    #[serde(skip)]
-    pub verification: Option<VerificationOutput>,
+described! {
+    /// One row of a rolling sweep: the point's conditions, its status, and (answered) its numbers
+    /// and the ratios of the model's assumptions, or (refused) the reason.
+    // Also the CSV row of a rolling answer: one declaration of the columns of rolling contacts.
+    #[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
+    pub struct SweepPoint {
+        /// R (m).
+        pub radius: f64 => [number "m"],
+        /// P (N).
+        pub load: f64 => [number "N"],
+        /// V (m/s).
+        pub velocity: f64 => [number "m/s"],
+        pub status: PointStatus => [],
+        /// The contact, when answered.
+        #[serde(flatten)]
+        pub contact: Option<ContactOutput> => [optional flatten],
+        #[serde(flatten)]
+        #[schema(inline, value_type = PointNotesFields)]
+        pub notes: PointNotes => [flatten by PointNotes::units()],
+        /// The numerical error of an answered point (in the sweep's `meta.verification`, the
+        /// worst over its points).
+        #[serde(skip)]
+        pub verification: Option<VerificationOutput> => [],
+    }
 }
 
 impl SweepPoint {
@@ -373,41 +346,12 @@ impl SweepPoint {
         row
     }
 
-    /// A number of the contact, for a column.
-    fn number(&self, read: fn(&ContactOutput) -> f64) -> Option<f64> {
-        self.contact.as_ref().map(read)
+    /// The CSV columns of rolling contacts: the fields', then the status and the note.
+    pub fn columns() -> &'static [Column<SweepPoint>] {
+        static COLUMNS: LazyLock<Vec<Column<SweepPoint>>> =
+            LazyLock::new(|| points::columns(fields::columns::<SweepPoint>()));
+        &COLUMNS
     }
-
-    /// The CSV columns of rolling contacts.
-    pub const COLUMNS: [Column<SweepPoint>; 15] = [
-        Column::number("radius", "m", |p| p.radius),
-        Column::number("load", "N", |p| p.load),
-        Column::number("velocity", "m/s", |p| p.velocity),
-        Column::optional("penetration", "m", |p| p.number(|c| c.penetration)),
-        Column::optional("contact_area", "m²", |p| p.number(|c| c.contact_area)),
-        Column::optional("half_width", "m", |p| p.number(|c| c.half_width)),
-        Column::optional("centroid_shift", "m", |p| p.number(|c| c.centroid_shift)),
-        Column::optional("pressure_centre_shift", "m", |p| {
-            p.number(|c| c.pressure_centre_shift)
-        }),
-        Column::optional("rolling_resistance_coefficient", "", |p| {
-            p.number(|c| c.rolling_resistance_coefficient)
-        }),
-        Column::optional("friction_coefficient", "", |p| {
-            p.number(|c| c.friction_coefficient)
-        }),
-        Column::optional("static_penetration", "m", |p| {
-            p.number(|c| c.static_contact.penetration)
-        }),
-        Column::optional("static_contact_area", "m²", |p| {
-            p.number(|c| c.static_contact.contact_area)
-        }),
-        Column::optional("static_friction_coefficient", "", |p| {
-            p.number(|c| c.static_contact.friction_coefficient)
-        }),
-        Column::text("status", |p| p.status.as_str().to_string()),
-        Column::text("note", |p| p.notes.note()),
-    ];
 }
 
 impl Row for SweepPoint {
@@ -434,15 +378,17 @@ impl Row for SweepPoint {
     }
 }
 
-/// A point of the contact boundary (m).
-#[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
-pub struct BoundaryOutput {
-    /// Lateral coordinate y (m).
-    pub y: f64,
-    /// Trailing edge a(y) (m).
-    pub exit: f64,
-    /// Leading edge b(y) (m).
-    pub entry: f64,
+described! {
+    /// A point of the contact boundary (m).
+    #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, ToSchema)]
+    pub struct BoundaryOutput {
+        /// Lateral coordinate y (m).
+        pub y: f64 => [unit "m"],
+        /// Trailing edge a(y) (m).
+        pub exit: f64 => [unit "m"],
+        /// Leading edge b(y) (m).
+        pub entry: f64 => [unit "m"],
+    }
 }
 
 impl From<&BoundaryPoint> for BoundaryOutput {
@@ -455,15 +401,17 @@ impl From<&BoundaryPoint> for BoundaryOutput {
     }
 }
 
-/// p(x, y) (Pa) on a grid: `values[j][i]` = p(x[i], y[j]) (m).
-#[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
-pub struct PressureOutput {
-    /// Grid abscissae in the rolling direction (m).
-    pub x: Vec<f64>,
-    /// Grid ordinates across it (m).
-    pub y: Vec<f64>,
-    /// p(x[i], y[j]) as `values[j][i]` (Pa).
-    pub values: Vec<Vec<f64>>,
+described! {
+    /// p(x, y) (Pa) on a grid: `values[j][i]` = p(x[i], y[j]) (m).
+    #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, ToSchema)]
+    pub struct PressureOutput {
+        /// Grid abscissae in the rolling direction (m).
+        pub x: Vec<f64> => [list "m"],
+        /// Grid ordinates across it (m).
+        pub y: Vec<f64> => [list "m"],
+        /// p(x[i], y[j]) as `values[j][i]` (Pa).
+        pub values: Vec<Vec<f64>> => [grid "Pa"],
+    }
 }
 
 impl From<&PressureGrid> for PressureOutput {
@@ -476,36 +424,40 @@ impl From<&PressureGrid> for PressureOutput {
     }
 }
 
-/// The `meta` block of a rolling answer.
-#[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
-pub struct RollingMeta {
-    #[serde(flatten)]
-    pub meta: Meta,
-    /// How far the numbers can be trusted.
-    pub verification: VerificationOutput,
-    /// How far the model can be trusted here (docs/model.md §7).
-    pub validity: ValidityOutput,
+described! {
+    /// The `meta` block of a rolling answer.
+    #[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
+    pub struct RollingMeta {
+        #[serde(flatten)]
+        pub meta: Meta => [],
+        /// How far the numbers can be trusted.
+        pub verification: VerificationOutput => [nested],
+        /// How far the model can be trusted here (docs/model.md §7).
+        pub validity: ValidityOutput => [nested],
+    }
 }
 
-/// The answer to a rolling job.
-#[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
-pub struct RollingOutput {
-    #[serde(flatten)]
-    pub contact: ContactOutput,
-    /// The contact boundary, `options.boundary_points` points over y.
-    pub boundary: Vec<BoundaryOutput>,
-    /// The pressure grid, when `options.pressure_grid` asked for one.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub pressure: Option<PressureOutput>,
-    /// Model version, cache key, the input as understood, references, verification.
-    pub meta: RollingMeta,
-    /// The contact solved (its R, P, V are in `meta.input` on the wire; the CSV row needs
-    /// them).
-    #[serde(skip)]
-    rolling: Rolling,
-    /// The validity's checks, for the CSV row.
-    #[serde(skip)]
-    checks: PointValidity,
+described! {
+    /// The answer to a rolling job.
+    #[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
+    pub struct RollingOutput {
+        #[serde(flatten)]
+        pub contact: ContactOutput => [flatten],
+        /// The contact boundary, `options.boundary_points` points over y.
+        pub boundary: Vec<BoundaryOutput> => [each],
+        /// The pressure grid, when `options.pressure_grid` asked for one.
+        #[serde(skip_serializing_if = "Option::is_none")]
+        pub pressure: Option<PressureOutput> => [optional nested],
+        /// Model version, cache key, the input as understood, references, verification.
+        pub meta: RollingMeta => [nested],
+        /// The contact solved (its R, P, V are in `meta.input` on the wire; the CSV row needs
+        /// them).
+        #[serde(skip)]
+        rolling: Rolling => [],
+        /// The validity's checks, for the CSV row.
+        #[serde(skip)]
+        checks: PointValidity => [],
+    }
 }
 
 impl RollingOutput {
@@ -533,19 +485,7 @@ impl RollingOutput {
 }
 
 impl Output for RollingOutput {
-    const UNITS: &'static UnitTable = unit_table![
-        contact_units!(""),
-        &[
-            ("boundary[].y", "m"),
-            ("boundary[].exit", "m"),
-            ("boundary[].entry", "m"),
-            ("pressure.x[]", "m"),
-            ("pressure.y[]", "m"),
-            ("pressure.values[][]", "Pa"),
-        ],
-        verification_units!("meta.verification."),
-        validity_units!("meta.validity."),
-    ];
+    const UNITS: &'static UnitTable = unit_table!(RollingOutput);
 
     /// One row: the contact's conditions and integrals, as a sweep's row.
     fn table(&self) -> Table {
@@ -555,6 +495,6 @@ impl Output for RollingOutput {
             self.meta.verification.clone(),
             self.checks.clone(),
         );
-        Table::new(&SweepPoint::COLUMNS, [&point])
+        Table::new(SweepPoint::columns(), [&point])
     }
 }

@@ -1,7 +1,10 @@
 //! The figure job: the data of one of the paper's Figures 3–9 (docs/model.md §5).
 
-use super::pictures::PictureError;
-use crate::render::svg::Chart;
+mod picture;
+pub use picture::FigurePicture;
+
+use std::borrow::Cow;
+
 use serde::{Deserialize, Serialize};
 use serde_json::{json, Value};
 use utoipa::ToSchema;
@@ -13,7 +16,7 @@ use super::{Control, JobError, Kind, Limits, Meta, References, Validated, Work};
 use crate::model::figures::{Axis, Figure, Plan, FIGURES};
 use crate::model::tables::{self, Use};
 use crate::render::{Column, Output, Table, UnitTable};
-use crate::unit_table;
+use crate::{described, unit_table};
 
 /// Input of a figure job.
 #[derive(Clone, Debug, PartialEq, Deserialize, Serialize, ToSchema)]
@@ -51,6 +54,7 @@ impl FigureJob {
 impl Kind for FigureJob {
     const NAME: &'static str = "figure";
     type Input = FigureInput;
+    type Picture = FigurePicture;
     type Output = FigureOutput;
 
     fn validate(input: Value, _limits: &Limits) -> Result<Validated<Self>, JobError> {
@@ -66,10 +70,6 @@ impl Kind for FigureJob {
 
     fn references(&self) -> &'static References {
         &ROLLING_REFERENCES
-    }
-
-    fn picture(answer: &Value) -> Result<Chart, PictureError> {
-        super::pictures::figure(answer)
     }
 
     fn work(&self) -> Work {
@@ -92,54 +92,60 @@ impl Kind for FigureJob {
 }
 
 /// An axis of a figure.
-#[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, ToSchema)]
 pub struct AxisOutput {
     /// What the axis shows, e.g. `contact_area`.
-    pub quantity: &'static str,
+    #[schema(value_type = String)]
+    pub quantity: Cow<'static, str>,
     /// SI unit ("" for a plain number).
-    pub unit: &'static str,
+    #[schema(value_type = String)]
+    pub unit: Cow<'static, str>,
 }
 
 impl From<Axis> for AxisOutput {
     fn from(a: Axis) -> Self {
         AxisOutput {
-            quantity: a.quantity,
-            unit: a.unit,
+            quantity: Cow::Borrowed(a.quantity),
+            unit: Cow::Borrowed(a.unit),
         }
     }
 }
 
-/// One curve.
-#[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
-pub struct SeriesOutput {
-    /// The curve's legend, e.g. `V = 4 nm/s`.
-    pub label: String,
-    /// R of the curve (m), when it is fixed along it.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub radius: Option<f64>,
-    /// P of the curve (N), when it is fixed along it.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub load: Option<f64>,
-    /// V of the curve (m/s).
-    pub velocity: f64,
-    /// [x, y] pairs in the units of the axes.
-    pub points: Vec<[f64; 2]>,
+described! {
+    /// One curve.
+    #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, ToSchema)]
+    pub struct SeriesOutput {
+        /// The curve's legend, e.g. `V = 4 nm/s`.
+        pub label: String => [],
+        /// R of the curve (m), when it is fixed along it.
+        #[serde(skip_serializing_if = "Option::is_none")]
+        pub radius: Option<f64> => [unit "m"],
+        /// P of the curve (N), when it is fixed along it.
+        #[serde(skip_serializing_if = "Option::is_none")]
+        pub load: Option<f64> => [unit "N"],
+        /// V of the curve (m/s).
+        pub velocity: f64 => [unit "m/s"],
+        /// [x, y] pairs in the units of the axes.
+        pub points: Vec<[f64; 2]> => [grid "x.unit, y.unit"],
+    }
 }
 
-/// The answer to a figure job.
-#[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
-pub struct FigureOutput {
-    /// The figure's number in the paper, 3 to 9.
-    pub figure: u8,
-    /// What the figure shows.
-    pub title: &'static str,
-    /// The horizontal axis: its quantity and SI unit.
-    pub x: AxisOutput,
-    /// The vertical axis: its quantity and SI unit.
-    pub y: AxisOutput,
-    /// The curves.
-    pub series: Vec<SeriesOutput>,
-    pub meta: Meta,
+described! {
+    /// The answer to a figure job.
+    #[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
+    pub struct FigureOutput {
+        /// The figure's number in the paper, 3 to 9.
+        pub figure: u8 => [unit ""],
+        /// What the figure shows.
+        pub title: &'static str => [],
+        /// The horizontal axis: its quantity and SI unit.
+        pub x: AxisOutput => [],
+        /// The vertical axis: its quantity and SI unit.
+        pub y: AxisOutput => [],
+        /// The curves.
+        pub series: Vec<SeriesOutput> => [each],
+        pub meta: Meta => [],
+    }
 }
 
 impl FigureOutput {
@@ -175,13 +181,7 @@ struct FigureRow<'a> {
 
 impl Output for FigureOutput {
     /// The points are in the units of the axes, which the answer names.
-    const UNITS: &'static UnitTable = unit_table![&[
-        ("figure", ""),
-        ("series[].radius", "m"),
-        ("series[].load", "N"),
-        ("series[].velocity", "m/s"),
-        ("series[].points[][]", "x.unit, y.unit"),
-    ]];
+    const UNITS: &'static UnitTable = unit_table!(FigureOutput);
 
     /// One row per point: the series' index and legend, then x and y in the axes' units.
     fn table(&self) -> Table {
@@ -206,8 +206,8 @@ impl Output for FigureOutput {
             })
             .collect();
         let mut table = Table::new(&columns(), &rows);
-        table.rename(2, self.x.quantity, self.x.unit);
-        table.rename(3, self.y.quantity, self.y.unit);
+        table.rename(2, &self.x.quantity, &self.x.unit);
+        table.rename(3, &self.y.quantity, &self.y.unit);
         table
     }
 }

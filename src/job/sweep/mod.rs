@@ -2,8 +2,9 @@
 //! rolling jobs (radius, load, speed) and three-body jobs (operating point, speed, mean
 //! diameter).
 
-use super::pictures::PictureError;
-use crate::render::svg::Chart;
+mod picture;
+pub use picture::SweepPicture;
+
 use std::ops::Range;
 
 use serde::{Deserialize, Serialize};
@@ -14,18 +15,15 @@ use super::input::{self, field, Checker, Field, Quantity};
 use super::kind::SMALL_ANSWER;
 use super::meta::{REFERENCES, ROLLING_REFERENCES};
 use super::points::{self, SweepSummary};
-use super::rolling::{contact_units, verification_units, RollingInput, RollingJob};
-use super::three_body::{
-    operating_fields, result_units, slot, three_body_verification_units, ThreeBodyInput,
-    ThreeBodyJob,
-};
+use super::rolling::{RollingInput, RollingJob};
+use super::three_body::{operating_fields, slot, ThreeBodyInput, ThreeBodyJob};
 use super::validity::Subject;
 use super::{Control, JobError, Kind, Limits, Meta, OnRefusal, References, Swept, Validated, Work};
 use crate::model::tables::{self, Use};
 use crate::model::three_body::{self, Diameters, OperatingPoint, ThreeBody, ThreeBodySolution};
 use crate::model::{Parameter, Rolling, RollingSolution, SolveOptions, MODEL_VERSION};
-use crate::render::{Output, Table, UnitTable};
-use crate::unit_table;
+use crate::render::{self, Fields, Output, Table, UnitTable};
+use crate::{described, unit_table};
 
 pub use super::rolling::SweepPoint;
 pub use super::three_body::ThreeBodySweepPoint;
@@ -141,6 +139,7 @@ impl SweepJob {
 impl Kind for SweepJob {
     const NAME: &'static str = "sweep";
     type Input = SweepInput;
+    type Picture = SweepPicture;
     type Output = SweepOutput;
 
     fn validate(value: Value, limits: &Limits) -> Result<Validated<Self>, JobError> {
@@ -189,10 +188,6 @@ impl Kind for SweepJob {
             SweepOfPoints::Rolling(_) => &ROLLING_REFERENCES,
             SweepOfPoints::ThreeBody(_) => &REFERENCES,
         }
-    }
-
-    fn picture(answer: &Value) -> Result<Chart, PictureError> {
-        super::pictures::sweep(answer)
     }
 
     fn work(&self) -> Work {
@@ -554,65 +549,60 @@ pub enum SweepPoints {
     ThreeBody(Vec<ThreeBodySweepPoint>),
 }
 
-/// The answer to a sweep.
-#[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
-pub struct SweepOutput {
-    /// One row per point; rolling: radius outermost, then load, then speed; three-body:
-    /// operating point, then speed, then mean diameter.
-    pub points: SweepPoints,
-    pub meta: SweepMeta,
-    /// Why the sweep stopped before its end, if it did (`meta.stopped` in words).
-    #[serde(skip)]
-    pub stop: Option<JobError>,
+/// The rows of either kind (the union: a sweep's are of one).
+impl Fields for SweepPoints {
+    fn fields() -> Vec<render::Field<Self>> {
+        let mut fields = render::Field::each::<SweepPoint>("");
+        fields.extend(render::Field::each::<ThreeBodySweepPoint>(""));
+        fields
+    }
 }
 
-/// The `meta` block of a sweep: the job's, and what it says of the rows.
-#[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
-pub struct SweepMeta {
-    #[serde(flatten)]
-    pub meta: Meta,
-    #[serde(flatten)]
-    pub summary: SweepSummary,
+described! {
+    /// The answer to a sweep.
+    #[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
+    pub struct SweepOutput {
+        /// One row per point; rolling: radius outermost, then load, then speed; three-body:
+        /// operating point, then speed, then mean diameter.
+        pub points: SweepPoints => [nested],
+        pub meta: SweepMeta => [nested],
+        /// Why the sweep stopped before its end, if it did (`meta.stopped` in words).
+        #[serde(skip)]
+        pub stop: Option<JobError> => [],
+    }
+}
+
+described! {
+    /// The `meta` block of a sweep: the job's, and what it says of the rows.
+    #[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
+    pub struct SweepMeta {
+        #[serde(flatten)]
+        pub meta: Meta => [],
+        #[serde(flatten)]
+        pub summary: SweepSummary => [flatten],
+    }
 }
 
 impl Output for SweepOutput {
     /// The points of a rolling sweep or of a three-body sweep.
-    const UNITS: &'static UnitTable = unit_table![
-        &[
-            ("points[].radius", "m"),
-            ("points[].load", "N"),
-            ("points[].velocity", "m/s"),
-            ("points[].mean_diameter", "m"),
-            ("points[].operating.separation", "m"),
-            ("points[].operating.total_load", "N"),
-            ("points[].operating.particle_load", "N"),
-        ],
-        contact_units!("points[]."),
-        result_units!("points[]."),
-        &[
-            ("points[].validity.inside_layer", ""),
-            ("points[].validity.parabolic_sphere", ""),
-            ("points[].validity.local_layer", ""),
-            ("points[].validity.adhesive_friction", ""),
-            ("points[].validity.surfaces_apart", ""),
-            ("points[].validity.asperity_gap", ""),
-            ("points[].validity.particles_in_contact", ""),
-            ("meta.counts.total", ""),
-            ("meta.counts.ok", ""),
-            ("meta.counts.warn", ""),
-            ("meta.counts.refused", ""),
-            ("meta.counts.missing", ""),
-            ("meta.validity.assumptions[].warned", ""),
-            ("meta.validity.assumptions[].first_warned", ""),
-        ],
-        verification_units!("meta.verification."),
-        three_body_verification_units!("meta.verification."),
-    ];
+    const UNITS: &'static UnitTable = unit_table!(SweepOutput);
+
+    /// How many points the model refused, and how to fail the sweep instead.
+    fn notice(&self) -> Option<String> {
+        let counts = self.meta.summary.counts;
+        (counts.refused > 0).then(|| {
+            format!(
+                "the model refused {} of {} points; their rows say why \
+                 (\"on_refusal\": \"fail\" fails the sweep instead)",
+                counts.refused, counts.total
+            )
+        })
+    }
 
     /// One row per point.
     fn table(&self) -> Table {
         match &self.points {
-            SweepPoints::Rolling(points) => Table::new(&SweepPoint::COLUMNS, points),
+            SweepPoints::Rolling(points) => Table::new(SweepPoint::columns(), points),
             SweepPoints::ThreeBody(points) => ThreeBodySweepPoint::table(points),
         }
     }

@@ -1,0 +1,62 @@
+//! What every kind's picture shares. A kind draws its answer from a typed view of the
+//! answer's JSON ([`Picture`]: the parts of the output it shows, as the output's own types),
+//! read back from the JSON, so that an answer solved in another process, or assembled from
+//! parts, is drawn exactly as one solved here.
+
+use serde::de::DeserializeOwned;
+use serde::Deserialize;
+use serde_json::Value;
+
+use super::{Kind, Limits};
+use crate::model::text::quantity_to;
+use crate::render::svg::Chart;
+
+/// Why an answer cannot be drawn: it is not the answer of the kind asked (a fault of ours).
+pub type PictureError = String;
+
+/// The parts of an answer a kind's picture shows, read from the answer's JSON.
+pub trait Picture: DeserializeOwned {
+    /// The picture.
+    fn chart(self) -> Result<Chart, PictureError>;
+}
+
+/// The picture of the answer whose JSON is `json`, drawn as `P`.
+pub fn draw<P: Picture>(json: &[u8]) -> Result<Chart, PictureError> {
+    let picture: P = serde_json::from_slice(json).map_err(|e| format!("the answer: {e}"))?;
+    picture.chart()
+}
+
+/// An answer's `meta`, for its input: the canonical input of a job of kind `K`.
+#[derive(Deserialize)]
+pub struct Asked {
+    input: Value,
+}
+
+impl Asked {
+    /// The job the input reads back as (a canonical input always does).
+    pub fn job<K: Kind>(self) -> Result<K, PictureError> {
+        K::validate(self.input, &Limits::default())
+            .map(|validated| validated.job)
+            .map_err(|e| format!("the answer's input does not read back: {e}"))
+    }
+}
+
+/// `value` (SI) in the unit a person reads, with it: `25 nm`; to four digits, so that the
+/// labels of close values in a legend differ.
+pub fn shown(value: f64, unit: &str) -> String {
+    quantity_to(value, unit, 4)
+}
+
+/// The symbol of a condition in a legend (`V = 4 nm/s`): the paper's, by the condition's name
+/// on the wire.
+pub fn symbol(name: &str) -> &str {
+    match name {
+        "velocity" => "V",
+        "load" | "particle_load" => "P",
+        "radius" => "R",
+        "mean_diameter" => "x_a",
+        "total_load" => "W",
+        "separation" => "d",
+        other => other,
+    }
+}

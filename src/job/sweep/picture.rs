@@ -1,0 +1,201 @@
+//! The picture of a sweep: the friction coefficient against the longest varied list, one
+//! curve per combination of the others; points at rest (V = 0) hollow, rolling ones
+//! filled; points without numbers (refused, or not solved) counted in a note.
+
+use std::collections::BTreeMap;
+
+use serde::Deserialize;
+
+use crate::job::picture::{shown, symbol, Picture, PictureError};
+use crate::job::points::PointStatus;
+use crate::job::rolling::ContactOutput;
+use crate::job::three_body::{operating_units, ThreeBodyResult};
+use crate::model::Parameter;
+use crate::render::svg::{Axis, Chart, Layer};
+
+/// What the picture shows of a sweep: its rows.
+#[derive(Deserialize)]
+pub struct SweepPicture {
+    points: Rows,
+}
+
+/// The rows of either kind, as the output writes them.
+#[derive(Deserialize)]
+#[serde(untagged)]
+enum Rows {
+    Rolling(Vec<RollingRow>),
+    ThreeBody(Vec<ThreeBodyRow>),
+}
+
+#[derive(Deserialize)]
+struct RollingRow {
+    radius: f64,
+    load: f64,
+    velocity: f64,
+    status: PointStatus,
+    #[serde(flatten)]
+    contact: Option<ContactOutput>,
+}
+
+#[derive(Deserialize)]
+struct ThreeBodyRow {
+    /// One operating point, by its name.
+    operating: BTreeMap<String, f64>,
+    velocity: f64,
+    mean_diameter: f64,
+    status: PointStatus,
+    #[serde(flatten)]
+    result: Option<ThreeBodyResult>,
+}
+
+/// A condition of a row: its name, unit and value.
+type Condition = (String, &'static str, f64);
+
+/// A row as the picture uses it: its conditions, in the order a curve is preferred along
+/// (speed first), and its friction coefficient (`None`: not answered).
+struct Drawn {
+    conditions: Vec<Condition>,
+    mu: Option<f64>,
+    velocity: f64,
+}
+
+impl Rows {
+    /// The rows drawn, and the name of the friction coefficient they give.
+    fn drawn(self) -> Result<(Vec<Drawn>, &'static str), PictureError> {
+        let answered =
+            |status: PointStatus| !matches!(status, PointStatus::Refused | PointStatus::Missing);
+        match self {
+            Rows::Rolling(rows) => {
+                let rows = rows.into_iter().map(|r| Drawn {
+                    conditions: vec![
+                        condition("velocity", Parameter::Velocity, r.velocity),
+                        condition("load", Parameter::Load, r.load),
+                        condition("radius", Parameter::Radius, r.radius),
+                    ],
+                    mu: r
+                        .contact
+                        .filter(|_| answered(r.status))
+                        .map(|c| c.friction_coefficient),
+                    velocity: r.velocity,
+                });
+                Ok((rows.collect(), "friction coefficient"))
+            }
+            Rows::ThreeBody(rows) => {
+                let units = operating_units();
+                let rows = rows.into_iter().map(|r| {
+                    let mut conditions = vec![
+                        condition("velocity", Parameter::Velocity, r.velocity),
+                        condition("mean_diameter", Parameter::MeanDiameter, r.mean_diameter),
+                    ];
+                    for (name, value) in r.operating {
+                        let unit = units.iter().find(|u| u.0 == name).map_or("", |u| u.1);
+                        conditions.push((name, unit, value));
+                    }
+                    let mu = r.result.filter(|_| answered(r.status));
+                    Drawn {
+                        conditions,
+                        mu: mu.map(|r| r.friction_coefficient.rolling),
+                        velocity: r.velocity,
+                    }
+                });
+                Ok((rows.collect(), "rolling friction coefficient"))
+            }
+        }
+    }
+}
+
+fn condition(name: &str, parameter: Parameter, value: f64) -> Condition {
+    (name.to_string(), parameter.unit(), value)
+}
+
+impl Picture for SweepPicture {
+    fn chart(self) -> Result<Chart, PictureError> {
+        let (rows, y_name) = self.points.drawn()?;
+        let first = rows.first().ok_or("the sweep has no point")?;
+        let values =
+            |i: usize| -> Vec<u64> { rows.iter().map(|r| r.conditions[i].2.to_bits()).collect() };
+        // The conditions that vary, each with its number of distinct values.
+        let varied: Vec<(usize, usize)> = (0..first.conditions.len())
+            .filter_map(|i| {
+                let mut seen = values(i);
+                seen.sort_unstable();
+                seen.dedup();
+                (seen.len() > 1).then_some((i, seen.len()))
+            })
+            .collect();
+        // The longest list; of equal ones, the first (`max_by_key` keeps the last).
+        let along = varied.iter().rev().max_by_key(|v| v.1).map_or(0, |v| v.0);
+        let (along_name, along_unit, _) = &first.conditions[along];
+        // Curves by the values of the other varied lists, in order of first appearance.
+        let mut curves: Vec<Curve> = Vec::new();
+        let mut unanswered = 0;
+        for row in &rows {
+            let Some(mu) = row.mu else {
+                unanswered += 1;
+                continue;
+            };
+            let label: Vec<String> = varied
+                .iter()
+                .filter(|v| v.0 != along)
+                .map(|v| {
+                    let (name, unit, value) = &row.conditions[v.0];
+                    format!("{} = {}", symbol(name), shown(*value, unit))
+                })
+                .collect();
+            let label = if label.is_empty() {
+                "sweep".to_string()
+            } else {
+                label.join(", ")
+            };
+            let point = (row.conditions[along].2, mu);
+            let index = match curves.iter().position(|c| c.0 == label) {
+                Some(i) => i,
+                None => {
+                    curves.push((label, Vec::new(), Vec::new()));
+                    curves.len() - 1
+                }
+            };
+            curves[index].1.push(point);
+            if row.velocity == 0.0 {
+                curves[index].2.push(point);
+            }
+        }
+        let mut layers = Vec::new();
+        let mut rest = Vec::new();
+        for (name, line, at_rest) in curves {
+            layers.push(Layer::Line {
+                group: name.clone(),
+                name,
+                points: line,
+                dashed: false,
+            });
+            rest.extend(at_rest);
+        }
+        if !rest.is_empty() {
+            layers.push(Layer::Markers {
+                name: "at rest, V = 0".to_string(),
+                points: rest,
+                hollow: true,
+            });
+        }
+        // Short lines: they stand under the legend.
+        let notes = match unanswered {
+            0 => Vec::new(),
+            n => vec![
+                format!("{n} of {} points not drawn:", rows.len()),
+                "refused, or not solved".to_string(),
+            ],
+        };
+        Ok(Chart {
+            title: format!("Sweep: {y_name} against {}", along_name.replace('_', " ")),
+            x: Axis::new(along_name, along_unit),
+            y: Axis::new(y_name, ""),
+            layers,
+            equal_aspect: false,
+            notes,
+        })
+    }
+}
+
+/// A sweep's curve: its label, its points, and those of them at rest.
+type Curve = (String, Vec<(f64, f64)>, Vec<(f64, f64)>);
