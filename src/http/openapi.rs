@@ -1,14 +1,20 @@
 //! The OpenAPI description, generated from the same route registration as the router (so it
 //! cannot drift from what is served).
 
+use std::collections::{BTreeMap, BTreeSet};
+
 use axum::Router;
+use serde_json::Value;
+use utoipa::openapi::extensions::Extensions;
 use utoipa::openapi::header::HeaderBuilder;
+use utoipa::openapi::schema::{AdditionalProperties, ArrayItems, Schema};
 use utoipa::openapi::{OpenApi as Spec, RefOr};
 use utoipa::OpenApi;
 use utoipa_axum::router::OpenApiRouter;
 
 use super::error::Problem;
 use super::{routes, AppState};
+use crate::job::registry;
 
 #[derive(OpenApi)]
 #[openapi(
@@ -35,6 +41,7 @@ pub fn router_and_spec() -> (Router<AppState>, Spec) {
         .merge(routes::router())
         .split_for_parts();
     document_validators(&mut spec);
+    document_units(&mut spec);
     (router, spec)
 }
 
@@ -77,5 +84,173 @@ fn document_validators(spec: &mut Spec) {
                 }
             }
         }
+    }
+}
+
+/// Gives every numeric field of every answer's schema its unit, as `x-unit`, from the unit
+/// table the answer's declaration makes (`described!`): the spec and `meta.units` say the
+/// same because one declaration makes both. A schema reached with two units (one shared by
+/// fields in different units, such as a comparison of μ or of A) is left without.
+fn document_units(spec: &mut Spec) {
+    let json = serde_json::to_value(&*spec).expect("an OpenAPI document serializes");
+    let mut units: BTreeMap<String, BTreeSet<&str>> = BTreeMap::new();
+    for kind in registry::all() {
+        let root = format!("/components/schemas/{}", kind.output_name());
+        for (path, unit) in kind.units().get().get() {
+            for leaf in reach(&json, root.clone(), &segments(path)) {
+                units.entry(leaf).or_default().insert(unit);
+            }
+        }
+    }
+    for (leaf, units) in units {
+        let (Some(unit), 1) = (units.first(), units.len()) else {
+            continue;
+        };
+        let extensions = match schema_at(spec, &leaf) {
+            Some(Schema::Object(object)) => &mut object.extensions,
+            Some(Schema::Array(array)) => &mut array.extensions,
+            _ => continue,
+        };
+        let extensions = extensions.get_or_insert_with(Extensions::default);
+        extensions.insert("x-unit".to_string(), Value::from(*unit));
+    }
+}
+
+/// The schema of `spec` at the JSON pointer `pointer` (one [`reach`] gives), for a change.
+fn schema_at<'a>(spec: &'a mut Spec, pointer: &str) -> Option<&'a mut Schema> {
+    let mut steps = pointer.trim_start_matches('/').split('/');
+    let (Some("components"), Some("schemas"), Some(name)) =
+        (steps.next(), steps.next(), steps.next())
+    else {
+        return None;
+    };
+    let mut at = spec.components.as_mut()?.schemas.get_mut(name)?;
+    while let Some(step) = steps.next() {
+        let RefOr::T(schema) = at else {
+            return None;
+        };
+        at = match (step, schema) {
+            ("properties", Schema::Object(o)) => o.properties.get_mut(steps.next()?)?,
+            ("additionalProperties", Schema::Object(o)) => {
+                match o.additional_properties.as_deref_mut()? {
+                    AdditionalProperties::RefOr(value) => value,
+                    AdditionalProperties::FreeForm(_) => return None,
+                }
+            }
+            ("items", Schema::Array(a)) => match &mut a.items {
+                ArrayItems::RefOrSchema(items) => items,
+                ArrayItems::False => return None,
+            },
+            ("allOf", Schema::AllOf(c)) => c.items.get_mut(steps.next()?.parse::<usize>().ok()?)?,
+            ("oneOf", Schema::OneOf(c)) => c.items.get_mut(steps.next()?.parse::<usize>().ok()?)?,
+            ("anyOf", Schema::AnyOf(c)) => c.items.get_mut(steps.next()?.parse::<usize>().ok()?)?,
+            _ => return None,
+        };
+    }
+    match at {
+        RefOr::T(schema) => Some(schema),
+        RefOr::Ref(_) => None,
+    }
+}
+
+/// The segments of a unit table's path: `boundary[].y` is `boundary`, `[]`, `y`.
+fn segments(path: &str) -> Vec<&str> {
+    path.split('.')
+        .flat_map(|part| {
+            let name = part.trim_end_matches("[]");
+            let lists = (part.len() - name.len()) / 2;
+            std::iter::once(name)
+                .filter(|n| !n.is_empty())
+                .chain(std::iter::repeat_n("[]", lists))
+        })
+        .collect()
+}
+
+/// The JSON pointers of the schemas `segments` reach from the schema at `at` (a pointer
+/// into `spec`), through references, compositions (`allOf` of a flattened struct, `oneOf`
+/// of an option), list items and map values.
+fn reach(spec: &Value, at: String, segments: &[&str]) -> Vec<String> {
+    let Some(node) = spec.pointer(&at) else {
+        return Vec::new();
+    };
+    let Some((first, rest)) = segments.split_first() else {
+        // A number's schema, not a reference to an object's (the path of one kind of row
+        // followed into the other's).
+        let number = node.get("$ref").is_none() && node.get("properties").is_none();
+        return if number { vec![at] } else { Vec::new() };
+    };
+    if let Some(target) = node.get("$ref").and_then(Value::as_str) {
+        return reach(spec, target.trim_start_matches('#').to_string(), segments);
+    }
+    let mut found = Vec::new();
+    for composite in ["allOf", "oneOf", "anyOf"] {
+        let parts = node.get(composite).and_then(Value::as_array);
+        for i in 0..parts.map_or(0, Vec::len) {
+            found.extend(reach(spec, format!("{at}/{composite}/{i}"), segments));
+        }
+    }
+    let next = if *first == "[]" {
+        node.get("items").map(|_| format!("{at}/items"))
+    } else if node["properties"].get(*first).is_some() {
+        Some(format!("{at}/properties/{first}"))
+    } else if node["additionalProperties"].is_object() {
+        Some(format!("{at}/additionalProperties"))
+    } else {
+        None
+    };
+    found.extend(next.into_iter().flat_map(|next| reach(spec, next, rest)));
+    found
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every numeric field of every kind's answer is a field of its schema, with its unit
+    /// (but for fields whose schema serves several units); so a field's unit, its place
+    /// in the answer and its place in the spec cannot part.
+    #[test]
+    fn every_unit_of_every_answer_is_in_the_spec_at_its_field() {
+        let spec = serde_json::to_value(router_and_spec().1).unwrap();
+        let mut shared = Vec::new();
+        for kind in registry::all() {
+            let root = format!("/components/schemas/{}", kind.output_name());
+            for (path, unit) in kind.units().get().get() {
+                let leaves = reach(&spec, root.clone(), &segments(path));
+                assert!(
+                    !leaves.is_empty(),
+                    "{}: {path} is not in the spec",
+                    kind.name()
+                );
+                for leaf in leaves {
+                    match spec.pointer(&leaf).unwrap().get("x-unit") {
+                        Some(given) => assert_eq!(given, unit, "{}: {path}", kind.name()),
+                        None => shared.push(leaf),
+                    }
+                }
+            }
+        }
+        shared.sort();
+        shared.dedup();
+        // A comparison holds μ or A, in their units; an estimate is in its parameter's; a
+        // row's operating point is a distance or a load.
+        assert_eq!(
+            shared,
+            [
+                "/components/schemas/Comparison/properties/fitted",
+                "/components/schemas/Comparison/properties/measured",
+                "/components/schemas/Comparison/properties/residual",
+                "/components/schemas/Comparison/properties/uncertainty",
+                "/components/schemas/Estimate/properties/bounds/items",
+                "/components/schemas/Estimate/properties/interval_95/items",
+                "/components/schemas/Estimate/properties/standard_error",
+                "/components/schemas/Estimate/properties/value",
+                "/components/schemas/ThreeBodySweepPoint/allOf/2/properties/operating/additionalProperties",
+            ]
+        );
+        assert_eq!(
+            segments("pressure.values[][]"),
+            ["pressure", "values", "[]", "[]"]
+        );
     }
 }

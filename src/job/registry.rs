@@ -19,7 +19,7 @@ use super::rolling::RollingJob;
 use super::sweep::SweepJob;
 use super::three_body::ThreeBodyJob;
 use super::{JobError, Limits};
-use crate::render::Draw;
+use crate::render::{Draw, Output, UnitTable};
 
 /// Schemas as utoipa collects them: (name, schema).
 type Schemas = Vec<(String, RefOr<Schema>)>;
@@ -32,6 +32,8 @@ pub struct Registered {
     picture: Draw,
     input_schema: fn() -> Cow<'static, str>,
     output_schema: fn(&mut Schemas) -> RefOr<Schema>,
+    output_name: fn() -> Cow<'static, str>,
+    units: &'static UnitTable,
 }
 
 impl Registered {
@@ -47,7 +49,19 @@ impl Registered {
             picture: draw::<K::Picture>,
             input_schema: <K::Input as ToSchema>::name,
             output_schema: output_schema::<K>,
+            output_name: <K::Output as ToSchema>::name,
+            units: K::Output::UNITS,
         }
+    }
+
+    /// The name of the OpenAPI schema of the kind's answer.
+    pub fn output_name(&self) -> Cow<'static, str> {
+        (self.output_name)()
+    }
+
+    /// The unit of every numeric field of the kind's answer, by path.
+    pub fn units(&self) -> &'static UnitTable {
+        self.units
     }
 
     /// Reads and validates an input of this kind.
@@ -79,6 +93,11 @@ const LIST: &[Registered] = &[
 ];
 
 static KINDS: &[Registered] = LIST;
+
+/// Every registered kind, in the order of [`LIST`].
+pub fn all() -> &'static [Registered] {
+    KINDS
+}
 
 /// The kinds' names, in the order of [`LIST`] (for the CLI's help, the OpenAPI enum, and
 /// errors naming the known kinds).

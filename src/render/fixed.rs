@@ -24,6 +24,11 @@ impl<T> Fixed<T> {
             json: OnceLock::new(),
         }
     }
+
+    /// The value itself.
+    pub fn get(&self) -> &T {
+        &self.value
+    }
 }
 
 impl<T: Serialize> Fixed<T> {

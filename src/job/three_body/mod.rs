@@ -693,7 +693,7 @@ described! {
     pub struct ThreeBodySweepPoint {
         /// The operating point as asked: `{"separation": d}`, `{"total_load": W}` or
         /// `{"particle_load": P}` (SI).
-        #[schema(value_type = Object)]
+        #[schema(value_type = BTreeMap<String, f64>)]
         pub operating: Value => [by operating_units()],
         /// V (m/s).
         pub velocity: f64 => [number "m/s"],
