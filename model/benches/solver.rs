@@ -1,12 +1,14 @@
 //! Speed of the physics core: one rolling solve at 1e-9 relative accuracy (target: < 100 µs
 //! median), through the similarity tables, and a `kelvin_layer` three-body system with a given
-//! total load (target: < 20 ms median). The service's own benchmarks (sweeps, figures, the work
+//! total load (target: < 20 ms median), and the static continuum contact (the table the
+//! local-layer row reads: target < 1 µs). The service's own benchmarks (sweeps, figures, the work
 //! a request adds, fits) are the service crate's `service` bench. Results and method:
 //! BENCHMARKS.md. Run with `cargo bench --bench solver`.
 
 use std::hint::black_box;
 
 use criterion::{criterion_group, criterion_main, Criterion};
+use thirdbody_model::continuum;
 use thirdbody_model::rolling::penetration_contact;
 use thirdbody_model::similarity::SimilarityTable;
 use thirdbody_model::tables::{self, Use};
@@ -100,5 +102,19 @@ fn three_body(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, rolling, three_body);
+/// The layer as a continuum at rest (docs/model.md §8): the direct solve on three
+/// resolutions, and the table every rolling and three-body answer's local-layer row reads.
+fn continuum(c: &mut Criterion) {
+    let mut group = c.benchmark_group("continuum");
+    let layer = thirdbody_model::Layer::default();
+    group.bench_function("static_contact_default", |b| {
+        b.iter(|| continuum::static_contact(black_box(25e-9), 1e-9, &layer).unwrap())
+    });
+    group.bench_function("static_area_table", |b| {
+        b.iter(|| continuum::static_area(black_box(25e-9), 1e-9, &layer))
+    });
+    group.finish();
+}
+
+criterion_group!(benches, rolling, three_body, continuum);
 criterion_main!(benches);

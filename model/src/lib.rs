@@ -2,6 +2,7 @@
 //! (docs/model.md §1–3, §5, §6). Pure numerics over plain structs in SI units: no I/O, no async,
 //! no serde. Everything else in the crate calls into this module.
 
+pub mod continuum;
 mod error;
 pub mod figures;
 pub mod fit;

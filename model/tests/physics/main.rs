@@ -1,6 +1,7 @@
 //! The physics core against its closed forms, the reference table and its stated trends:
 //! one test binary, a module per concern.
 
+mod continuum;
 mod honest_edges;
 mod numerical_honesty;
 mod reference_table;
