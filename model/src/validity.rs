@@ -2,6 +2,9 @@
 //! on a solved contact as a ratio, with its status. The verification block of an answer says
 //! how exact the numbers are; this says how far the model itself can be trusted there.
 
+use std::f64::consts::PI;
+
+use super::continuum::static_area;
 use super::three_body::{LayerContact, ThreeBody, ThreeBodySolution};
 use super::{Rolling, RollingSolution};
 
@@ -25,8 +28,11 @@ pub enum Assumption {
     /// The sphere is a paraboloid: a_max/R with a_max the largest extent of the contact;
     /// the profile's error is about (a_max/R)²/4. Warn when that passes 0.05; violated at 1.
     Parabolic,
-    /// The layer is local (Winkler): half-width/H. Warn below 1 (a thick layer spreads the
-    /// load, which the local law ignores).
+    /// The layer is local (Winkler): A_local/A_continuum at rest, the static contact area
+    /// under the local law over that of the layer as a continuum (docs/model.md §7, §8, by
+    /// its table). Warn when off by more than 5 % either way: a thick layer spreads the
+    /// load (the local law overstates the area), a thin nearly incompressible one squeezes
+    /// out sideways (it understates it).
     LocalLayer,
     /// Adhesive friction is meaningful: μ of eq. 12. Warn above 1.
     AdhesiveFriction,
@@ -57,7 +63,7 @@ impl Assumption {
         let (warn, violated) = match self {
             InsideLayer => (ratio > 0.1, ratio >= 1.0),
             Parabolic => (ratio * ratio / 4.0 > 0.05, ratio >= 1.0),
-            LocalLayer => (ratio < 1.0, false),
+            LocalLayer => ((ratio - 1.0).abs() > 0.05, false),
             AdhesiveFriction => (ratio > 1.0, false),
             SurfacesApart => (false, ratio <= 0.0),
             AsperityGap => (ratio < 3.0, false),
@@ -132,17 +138,21 @@ pub fn rolling(rolling: &Rolling, s: &RollingSolution) -> Vec<Check> {
             (s.half_width, r),
             (rest.half_width, r),
         ),
-        Check::new(
-            Assumption::LocalLayer,
-            (s.half_width, h),
-            (rest.half_width, h),
-        ),
+        local_layer(rest.contact_area, r, rolling.load, &rolling.layer),
         Check::new(
             Assumption::AdhesiveFriction,
             (s.friction_coefficient, 1.0),
             (rest.friction_coefficient, 1.0),
         ),
     ]
+}
+
+/// The local-layer check of a sphere of radius `radius` under `load` at rest, whose contact
+/// area under the local law is `local_area`: measured at rest, for the answer and its V = 0
+/// companion alike.
+fn local_layer(local_area: f64, radius: f64, load: f64, layer: &crate::Layer) -> Check {
+    let areas = (local_area, static_area(radius, load, layer));
+    Check::new(Assumption::LocalLayer, areas, areas)
 }
 
 /// The assumptions of docs/model.md §7 on a three-body system, measured on its largest particle
@@ -167,11 +177,6 @@ pub fn three_body(system: &ThreeBody, s: &ThreeBodySolution) -> Vec<Check> {
             (half_width(w_rest), radius),
         ),
         Check::new(
-            Assumption::LocalLayer,
-            (half_width(w_moving), h),
-            (half_width(w_rest), h),
-        ),
-        Check::new(
             Assumption::AdhesiveFriction,
             (moving.friction_coefficient, 1.0),
             (rest.friction_coefficient, 1.0),
@@ -187,6 +192,15 @@ pub fn three_body(system: &ThreeBody, s: &ThreeBodySolution) -> Vec<Check> {
             (rest.particles_in_contact, 1.0),
         ),
     ];
+    // The local law takes the particles only in the Kelvin-layer contact (Hertz's treats
+    // the layer as a half-space), and at rest its largest particle carries P = πkRω²
+    // (docs/model.md §3) on the area 2πRω.
+    if system.layer_contact == LayerContact::KelvinLayer && w_rest > 0.0 {
+        let k = system.layer.elastic_modulus / h;
+        let load = PI * k * radius * w_rest * w_rest;
+        let area = 2.0 * PI * radius * w_rest;
+        checks.insert(2, local_layer(area, radius, load, &system.layer));
+    }
     if let Some(a) = &system.asperities {
         checks.push(Check::new(
             Assumption::AsperityGap,
@@ -212,8 +226,10 @@ mod tests {
             (Parabolic, 0.2_f64.sqrt() * 0.999, Status::Ok),
             (Parabolic, 0.2_f64.sqrt() * 1.001, Status::Warn),
             (Parabolic, 1.0, Status::Violated),
-            (LocalLayer, 0.99, Status::Warn),
-            (LocalLayer, 1.0, Status::Ok),
+            (LocalLayer, 1.06, Status::Warn),
+            (LocalLayer, 0.94, Status::Warn),
+            (LocalLayer, 1.04, Status::Ok),
+            (LocalLayer, 0.96, Status::Ok),
             (AdhesiveFriction, 1.01, Status::Warn),
             (SurfacesApart, 0.0, Status::Violated),
             (SurfacesApart, 1e-9, Status::Ok),
@@ -238,5 +254,13 @@ mod tests {
         // δ/H and a_max/R of the reference row (docs/model.md §3: δ = 0.6237 nm, b(0) = 5.5842 nm).
         assert!((checks[0].ratio() - 0.6237e-2).abs() < 1e-6);
         assert!((checks[1].ratio() * 25.0 - 5.5842).abs() < 1e-4);
+        // The local law's 102.333 nm² at rest against the continuum's 13.39 nm² (§8).
+        let local = &checks[2];
+        assert!(
+            (local.ratio() / 7.643 - 1.0).abs() < 0.01,
+            "{}",
+            local.ratio()
+        );
+        assert_eq!(local.ratio(), local.ratio_at_rest());
     }
 }

@@ -363,6 +363,11 @@ fn length(x: f64) -> String {
     quantity(x, "m")
 }
 
+/// An area as people read it: 13.4 nm².
+fn area(x: f64) -> String {
+    quantity(x, "m^2")
+}
+
 /// A plain number (a ratio, a percentage, a friction coefficient) to three digits.
 fn significant(x: f64) -> String {
     quantity(x, "")
@@ -409,9 +414,10 @@ static DESCRIBED: [Described; 7] = [
     ),
     Described::new(
         "local_layer",
-        "the layer is local (Winkler): the contact is wide compared with the layer",
-        "contact half-width / thickness",
-        "warn below 1",
+        "the layer is local (Winkler): each point of it gives way alone, as under a contact \
+         much wider than a compressible layer",
+        "contact area at rest under the local law / that of the layer as a continuum",
+        "warn when off by more than 5 % either way",
     ),
     Described::new(
         "adhesive_friction",
@@ -502,15 +508,30 @@ fn note(check: &Check, subject: Subject) -> String {
             length(reference),
             significant(25.0 * ratio * ratio)
         ),
-        LocalLayer => format!(
-            "{when}{} contact half-width {} is smaller than the layer's thickness {}: a real \
-             layer spreads the load over about its thickness, which the local (Winkler) law \
-             ignores, so the area's response to load and speed is overestimated. The paper's \
-             own parameters are in this regime",
-            whose(subject),
-            length(value),
-            length(reference)
-        ),
+        LocalLayer => {
+            let (how, why) = if ratio > 1.0 {
+                (
+                    "overstates",
+                    "the layer spreads the load over about its thickness, which the local law \
+                     ignores. The paper's own parameters are in this regime",
+                )
+            } else {
+                (
+                    "understates",
+                    "a thin, nearly incompressible layer squeezes out sideways, which the local \
+                     law's springs cannot",
+                )
+            };
+            format!(
+                "at rest {} contact area is {} under the local (Winkler) law but {} with the \
+                 layer as a continuum bonded to its base (docs/model.md §8): the local law \
+                 {how} it {}×, and μ = τ_a A / P with it; {why}",
+                whose(subject),
+                area(value),
+                area(reference),
+                significant(ratio)
+            )
+        }
         AdhesiveFriction => format!(
             "{when}μ = {} is above 1: the load is too small for τ_a A / P to be a friction \
              coefficient",

@@ -137,17 +137,74 @@ fn the_paper_s_particle_warns_on_the_local_layer_only_and_says_why() {
     }
     let local = validity(&answer, "local_layer");
     let value = local["value"].as_f64().unwrap();
-    // Half-width √(2Rδ) = b(0) of docs/model.md §3 (5.5842 nm) over H = 100 nm.
-    assert!((value - 0.055842).abs() < 1e-6, "{value}");
-    assert!(local["note"]
-        .as_str()
-        .unwrap()
-        .contains("paper's own parameters"));
+    // A_local/A_continuum at rest (docs/model.md §7): the local law's 102.333 nm² (§3)
+    // against the continuum's 13.4 nm² (§8), within the table's 0.5 %.
+    assert!((value / (102.333 / 13.39) - 1.0).abs() < 5e-3, "{value}");
+    assert_eq!(local["at_rest"], local["value"]);
+    let note = local["note"].as_str().unwrap();
+    for said in [
+        "102 nm²",
+        "13.4 nm²",
+        "overstates it 7.6",
+        "paper's own parameters",
+    ] {
+        assert!(note.contains(said), "{note}");
+    }
     // The inside-layer ratio is δ/H (0.6237 nm / 100 nm), and the V = 0 one δ₀/H.
     // (to the table's four digits).
     let inside = validity(&answer, "inside_layer");
     assert!((inside["value"].as_f64().unwrap() * 100.0 - 0.6237).abs() < 5e-5);
     assert!((inside["at_rest"].as_f64().unwrap() * 100.0 - 0.6515).abs() < 5e-5);
+}
+
+/// The local law is right where a compressible layer is much thinner than the contact, and
+/// wrong, the other way, where the layer is thin but nearly incompressible (docs/model.md
+/// §8): the row says which.
+#[test]
+fn the_local_layer_row_tells_a_thin_layer_from_a_squeezed_one() {
+    let thin = rolling(json!({"radius": "10 um", "load": "1 uN",
+        "layer": {"thickness": "2 nm", "poisson_ratio": 0.35}}))
+    .unwrap();
+    let local = validity(&thin, "local_layer");
+    assert_eq!(local["status"], "ok", "{local}");
+    assert!(
+        (local["value"].as_f64().unwrap() - 1.0).abs() < 0.01,
+        "{local}"
+    );
+    let squeezed = rolling(json!({"radius": "100 nm", "load": "2 nN",
+        "layer": {"thickness": "1 nm", "poisson_ratio": 0.45}}))
+    .unwrap();
+    let local = validity(&squeezed, "local_layer");
+    assert_eq!(local["status"], "warn", "{local}");
+    assert!(local["value"].as_f64().unwrap() < 0.91, "{local}");
+    assert!(
+        local["note"].as_str().unwrap().contains("understates"),
+        "{local}"
+    );
+}
+
+/// A three-body system measures the row on its largest particle at rest, in the
+/// Kelvin-layer contact; Hertz's contact treats the layer as a half-space, and has no row.
+#[test]
+fn a_system_measures_the_local_layer_on_its_largest_particle() {
+    let system = |contact: &str| {
+        answer(
+            json!({"kind": "three_body", "input": {"layer_contact": contact,
+            "operating": {"total_load": "1 mN"}}}),
+        )
+        .unwrap()
+    };
+    let kelvin = system("kelvin_layer");
+    let local = validity(&kelvin, "local_layer");
+    assert_eq!(local["status"], "warn");
+    assert!(local["value"].as_f64().unwrap() > 2.0, "{local}");
+    assert!(local["note"]
+        .as_str()
+        .unwrap()
+        .contains("largest particle's"));
+    let hertz = system("hertz");
+    let names = hertz["meta"]["validity"]["assumptions"].as_array().unwrap();
+    assert!(names.iter().all(|a| a["name"] != "local_layer"));
 }
 
 #[test]
