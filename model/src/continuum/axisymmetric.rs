@@ -16,16 +16,12 @@ use std::f64::consts::PI;
 
 use nalgebra::{DMatrix, DVector};
 
-use super::compliance::{contact_modulus, layer_correction};
-use crate::quadrature::gauss_legendre_16;
+use super::compliance::{contact_modulus, correction_rule};
 use crate::roots::brent;
 use crate::{Layer, ModelError};
 
 /// Rings of the coarsest of the three resolutions (each next has twice as many).
 const RINGS: usize = 24;
-
-/// Beyond s = qH = 24 the layer's correction is below 1e-16 of the half-space's.
-const S_MAX: f64 = 24.0;
 
 /// The contact of a sphere at rest on the layer as a continuum.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -181,19 +177,10 @@ fn influence(layer: &Layer, points: &[f64], edges: &[f64]) -> DMatrix<f64> {
     });
     // (2(1 − ν²)/E) c ∫ (C(s) − 1) J1(sc/H) J0(sr/H) ds/s, with 2(1 − ν²)/E = 2/E*.
     let extent = edges.last().copied().unwrap_or(0.0) / h;
-    // Panels short enough for 16 Gauss nodes to follow two periods of the Bessel factors.
-    let panel = (2.0 / extent.max(1e-300)).min(1.0);
-    let panels = (S_MAX / panel).ceil() as usize;
-    let (x, w) = gauss_legendre_16();
-    let mut nodes = Vec::with_capacity(panels * x.len());
-    for m in 0..panels {
-        let (lo, hi) = (m as f64 * panel, ((m + 1) as f64 * panel).min(S_MAX));
-        for (xk, wk) in x.iter().zip(w) {
-            let s = lo + 0.5 * (hi - lo) * (xk + 1.0);
-            let weight = 0.5 * (hi - lo) * wk * layer_correction(s, nu) / s;
-            nodes.push((s, weight));
-        }
-    }
+    let nodes: Vec<(f64, f64)> = correction_rule(nu, extent)
+        .into_iter()
+        .map(|(s, weight)| (s, weight / s))
+        .collect();
     let at_points = DMatrix::from_fn(points.len(), nodes.len(), |i, k| {
         let (s, weight) = nodes[k];
         weight * libm::j0(s * points[i] / h)

@@ -2,7 +2,11 @@
 //! ŵ(q) = S(q) p̂(q), S(q) = 2(1 − ν²)/(E q) · C(qH). C → 1 for qH → ∞ (a half-space), and
 //! S → H/E_L for qH → 0 (the local law of §2–3, with the same k = E_L/H).
 
+use crate::quadrature::gauss_legendre_16;
 use crate::Layer;
+
+/// Beyond s = qH = 24 the layer's correction is below 1e-16 of the half-space's.
+const S_MAX: f64 = 24.0;
 
 /// E, the relaxed Young's modulus of a layer whose oedometric (longitudinal) modulus is E_L:
 /// E = E_L (1 + ν)(1 − 2ν)/(1 − ν), so that the thin-layer limit is the local law.
@@ -29,6 +33,24 @@ pub fn layer_correction(s: f64, nu: f64) -> f64 {
     let numerator = (a * e2 + 2.0 * s + 2.0 * s * s + b) * sech;
     let denominator = a + (2.0 * s * s + b) * sech;
     -numerator / denominator
+}
+
+/// The nodes s and weights w·(C(s) − 1) of a rule for ∫₀^∞ (C(s) − 1) g(s) ds, where g
+/// oscillates no faster than the Bessel functions of s·r/H for r up to `reach`·H: 16 Gauss
+/// nodes on panels short enough to follow two periods, up to where C − 1 is negligible.
+pub fn correction_rule(nu: f64, reach: f64) -> Vec<(f64, f64)> {
+    let panel = (2.0 / reach.max(1e-300)).min(1.0);
+    let panels = (S_MAX / panel).ceil() as usize;
+    let (x, w) = gauss_legendre_16();
+    let mut nodes = Vec::with_capacity(panels * x.len());
+    for m in 0..panels {
+        let (lo, hi) = (m as f64 * panel, ((m + 1) as f64 * panel).min(S_MAX));
+        for (xk, wk) in x.iter().zip(w) {
+            let s = lo + 0.5 * (hi - lo) * (xk + 1.0);
+            nodes.push((s, 0.5 * (hi - lo) * wk * layer_correction(s, nu)));
+        }
+    }
+    nodes
 }
 
 /// C(s) itself (1 + [`layer_correction`]).

@@ -12,12 +12,8 @@ use realfft::num_complex::Complex;
 use realfft::{ComplexToReal, RealFftPlanner, RealToComplex};
 use rustfft::{Fft, FftPlanner};
 
-use super::compliance::{contact_modulus, layer_correction};
-use crate::quadrature::gauss_legendre_16;
+use super::compliance::{contact_modulus, correction_rule};
 use crate::Layer;
-
-/// Beyond s = qH = 24 the layer's correction is below 1e-16 of the half-space's.
-const S_MAX: f64 = 24.0;
 
 /// The deflection of the layer's surface under pixel pressures: n × n pixels of side h.
 pub struct Influence {
@@ -182,18 +178,7 @@ fn correction(layer: &Layer, h: f64, n: usize) -> Correction {
     let step = 0.5 * h;
     let extent = 2.0 * (n as f64) * h * std::f64::consts::SQRT_2;
     let count = (extent / step).ceil() as usize + 2;
-    // Panels short enough for 16 Gauss nodes to follow two periods of J₀.
-    let panel = (2.0 * thickness / extent).min(1.0);
-    let panels = (S_MAX / panel).ceil() as usize;
-    let (x, w) = gauss_legendre_16();
-    let mut nodes = Vec::with_capacity(panels * x.len());
-    for k in 0..panels {
-        let (lo, hi) = (k as f64 * panel, ((k + 1) as f64 * panel).min(S_MAX));
-        for (xk, wk) in x.iter().zip(w) {
-            let s = lo + 0.5 * (hi - lo) * (xk + 1.0);
-            nodes.push((s, 0.5 * (hi - lo) * wk * layer_correction(s, nu)));
-        }
-    }
+    let nodes = correction_rule(nu, extent / thickness);
     let scale = 1.0 / (PI * contact_modulus(layer) * thickness);
     let values = (0..count)
         .map(|i| {
