@@ -24,8 +24,8 @@ pub struct GridContact {
     pub pressure: Vec<f64>,
     /// δ (m).
     pub penetration: f64,
-    /// The pixels in contact times the pixel's area (m²).
-    pub counted_area: f64,
+    /// The contact area (m²), each row's edges placed between pixels ([`sub_cell_area`]).
+    pub contact_area: f64,
     /// Conjugate-gradient iterations.
     pub iterations: u32,
 }
@@ -138,16 +138,14 @@ pub fn press(
             .collect()
     });
     normalise(&mut pressure, load / area);
-    let done = |pressure: Vec<f64>, penetration: f64, iterations: u32| {
-        let in_contact = pressure.iter().filter(|p| **p > 0.0).count();
-        GridContact {
-            size: n,
-            pixel,
-            pressure,
-            penetration,
-            counted_area: in_contact as f64 * area,
-            iterations,
-        }
+    let own = instant * surface.deflect_scale();
+    let done = |pressure: Vec<f64>, gap: &[f64], penetration: f64, iterations: u32| GridContact {
+        size: n,
+        pixel,
+        contact_area: sub_cell_area(&pressure, gap, n, pixel, own),
+        pressure,
+        penetration,
+        iterations,
     };
     let mut direction = vec![0.0; n * n];
     let (mut g_old, mut conjugate) = (1.0, false);
@@ -167,7 +165,7 @@ pub fn press(
         let flat = masked(&gap, &in_contact).all(|g| g.abs() <= slack);
         let apart = gap.iter().zip(&in_contact).all(|(g, c)| *c || *g >= -slack);
         if flat && apart {
-            return Ok(done(pressure, mean_gap, iteration));
+            return Ok(done(pressure, &gap, mean_gap, iteration));
         }
         let g_norm: f64 = masked(&gap, &in_contact).map(|g| g * g).sum();
         let beta = if conjugate { g_norm / g_old } else { 0.0 };
@@ -194,16 +192,15 @@ pub fn press(
         // curvature: start the conjugation again from the gap itself. The gap has none
         // only where it is flat over the contact to rounding: solved, if nothing outside
         // penetrates (else the method is stuck: say so rather than answer).
-        let own: f64 = masked(&direction, &in_contact).map(|d| d * d).sum();
-        let scale = instant * surface.deflect_scale();
-        let curved = curvature > 1e-12 * own * scale;
+        let scale: f64 = masked(&direction, &in_contact).map(|d| d * d).sum();
+        let curved = curvature > 1e-12 * scale * own;
         if !curved {
             if conjugate {
                 conjugate = false;
                 continue;
             }
             if apart {
-                return Ok(done(pressure, mean_gap, iteration));
+                return Ok(done(pressure, &gap, mean_gap, iteration));
             }
             break;
         }
@@ -232,6 +229,44 @@ pub fn press(
         what: "continuum contact pressure (conjugate gradients)",
         iterations: MAX_ITERATIONS,
     })
+}
+
+/// The contact area of `pressure` on n × n pixels of side `pixel`, row by row along x: each
+/// row's edges lie between its outermost pixels in contact and their neighbours out of it,
+/// where the pressure (inside) and the gap as a pressure, gap/`own` (outside, `own` the
+/// pixel's compliance to its own pressure), cross zero linearly. Counting pixels jumps as
+/// the grid is refined; this converges smoothly (first order in the pixel: 3.5, 2.0, 1.0 %
+/// on 32, 64, 128 pixels for Hertz), so two resolutions extrapolate it.
+pub fn sub_cell_area(pressure: &[f64], gap: &[f64], n: usize, pixel: f64, own: f64) -> f64 {
+    let signed = |k: usize| {
+        if pressure[k] > 0.0 {
+            pressure[k]
+        } else {
+            -gap[k].max(0.0) / own
+        }
+    };
+    let mut length = 0.0;
+    for j in 0..n {
+        let at = |i: usize| i * n + j;
+        let mut inside = (0..n).filter(|&i| pressure[at(i)] > 0.0);
+        let Some(first) = inside.next() else {
+            continue;
+        };
+        let last = inside.next_back().unwrap_or(first);
+        // The distance past pixel `a` (in contact) towards its neighbour `b` where the
+        // interpolated pressure vanishes; half a pixel at the grid's border.
+        let beyond = |a: usize, b: Option<usize>| match b {
+            Some(b) => {
+                let (sa, sb) = (signed(at(a)), signed(at(b)));
+                pixel * sa / (sa - sb)
+            }
+            None => 0.5 * pixel,
+        };
+        let left = beyond(first, first.checked_sub(1));
+        let right = beyond(last, (last + 1 < n).then_some(last + 1));
+        length += (last - first) as f64 * pixel + left + right;
+    }
+    length * pixel
 }
 
 /// Scales `pressure` to sum to `total`.
@@ -264,8 +299,9 @@ mod tests {
     use super::*;
     use crate::continuum::static_contact;
 
-    /// On the grid, the pressed contact is the axisymmetric solver's: δ within 0.5 %, and
-    /// the counted area within the pixels along the edge.
+    /// On the grid, the pressed contact is the axisymmetric solver's: δ within 0.5 %, the
+    /// area within 3 % on 64 pixels a side, and, extrapolated from 64 and 128, within 0.3 %
+    /// (the error of the edges is first order in the pixel and smooth).
     #[test]
     fn on_the_grid_the_pressed_contact_is_the_axisymmetric_one() {
         for (thickness, nu) in [(100e-9, 0.35), (5e-9, 0.3), (2e-9, 0.45)] {
@@ -275,29 +311,30 @@ mod tests {
                 ..Layer::default()
             };
             let (radius, load) = (25e-9, 1e-9);
-            let n = 64;
-            let pixel = grid_for(radius, load, &layer, n);
-            let influence = Influence::new(&layer, n, pixel);
-            let pressing = Pressing {
-                surface: &influence,
-                pixel,
-                radius,
-                load,
-                instant: 1.0,
-                memory: None,
+            let pressed = |n: usize| {
+                let pixel = grid_for(radius, load, &layer, n);
+                let influence = Influence::new(&layer, n, pixel);
+                let pressing = Pressing {
+                    surface: &influence,
+                    pixel,
+                    radius,
+                    load,
+                    instant: 1.0,
+                    memory: None,
+                };
+                press(&pressing, None, 1e-10).unwrap()
             };
-            let grid = press(&pressing, None, 1e-10).unwrap();
+            let (coarse, fine) = (pressed(64), pressed(128));
             let exact = static_contact(radius, load, &layer).unwrap();
-            let delta = grid.penetration / exact.penetration - 1.0;
+            let delta = coarse.penetration / exact.penetration - 1.0;
             assert!(delta.abs() < 5e-3, "H = {thickness}: δ off by {delta:e}");
-            // The edge pixels: about 2πa/h of them, each half in on average.
-            let a = exact.contact_radius;
-            let edge = 2.0 * PI * a * pixel;
-            let area = grid.counted_area - exact.contact_area;
+            let area = coarse.contact_area / exact.contact_area - 1.0;
+            assert!(area.abs() < 0.03, "H = {thickness}: A off by {area:e}");
+            let extrapolated = 2.0 * fine.contact_area - coarse.contact_area;
+            let area = extrapolated / exact.contact_area - 1.0;
             assert!(
-                area.abs() < edge,
-                "H = {thickness}: A off by {:e}",
-                area / exact.contact_area
+                area.abs() < 3e-3,
+                "H = {thickness}: A extrapolated off by {area:e}"
             );
         }
     }

@@ -193,12 +193,12 @@ mod tests {
                 }
                 if v == 4e-9 {
                     let local = solve(&Rolling::default(), &SolveOptions::default()).unwrap();
-                    let ratio = local.contact_area / rolled.contact.counted_area;
+                    let ratio = local.contact_area / rolled.contact.contact_area;
                     assert!((8.5..11.5).contains(&ratio), "A: {ratio}");
                     let ratio = local.pressure_centre_shift / rolled.pressure_centre_shift;
                     assert!((1.5..2.0).contains(&ratio), "x_p: {ratio}");
                 }
-                rolled.contact.counted_area
+                rolled.contact.contact_area
             })
             .collect();
         assert!(areas.windows(2).all(|w| w[1] < w[0]), "{areas:?}");
@@ -231,7 +231,7 @@ mod tests {
         let off = |got: f64, want: f64| got / want - 1.0;
         let delta = off(rolled.contact.penetration, exact.penetration);
         assert!(delta.abs() < 1e-4, "δ off by {delta:e}");
-        let area = off(rolled.contact.counted_area, exact.contact_area);
+        let area = off(rolled.contact.contact_area, exact.contact_area);
         assert!(area.abs() < 0.02, "A off by {area:e}");
         let xp = off(rolled.pressure_centre_shift, exact.pressure_centre_shift);
         assert!(xp.abs() < 0.01, "x_p off by {xp:e}");
