@@ -124,7 +124,8 @@ fn continuum(c: &mut Criterion) {
     for velocity in [0.0, 4e-9] {
         group.bench_function(format!("grid_64_roll_V={velocity:e}"), |b| {
             b.iter(|| {
-                continuum::roll(25e-9, 1e-9, velocity, &layer, &influence, pixel, 1e-8).unwrap()
+                continuum::roll(25e-9, 1e-9, velocity, &layer, &influence, pixel, 0.0, 1e-8)
+                    .unwrap()
             })
         });
     }

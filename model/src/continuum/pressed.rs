@@ -16,8 +16,10 @@ const MAX_ITERATIONS: u32 = 2000;
 /// The pressure of a pressed contact on the grid.
 #[derive(Clone, Debug, PartialEq)]
 pub struct GridContact {
-    /// Pixels per side (pixel (i, j) at x = (i + ½ − n/2) h, y = (j + ½ − n/2) h).
+    /// Pixels per side (pixel (i, j) at x = x₀ + (i + ½ − n/2) h, y = (j + ½ − n/2) h).
     pub size: usize,
+    /// x₀ (m), the x of the grid's middle (negative: the grid reaches further behind).
+    pub middle: f64,
     /// The pixel's side (m).
     pub pixel: f64,
     /// Pressure on each pixel (Pa), row-major with x along rows.
@@ -91,6 +93,8 @@ pub struct Pressing<'a> {
     pub radius: f64,
     /// P (N).
     pub load: f64,
+    /// x₀ (m), the x of the grid's middle relative to the sphere's centre.
+    pub middle: f64,
     /// The share of the surface's response that acts at once (1 at rest; less for a
     /// viscoelastic layer, whose memory gives the rest through `memory`).
     pub instant: f64,
@@ -111,6 +115,7 @@ pub fn press(
         pixel,
         radius,
         load,
+        middle,
         instant,
         memory,
     } = *pressing;
@@ -119,7 +124,7 @@ pub fn press(
     let centre = |k: usize| (k as f64 + 0.5 - 0.5 * n as f64) * pixel;
     let mut profile: Vec<f64> = (0..n * n)
         .map(|k| {
-            let (x, y) = (centre(k / n), centre(k % n));
+            let (x, y) = (middle + centre(k / n), centre(k % n));
             (x * x + y * y) / (2.0 * radius)
         })
         .collect();
@@ -134,13 +139,17 @@ pub fn press(
     let mut pressure = start.unwrap_or_else(|| {
         let reach = n as f64 * pixel / 6.0;
         (0..n * n)
-            .map(|k| f64::from(u8::from(centre(k / n).hypot(centre(k % n)) < reach)))
+            .map(|k| {
+                let x = middle + centre(k / n);
+                f64::from(u8::from(x.hypot(centre(k % n)) < reach))
+            })
             .collect()
     });
     normalise(&mut pressure, load / area);
     let own = instant * surface.deflect_scale();
     let done = |pressure: Vec<f64>, gap: &[f64], penetration: f64, iterations: u32| GridContact {
         size: n,
+        middle,
         pixel,
         contact_area: sub_cell_area(&pressure, gap, n, pixel, own),
         pressure,
@@ -319,6 +328,7 @@ mod tests {
                     pixel,
                     radius,
                     load,
+                    middle: 0.0,
                     instant: 1.0,
                     memory: None,
                 };
