@@ -199,11 +199,11 @@ impl Lifecycle {
     /// is full, the service is draining, or there is no room to keep the job's result.
     pub(super) async fn submit(self: &Arc<Self>, keyed: Keyed) -> Result<JobRecord, EngineError> {
         self.store_reachable()?;
-        let job = keyed.job().clone();
+        let (kind, work) = (keyed.job().kind(), keyed.job().work());
         // A job whose answer is cached is answered at once: it takes no place in the queue.
         if let Some(solved) = self.solver.cached(keyed.key()).await {
-            let mut record = JobRecord::queued(self.ids.next(), job.kind(), job.work());
-            let done = match job.work() {
+            let mut record = JobRecord::queued(self.ids.next(), kind, work);
+            let done = match work {
                 Work::Known(total) => total,
                 Work::Unknown => 0,
             };
@@ -231,20 +231,21 @@ impl Lifecycle {
         {
             return Err(EngineError::Overloaded);
         }
-        let units = match job.work() {
+        let units = match work {
             Work::Known(units) => units,
             Work::Unknown => 1,
         };
-        let ticket = match self.backlog.admit(job.cost_class(), units) {
+        let ticket = match self.backlog.admit(keyed.job().cost_class(), units) {
             Ok(ticket) => ticket,
             Err(backlogged) => {
                 self.queued.fetch_sub(1, Ordering::SeqCst);
                 return Err(EngineError::Backlogged(backlogged));
             }
         };
-        let record = JobRecord::queued(self.ids.next(), job.kind(), job.work());
+        let record = JobRecord::queued(self.ids.next(), kind, work);
         let id = record.id;
-        if let Err(refusal) = self.jobs.insert(record.clone(), job.result_bytes()).await {
+        let result_bytes = keyed.job().result_bytes();
+        if let Err(refusal) = self.jobs.insert(record.clone(), result_bytes).await {
             self.queued.fetch_sub(1, Ordering::SeqCst);
             return Err(refusal.into());
         }
@@ -257,11 +258,10 @@ impl Lifecycle {
             status: watch::Sender::new(JobStatus::Queued),
         });
         self.live().insert(id, live.clone());
-        let span = tracing::info_span!("job", id = %id, kind = %job.kind());
+        let span = tracing::info_span!("job", id = %id, kind = %kind);
         let lifecycle = self.clone();
         self.tracker.spawn(
             async move {
-                let work = job.work();
                 let state = lifecycle.run_job(&live, id, keyed, &ticket).await;
                 drop(ticket);
                 let status = state.status();
@@ -436,7 +436,7 @@ impl Lifecycle {
     }
 
     /// Resolves when every asynchronous job has finished (call after `begin_drain`).
-    pub(super) async fn jobs_finished(&self) {
+    async fn jobs_finished(&self) {
         self.tracker.close();
         self.tracker.wait().await;
     }
@@ -459,7 +459,7 @@ impl Lifecycle {
 
     /// Stops every job not finished yet (the drain ran out of time): they end
     /// `interrupted`.
-    pub(super) fn interrupt_unfinished_jobs(&self) {
+    fn interrupt_unfinished_jobs(&self) {
         if let Some(shared) = &self.fleet {
             shared.interrupt();
         }

@@ -116,21 +116,21 @@ impl Solver {
 
     /// The cached answer to an input seen before (`text`: its kind and compact JSON), found
     /// without validating the input again; `None` if it was not seen or its answer expired.
-    pub async fn cached_input(&self, text: &str) -> Option<Arc<Solved>> {
+    pub(super) async fn cached_input(&self, text: &str) -> Option<Arc<Solved>> {
         let key = self.input_keys.get(text)?;
         self.cached(&key).await
     }
 
     /// Remembers that the input `text` (as for [`Solver::cached_input`]) is a valid job
     /// with cache key `key`, if it was seen before ([`Doorkeeper`]).
-    pub fn remember_input(&self, text: String, key: String) {
+    pub(super) fn remember_input(&self, text: String, key: String) {
         if self.doorkeeper.seen_before(&text) {
             self.input_keys.insert(text, key.into());
         }
     }
 
     /// The cached answer under `key`, counted as a hit.
-    pub async fn cached(&self, key: &str) -> Option<Arc<Solved>> {
+    pub(super) async fn cached(&self, key: &str) -> Option<Arc<Solved>> {
         let solved = self.cache.get(key).await;
         if solved.is_some() {
             self.cache_hits.increment(1);
@@ -139,7 +139,7 @@ impl Solver {
     }
 
     /// Keeps `solved` in the cache.
-    pub async fn keep(&self, solved: Arc<Solved>) {
+    pub(super) async fn keep(&self, solved: Arc<Solved>) {
         self.cache.insert(solved).await;
     }
 
@@ -196,13 +196,13 @@ impl Solver {
     }
 
     /// Waits for a solver thread's permit (first come, first served).
-    pub async fn permit(&self) -> OwnedSemaphorePermit {
+    pub(super) async fn permit(&self) -> OwnedSemaphorePermit {
         self.pool.acquire().await
     }
 
     /// The control of a job run by this engine: one thread, `deadline`, the point memo and
     /// the background thread.
-    pub fn control(&self, deadline: Instant) -> Control {
+    pub(super) fn control(&self, deadline: Instant) -> Control {
         let control = Control::new(Some(deadline), 1).with_memo(self.points.clone());
         match &self.background {
             Some(background) => control.with_later(background.clone()),
@@ -211,7 +211,7 @@ impl Solver {
     }
 
     /// Counts a job as running (the `jobs_running` gauge) until the guard is dropped.
-    pub fn running(&self) -> Running {
+    pub(super) fn running(&self) -> Running {
         self.jobs_running.increment(1.0);
         Running(self.jobs_running.clone())
     }
@@ -282,7 +282,7 @@ impl Solver {
 }
 
 /// A job counted as running ([`Solver::running`]) until dropped.
-pub struct Running(Gauge);
+pub(super) struct Running(Gauge);
 
 impl Drop for Running {
     fn drop(&mut self) {

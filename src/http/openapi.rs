@@ -14,7 +14,7 @@ use utoipa_axum::router::OpenApiRouter;
 
 use super::error::Problem;
 use super::{routes, AppState};
-use crate::job::registry;
+use crate::job::registry::{self, Registered};
 
 #[derive(OpenApi)]
 #[openapi(
@@ -94,12 +94,9 @@ fn document_validators(spec: &mut Spec) {
 fn document_units(spec: &mut Spec) {
     let json = serde_json::to_value(&*spec).expect("an OpenAPI document serializes");
     let mut units: BTreeMap<String, BTreeSet<&str>> = BTreeMap::new();
-    for kind in registry::all() {
-        let root = format!("/components/schemas/{}", kind.output_name());
-        for (path, unit) in kind.units().get().get() {
-            for leaf in reach(&json, root.clone(), &segments(path)) {
-                units.entry(leaf).or_default().insert(unit);
-            }
+    for (_, _, unit, leaves) in unit_paths(&json) {
+        for leaf in leaves {
+            units.entry(leaf).or_default().insert(unit);
         }
     }
     for (leaf, units) in units {
@@ -114,6 +111,23 @@ fn document_units(spec: &mut Spec) {
         let extensions = extensions.get_or_insert_with(Extensions::default);
         extensions.insert("x-unit".to_string(), Value::from(*unit));
     }
+}
+
+/// Each path of each kind's unit table, with its kind, its unit and the schemas of `json`
+/// (the spec) it reaches.
+type UnitPath = (&'static Registered, &'static str, &'static str, Vec<String>);
+
+fn unit_paths(json: &Value) -> Vec<UnitPath> {
+    let kinds = registry::all().iter();
+    kinds
+        .flat_map(|kind| {
+            let root = format!("/components/schemas/{}", kind.output_name());
+            kind.units().get().get().iter().map(move |(path, unit)| {
+                let leaves = reach(json, root.clone(), &segments(path));
+                (kind, path.as_str(), *unit, leaves)
+            })
+        })
+        .collect()
 }
 
 /// The schema of `spec` at the JSON pointer `pointer` (one [`reach`] gives), for a change.
@@ -213,20 +227,16 @@ mod tests {
     fn every_unit_of_every_answer_is_in_the_spec_at_its_field() {
         let spec = serde_json::to_value(router_and_spec().1).unwrap();
         let mut shared = Vec::new();
-        for kind in registry::all() {
-            let root = format!("/components/schemas/{}", kind.output_name());
-            for (path, unit) in kind.units().get().get() {
-                let leaves = reach(&spec, root.clone(), &segments(path));
-                assert!(
-                    !leaves.is_empty(),
-                    "{}: {path} is not in the spec",
-                    kind.name()
-                );
-                for leaf in leaves {
-                    match spec.pointer(&leaf).unwrap().get("x-unit") {
-                        Some(given) => assert_eq!(given, unit, "{}: {path}", kind.name()),
-                        None => shared.push(leaf),
-                    }
+        for (kind, path, unit, leaves) in unit_paths(&spec) {
+            assert!(
+                !leaves.is_empty(),
+                "{}: {path} is not in the spec",
+                kind.name()
+            );
+            for leaf in leaves {
+                match spec.pointer(&leaf).unwrap().get("x-unit") {
+                    Some(given) => assert_eq!(given, unit, "{}: {path}", kind.name()),
+                    None => shared.push(leaf),
                 }
             }
         }

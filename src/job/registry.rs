@@ -112,7 +112,7 @@ pub const NAMES: [&str; LIST.len()] = {
 };
 
 /// The kind named `name`, or the error naming the known ones.
-pub fn find(name: &str) -> Result<&'static Registered, JobError> {
+fn find(name: &str) -> Result<&'static Registered, JobError> {
     KINDS
         .iter()
         .find(|k| k.name == name)
@@ -177,7 +177,7 @@ impl KindName {
         self.0.name
     }
 
-    /// How an answer of this kind is drawn ([`Kind::picture`]).
+    /// How an answer of this kind is drawn ([`Kind::Picture`], drawn by [`super::picture::draw`]).
     pub fn picture(self) -> Draw {
         self.0.picture
     }

@@ -49,11 +49,7 @@ impl<T: 'static> Field<T> {
     /// A number (or numbers: `path` ends in `[]` for a list) at `path`, in `unit`, which is
     /// no column.
     pub fn unit(path: &str, unit: &'static str) -> Vec<Field<T>> {
-        vec![Field {
-            path: path.to_string(),
-            unit,
-            column: None,
-        }]
+        Self::paths(path, [(String::new(), unit)])
     }
 
     /// The fields of a `U` under `key` (`""`: flattened into `T`). With `columns`, its columns
@@ -78,14 +74,8 @@ impl<T: 'static> Field<T> {
 
     /// The fields of each `U` of a list under `key` (never columns: a row is one record).
     pub fn each<U: Fields>(key: &str) -> Vec<Field<T>> {
-        U::fields()
-            .into_iter()
-            .map(|inner| Field {
-                path: under(key, &under("[]", &inner.path)),
-                unit: inner.unit,
-                column: None,
-            })
-            .collect()
+        let inner = U::fields().into_iter();
+        Self::paths(key, inner.map(|f| (under("[]", &f.path), f.unit)))
     }
 
     /// The numbers at each (path, unit) of `paths`, under `key`: fields whose paths come
@@ -107,21 +97,16 @@ impl<T: 'static> Field<T> {
     /// The fields of a `U` under `key`, every one in `unit`: a type whose numbers are in the
     /// unit of what holds it (a measured value and its fit), no columns.
     pub fn nested_in<U: Fields>(key: &str, unit: &'static str) -> Vec<Field<T>> {
-        U::fields()
-            .into_iter()
-            .map(|inner| Field {
-                path: under(key, &inner.path),
-                unit,
-                column: None,
-            })
-            .collect()
+        Self::paths(key, U::fields().into_iter().map(|f| (f.path, unit)))
     }
 }
 
 /// `path` under `key`: `key.path`, `key[]…` for a list's, `path` for an empty key
-/// (flattened).
+/// (flattened) and `key` for an empty path.
 fn under(key: &str, path: &str) -> String {
-    if key.is_empty() {
+    if path.is_empty() {
+        key.to_string()
+    } else if key.is_empty() {
         path.to_string()
     } else if path.starts_with('[') {
         format!("{key}{path}")

@@ -65,24 +65,22 @@ pub fn roll(
     let own = -(-0.5 * pixel / lambda).exp_m1();
     let next = (-0.5 * pixel / lambda).exp() * -(-pixel / lambda).exp_m1();
     let instant = theta + (1.0 - theta) * own;
-    // The history each pixel's material brings: Σ_{m ≥ 1} w_m p(x + m h), as if the pressure
-    // had always been `pressure` (the start), then carried one pixel a step.
+    // The history each pixel's material brings, Σ_{m ≥ 1} w_m p(x + m h): from the pixel
+    // ahead (k + n), its pressure there and the history it had there.
+    let brought =
+        |k: usize, pressure: &[f64], tail: &[f64]| next * pressure[k + n] + decay * tail[k + n];
+    // A step carries every pixel's material one pixel on.
     let carry = |pressure: &[f64], tail: &[f64]| -> Vec<f64> {
         let mut carried = vec![0.0; n * n];
-        for i in 0..n - 1 {
-            for j in 0..n {
-                let ahead = (i + 1) * n + j;
-                carried[i * n + j] = next * pressure[ahead] + decay * tail[ahead];
-            }
+        for (k, c) in carried.iter_mut().enumerate().take(n * (n - 1)) {
+            *c = brought(k, pressure, tail);
         }
         carried
     };
+    // The start: as if the pressure had always been the one at rest (front row first).
     let mut tail = vec![0.0; n * n];
-    for i in (0..n - 1).rev() {
-        for j in 0..n {
-            let ahead = (i + 1) * n + j;
-            tail[i * n + j] = next * rest.pressure[ahead] + decay * tail[ahead];
-        }
+    for k in (0..n * (n - 1)).rev() {
+        tail[k] = brought(k, &rest.pressure, &tail);
     }
     let mut pressure = rest.pressure;
     for step in 1..=MAX_STEPS_PER_PIXEL * n {

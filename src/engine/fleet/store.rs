@@ -98,27 +98,35 @@ impl RedisJobStore {
         let job = keys::job(record.id);
         let id = record.id.to_string();
         let mut pipe = redis::pipe();
-        let fields = [
-            ("kind", record.kind.name().to_string()),
-            ("work", work_text(record.work)),
-            ("status", JobStatus::Queued.as_str().to_string()),
-            ("done", "0".to_string()),
-            ("job", wire.to_string()),
-            ("key", key.to_string()),
-            ("deadline", unix_millis(deadline).to_string()),
-            ("parts", parts.len().max(1).to_string()),
-            ("parts_done", "0".to_string()),
+        // Borrowed where they can be: the job's text may be long (a fit's data).
+        let (work, deadline) = (work_text(record.work), unix_millis(deadline).to_string());
+        let count = parts.len().max(1).to_string();
+        let fields: [(&str, &str); 9] = [
+            ("kind", record.kind.name()),
+            ("work", &work),
+            ("status", JobStatus::Queued.as_str()),
+            ("done", "0"),
+            ("job", wire),
+            ("key", key),
+            ("deadline", &deadline),
+            ("parts", &count),
+            ("parts_done", "0"),
         ];
         pipe.atomic().hset_multiple(&job.record, &fields).ignore();
         if parts.is_empty() {
             pipe.xadd(keys::STREAM, "*", &[("job", &id)]).ignore();
         }
         for (index, range) in parts.iter().enumerate() {
-            let entry = [
-                ("job", id.clone()),
-                ("part", index.to_string()),
-                ("start", range.start.to_string()),
-                ("end", range.end.to_string()),
+            let (part, start, end) = (
+                index.to_string(),
+                range.start.to_string(),
+                range.end.to_string(),
+            );
+            let entry: [(&str, &str); 4] = [
+                ("job", &id),
+                ("part", &part),
+                ("start", &start),
+                ("end", &end),
             ];
             pipe.xadd(keys::STREAM, "*", &entry).ignore();
         }

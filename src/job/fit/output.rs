@@ -3,6 +3,7 @@
 
 use std::borrow::Cow;
 use std::collections::BTreeMap;
+use std::sync::LazyLock;
 
 use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
@@ -184,8 +185,9 @@ described! {
 impl Conditions {
     /// Each condition it gives: its name, unit and value (R, P, W, V in that order).
     pub fn given(&self) -> Vec<(String, &'static str, f64)> {
-        let columns = fields::columns::<Conditions>();
-        let given = columns.iter().filter_map(|c| {
+        static COLUMNS: LazyLock<Vec<Column<Conditions>>> =
+            LazyLock::new(fields::columns::<Conditions>);
+        let given = COLUMNS.iter().filter_map(|c| {
             let value = c.value(self)?;
             Some((c.name.to_string(), c.unit, value))
         });

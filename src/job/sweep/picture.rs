@@ -61,7 +61,7 @@ struct Drawn {
 
 impl Rows {
     /// The rows drawn, and the name of the friction coefficient they give.
-    fn drawn(self) -> Result<(Vec<Drawn>, &'static str), PictureError> {
+    fn drawn(self) -> (Vec<Drawn>, &'static str) {
         let answered =
             |status: PointStatus| !matches!(status, PointStatus::Refused | PointStatus::Missing);
         match self {
@@ -78,7 +78,7 @@ impl Rows {
                         .map(|c| c.friction_coefficient),
                     velocity: r.velocity,
                 });
-                Ok((rows.collect(), "friction coefficient"))
+                (rows.collect(), "friction coefficient")
             }
             Rows::ThreeBody(rows) => {
                 let units = operating_units();
@@ -98,7 +98,7 @@ impl Rows {
                         velocity: r.velocity,
                     }
                 });
-                Ok((rows.collect(), "rolling friction coefficient"))
+                (rows.collect(), "rolling friction coefficient")
             }
         }
     }
@@ -110,7 +110,7 @@ fn condition(name: &str, parameter: Parameter, value: f64) -> Condition {
 
 impl Picture for SweepPicture {
     fn chart(self) -> Result<Chart, PictureError> {
-        let (rows, y_name) = self.points.drawn()?;
+        let (rows, y_name) = self.points.drawn();
         let first = rows.first().ok_or("the sweep has no point")?;
         let values =
             |i: usize| -> Vec<u64> { rows.iter().map(|r| r.conditions[i].2.to_bits()).collect() };

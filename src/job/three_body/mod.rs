@@ -694,7 +694,7 @@ described! {
         /// The operating point as asked: `{"separation": d}`, `{"total_load": W}` or
         /// `{"particle_load": P}` (SI).
         #[schema(value_type = BTreeMap<String, f64>)]
-        pub operating: Value => [by operating_units()],
+        pub operating: Value => [by operating_units().to_vec()],
         /// V (m/s).
         pub velocity: f64 => [number "m/s"],
         /// x_a (m).
@@ -718,11 +718,14 @@ described! {
 
 /// The name and unit of each kind of operating point, in the order of
 /// [`OperatingPoint::KINDS`].
-pub(crate) fn operating_units() -> Vec<(String, &'static str)> {
-    let input = OperatingInput::default();
-    let names = operating_fields!(field!(input)).map(|f| f.name.to_string());
-    let units = OperatingPoint::KINDS.map(|(parameter, _)| parameter.unit());
-    names.into_iter().zip(units).collect()
+pub(crate) fn operating_units() -> &'static [(String, &'static str)] {
+    static UNITS: LazyLock<Vec<(String, &'static str)>> = LazyLock::new(|| {
+        let input = OperatingInput::default();
+        let names = operating_fields!(field!(input)).map(|f| f.name.to_string());
+        let units = OperatingPoint::KINDS.map(|(parameter, _)| parameter.unit());
+        names.into_iter().zip(units).collect()
+    });
+    &UNITS
 }
 
 impl ThreeBodySweepPoint {
