@@ -113,20 +113,16 @@ fn continuum(c: &mut Criterion) {
     group.bench_function("static_area_table", |b| {
         b.iter(|| continuum::static_area(black_box(25e-9), 1e-9, &layer))
     });
-    // On the grid: 64 pixels a side, the default sphere at rest and rolling at 4 nm/s.
-    let n = 64;
-    let pixel = continuum::grid_for(25e-9, 1e-9, &layer, n);
-    let influence = continuum::Influence::new(&layer, n, pixel);
+    // The whole continuum answer (three grids: fine, coarse, and a longer wake), at rest
+    // and at the default 4 nm/s, and the fine grid's influence alone.
     group.sample_size(10);
-    group.bench_function("grid_64_influence", |b| {
-        b.iter(|| continuum::Influence::new(black_box(&layer), n, pixel))
-    });
     for velocity in [0.0, 4e-9] {
-        group.bench_function(format!("grid_64_roll_V={velocity:e}"), |b| {
-            b.iter(|| {
-                continuum::roll(25e-9, 1e-9, velocity, &layer, &influence, pixel, 0.0, 1e-8)
-                    .unwrap()
-            })
+        let point = Rolling {
+            velocity,
+            ..Rolling::default()
+        };
+        group.bench_function(format!("answer_V={velocity:e}"), |b| {
+            b.iter(|| continuum::solve(black_box(&point), &SolveOptions::default()).unwrap())
         });
     }
     group.finish();

@@ -175,9 +175,11 @@ pub struct Verification {
     pub table_error: Option<f64>,
 }
 
-/// The rolling contact (docs/model.md §3), in SI units.
+/// The rolling contact (docs/model.md §3), in SI units, with how far it can be trusted:
+/// [`Verification`] for the local law's exact solution, the grid's error for the layer as a
+/// continuum ([`crate::continuum::GridVerification`]).
 #[derive(Clone, Debug, PartialEq)]
-pub struct RollingSolution {
+pub struct RollingSolution<V = Verification> {
     /// δ (m).
     pub penetration: f64,
     /// A (m²).
@@ -192,14 +194,14 @@ pub struct RollingSolution {
     pub rolling_resistance_coefficient: f64,
     /// μ = τ_a A / P (eq. 12).
     pub friction_coefficient: f64,
-    /// The same sphere at V = 0 (closed form).
+    /// The same sphere at V = 0 (closed form for the local law).
     pub static_contact: ElasticContact,
     pub boundary: Vec<BoundaryPoint>,
     pub pressure: Option<PressureGrid>,
-    pub verification: Verification,
+    pub verification: V,
 }
 
-impl RollingSolution {
+impl<V> RollingSolution<V> {
     /// The integral quantities an answer reports, in the order of the struct: δ, A,
     /// half-width, x_c, x_p, μ_r, μ, and the static companion's δ, A, μ.
     pub fn quantities(&self) -> [f64; 10] {

@@ -4,7 +4,7 @@
 
 use std::f64::consts::PI;
 
-use super::continuum::static_area;
+use super::continuum::{static_area, ContinuumVerification};
 use super::three_body::{LayerContact, ThreeBody, ThreeBodySolution};
 use super::{Rolling, RollingSolution};
 
@@ -43,11 +43,14 @@ pub enum Assumption {
     AsperityGap,
     /// Three-body: particles in contact, n_a. Warn below 1 (a fraction of a particle).
     ParticlesInContact,
+    /// The layer as a continuum: pixels across the contact on the fine grid, 2√(A/π)/h
+    /// (docs/model.md §8). Warn below 24.
+    Resolution,
 }
 
 impl Assumption {
     /// Every assumption.
-    pub const ALL: [Assumption; 7] = [
+    pub const ALL: [Assumption; 8] = [
         Assumption::InsideLayer,
         Assumption::Parabolic,
         Assumption::LocalLayer,
@@ -55,6 +58,7 @@ impl Assumption {
         Assumption::SurfacesApart,
         Assumption::AsperityGap,
         Assumption::ParticlesInContact,
+        Assumption::Resolution,
     ];
 
     /// The status of `ratio`.
@@ -68,6 +72,7 @@ impl Assumption {
             SurfacesApart => (false, ratio <= 0.0),
             AsperityGap => (ratio < 3.0, false),
             ParticlesInContact => (ratio < 1.0, false),
+            Resolution => (ratio < 24.0, false),
         };
         if violated {
             Status::Violated
@@ -122,7 +127,7 @@ impl Check {
 }
 
 /// The assumptions of docs/model.md §7 on one rolling contact.
-pub fn rolling(rolling: &Rolling, s: &RollingSolution) -> Vec<Check> {
+pub fn rolling<V>(rolling: &Rolling, s: &RollingSolution<V>) -> Vec<Check> {
     let h = rolling.layer.thickness;
     let r = rolling.radius;
     let rest = &s.static_contact;
@@ -145,6 +150,40 @@ pub fn rolling(rolling: &Rolling, s: &RollingSolution) -> Vec<Check> {
             (rest.friction_coefficient, 1.0),
         ),
     ]
+}
+
+/// The assumptions of docs/model.md §8 on one rolling contact on the layer as a continuum:
+/// §7's, less the local layer's (the continuum is what it is measured against), and the
+/// grid's resolution of the contact.
+pub fn continuum(rolling: &Rolling, s: &RollingSolution<ContinuumVerification>) -> Vec<Check> {
+    let h = rolling.layer.thickness;
+    let r = rolling.radius;
+    let rest = &s.static_contact;
+    let mut checks = vec![
+        Check::new(
+            Assumption::InsideLayer,
+            (s.penetration, h),
+            (rest.penetration, h),
+        ),
+        Check::new(
+            Assumption::Parabolic,
+            (s.verification.extent, r),
+            (rest.half_width, r),
+        ),
+        Check::new(
+            Assumption::AdhesiveFriction,
+            (s.friction_coefficient, 1.0),
+            (rest.friction_coefficient, 1.0),
+        ),
+    ];
+    if let Some(grid) = s.verification.grid {
+        checks.push(Check::new(
+            Assumption::Resolution,
+            (grid.across, 1.0),
+            (grid.across_at_rest, 1.0),
+        ));
+    }
+    checks
 }
 
 /// The local-layer check of a sphere of radius `radius` under `load` at rest, whose contact

@@ -6,21 +6,25 @@
 //! At rest and axisymmetric: [`static_contact`] (rings, exact to 0.1 %) and its table
 //! [`static_area`] (the local-layer row of every answer). On the pixel grid: [`Influence`]
 //! (the free FFT convolution of the layer's response), [`press`] (a sphere at rest, or the
-//! symmetric step of a march) and [`roll`] (steady rolling, marched). The grid solver is
-//! not yet an answer of the service: its area errs by about 1.3/n on n pixels a side
-//! (first order, smooth, so two resolutions extrapolate it), and its error and domain are
-//! not yet measured per answer (issue 23).
+//! symmetric step of a march) and [`roll`] (steady rolling, marched), and [`solve`], the
+//! rolling answer with its error from two grids and two domains.
 
+mod answer;
 mod axisymmetric;
 mod compliance;
 mod grid;
 mod pressed;
 mod rolling;
+mod shape;
 mod table;
 
+pub use answer::{
+    area_floor, solve, solve_at, ContinuumVerification, GridUsed, QuantityErrors, AREA_SCATTER,
+    EDGE_BIAS, PER_RADIUS, THIN, THIN_POISSON,
+};
 pub use axisymmetric::{static_contact, StaticContinuum};
 pub use compliance::{contact_modulus, layer_correction, layer_factor, young_modulus};
-pub use grid::Influence;
-pub use pressed::{grid_for, press, sub_cell_area, GridContact, Pressing, Springs, Surface};
-pub use rolling::{roll, RolledContact};
+pub use grid::{Grid, Influence};
+pub use pressed::{area_between, press, row_edges, GridContact, Pressing, Springs, Surface};
+pub use rolling::{roll, Rolled, RolledContact};
 pub use table::{hertz_radius, static_area};

@@ -138,3 +138,34 @@ fn a_thin_nearly_incompressible_layer_is_softer_than_its_local_law() {
     assert!(area(0.45) > 1.1, "{}", area(0.45));
     assert!(area(0.2) < 1.0, "{}", area(0.2));
 }
+
+/// A thin, nearly incompressible layer (ν → 0.5, a ≫ H) is never local: it squeezes out
+/// sideways, and tends to p = 3G(a² − r²)²/(32RH³), δ = a²/(4R), P = πGa⁶/(32RH³)
+/// (docs/model.md §8; Johnson §5.9), with an error ∝ H/a. At ν = 0.49999 the area falls
+/// short of it by 2.8 H/a: linearly extrapolated from H/a = 0.05 and 0.025 to H/a = 0, it
+/// is the limit within 1 %; δ is within 1.5 % at H/a = 0.05 and 0.1 % at 0.025.
+#[test]
+fn a_thin_incompressible_layer_tends_to_its_squeeze_film_limit() {
+    let (radius, load, shear, nu) = (1e-6, 5e-5, 1e9, 0.49999);
+    let young = 2.0 * shear * (1.0 + nu);
+    let off = |thickness: f64| {
+        let layer = Layer {
+            thickness,
+            poisson_ratio: nu,
+            // E_L for this E (docs/model.md §8: E = E_L (1 + ν)(1 − 2ν)/(1 − ν)).
+            elastic_modulus: young * (1.0 - nu) / ((1.0 + nu) * (1.0 - 2.0 * nu)),
+            ..Layer::default()
+        };
+        let a = (32.0 * radius * thickness.powi(3) * load / (PI * shear)).powf(1.0 / 6.0);
+        let c = static_contact(radius, load, &layer).unwrap();
+        let delta = c.penetration / (a * a / (4.0 * radius)) - 1.0;
+        (thickness / a, c.contact_area / (PI * a * a) - 1.0, delta)
+    };
+    let ((thick, area_thick, delta_thick), (thin, area_thin, delta_thin)) =
+        (off(2e-9), off(0.5e-9));
+    assert!((thick - 0.05).abs() < 1e-3 && (thin - 0.025).abs() < 1e-3);
+    let limit = (thick * area_thin - thin * area_thick) / (thick - thin);
+    assert!(limit.abs() < 0.01, "A at H/a → 0 off by {limit:e}");
+    assert!(area_thin < 0.0 && area_thin.abs() < 0.6 * area_thick.abs());
+    assert!(delta_thick.abs() < 0.015 && delta_thin.abs() < 1e-3);
+}

@@ -2,6 +2,7 @@
 //! one test binary, a module per concern.
 
 mod continuum;
+mod continuum_rolling;
 mod honest_edges;
 mod numerical_honesty;
 mod reference_table;

@@ -1,0 +1,390 @@
+//! A rolling answer on the layer as a continuum (docs/model.md §8): the same quantities as the
+//! local law's answer (§3), with their error.
+//!
+//! On the grid ([`super::roll`]), three marches: a fine grid, a coarse one (two thirds of
+//! the pixels a side) and a coarse one reaching twice as far behind. The grid is sized from
+//! the static continuum contact radius a₀ (the table of [`super::static_area`]):
+//! a₀·[`MARGIN`] to each side and ahead (the rolling contact is never wider than the static
+//! one), and behind that the wake where the layer is still recovering, min(3 V T_ε, 6 a₀).
+//! The pixel is a twelfth of the smallest contact's radius (the instantaneous elastic one,
+//! V → ∞), at most the layer's thickness. The answer is the fine grid's; the others' differences from it are its error.
+//!
+//! On a layer much thinner than the contact (r₀/H ≥ [`THIN`], ν ≤ [`THIN_POISSON`]) the
+//! continuum is the local law to within a few per cent (§8's thin-layer fast path), and
+//! a grid would need pixels finer than the layer: the answer is §3's exact local solution,
+//! its error the two laws' difference at rest from the axisymmetric solver.
+
+use std::f64::consts::PI;
+
+use super::axisymmetric::static_contact;
+use super::grid::{Grid, Influence};
+use super::pressed::GridContact;
+use super::rolling::{roll, Rolled, RolledContact};
+use super::shape::{boundary, chords, lateral_half_width, pressure_grid};
+use super::table::static_area;
+use crate::limits::ElasticContact;
+use crate::{Layer, ModelError, Rolling, RollingSolution, SolveOptions};
+
+/// Pixels in the radius of the smallest contact the sphere can have, the instantaneous
+/// elastic one (V → ∞), on the fine grid: every rolling contact is at least 24 pixels
+/// across (the `resolution` row warns below).
+pub const PER_RADIUS: usize = 12;
+
+/// The grid reaches this many static contact radii to each side of the contact and ahead.
+const MARGIN: f64 = 1.25;
+
+/// The march stops when a step changes the pressure by less than this share of its sum
+/// (it then lies within about ten times that of its steady state).
+const TOLERANCE: f64 = 1e-5;
+
+/// Pixels a grid may have: a finer grid is refused rather than left to run for minutes.
+const MAX_PIXELS: usize = 256 * 256;
+
+/// Contacts of a radius r₀ = √(2Rδ₀) (the local law's at rest) at least this many
+/// thicknesses are answered by the local law ...
+pub const THIN: f64 = 20.0;
+/// ... on layers of a Poisson ratio up to this (a thin incompressible layer is never local).
+pub const THIN_POISSON: f64 = 0.4;
+
+/// How an answer on the layer as a continuum was found, and how far it can be trusted.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ContinuumVerification {
+    pub errors: QuantityErrors,
+    /// The part of the errors of δ and A that is the domain's: their largest relative
+    /// change when the grid reaches twice as far behind (0 for the thin-layer path).
+    pub domain_error: f64,
+    /// The contact's largest extent from the sphere's centre (m): its lateral half-width or
+    /// its farthest edge along x (the parabolic-sphere row's a_max).
+    pub extent: f64,
+    /// The fine grid, for an answer on the grid; none for the thin-layer path.
+    pub grid: Option<GridUsed>,
+}
+
+/// The fine grid of an answer.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GridUsed {
+    /// Pixels along x and across.
+    pub nx: usize,
+    pub ny: usize,
+    /// The pixel (m).
+    pub pixel: f64,
+    /// Pixels across the rolling contact, 2√(A/π)/h, and across the static one.
+    pub across: f64,
+    pub across_at_rest: f64,
+    /// Steps of the march.
+    pub steps: usize,
+}
+
+/// Error bounds of the reported quantities. On the grid: each the change from the coarse
+/// grid to the fine one (twice that for the areas, whose error is first order in the pixel:
+/// at two thirds the pixels the change is half the fine grid's error), plus the change when
+/// the grid reaches twice as far behind; for the areas never below the edges' error within
+/// their pixels ([`area_floor`]). μ shares A's relative error, μ_r x_p's.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct QuantityErrors {
+    /// Of δ (relative).
+    pub penetration: f64,
+    /// Of A (relative).
+    pub contact_area: f64,
+    /// Of x_c (m).
+    pub centroid_shift: f64,
+    /// Of x_p (m).
+    pub pressure_centre_shift: f64,
+    /// Of the static δ (relative).
+    pub static_penetration: f64,
+    /// Of the static A (relative).
+    pub static_contact_area: f64,
+}
+
+impl QuantityErrors {
+    /// The largest relative bound (δ and A, rolling and static).
+    pub fn relative(&self) -> f64 {
+        [
+            self.penetration,
+            self.contact_area,
+            self.static_penetration,
+            self.static_contact_area,
+        ]
+        .into_iter()
+        .fold(0.0, f64::max)
+    }
+}
+
+/// The contact edges' error within their pixels, in pixels: against the axisymmetric
+/// solver at 6 to 24 pixels a radius on layers far thicker than a pixel, the area between
+/// the edges ([`super::row_edges`]) is off by at most 0.113 pixels a radius, with no trend
+/// in the sign. Two resolutions can both land near the same error and so miss it.
+pub const AREA_SCATTER: f64 = 0.12;
+
+/// The edges' bias where the pixel approaches the layer's thickness H: there the pressure
+/// falls to the edge more steeply than the square root the edges assume, and the area
+/// comes out short, by up to 1.7 % at a pixel of H, 1.2 % at H/2, 0.4 % at H/4 (against
+/// the axisymmetric solver, a₀/H from 1 to 20, ν from 0 to 0.45): bounded by this times
+/// √(h/H), at most this.
+pub const EDGE_BIAS: f64 = 0.025;
+
+/// The floor of the area's relative error on a grid of pixel `pixel` for a contact of
+/// area `area` on a layer of thickness `thickness`: the edges' scatter and bias.
+pub fn area_floor(area: f64, pixel: f64, thickness: f64) -> f64 {
+    AREA_SCATTER * pixel / (area / PI).sqrt() + EDGE_BIAS * (pixel / thickness).min(1.0).sqrt()
+}
+
+/// The steady rolling answer of `rolling` on the layer as a continuum, with `options`'
+/// boundary points and pressure grid (its quadrature is the local law's and unused here).
+pub fn solve(
+    rolling: &Rolling,
+    options: &SolveOptions,
+) -> Result<RollingSolution<ContinuumVerification>, ModelError> {
+    solve_at(rolling, options, PER_RADIUS)
+}
+
+/// [`solve`] with `per_radius` pixels in the smallest contact's radius on the fine grid (the
+/// coarse grid's pixel is half as large again): finer than the service's to check its
+/// error.
+pub fn solve_at(
+    rolling: &Rolling,
+    options: &SolveOptions,
+    per_radius: usize,
+) -> Result<RollingSolution<ContinuumVerification>, ModelError> {
+    if let Some(error) = rolling.violations().into_iter().next() {
+        return Err(error.into());
+    }
+    if let Some(error) = options.violations().into_iter().next() {
+        return Err(ModelError::InvalidOption(error));
+    }
+    let local = crate::solve(rolling, options)?;
+    let layer = &rolling.layer;
+    let thin = local.static_contact.half_width >= THIN * layer.thickness
+        && layer.poisson_ratio <= THIN_POISSON;
+    let solution = if thin {
+        thin_layer(rolling, local)?
+    } else {
+        on_grid(rolling, options, per_radius)?
+    };
+    let e = &solution.verification.errors;
+    let bounds = [e.relative(), e.centroid_shift, e.pressure_centre_shift];
+    if solution
+        .quantities()
+        .iter()
+        .chain(&bounds)
+        .any(|q| !q.is_finite())
+    {
+        return Err(ModelError::NotRepresentable {
+            what: "the continuum contact".to_string(),
+        });
+    }
+    Ok(solution)
+}
+
+/// §8's thin-layer fast path: `local`, the exact local answer, with the two laws' relative
+/// difference at rest (from the axisymmetric solver, with its own error) as its error.
+fn thin_layer(
+    rolling: &Rolling,
+    local: RollingSolution,
+) -> Result<RollingSolution<ContinuumVerification>, ModelError> {
+    let rest = static_contact(rolling.radius, rolling.load, &rolling.layer)?;
+    let off = |local: f64, continuum: f64| (local / continuum - 1.0).abs() + rest.relative_error;
+    let area = off(local.static_contact.contact_area, rest.contact_area);
+    let penetration = off(local.static_contact.penetration, rest.penetration);
+    let extent = local.boundary.iter().fold(local.half_width, |m, b| {
+        m.max(b.exit.abs()).max(b.entry.abs())
+    });
+    let errors = QuantityErrors {
+        penetration,
+        contact_area: area,
+        centroid_shift: area * local.centroid_shift.abs(),
+        pressure_centre_shift: area * local.pressure_centre_shift.abs(),
+        static_penetration: penetration,
+        static_contact_area: area,
+    };
+    Ok(RollingSolution {
+        penetration: local.penetration,
+        contact_area: local.contact_area,
+        half_width: local.half_width,
+        centroid_shift: local.centroid_shift,
+        pressure_centre_shift: local.pressure_centre_shift,
+        rolling_resistance_coefficient: local.rolling_resistance_coefficient,
+        friction_coefficient: local.friction_coefficient,
+        static_contact: local.static_contact,
+        boundary: local.boundary,
+        pressure: local.pressure,
+        verification: ContinuumVerification {
+            errors,
+            domain_error: 0.0,
+            extent,
+            grid: None,
+        },
+    })
+}
+
+/// The answer on the grid: fine, coarse, and coarse reaching twice as far behind.
+fn on_grid(
+    rolling: &Rolling,
+    options: &SolveOptions,
+    per_radius: usize,
+) -> Result<RollingSolution<ContinuumVerification>, ModelError> {
+    let Rolling {
+        radius,
+        load,
+        velocity,
+        layer,
+    } = *rolling;
+    let a0 = (static_area(radius, load, &layer) / PI).sqrt();
+    // The contact at V → ∞: the layer with the instantaneous modulus E T_ε/T_σ.
+    let stiff = Layer {
+        elastic_modulus: layer.elastic_modulus * (1.0 + layer.kappa()),
+        ..layer
+    };
+    let smallest = (static_area(radius, load, &stiff) / PI).sqrt();
+    let wake = if velocity > 0.0 {
+        (3.0 * velocity * layer.retardation_time).min(6.0 * a0)
+    } else {
+        0.0
+    };
+    // The pixel: at most the layer's thickness (finer, the layer's correction would vary
+    // across a pixel faster than its Gauss rule follows).
+    let fine_pixel = (smallest / per_radius as f64).min(layer.thickness);
+    let solved = |pixel: f64, wake: f64| -> Result<Solved, ModelError> {
+        let (grid, middle) = domain(a0, pixel, wake)?;
+        let influence = Influence::new(&layer, grid);
+        let rolled = Rolled {
+            radius,
+            load,
+            velocity,
+            layer: &layer,
+            surface: &influence,
+            middle,
+        };
+        let contact = roll(&rolled, TOLERANCE)?;
+        if touches_border(&contact.contact) {
+            return Err(ModelError::OutOfModel(
+                "the continuum contact reached the border of its grid".to_string(),
+            ));
+        }
+        Ok(Solved::new(contact))
+    };
+    let coarse_pixel = 1.5 * fine_pixel;
+    let fine = solved(fine_pixel, wake)?;
+    let coarse = solved(coarse_pixel, wake)?;
+    let far = if wake > 0.0 {
+        solved(coarse_pixel, 2.0 * wake)?
+    } else {
+        coarse.clone()
+    };
+    // Each quantity's change to the fine grid and to the far domain, from the coarse grid.
+    let changes = |f: fn(&Solved) -> f64| {
+        let change = |a: &Solved| (f(a) / f(&coarse) - 1.0).abs();
+        (change(&fine), change(&far))
+    };
+    let absolute =
+        |f: fn(&Solved) -> f64| (f(&fine) - f(&coarse)).abs() + (f(&far) - f(&coarse)).abs();
+    let contact = &fine.rolled.contact;
+    let rest = &fine.rest;
+    let pixel = contact.grid.pixel;
+    let area_error = |(grid, domain): (f64, f64), area: f64| {
+        (2.0 * grid + domain).max(area_floor(area, pixel, layer.thickness))
+    };
+    let (d, a, d0, a0_) = (
+        changes(|s| s.rolled.contact.penetration),
+        changes(|s| s.rolled.contact.contact_area),
+        changes(|s| s.rest.penetration),
+        changes(|s| s.rest.contact_area),
+    );
+    // At rest the contact is symmetric in x: its shifts are nought, not the grid's rounding.
+    let shift = |x: f64| if velocity > 0.0 { x } else { 0.0 };
+    let errors = QuantityErrors {
+        penetration: d.0 + d.1,
+        contact_area: area_error(a, contact.contact_area),
+        centroid_shift: shift(absolute(|s| s.rolled.centroid_shift)),
+        pressure_centre_shift: shift(absolute(|s| s.rolled.pressure_centre_shift)),
+        static_penetration: d0.0 + d0.1,
+        static_contact_area: area_error(a0_, rest.contact_area),
+    };
+    let shear = layer.interfacial_shear_strength();
+    let half_width = lateral_half_width(contact);
+    let pressure_centre_shift = shift(fine.rolled.pressure_centre_shift);
+    let (contact_area, static_area) = (contact.contact_area, rest.contact_area);
+    let across = |area: f64| 2.0 * (area / PI).sqrt() / pixel;
+    Ok(RollingSolution {
+        penetration: contact.penetration,
+        contact_area,
+        half_width,
+        centroid_shift: shift(fine.rolled.centroid_shift),
+        pressure_centre_shift,
+        rolling_resistance_coefficient: pressure_centre_shift / radius,
+        friction_coefficient: shear * contact_area / load,
+        static_contact: ElasticContact {
+            penetration: rest.penetration,
+            half_width: (static_area / PI).sqrt(),
+            contact_area: static_area,
+            friction_coefficient: shear * static_area / load,
+        },
+        boundary: boundary(contact, half_width, options.boundary_points),
+        pressure: options
+            .pressure_grid
+            .map(|n| pressure_grid(contact, half_width, n)),
+        verification: ContinuumVerification {
+            errors,
+            domain_error: d.1.max(a.1),
+            extent: chords(contact)
+                .iter()
+                .fold(half_width, |m, (_, exit, entry)| {
+                    m.max(exit.abs()).max(entry.abs())
+                }),
+            grid: Some(GridUsed {
+                nx: contact.grid.nx,
+                ny: contact.grid.ny,
+                pixel,
+                across: across(contact_area),
+                across_at_rest: across(static_area),
+                steps: fine.rolled.steps,
+            }),
+        },
+    })
+}
+
+/// A march's steady contact and the contact at rest it started from.
+#[derive(Clone)]
+struct Solved {
+    rolled: RolledContact,
+    rest: GridContact,
+}
+
+impl Solved {
+    fn new(rolled: RolledContact) -> Solved {
+        Solved {
+            rest: rolled.rest.clone(),
+            rolled,
+        }
+    }
+}
+
+/// The grid of pixels of side `pixel` around the static contact of radius `a0`, and its
+/// middle's x: `MARGIN` radii to each side and ahead, and `wake` more behind.
+fn domain(a0: f64, pixel: f64, wake: f64) -> Result<(Grid, f64), ModelError> {
+    let side = MARGIN * a0;
+    let (front, back) = (side, side + wake);
+    let even = |length: f64| 2 * (0.5 * length / pixel).ceil() as usize;
+    let grid = Grid {
+        nx: even(front + back),
+        ny: even(2.0 * side),
+        pixel,
+    };
+    if grid.pixels() > MAX_PIXELS {
+        return Err(ModelError::OutOfModel(format!(
+            "the layer as a continuum would need a grid of {} × {} pixels here (at most \
+             {MAX_PIXELS}): the contact is too wide for its pixels, which must be finer than \
+             the layer (a thin, nearly incompressible layer)",
+            grid.nx, grid.ny
+        )));
+    }
+    Ok((grid, 0.5 * (front - back)))
+}
+
+/// Whether a pixel on the grid's border carries pressure (the contact is cut off there).
+fn touches_border(contact: &GridContact) -> bool {
+    let Grid { nx, ny, .. } = contact.grid;
+    let loaded = |i: usize, j: usize| contact.pressure[i * ny + j] > 0.0;
+    (0..nx).any(|i| loaded(i, 0) || loaded(i, ny - 1))
+        || (0..ny).any(|j| loaded(0, j) || loaded(nx - 1, j))
+}
