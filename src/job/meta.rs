@@ -26,48 +26,80 @@ pub struct Reference {
 /// Papers behind the numbers, a fixed part of answers.
 pub type References = Fixed<&'static [Reference]>;
 
-/// The papers behind the numbers: [`ROLLING_REFERENCES`] behind every job, all of them behind
-/// three-body jobs.
-pub static REFERENCES: References = Fixed::new(&ALL_REFERENCES);
+/// The papers behind the numbers: all of them behind three-body jobs.
+pub static REFERENCES: References =
+    Fixed::new(&[PAPER, STRIPS, SHEAR_STRENGTH, THREE_BODY, ASPERITIES]);
 
-/// The papers behind one particle rolling over the layer: the model, the strip method and
-/// the shear strength.
-pub static ROLLING_REFERENCES: References = Fixed::new(ALL_REFERENCES.split_at(3).0);
+/// The papers behind one particle rolling over the layer under the local law: the model, the
+/// strip method and the shear strength.
+pub static ROLLING_REFERENCES: References = Fixed::new(&[PAPER, STRIPS, SHEAR_STRENGTH]);
 
-const ALL_REFERENCES: [Reference; 5] = [
-    Reference {
-        role: "model: three-body contact with particles rolling over a Kelvin layer (eqs. 1–13)",
-        citation: "Contact problem of a system of particles rolling over a viscoelastic layer \
-                   bonded to the rigid half-space. Advances in Mechanical Engineering, 2019",
-        doi: Some("10.1177/1687814019872303"),
-    },
-    Reference {
-        role: "strip method for rolling contact (eq. 10)",
-        citation: "D. J. Haines and E. Ollerton, Contact stress distributions on elliptical \
-                   contact surfaces subjected to radial and tangential forces. Proceedings of \
-                   the Institution of Mechanical Engineers 177 (1963)",
-        doi: None,
-    },
-    Reference {
-        role: "interfacial shear strength τ_a = G/1000 (eq. 12)",
-        citation: "G. G. Adams, S. Müftü and N. Mohd Azhar, A scale-dependent model for \
-                   multi-asperity contact and friction. Journal of Tribology 125 (2003)",
-        doi: None,
-    },
-    Reference {
-        role: "three-body microcontact model: particles between rough surfaces (eqs. 6–8)",
-        citation: "J. H. Horng's three-body microcontact model for rough surfaces, reference 16 \
-                   of the model paper",
-        doi: None,
-    },
-    Reference {
-        role: "asperity contact: elastic, elastic-plastic and plastic regimes",
-        citation: "Y. Zhao, D. M. Maietta and L. Chang, An asperity microcontact model \
-                   incorporating the transition from elastic deformation to fully plastic \
-                   flow. Journal of Tribology 122 (2000)",
-        doi: None,
-    },
-];
+/// The papers behind one particle rolling over the layer as a continuum (docs/model.md §8):
+/// the model's layer and shear strength, the layer's compliance, the pixels' influence and
+/// the solver.
+pub static CONTINUUM_REFERENCES: References =
+    Fixed::new(&[PAPER, SHEAR_STRENGTH, LAYER, PIXELS, SOLVER]);
+
+const PAPER: Reference = Reference {
+    role: "model: three-body contact with particles rolling over a Kelvin layer (eqs. 1–13)",
+    citation: "Contact problem of a system of particles rolling over a viscoelastic layer \
+               bonded to the rigid half-space. Advances in Mechanical Engineering, 2019",
+    doi: Some("10.1177/1687814019872303"),
+};
+
+const STRIPS: Reference = Reference {
+    role: "strip method for rolling contact (eq. 10)",
+    citation: "D. J. Haines and E. Ollerton, Contact stress distributions on elliptical \
+               contact surfaces subjected to radial and tangential forces. Proceedings of \
+               the Institution of Mechanical Engineers 177 (1963)",
+    doi: None,
+};
+
+const SHEAR_STRENGTH: Reference = Reference {
+    role: "interfacial shear strength τ_a = G/1000 (eq. 12)",
+    citation: "G. G. Adams, S. Müftü and N. Mohd Azhar, A scale-dependent model for \
+               multi-asperity contact and friction. Journal of Tribology 125 (2003)",
+    doi: None,
+};
+
+const THREE_BODY: Reference = Reference {
+    role: "three-body microcontact model: particles between rough surfaces (eqs. 6–8)",
+    citation: "J. H. Horng's three-body microcontact model for rough surfaces, reference 16 \
+               of the model paper",
+    doi: None,
+};
+
+const ASPERITIES: Reference = Reference {
+    role: "asperity contact: elastic, elastic-plastic and plastic regimes",
+    citation: "Y. Zhao, D. M. Maietta and L. Chang, An asperity microcontact model \
+               incorporating the transition from elastic deformation to fully plastic \
+               flow. Journal of Tribology 122 (2000)",
+    doi: None,
+};
+
+const LAYER: Reference = Reference {
+    role: "the layer as a continuum: surface compliance of an elastic layer bonded to a rigid \
+           base (eq. A.30)",
+    citation: "G. Carbone and L. Mangialardi, Analysis of the adhesive contact of confined \
+               layers by using a Green's function approach. Journal of the Mechanics and \
+               Physics of Solids 56 (2008)",
+    doi: None,
+};
+
+const PIXELS: Reference = Reference {
+    role: "the half-space's deflection under a uniformly loaded rectangle (the grid's pixel)",
+    citation: "A. E. H. Love, The stress produced in a semi-infinite solid by pressure on part \
+               of the boundary. Philosophical Transactions of the Royal Society A 228 (1929)",
+    doi: Some("10.1098/rsta.1929.0009"),
+};
+
+const SOLVER: Reference = Reference {
+    role: "the contact pressure on the grid: constrained conjugate gradients with the load",
+    citation: "I. A. Polonsky and L. M. Keer, A numerical method for solving rough contact \
+               problems based on the multi-level multi-summation and conjugate gradient \
+               techniques. Wear 231 (1999)",
+    doi: Some("10.1016/S0043-1648(99)00113-1"),
+};
 
 /// The version of this software (the crate's).
 pub const SOFTWARE_VERSION: &str = env!("CARGO_PKG_VERSION");

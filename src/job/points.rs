@@ -13,7 +13,7 @@ use serde::ser::SerializeMap;
 use serde::{Deserialize, Serialize, Serializer};
 use utoipa::ToSchema;
 
-use super::rolling::VerificationOutput;
+use super::rolling::ContactVerification;
 use super::three_body::ThreeBodyVerificationOutput;
 use super::validity::{PointValidity, Subject, SweepValidityOutput, ValidityStatus, ValidityTally};
 use super::{JobError, Swept};
@@ -223,14 +223,14 @@ impl PointCounts {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, ToSchema)]
 #[serde(untagged)]
 pub enum SweepVerification {
-    Rolling(VerificationOutput),
+    Rolling(ContactVerification),
     ThreeBody(ThreeBodyVerificationOutput),
 }
 
 /// The fields of either kind's verification (the union: a sweep's is one of them).
 impl Fields for SweepVerification {
     fn fields() -> Vec<Field<Self>> {
-        let mut fields = Field::nested::<VerificationOutput>("", None, |_| None);
+        let mut fields = Field::nested::<ContactVerification>("", None, |_| None);
         fields.extend(Field::nested::<ThreeBodyVerificationOutput>(
             "",
             None,

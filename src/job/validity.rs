@@ -27,7 +27,8 @@ described! {
     #[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
     pub struct AssumptionOutput {
         /// `inside_layer`, `parabolic_sphere`, `local_layer`, `adhesive_friction`,
-        /// `surfaces_apart`, `asperity_gap` or `particles_in_contact`.
+        /// `surfaces_apart`, `asperity_gap`, `particles_in_contact` or (the layer as a
+        /// continuum) `resolution`.
         pub name: &'static str => [],
         /// The assumption in words.
         #[schema(value_type = String)]
@@ -399,7 +400,7 @@ impl Described {
 }
 
 /// Each assumption described, in the order of [`Assumption::ALL`].
-static DESCRIBED: [Described; 7] = [
+static DESCRIBED: [Described; 8] = [
     Described::new(
         "inside_layer",
         "the sphere stays inside the layer: the rigid base is never reached",
@@ -442,6 +443,12 @@ static DESCRIBED: [Described; 7] = [
         "at least one particle is in contact",
         "particles in contact",
         "warn below 1",
+    ),
+    Described::new(
+        "resolution",
+        "the grid of the layer as a continuum resolves the contact",
+        "pixels across the contact on the fine grid",
+        "warn below 24",
     ),
 ];
 
@@ -522,10 +529,17 @@ fn note(check: &Check, subject: Subject) -> String {
                      law's springs cannot",
                 )
             };
+            let instead = match subject {
+                Subject::Particle => {
+                    ". Ask for `\"layer\": {\"model\": \"continuum\"}` for the answer of the \
+                     layer as a continuum"
+                }
+                Subject::System => "",
+            };
             format!(
                 "at rest {} contact area is {} under the local (Winkler) law but {} with the \
                  layer as a continuum bonded to its base (docs/model.md §8): the local law \
-                 {how} it {}×, and μ = τ_a A / P with it; {why}",
+                 {how} it {}×, and μ = τ_a A / P with it; {why}{instead}",
                 whose(subject),
                 area(value),
                 area(reference),
@@ -550,6 +564,11 @@ fn note(check: &Check, subject: Subject) -> String {
             "{when}only {} are in contact, fewer than one: the means per particle describe \
              a fraction of a particle",
             count(value, "particle", "particles")
+        ),
+        Resolution => format!(
+            "{when}the contact is {} pixels across on the grid: the place of its edges within \
+             their pixels limits the area's accuracy (`meta.verification` gives its error)",
+            significant(value)
         ),
     }
 }
@@ -581,7 +600,9 @@ fn violation(check: &Check, subject: Subject) -> String {
             "the separation {} is not positive: the surfaces touch, outside the three-body model",
             length(value)
         ),
-        LocalLayer | AdhesiveFriction | AsperityGap | ParticlesInContact => note(check, subject),
+        LocalLayer | AdhesiveFriction | AsperityGap | ParticlesInContact | Resolution => {
+            note(check, subject)
+        }
     };
     format!("{when}{cause}{rest}")
 }

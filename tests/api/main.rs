@@ -2,6 +2,7 @@
 //! its own engine, cache and metrics), plus in-process router tests with `oneshot`.
 
 mod checks;
+mod continuum;
 mod errors;
 mod fits;
 mod forms;

@@ -515,7 +515,7 @@ fn check_exits_0_when_every_check_holds_1_when_one_fails_2_on_bad_input() {
         "{}",
         String::from_utf8_lossy(&out.stdout)
     );
-    assert!(String::from_utf8_lossy(&out.stdout).ends_with("5 checks: 5 passed, 0 failed\n"));
+    assert!(String::from_utf8_lossy(&out.stdout).ends_with("6 checks: 6 passed, 0 failed\n"));
 
     let dir = scratch("check");
     let checks = dir.join("checks.json");

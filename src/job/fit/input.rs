@@ -205,7 +205,7 @@ impl FitInput {
     /// Reads the fit under `checker`; `max_points` bounds the number of points.
     pub fn read(&self, checker: &mut Checker, max_points: usize) -> Problem {
         let input = self;
-        let base = checker.nested(field!(input.layer), |c, layer| layer.read(c));
+        let base = checker.nested(field!(input.layer), |c, layer| layer.read_local(c));
         checker.parameters(base.violations());
         let (free, bounds) = checker.nested(field!(input.parameters), |c, p| {
             read_parameters(p, &base, c)
@@ -246,7 +246,7 @@ impl FitInput {
             })
             .collect();
         FitInput {
-            layer: Some(LayerInput::of(&problem.parameterization.base)),
+            layer: Some(LayerInput::of(&problem.parameterization.base, None)),
             series: Some(series),
             parameters: Some(ParametersInput::of(problem)),
         }

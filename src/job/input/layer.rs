@@ -6,10 +6,27 @@ use utoipa::ToSchema;
 use super::{field, Checker, Quantity};
 use crate::model::{Layer, Parameter};
 
+/// How the layer gives way under the sphere (docs/model.md §8).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize, Serialize, ToSchema)]
+#[serde(rename_all = "lowercase")]
+pub enum LayerModel {
+    /// The paper's local (Winkler) law: each point of the layer a spring, k = E_L/H. Exact
+    /// for contacts much wider than the layer; the paper's model and its figures.
+    #[default]
+    Local,
+    /// The layer as a viscoelastic solid bonded to a rigid base, solved on a grid: right at
+    /// any width, and the answer for contacts a few thicknesses wide or narrower, where the
+    /// local law overstates the area (the `local_layer` validity row says by how much).
+    /// Rolling jobs and their sweeps; milliseconds to a second per answer.
+    Continuum,
+}
+
 /// The Kelvin layer.
 #[derive(Clone, Debug, Default, PartialEq, Deserialize, Serialize, ToSchema)]
 #[serde(deny_unknown_fields)]
 pub struct LayerInput {
+    /// How the layer gives way: `local` (default, the paper's law) or `continuum`.
+    pub model: Option<LayerModel>,
     /// E_L, relaxed longitudinal modulus (Pa; default 3 GPa).
     pub elastic_modulus: Option<Quantity>,
     /// H, layer thickness (m; default 100 nm).
@@ -52,9 +69,25 @@ impl LayerInput {
         }
     }
 
-    /// The input that gives `layer`: every field, in SI.
-    pub fn of(layer: &Layer) -> LayerInput {
+    /// [`LayerInput::read`] where only the local law is offered (three-body systems and
+    /// fits): `model: "continuum"` is an error naming the field.
+    pub fn read_local(&self, checker: &mut Checker) -> Layer {
+        if self.model == Some(LayerModel::Continuum) {
+            checker.invalid(
+                "model",
+                "continuum".into(),
+                "\"local\": here the layer is the paper's local law (the continuum is offered \
+                 for rolling jobs and their sweeps)",
+            );
+        }
+        self.read(checker)
+    }
+
+    /// The input that gives `layer` under `model`: every field, in SI (`model` absent
+    /// where only the local law is offered).
+    pub fn of(layer: &Layer, model: Option<LayerModel>) -> LayerInput {
         LayerInput {
+            model,
             elastic_modulus: Quantity::si(layer.elastic_modulus),
             thickness: Quantity::si(layer.thickness),
             poisson_ratio: Quantity::si(layer.poisson_ratio),

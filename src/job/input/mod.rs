@@ -22,7 +22,7 @@ use utoipa::ToSchema;
 
 pub use checker::Checker;
 pub use json::parse;
-pub use layer::LayerInput;
+pub use layer::{LayerInput, LayerModel};
 pub use quadrature::QuadratureKind;
 
 use super::JobError;

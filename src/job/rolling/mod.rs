@@ -9,16 +9,20 @@ use serde::{Deserialize, Serialize};
 use serde_json::Value;
 use utoipa::ToSchema;
 
-use super::input::{self, field, Checker, LayerInput, QuadratureKind, Quantity};
+use super::input::{self, field, Checker, LayerInput, LayerModel, QuadratureKind, Quantity};
 use super::kind::SMALL_ANSWER;
-use super::meta::ROLLING_REFERENCES;
+use super::meta::{CONTINUUM_REFERENCES, ROLLING_REFERENCES};
 use super::points::{self, PointNotes, PointNotesFields, PointStatus, Row, SweepVerification};
 use super::validity::{self, PointValidity, Subject, ValidityOutput};
 use super::{Control, JobError, Kind, Limits, Meta, References, Validated, Work};
+use crate::model::continuum::{self, ContinuumVerification};
 use crate::model::rolling::{BoundaryPoint, PressureGrid, Verification};
 use crate::model::tables::{self, Use};
-use crate::model::{self, Parameter, Rolling, RollingSolution, SolveOption, SolveOptions};
-use crate::render::{fields, Column, Output, Table, UnitTable};
+use crate::model::validity::Check;
+use crate::model::{
+    self, ModelError, Parameter, Rolling, RollingSolution, SolveOption, SolveOptions,
+};
+use crate::render::{fields, Column, Field, Fields, Output, Table, UnitTable};
 use crate::{described, unit_table};
 
 /// Input of a rolling job; every field optional (docs/model.md §5 defaults).
@@ -83,6 +87,8 @@ impl OptionsInput {
 pub struct RollingJob {
     pub rolling: Rolling,
     pub options: SolveOptions,
+    /// How the layer gives way.
+    pub law: LayerModel,
 }
 
 impl RollingJob {
@@ -99,7 +105,21 @@ impl RollingJob {
         let options = checker.nested(field!(input.options), |c, o| o.read(c));
         checker.parameters(rolling.violations());
         checker.options(options.violations());
-        RollingJob { rolling, options }
+        let law = input.layer.as_ref().and_then(|l| l.model);
+        RollingJob {
+            rolling,
+            options,
+            law: law.unwrap_or_default(),
+        }
+    }
+
+    /// The contact `point` (this job's, or a sweep's point over it) solved under the job's
+    /// law and options: the local law through its similarity table as `method` allows.
+    pub fn solve(&self, point: &Rolling, method: Use) -> Result<Solved, ModelError> {
+        match self.law {
+            LayerModel::Local => tables::solve(point, &self.options, method).map(Solved::Local),
+            LayerModel::Continuum => continuum::solve(point, &self.options).map(Solved::Continuum),
+        }
     }
 
     /// The input that gives this job: every field, in SI.
@@ -109,7 +129,7 @@ impl RollingJob {
             radius: Quantity::si(r.radius),
             load: Quantity::si(r.load),
             velocity: Quantity::si(r.velocity),
-            layer: Some(LayerInput::of(&r.layer)),
+            layer: Some(LayerInput::of(&r.layer, Some(self.law))),
             options: Some(OptionsInput::of(&self.options)),
         }
     }
@@ -131,19 +151,31 @@ impl Kind for RollingJob {
     }
 
     fn references(&self) -> &'static References {
-        &ROLLING_REFERENCES
+        match self.law {
+            LayerModel::Local => &ROLLING_REFERENCES,
+            LayerModel::Continuum => &CONTINUUM_REFERENCES,
+        }
     }
 
     fn work(&self) -> Work {
         Work::Known(1)
     }
 
-    /// The default rule with a modest boundary and no pressure grid: ≈ 7 µs through the
-    /// layer's table, ≈ 50 µs (up to ≈ 150 µs at high speed) by strip sums.
+    /// A continuum answer costs a hundred times a local one.
+    fn cost_class(&self) -> &'static str {
+        match self.law {
+            LayerModel::Local => Self::NAME,
+            LayerModel::Continuum => "rolling on the continuum",
+        }
+    }
+
+    /// The local law's default rule with a modest boundary and no pressure grid: ≈ 7 µs
+    /// through the layer's table, ≈ 50 µs (up to ≈ 150 µs at high speed) by strip sums.
     fn small(&self) -> bool {
         /// Boundary points a small job may ask for (≈ 0.15 µs each).
         const SMALL_BOUNDARY: usize = 401;
-        self.options.quadrature == model::Quadrature::default()
+        self.law == LayerModel::Local
+            && self.options.quadrature == model::Quadrature::default()
             && self.options.pressure_grid.is_none()
             && self.options.boundary_points <= SMALL_BOUNDARY
     }
@@ -160,11 +192,14 @@ impl Kind for RollingJob {
     }
 
     fn run(&self, meta: Meta, control: &Control) -> Result<RollingOutput, JobError> {
-        let solution =
-            control.solve(|| tables::solve(&self.rolling, &self.options, Use::IfBuilt))?;
+        let solution = control.solve(|| self.solve(&self.rolling, Use::IfBuilt))?;
         // Solved exactly, as the first answer on a layer is: the table for the answers after
         // it is built off this request's path.
-        if let Some(kappa) = tables::wanted(&self.rolling, &self.options) {
+        let local = self.law == LayerModel::Local;
+        if let Some(kappa) = local
+            .then(|| tables::wanted(&self.rolling, &self.options))
+            .flatten()
+        {
             let quadrature = self.options.quadrature;
             control.later(format!("similarity table κ = {kappa:e}"), move || {
                 let _ = tables::get_or_build(kappa, quadrature);
@@ -260,6 +295,212 @@ impl VerificationOutput {
     }
 }
 
+described! {
+    /// How far an answer on the layer as a continuum can be trusted (docs/model.md §8), per
+    /// quantity. On the grid: the changes from a coarse grid (pixels half as large again) and
+    /// to a domain reaching twice as far behind the contact. On the thin-layer path: the
+    /// local law's difference from the continuum at rest.
+    #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, ToSchema)]
+    pub struct ContinuumVerificationOutput {
+        /// `grid` (solved on a grid of pixels) or `thin_layer` (a contact many layer
+        /// thicknesses wide on a compressible layer: the local law's exact answer, which the
+        /// continuum tends to there).
+        pub method: ContinuumMethod => [],
+        /// A bound on δ's relative error (dimensionless).
+        pub penetration_error: f64 => [unit ""],
+        /// A bound on A's (and μ's) relative error (dimensionless).
+        pub contact_area_error: f64 => [unit ""],
+        /// A bound on x_c's error (m).
+        pub centroid_shift_error: f64 => [unit "m"],
+        /// A bound on x_p's (and R μ_r's) error (m).
+        pub pressure_centre_shift_error: f64 => [unit "m"],
+        /// A bound on the static companion's δ's relative error (dimensionless).
+        pub static_penetration_error: f64 => [unit ""],
+        /// A bound on the static companion's A's relative error (dimensionless).
+        pub static_contact_area_error: f64 => [unit ""],
+        /// The part of the errors of δ and A that is the domain's: their largest relative
+        /// change when the grid reaches twice as far behind (dimensionless).
+        pub domain_error: f64 => [unit ""],
+        /// Whether the errors of δ and A are within §8's tolerances (0.5 % and 1 %); false: the
+        /// answer is given, less exact than that.
+        pub within_tolerance: bool => [],
+        /// The fine grid (absent on the thin-layer path).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        pub grid: Option<GridOutput> => [optional nested],
+        /// Whether the solve reached its steady state (an answer is given only then).
+        pub converged: bool => [],
+    }
+}
+
+/// How an answer on the layer as a continuum was found.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, ToSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum ContinuumMethod {
+    Grid,
+    ThinLayer,
+}
+
+described! {
+    /// The fine grid of an answer on the layer as a continuum.
+    #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, ToSchema)]
+    pub struct GridOutput {
+        /// Pixels along the rolling direction (count).
+        pub length: usize => [unit ""],
+        /// Pixels across it (count).
+        pub width: usize => [unit ""],
+        /// The pixel's side (m).
+        pub pixel: f64 => [unit "m"],
+        /// Pixels across the rolling contact, 2√(A/π)/h (count).
+        pub pixels_across: f64 => [unit ""],
+        /// Steps of the march to the steady state (count).
+        pub march_steps: usize => [unit ""],
+    }
+}
+
+/// §8's tolerances on an answer of the layer as a continuum: 1 % in A, 0.5 % in δ.
+const AREA_TOLERANCE: f64 = 0.01;
+const PENETRATION_TOLERANCE: f64 = 0.005;
+
+impl From<&ContinuumVerification> for ContinuumVerificationOutput {
+    fn from(v: &ContinuumVerification) -> Self {
+        let e = &v.errors;
+        let within = |errors: [f64; 2], tolerance: f64| errors.iter().all(|e| *e <= tolerance);
+        ContinuumVerificationOutput {
+            method: match v.grid {
+                Some(_) => ContinuumMethod::Grid,
+                None => ContinuumMethod::ThinLayer,
+            },
+            penetration_error: e.penetration,
+            contact_area_error: e.contact_area,
+            centroid_shift_error: e.centroid_shift,
+            pressure_centre_shift_error: e.pressure_centre_shift,
+            static_penetration_error: e.static_penetration,
+            static_contact_area_error: e.static_contact_area,
+            domain_error: v.domain_error,
+            within_tolerance: within([e.contact_area, e.static_contact_area], AREA_TOLERANCE)
+                && within([e.penetration, e.static_penetration], PENETRATION_TOLERANCE),
+            grid: v.grid.map(|g| GridOutput {
+                length: g.nx,
+                width: g.ny,
+                pixel: g.pixel,
+                pixels_across: g.across,
+                march_steps: g.steps,
+            }),
+            converged: true,
+        }
+    }
+}
+
+impl ContinuumVerificationOutput {
+    /// The worse of two answers' errors, field by field (a sweep's, over its points): its
+    /// method and grid are those of the worse answer in A.
+    pub fn worst(&self, other: &ContinuumVerificationOutput) -> ContinuumVerificationOutput {
+        let (a, b) = (self, other);
+        let worse = if b.contact_area_error > a.contact_area_error {
+            b
+        } else {
+            a
+        };
+        ContinuumVerificationOutput {
+            method: worse.method,
+            penetration_error: a.penetration_error.max(b.penetration_error),
+            contact_area_error: a.contact_area_error.max(b.contact_area_error),
+            centroid_shift_error: a.centroid_shift_error.max(b.centroid_shift_error),
+            pressure_centre_shift_error: a
+                .pressure_centre_shift_error
+                .max(b.pressure_centre_shift_error),
+            static_penetration_error: a.static_penetration_error.max(b.static_penetration_error),
+            static_contact_area_error: a.static_contact_area_error.max(b.static_contact_area_error),
+            domain_error: a.domain_error.max(b.domain_error),
+            within_tolerance: a.within_tolerance && b.within_tolerance,
+            grid: worse.grid.clone(),
+            converged: a.converged && b.converged,
+        }
+    }
+}
+
+/// The numerical error of a rolling answer: the local law's quadrature, or the continuum's
+/// grid.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, ToSchema)]
+#[serde(untagged)]
+pub enum ContactVerification {
+    Local(VerificationOutput),
+    Continuum(ContinuumVerificationOutput),
+}
+
+/// The fields of either law's verification (the union: an answer's is one of them).
+impl Fields for ContactVerification {
+    fn fields() -> Vec<Field<Self>> {
+        let mut fields = Field::nested::<VerificationOutput>("", None, |_| None);
+        fields.extend(Field::nested::<ContinuumVerificationOutput>(
+            "",
+            None,
+            |_| None,
+        ));
+        fields
+    }
+}
+
+impl ContactVerification {
+    /// The worse of the two, field by field (a sweep's points are all of one law).
+    pub fn worst(&self, other: &ContactVerification) -> ContactVerification {
+        match (self, other) {
+            (ContactVerification::Local(a), ContactVerification::Local(b)) => {
+                ContactVerification::Local(a.worst(b))
+            }
+            (ContactVerification::Continuum(a), ContactVerification::Continuum(b)) => {
+                ContactVerification::Continuum(a.worst(b))
+            }
+            (a, _) => a.clone(),
+        }
+    }
+}
+
+/// A rolling contact solved under one of the layer's laws.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Solved {
+    Local(RollingSolution),
+    Continuum(RollingSolution<ContinuumVerification>),
+}
+
+impl Solved {
+    /// The assumptions measured on it (docs/model.md §7, §8).
+    fn checks(&self, rolling: &Rolling) -> Vec<Check> {
+        match self {
+            Solved::Local(s) => model::validity::rolling(rolling, s),
+            Solved::Continuum(s) => model::validity::continuum(rolling, s),
+        }
+    }
+
+    fn contact(&self) -> ContactOutput {
+        match self {
+            Solved::Local(s) => s.into(),
+            Solved::Continuum(s) => s.into(),
+        }
+    }
+
+    fn verification(&self) -> ContactVerification {
+        match self {
+            Solved::Local(s) => ContactVerification::Local((&s.verification).into()),
+            Solved::Continuum(s) => ContactVerification::Continuum((&s.verification).into()),
+        }
+    }
+
+    fn boundary(&self) -> &[BoundaryPoint] {
+        match self {
+            Solved::Local(s) => &s.boundary,
+            Solved::Continuum(s) => &s.boundary,
+        }
+    }
+
+    fn pressure(&self) -> Option<&PressureGrid> {
+        match self {
+            Solved::Local(s) => s.pressure.as_ref(),
+            Solved::Continuum(s) => s.pressure.as_ref(),
+        }
+    }
+}
+
 impl From<&Verification> for VerificationOutput {
     fn from(v: &Verification) -> Self {
         VerificationOutput {
@@ -274,8 +515,8 @@ impl From<&Verification> for VerificationOutput {
     }
 }
 
-impl From<&RollingSolution> for ContactOutput {
-    fn from(s: &RollingSolution) -> Self {
+impl<V> From<&RollingSolution<V>> for ContactOutput {
+    fn from(s: &RollingSolution<V>) -> Self {
         ContactOutput {
             penetration: s.penetration,
             contact_area: s.contact_area,
@@ -315,21 +556,18 @@ described! {
         /// The numerical error of an answered point (in the sweep's `meta.verification`, the
         /// worst over its points).
         #[serde(skip)]
-        pub verification: Option<VerificationOutput> => [],
+        pub verification: Option<ContactVerification> => [],
     }
 }
 
 impl SweepPoint {
     /// The row of `rolling`, solved as `solution`, unless the model's domain excludes it.
-    pub fn new(rolling: &Rolling, solution: &RollingSolution) -> Result<Self, JobError> {
-        let validity = PointValidity::assess(
-            model::validity::rolling(rolling, solution),
-            Subject::Particle,
-        )?;
+    pub fn new(rolling: &Rolling, solution: &Solved) -> Result<Self, JobError> {
+        let validity = PointValidity::assess(solution.checks(rolling), Subject::Particle)?;
         Ok(SweepPoint::answered(
             rolling,
-            solution.into(),
-            (&solution.verification).into(),
+            solution.contact(),
+            solution.verification(),
             validity,
         ))
     }
@@ -337,7 +575,7 @@ impl SweepPoint {
     fn answered(
         rolling: &Rolling,
         contact: ContactOutput,
-        verification: VerificationOutput,
+        verification: ContactVerification,
         validity: PointValidity,
     ) -> SweepPoint {
         let mut row = SweepPoint::unanswered(rolling, PointNotes::Answered(validity));
@@ -430,8 +668,9 @@ described! {
     pub struct RollingMeta {
         #[serde(flatten)]
         pub meta: Meta => [],
-        /// How far the numbers can be trusted.
-        pub verification: VerificationOutput => [nested],
+        /// How far the numbers can be trusted: the local law's quadrature error, or the
+        /// continuum's grid error.
+        pub verification: ContactVerification => [nested],
         /// How far the model can be trusted here (docs/model.md §7).
         pub validity: ValidityOutput => [nested],
     }
@@ -463,19 +702,15 @@ described! {
 impl RollingOutput {
     /// The answer for `rolling`, solved as `solution`, with `meta`, the job's [`Meta`];
     /// refused where the model's domain excludes it.
-    pub fn new(
-        rolling: &Rolling,
-        solution: &RollingSolution,
-        meta: Meta,
-    ) -> Result<Self, JobError> {
-        let checks = model::validity::rolling(rolling, solution);
+    pub fn new(rolling: &Rolling, solution: &Solved, meta: Meta) -> Result<Self, JobError> {
+        let checks = solution.checks(rolling);
         Ok(RollingOutput {
-            contact: solution.into(),
-            boundary: solution.boundary.iter().map(Into::into).collect(),
-            pressure: solution.pressure.as_ref().map(Into::into),
+            contact: solution.contact(),
+            boundary: solution.boundary().iter().map(Into::into).collect(),
+            pressure: solution.pressure().map(Into::into),
             meta: RollingMeta {
                 meta,
-                verification: (&solution.verification).into(),
+                verification: solution.verification(),
                 validity: validity::assess(&checks, Subject::Particle)?,
             },
             rolling: *rolling,

@@ -5,6 +5,7 @@
 use serde::Deserialize;
 
 use super::{BoundaryOutput, ContactOutput, PressureOutput, RollingJob};
+use crate::job::input::LayerModel;
 use crate::job::picture::{shown, Asked, Picture, PictureError};
 use crate::render::svg::{Axis, Chart, Layer};
 
@@ -20,7 +21,8 @@ pub struct RollingPicture {
 
 impl Picture for RollingPicture {
     fn chart(self) -> Result<Chart, PictureError> {
-        let rolling = self.meta.job::<RollingJob>()?.rolling;
+        let job = self.meta.job::<RollingJob>()?;
+        let rolling = job.rolling;
         let contact = &self.contact;
         let mut layers = Vec::new();
         if let Some(grid) = self.pressure {
@@ -53,8 +55,12 @@ impl Picture for RollingPicture {
             points: vec![(contact.centroid_shift, 0.0)],
             hollow: true,
         });
+        let law = match job.law {
+            LayerModel::Local => "",
+            LayerModel::Continuum => " (layer as a continuum)",
+        };
         let title = format!(
-            "Contact region, R = {}, P = {}, μ = {}",
+            "Contact region{law}, R = {}, P = {}, μ = {}",
             shown(rolling.radius, "m"),
             shown(rolling.load, "N"),
             shown(contact.friction_coefficient, "")

@@ -11,17 +11,18 @@ use serde::{Deserialize, Serialize};
 use serde_json::{json, Value};
 use utoipa::ToSchema;
 
+use super::input::LayerModel;
 use super::input::{self, field, Checker, Field, Quantity};
 use super::kind::SMALL_ANSWER;
-use super::meta::{REFERENCES, ROLLING_REFERENCES};
+use super::meta::REFERENCES;
 use super::points::{self, SweepSummary};
-use super::rolling::{RollingInput, RollingJob};
+use super::rolling::{RollingInput, RollingJob, Solved};
 use super::three_body::{operating_fields, slot, ThreeBodyInput, ThreeBodyJob};
 use super::validity::Subject;
 use super::{Control, JobError, Kind, Limits, Meta, OnRefusal, References, Swept, Validated, Work};
-use crate::model::tables::{self, Use};
+use crate::model::tables::Use;
 use crate::model::three_body::{self, Diameters, OperatingPoint, ThreeBody, ThreeBodySolution};
-use crate::model::{Parameter, Rolling, RollingSolution, SolveOptions, MODEL_VERSION};
+use crate::model::{Parameter, Rolling, SolveOptions, MODEL_VERSION};
 use crate::render::{self, Fields, Output, Table, UnitTable};
 use crate::{described, unit_table};
 
@@ -184,8 +185,8 @@ impl Kind for SweepJob {
     }
 
     fn references(&self) -> &'static References {
-        match self.points {
-            SweepOfPoints::Rolling(_) => &ROLLING_REFERENCES,
+        match &self.points {
+            SweepOfPoints::Rolling(s) => s.base.references(),
             SweepOfPoints::ThreeBody(_) => &REFERENCES,
         }
     }
@@ -194,9 +195,12 @@ impl Kind for SweepJob {
         self.size().map_or(Work::Unknown, Work::Known)
     }
 
-    /// A three-body point costs a hundred rolling points.
+    /// A three-body point costs a hundred rolling points, a continuum point more.
     fn cost_class(&self) -> &'static str {
-        match self.points {
+        match &self.points {
+            SweepOfPoints::Rolling(s) if s.base.law == LayerModel::Continuum => {
+                "sweep of rolling on the continuum"
+            }
             SweepOfPoints::Rolling(_) => "sweep of rolling",
             SweepOfPoints::ThreeBody(_) => "sweep of three_body",
         }
@@ -233,17 +237,18 @@ impl Kind for SweepJob {
         let (points, summary, stop) = match &self.points {
             SweepOfPoints::Rolling(s) => {
                 let all = s.points();
-                let options = &s.base.options;
+                let base = &s.base;
+                let (options, law) = (&base.options, base.law);
                 let method = Use::for_solves(all.len(), options.quadrature);
                 let contacts = part(all, range)?;
-                let solve = |p: &Rolling| tables::solve(p, options, method);
-                let swept = if method == Use::Build {
+                let solve = |p: &Rolling| base.solve(p, method);
+                let swept = if method == Use::Build && law == LayerModel::Local {
                     // A point costs a microsecond: cheaper to solve again than to keep.
                     control.map_each(&contacts, on_refusal, |p| SweepPoint::new(p, &solve(p)?))
                 } else {
                     let kept = control.kept(
-                        |p| format!("{MODEL_VERSION} rolling {p:?} {options:?}"),
-                        |_| std::mem::size_of::<RollingSolution>(),
+                        |p| format!("{MODEL_VERSION} rolling {law:?} {p:?} {options:?}"),
+                        |_| std::mem::size_of::<Solved>(),
                         solve,
                     );
                     control.map_each(&contacts, on_refusal, |p| SweepPoint::new(p, &kept(p)?))

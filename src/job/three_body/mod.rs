@@ -362,7 +362,7 @@ impl ThreeBodyJob {
                 OperatingPoint::Separation(f64::NAN)
             }
         };
-        let layer = checker.nested(field!(input.layer), |c, l| l.read(c));
+        let layer = checker.nested(field!(input.layer), |c, l| l.read_local(c));
         let options = checker.nested(field!(input.options), |c, o| o.read(c));
         let system = ThreeBody {
             diameters,
@@ -400,7 +400,7 @@ impl ThreeBodyJob {
             nominal_area: Quantity::si(s.nominal_area),
             upper_surface: Some(UpperSurfaceInput::of(&s.upper)),
             particle: Some(ParticleInput::of(&s.particle)),
-            layer: Some(LayerInput::of(&s.layer)),
+            layer: Some(LayerInput::of(&s.layer, None)),
             layer_contact: Some(match s.layer_contact {
                 LayerContact::KelvinLayer => LayerContactKind::KelvinLayer,
                 LayerContact::Hertz => LayerContactKind::Hertz,

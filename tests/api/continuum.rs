@@ -1,0 +1,121 @@
+//! The layer as a continuum over HTTP (docs/model.md §8): `"layer": {"model": "continuum"}`
+//! on rolling jobs and their sweeps, its error and validity in `meta`, and a clear refusal
+//! where only the local law is offered.
+
+use serde_json::{json, Value};
+use thirdbody::job::{Job, Limits};
+
+use crate::helpers::{problem, spawn_app};
+use crate::solve::engine_answer;
+
+fn rows(validity: &Value) -> Vec<&str> {
+    validity["assumptions"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|a| a["name"].as_str().unwrap())
+        .collect()
+}
+
+#[tokio::test]
+async fn the_default_job_on_the_continuum_answers_with_its_own_error() {
+    let app = spawn_app(&[]).await;
+    let input = json!({"layer": {"model": "continuum"}});
+    let response = app.post("/v1/rolling", &input).await;
+    assert_eq!(response.status(), 200);
+    let body: Value = response.json().await.unwrap();
+    // Issue 23: about 8.3 nm² (the local law's 85.2 nm²), Hertz-like at rest (13.4 nm²).
+    let area = body["contact_area"].as_f64().unwrap() * 1e18;
+    assert!((8.1..8.4).contains(&area), "{area}");
+    let at_rest = body["static"]["contact_area"].as_f64().unwrap() * 1e18;
+    assert!((13.3..13.5).contains(&at_rest), "{at_rest}");
+    let meta = &body["meta"];
+    assert_eq!(meta["input"]["layer"]["model"], "continuum");
+    let verification = &meta["verification"];
+    assert_eq!(verification["method"], "grid");
+    assert_eq!(verification["within_tolerance"], true);
+    assert!(verification["contact_area_error"].as_f64().unwrap() <= 0.01);
+    assert!(verification["grid"]["pixels_across"].as_f64().unwrap() >= 24.0);
+    assert_eq!(
+        rows(&meta["validity"]),
+        [
+            "inside_layer",
+            "parabolic_sphere",
+            "adhesive_friction",
+            "resolution"
+        ]
+    );
+    let cited = meta["references"].to_string();
+    assert!(
+        cited.contains("Carbone") && cited.contains("Polonsky"),
+        "{cited}"
+    );
+    let job = Job::from_value(
+        json!({"kind": "rolling", "input": input}),
+        &Limits::default(),
+    );
+    assert_eq!(body, engine_answer(job.unwrap()));
+}
+
+#[tokio::test]
+async fn the_local_laws_warning_points_to_the_continuum() {
+    let app = spawn_app(&[]).await;
+    let body: Value = app
+        .post("/v1/rolling", &json!({}))
+        .await
+        .json()
+        .await
+        .unwrap();
+    assert_eq!(body["meta"]["input"]["layer"]["model"], "local");
+    let local_layer = body["meta"]["validity"]["assumptions"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|a| a["name"] == "local_layer")
+        .unwrap();
+    assert_eq!(local_layer["status"], "warn");
+    let note = local_layer["note"].as_str().unwrap();
+    assert!(note.contains(r#""model": "continuum""#), "{note}");
+}
+
+#[tokio::test]
+async fn where_only_the_local_law_is_offered_the_continuum_is_an_error_naming_its_field() {
+    let app = spawn_app(&[]).await;
+    let input = json!({"operating": {"total_load": "1 mN"}, "layer": {"model": "continuum"}});
+    let refused = problem(app.post("/v1/three-body", &input).await, 422).await;
+    assert_eq!(refused["errors"][0]["field"], "layer.model");
+    assert_eq!(refused["errors"][0]["value"], "continuum");
+    let unknown = json!({"layer": {"model": "winkler"}});
+    let refused = problem(app.post("/v1/rolling", &unknown).await, 422).await;
+    assert!(
+        refused["detail"].as_str().unwrap().contains("winkler"),
+        "{refused}"
+    );
+}
+
+#[tokio::test]
+async fn a_continuum_sweep_runs_as_a_job_and_each_point_carries_its_error() {
+    let app = spawn_app(&[]).await;
+    let sweep = json!({"base": {"layer": {"model": "continuum"}},
+                       "vary": {"velocity": ["0 nm/s", "2 nm/s", "8 nm/s"]}});
+    let location = app.submit(&json!({"kind": "sweep", "input": sweep})).await;
+    let job = app
+        .wait_for_job(&location, |job| job["status"] == "succeeded")
+        .await;
+    let answer = app.result(&job).await;
+    let points = answer["points"].as_array().unwrap();
+    let areas: Vec<f64> = points
+        .iter()
+        .map(|p| {
+            assert_eq!(p["status"], "ok", "{p}");
+            p["contact_area"].as_f64().unwrap()
+        })
+        .collect();
+    assert!(areas.windows(2).all(|w| w[1] < w[0]), "{areas:?}");
+    // The worst error over the points (at 8 nm/s the contact is the smallest on its grid).
+    let verification = &answer["meta"]["verification"];
+    assert_eq!(verification["method"], "grid");
+    let error = verification["contact_area_error"].as_f64().unwrap();
+    assert!(error > 0.0 && error <= 0.02, "{error}");
+    assert!(answer["meta"]["references"].to_string().contains("Carbone"));
+}
