@@ -19,8 +19,8 @@ use std::f64::consts::PI;
 use super::axisymmetric::static_contact;
 use super::grid::{Grid, Influence};
 use super::pressed::GridContact;
-use super::rolling::{roll, Rolled, RolledContact};
-use super::shape::{boundary, chords, lateral_half_width, pressure_grid};
+use super::rolling::{at_rest, roll, Rolled, RolledContact};
+use super::shape::{boundary, chords, lateral_half_width, pressure_grid, resampled};
 use super::table::static_area;
 use crate::limits::ElasticContact;
 use crate::{Layer, ModelError, Rolling, RollingSolution, SolveOptions};
@@ -244,7 +244,14 @@ fn on_grid(
     // The pixel: at most the layer's thickness (finer, the layer's correction would vary
     // across a pixel faster than its Gauss rule follows).
     let fine_pixel = (smallest / per_radius as f64).min(layer.thickness);
-    let solved = |pixel: f64, wake: f64| -> Result<Solved, ModelError> {
+    // A march on a grid of `pixel` reaching `wake` behind, from `start` (a contact on
+    // another grid, resampled; else the contact at rest on this grid, solved here, from
+    // `rest_from` resampled if given): its steady contact, and its contact at rest.
+    let march = |pixel: f64,
+                 wake: f64,
+                 start: Option<&GridContact>,
+                 rest_from: Option<&GridContact>|
+     -> Result<Solved, ModelError> {
         let (grid, middle) = domain(a0, pixel, wake)?;
         let influence = Influence::new(&layer, grid);
         let rolled = Rolled {
@@ -255,31 +262,48 @@ fn on_grid(
             surface: &influence,
             middle,
         };
-        let contact = roll(&rolled, TOLERANCE)?;
-        if touches_border(&contact.contact) {
+        let resample = |contact: &GridContact| resampled(contact, &grid, middle);
+        let rest = match start {
+            Some(_) if rest_from.is_none() => None,
+            _ => Some(at_rest(&rolled, rest_from.map(resample), 0.1 * TOLERANCE)?),
+        };
+        let from = match (start, &rest) {
+            (Some(contact), _) => resample(contact),
+            (None, Some(rest)) => rest.pressure.clone(),
+            (None, None) => unreachable!("a march starts from a contact or from rest"),
+        };
+        let rolled = roll(&rolled, from, TOLERANCE)?;
+        if touches_border(&rolled.contact) {
             return Err(ModelError::OutOfModel(
                 "the continuum contact reached the border of its grid".to_string(),
             ));
         }
-        Ok(Solved::new(contact))
+        Ok(Solved { rolled, rest })
     };
+    // The coarse march first, from rest: the others start from its steady contact.
     let coarse_pixel = 1.5 * fine_pixel;
-    let fine = solved(fine_pixel, wake)?;
-    let coarse = solved(coarse_pixel, wake)?;
+    let coarse = march(coarse_pixel, wake, None, None)?;
+    let coarse_rest = coarse.rest.as_ref();
     let far = if wake > 0.0 {
-        solved(coarse_pixel, 2.0 * wake)?
+        march(coarse_pixel, 2.0 * wake, Some(&coarse.rolled.contact), None)?
     } else {
         coarse.clone()
     };
-    // Each quantity's change to the fine grid and to the far domain, from the coarse grid.
+    let fine = march(fine_pixel, wake, Some(&coarse.rolled.contact), coarse_rest)?;
+    // Each quantity's change to the fine grid and to the far domain, from the coarse grid
+    // (at rest the far domain is the same problem: no change).
     let changes = |f: fn(&Solved) -> f64| {
         let change = |a: &Solved| (f(a) / f(&coarse) - 1.0).abs();
         (change(&fine), change(&far))
     };
+    let rest_changes = |f: fn(&GridContact) -> f64| {
+        let rest = |s: &Solved| f(s.rest.as_ref().expect("solved at rest"));
+        ((rest(&fine) / rest(&coarse) - 1.0).abs(), 0.0)
+    };
     let absolute =
         |f: fn(&Solved) -> f64| (f(&fine) - f(&coarse)).abs() + (f(&far) - f(&coarse)).abs();
     let contact = &fine.rolled.contact;
-    let rest = &fine.rest;
+    let rest = fine.rest.as_ref().expect("solved at rest");
     let pixel = contact.grid.pixel;
     let area_error = |(grid, domain): (f64, f64), area: f64| {
         (2.0 * grid + domain).max(area_floor(area, pixel, layer.thickness))
@@ -287,8 +311,8 @@ fn on_grid(
     let (d, a, d0, a0_) = (
         changes(|s| s.rolled.contact.penetration),
         changes(|s| s.rolled.contact.contact_area),
-        changes(|s| s.rest.penetration),
-        changes(|s| s.rest.contact_area),
+        rest_changes(|c| c.penetration),
+        rest_changes(|c| c.contact_area),
     );
     // At rest the contact is symmetric in x: its shifts are nought, not the grid's rounding.
     let shift = |x: f64| if velocity > 0.0 { x } else { 0.0 };
@@ -343,20 +367,11 @@ fn on_grid(
     })
 }
 
-/// A march's steady contact and the contact at rest it started from.
+/// A march's steady contact, and the contact at rest on its grid (where it was solved).
 #[derive(Clone)]
 struct Solved {
     rolled: RolledContact,
-    rest: GridContact,
-}
-
-impl Solved {
-    fn new(rolled: RolledContact) -> Solved {
-        Solved {
-            rest: rolled.rest.clone(),
-            rolled,
-        }
-    }
+    rest: Option<GridContact>,
 }
 
 /// The grid of pixels of side `pixel` around the static contact of radius `a0`, and its

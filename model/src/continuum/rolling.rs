@@ -10,7 +10,8 @@
 //! pixel a step with the history explicit: each step is a symmetric problem (the share of
 //! the response that acts at once, plus the deflection the history leaves), solved by
 //! conjugate gradients from the step before, until a step changes nothing (§8 names this
-//! method; Koumi, Nelias et al.). The march starts from the contact at rest.
+//! method; Koumi, Nelias et al.). The march starts from the contact at rest, or from a
+//! coarser grid's steady contact.
 
 use super::grid::Grid;
 use super::pressed::{press, GridContact, Pressing, Surface};
@@ -32,8 +33,6 @@ const LOOSEST: f64 = 1e-3;
 #[derive(Clone, Debug, PartialEq)]
 pub struct RolledContact {
     pub contact: GridContact,
-    /// The contact at rest the march started from.
-    pub rest: GridContact,
     /// x_c (m): the centroid of the contact area.
     pub centroid_shift: f64,
     /// x_p (m): the centre of pressure.
@@ -57,38 +56,53 @@ pub struct Rolled<'a> {
     pub middle: f64,
 }
 
-/// The steady contact of `rolled`: the march stops when a step changes the pressure by
-/// less than `tolerance` of its sum. A step carries the material a few pixels on (nx/16,
-/// at least one): the carry is exact for a pressure that no longer changes, so the steady
-/// state is the same as one pixel a step, and it is reached in fewer (at the default job
-/// 25 steps rather than 81 on 64 pixels; much longer strides overshoot and take more),
-/// until the steps change little: from there one pixel a step, as strides can overshoot
-/// without end near the steady state (seen at 1 nm/s on 60 pixels). A
-/// step's pressure is solved only as exactly as the march's last change warrants, and
-/// exactly (a tenth of `tolerance`) at the end.
-pub fn roll(rolled: &Rolled, tolerance: f64) -> Result<RolledContact, ModelError> {
+impl Rolled<'_> {
+    /// The sphere pressed at rest.
+    fn pressing(&self) -> Pressing<'_> {
+        Pressing {
+            surface: self.surface,
+            radius: self.radius,
+            load: self.load,
+            middle: self.middle,
+            instant: 1.0,
+            memory: None,
+        }
+    }
+}
+
+/// The contact of `rolled`'s sphere at rest on its surface, from `start` (else a uniform
+/// disc), to `tolerance` of δ.
+pub fn at_rest(
+    rolled: &Rolled,
+    start: Option<Vec<f64>>,
+    tolerance: f64,
+) -> Result<GridContact, ModelError> {
+    press(&rolled.pressing(), start, tolerance)
+}
+
+/// The steady contact of `rolled`, marched from `start` (a pressure on the surface's grid:
+/// the contact at rest, or a coarser grid's steady contact): the march stops when a step
+/// changes the pressure by less than `tolerance` of its sum. A step carries the material
+/// a few pixels on (nx/16, at least one): the carry is exact for a pressure that no longer
+/// changes, so the steady state is the same as one pixel a step, and it is reached in
+/// fewer (at the default job 25 steps rather than 81 on 64 pixels), until the steps change
+/// little: from there one pixel a step, as strides can overshoot without end near the
+/// steady state (seen at 1 nm/s on 60 pixels); a step that changes the pressure more than
+/// the one before halves the stride. A step's pressure is solved only as exactly as the
+/// march's last change warrants, and exactly (a tenth of `tolerance`) at the end. At
+/// V = 0 it is the contact at rest.
+pub fn roll(rolled: &Rolled, start: Vec<f64>, tolerance: f64) -> Result<RolledContact, ModelError> {
     let Rolled {
-        radius,
-        load,
         velocity,
         layer,
         surface,
-        middle,
+        ..
     } = *rolled;
-    let grid = surface.grid();
-    let Grid { nx, ny, pixel } = grid;
+    let Grid { nx, ny, pixel } = surface.grid();
     let exact = 0.1 * tolerance;
-    let at_rest = Pressing {
-        surface,
-        radius,
-        load,
-        middle,
-        instant: 1.0,
-        memory: None,
-    };
-    let rest = press(&at_rest, None, exact)?;
+    let at_rest = rolled.pressing();
     if velocity == 0.0 {
-        return Ok(rolled_contact(rest.clone(), rest, 0));
+        return Ok(rolled_contact(press(&at_rest, Some(start), exact)?, 0));
     }
     let theta = layer.relaxation_time / layer.retardation_time;
     let lambda = velocity * layer.retardation_time;
@@ -109,12 +123,12 @@ pub fn roll(rolled: &Rolled, tolerance: f64) -> Result<RolledContact, ModelError
         carried
     };
     let mut stride = (nx / 16).max(1);
-    // The start: as if the pressure had always been the one at rest (front row first).
+    // The start: as if the pressure had always been `start` (front row first).
+    let mut pressure = start;
     let mut tail = vec![0.0; nx * ny];
     for k in (0..ny * (nx - 1)).rev() {
-        tail[k] = brought(k, &rest.pressure, &tail);
+        tail[k] = brought(k, &pressure, &tail);
     }
-    let mut pressure = rest.pressure.clone();
     let mut step_tolerance = LOOSEST;
     let mut last_change = f64::INFINITY;
     let max_steps = MAX_STEPS_PER_PIXEL * nx;
@@ -146,7 +160,7 @@ pub fn roll(rolled: &Rolled, tolerance: f64) -> Result<RolledContact, ModelError
         }
         pressure.clone_from(&contact.pressure);
         if change <= tolerance * total && step_tolerance <= exact {
-            return Ok(rolled_contact(contact, rest, step));
+            return Ok(rolled_contact(contact, step));
         }
         step_tolerance = (0.01 * change / total).clamp(exact, step_tolerance);
     }
@@ -158,7 +172,7 @@ pub fn roll(rolled: &Rolled, tolerance: f64) -> Result<RolledContact, ModelError
 
 /// The contact with its centroid (between its row edges, as its area) and centre of
 /// pressure.
-fn rolled_contact(contact: GridContact, rest: GridContact, steps: usize) -> RolledContact {
+fn rolled_contact(contact: GridContact, steps: usize) -> RolledContact {
     let ny = contact.grid.ny;
     let x = |k: usize| contact.middle + contact.grid.x(k / ny);
     let (load, moment) = contact
@@ -180,7 +194,6 @@ fn rolled_contact(contact: GridContact, rest: GridContact, steps: usize) -> Roll
         pressure_centre_shift: moment / load,
         steps,
         contact,
-        rest,
     }
 }
 
@@ -213,7 +226,8 @@ mod tests {
             surface,
             middle,
         };
-        roll(&rolled, 1e-8).unwrap()
+        let rest = at_rest(&rolled, None, 1e-9).unwrap();
+        roll(&rolled, rest.pressure, 1e-8).unwrap()
     }
 
     /// The default sphere on the default layer as a continuum, on 64 pixels a side.
@@ -291,18 +305,16 @@ mod tests {
             },
             stiffness: layer.elastic_modulus / layer.thickness,
         };
-        let rolled = roll(
-            &Rolled {
-                radius: rolling.radius,
-                load: rolling.load,
-                velocity: rolling.velocity,
-                layer: &layer,
-                surface: &springs,
-                middle: 0.0,
-            },
-            1e-10,
-        )
-        .unwrap();
+        let sphere = Rolled {
+            radius: rolling.radius,
+            load: rolling.load,
+            velocity: rolling.velocity,
+            layer: &layer,
+            surface: &springs,
+            middle: 0.0,
+        };
+        let rest = at_rest(&sphere, None, 1e-11).unwrap();
+        let rolled = roll(&sphere, rest.pressure, 1e-10).unwrap();
         let off = |got: f64, want: f64| got / want - 1.0;
         let delta = off(rolled.contact.penetration, exact.penetration);
         assert!(delta.abs() < 1e-4, "δ off by {delta:e}");

@@ -99,11 +99,8 @@ fn closing(y: f64, row: f64, tip: f64) -> f64 {
     }
 }
 
-/// p on an n × n grid over [−w, w]² (w the lateral half-width, as the local law's map),
-/// bilinear between the pixels' centres, zero outside the contact.
+/// p on an n × n grid over [−w, w]² (w the lateral half-width, as the local law's map).
 pub(super) fn pressure_grid(contact: &GridContact, half_width: f64, n: usize) -> PressureGrid {
-    let grid = contact.grid;
-    let Grid { nx, ny, pixel } = grid;
     let axis: Vec<f64> = (0..n)
         .map(|i| {
             if n == 1 {
@@ -113,25 +110,37 @@ pub(super) fn pressure_grid(contact: &GridContact, half_width: f64, n: usize) ->
             }
         })
         .collect();
-    // Fractional pixel index of a coordinate (pixel centres at integers).
-    let index = |offset: f64, count: usize| offset / pixel - 0.5 + 0.5 * count as f64;
-    let value = |x: f64, y: f64| {
-        let (u, v) = (index(x - contact.middle, nx), index(y, ny));
-        if u < 0.0 || v < 0.0 || u > (nx - 1) as f64 || v > (ny - 1) as f64 {
-            return 0.0;
-        }
-        let (i, j) = ((u as usize).min(nx - 2), (v as usize).min(ny - 2));
-        let (s, t) = (u - i as f64, v - j as f64);
-        let p = |i: usize, j: usize| contact.pressure[i * ny + j];
-        (1.0 - s) * ((1.0 - t) * p(i, j) + t * p(i, j + 1))
-            + s * ((1.0 - t) * p(i + 1, j) + t * p(i + 1, j + 1))
-    };
     PressureGrid {
         values: axis
             .iter()
-            .map(|&y| axis.iter().map(|&x| value(x, y)).collect())
+            .map(|&y| axis.iter().map(|&x| pressure_at(contact, x, y)).collect())
             .collect(),
         x: axis.clone(),
         y: axis,
     }
+}
+
+/// `contact`'s pressure on the pixels of `grid` whose middle is at x = `middle`: a coarser
+/// grid's steady contact as the start of a finer grid's march.
+pub(super) fn resampled(contact: &GridContact, grid: &Grid, middle: f64) -> Vec<f64> {
+    (0..grid.pixels())
+        .map(|k| pressure_at(contact, middle + grid.x(k / grid.ny), grid.y(k % grid.ny)))
+        .collect()
+}
+
+/// The pressure at (x, y) from the sphere's centre: bilinear between the pixels' centres,
+/// zero outside them.
+fn pressure_at(contact: &GridContact, x: f64, y: f64) -> f64 {
+    let Grid { nx, ny, pixel } = contact.grid;
+    // Fractional pixel index of a coordinate (pixel centres at integers).
+    let index = |offset: f64, count: usize| offset / pixel - 0.5 + 0.5 * count as f64;
+    let (u, v) = (index(x - contact.middle, nx), index(y, ny));
+    if u < 0.0 || v < 0.0 || u > (nx - 1) as f64 || v > (ny - 1) as f64 {
+        return 0.0;
+    }
+    let (i, j) = ((u as usize).min(nx - 2), (v as usize).min(ny - 2));
+    let (s, t) = (u - i as f64, v - j as f64);
+    let p = |i: usize, j: usize| contact.pressure[i * ny + j];
+    (1.0 - s) * ((1.0 - t) * p(i, j) + t * p(i, j + 1))
+        + s * ((1.0 - t) * p(i + 1, j) + t * p(i + 1, j + 1))
 }
