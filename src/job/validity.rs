@@ -531,8 +531,8 @@ fn note(check: &Check, subject: Subject) -> String {
             };
             let instead = match subject {
                 Subject::Particle => {
-                    ". Ask for `\"layer\": {\"model\": \"continuum\"}` for the answer of the \
-                     layer as a continuum"
+                    ". For the answer of the layer as a continuum, ask for \"layer\": \
+                     {\"model\": \"continuum\"}"
                 }
                 Subject::System => "",
             };

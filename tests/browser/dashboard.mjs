@@ -58,6 +58,22 @@ try {
   if (!/0\.0947/.test(mu)) fail(`the default friction coefficient is shown as ${mu}`);
   await page.screenshot({ path: `${shots}/rolling.png`, fullPage: true });
 
+  // The same particle on the layer as a continuum: about 8.3 nm², its accuracy said.
+  await page.selectOption("#form-rolling select[name='layer.model']", "continuum");
+  await page.locator("#form-rolling").getByRole("button", { name: "Solve" }).click();
+  await page.waitForFunction(() => document.querySelector("#status").textContent.includes("continuum"));
+  const area = await page.locator("#table tr", { hasText: "contact_area" }).first().textContent();
+  if (!/8\.[1-4]\d*\s*nm²/.test(area)) fail(`the continuum's contact area is shown as ${area}`);
+  await page.screenshot({ path: `${shots}/rolling-continuum.png`, fullPage: true });
+
+  // Both laws together: two regions on one plane, their numbers side by side.
+  await page.getByRole("button", { name: "Compare both laws" }).click();
+  await page.waitForFunction(() => document.querySelectorAll("#picture svg polygon.series").length === 2);
+  const compared = await page.locator("#table tr", { hasText: "friction_coefficient" }).first().textContent();
+  if (!/0\.0947/.test(compared) || !/0\.0091/.test(compared)) fail(`the compared μ reads ${compared}`);
+  await page.screenshot({ path: `${shots}/rolling-compare.png`, fullPage: true });
+  await page.selectOption("#form-rolling select[name='layer.model']", "local");
+
   // A three-body system: its distribution of diameters.
   await page.getByRole("tab", { name: "Three-body system" }).click();
   await page.locator("#form-three-body").getByRole("button", { name: "Solve" }).click();
@@ -105,7 +121,7 @@ try {
 
   if (errors.length) fail(`console errors: ${errors.join(" | ")}`);
   if (outside.length) fail(`requests left the server: ${outside.join(", ")}`);
-  if (!process.exitCode) console.log(`dashboard: rolling, three-body, a 200-point sweep, a sweep with a refused point and Figure 6 work; screenshots in ${shots}`);
+  if (!process.exitCode) console.log(`dashboard: rolling (both laws, compared), three-body, a 200-point sweep, a sweep with a refused point and Figure 6 work; screenshots in ${shots}`);
 } finally {
   await browser.close();
   child.kill();

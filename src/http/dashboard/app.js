@@ -10,7 +10,7 @@ const $ = (selector) => document.querySelector(selector);
  *  plain numbers become numbers, anything else is sent as typed (a value with its unit). */
 function inputOf(form) {
   const input = {};
-  for (const field of form.querySelectorAll("input[name]")) {
+  for (const field of form.querySelectorAll("input[name], select[name]")) {
     const text = field.value.trim();
     if (text === "") continue;
     const path = field.name.split(".");
@@ -109,9 +109,10 @@ function showTable(answer) {
   }
 }
 
-function showWarnings(answer) {
+/** The answer's warnings, in place of those shown (or after them, `after`: comparing). */
+function showWarnings(answer, after = false) {
   const box = $("#warnings");
-  box.replaceChildren();
+  if (!after) box.replaceChildren();
   const meta = answer.meta || {};
   const notes = (meta.warnings || []).map((w) => w.message);
   for (const a of (meta.validity && meta.validity.assumptions) || []) {
@@ -119,7 +120,7 @@ function showWarnings(answer) {
       // A sweep: how many points each assumption warns on, and why on the first.
       if (a.warned > 0) notes.push(`warn on ${a.warned} points: ${a.assumption} (first, points[${a.first_warned}]: ${a.note})`);
     } else if (a.status !== "ok") {
-      notes.push(`${a.status}: ${a.assumption} (${a.ratio} = ${Number(a.value).toPrecision(3)}; ${a.rule})`);
+      notes.push(`${a.status}: ${a.assumption} (${a.ratio} = ${Number(a.value).toPrecision(3)}): ${a.note || a.rule}`);
     }
   }
   const counts = meta.counts;
@@ -162,6 +163,103 @@ function showDownloads(fetchIn, name) {
   }
 }
 
+/** What a continuum answer's verification says of its accuracy, in a sentence. */
+function accuracy(answer) {
+  const v = answer.meta && answer.meta.verification;
+  if (!v || v.method === undefined) return "";
+  const percent = (x) => `${(100 * x).toPrecision(2)} %`;
+  const how = v.method === "grid"
+    ? `on a ${v.grid.length} × ${v.grid.width} grid, ${Math.round(v.grid.pixels_across)} pixels across the contact`
+    : "by the local law, which a layer this thin follows";
+  const within = v.within_tolerance ? "" : " (less exact than 1 % in A)";
+  return ` Layer as a continuum, ${how}: A within ±${percent(v.contact_area_error)}, δ within ±${percent(v.penetration_error)}${within}.`;
+}
+
+// ---- Comparing the two laws of the layer ------------------------------------------------
+
+const SVG = "http://www.w3.org/2000/svg";
+
+function element(name, attributes, text) {
+  const node = document.createElementNS(SVG, name);
+  for (const [key, value] of Object.entries(attributes)) node.setAttribute(key, value);
+  if (text !== undefined) node.textContent = text;
+  return node;
+}
+
+/** Both laws' contact regions (and their circles at rest) on one plane, to scale. */
+function comparison(answers) {
+  const colours = { local: "#1f77b4", continuum: "#d62728" };
+  const outline = (a) => [...a.boundary.map((p) => [p.entry, p.y]), ...a.boundary.slice().reverse().map((p) => [p.exit, p.y])];
+  const rest = (a) => Math.sqrt(a.static.contact_area / Math.PI);
+  let reach = 0;
+  for (const [, a] of answers) {
+    reach = Math.max(reach, rest(a), ...outline(a).map(([x, y]) => Math.max(Math.abs(x), Math.abs(y))));
+  }
+  const [scale, unit] = readable(reach, "m");
+  const factor = scale / reach;
+  const size = 400, margin = 50, half = size / 2;
+  const px = (x) => margin + half + (x / reach) * half * 0.95;
+  const py = (y) => margin + half - (y / reach) * half * 0.95;
+  const svg = element("svg", { xmlns: SVG, width: size + 2 * margin + 220, height: size + 2 * margin, viewBox: `0 0 ${size + 2 * margin + 220} ${size + 2 * margin}`, "font-family": "sans-serif", "font-size": 13 });
+  svg.append(element("title", {}, "Contact regions under both laws of the layer"));
+  svg.append(element("rect", { x: margin, y: margin, width: size, height: size, fill: "none", stroke: "#444" }));
+  for (const t of [-1, -0.5, 0, 0.5, 1]) {
+    const value = (t * reach * 0.95 * factor).toPrecision(2);
+    svg.append(element("text", { x: px(t * reach * 0.95), y: margin + size + 18, "text-anchor": "middle" }, value));
+    svg.append(element("text", { x: margin - 6, y: py(t * reach * 0.95) + 4, "text-anchor": "end" }, value));
+  }
+  svg.append(element("text", { x: margin + half, y: margin + size + 40, "text-anchor": "middle" }, `x (rolling direction) [${unit}]`));
+  svg.append(element("text", { x: 14, y: margin + half, "text-anchor": "middle", transform: `rotate(-90 14 ${margin + half})` }, `y [${unit}]`));
+  let row = 0;
+  for (const [model, a] of answers) {
+    const colour = colours[model];
+    const points = outline(a).map(([x, y]) => `${px(x).toFixed(1)},${py(y).toFixed(1)}`).join(" ");
+    svg.append(element("polygon", { class: "series", "data-name": model, points, fill: colour, "fill-opacity": 0.25, stroke: colour, "stroke-width": 2 }));
+    svg.append(element("circle", { cx: px(0), cy: py(0), r: (rest(a) / reach) * half * 0.95, fill: "none", stroke: colour, "stroke-dasharray": "6 4" }));
+    const [area, areaUnit] = readable(a.contact_area, "m^2");
+    svg.append(element("rect", { x: size + 2 * margin, y: margin + 22 * row - 10, width: 24, height: 12, fill: colour, "fill-opacity": 0.4, stroke: colour }));
+    svg.append(element("text", { class: "entry", x: size + 2 * margin + 32, y: margin + 22 * row }, `${model}: A = ${area.toPrecision(3)} ${areaUnit}`));
+    row += 1;
+  }
+  svg.append(element("text", { x: size + 2 * margin, y: margin + 22 * row + 6 }, "dashed: the same particle at rest"));
+  return svg;
+}
+
+/** Solves the rolling form under both laws: their regions drawn together, their numbers side by side. */
+async function compare(form) {
+  const { url, body } = requestOf(form);
+  status("Solving under both laws…");
+  const answers = [];
+  for (const model of ["local", "continuum"]) {
+    const asked = structuredClone(body);
+    (asked.layer ??= {}).model = model;
+    const response = await post(url, asked);
+    const answer = await response.json();
+    if (!response.ok) return showProblem(answer);
+    answers.push([model, answer]);
+  }
+  $("#picture").replaceChildren(comparison(answers));
+  const table = $("#table");
+  table.replaceChildren();
+  const head = table.insertRow();
+  for (const name of ["quantity", "local law", "layer as a continuum"]) {
+    const th = document.createElement("th");
+    th.textContent = name;
+    head.append(th);
+  }
+  // The two answers have the same quantities, in the same order.
+  const [local, continuum] = answers.map(([, a]) => rows(a, a.meta.units || {}));
+  continuum.forEach(([name, value, unit], i) => {
+    const row = table.insertRow();
+    const [, theirs, theirUnit] = local[i];
+    for (const cell of [name, `${theirs} ${theirUnit}`, `${value} ${unit}`]) row.insertCell().textContent = cell;
+  });
+  showWarnings(answers[0][1]);
+  showWarnings(answers[1][1], true);
+  status(`Both laws solved.${accuracy(answers[1][1])}`);
+  $("#downloads").replaceChildren();
+}
+
 async function post(url, body, accept = "application/json") {
   return fetch(url, { method: "POST", headers: { "content-type": "application/json", accept }, body: JSON.stringify(body) });
 }
@@ -172,7 +270,7 @@ async function solve(form) {
   const response = await post(url, body);
   const answer = await response.json();
   if (!response.ok) return showProblem(answer);
-  status(`Solved (${response.headers.get("x-cache") || "miss"}).`);
+  status(`Solved (${response.headers.get("x-cache") || "miss"}).${accuracy(answer)}`);
   showTable(answer);
   showWarnings(answer);
   const picture = await post(url, body, "image/svg+xml");
@@ -285,6 +383,7 @@ document.addEventListener("DOMContentLoaded", () => {
       button.addEventListener("click", () => copy(form, button.dataset.copy));
     }
   }
+  $("#compare").addEventListener("click", () => compare($("#form-rolling")).catch((e) => status(String(e), true)));
   const buttons = $("#figure-buttons");
   for (let n = 3; n <= 9; n++) {
     const button = document.createElement("button");
