@@ -128,54 +128,24 @@ impl Check {
 
 /// The assumptions of docs/model.md §7 on one rolling contact.
 pub fn rolling<V>(rolling: &Rolling, s: &RollingSolution<V>) -> Vec<Check> {
-    let h = rolling.layer.thickness;
-    let r = rolling.radius;
     let rest = &s.static_contact;
     // b(0) is the half-width and |a(0)| < b(0) (docs/model.md §3): the half-width is a_max.
-    vec![
-        Check::new(
-            Assumption::InsideLayer,
-            (s.penetration, h),
-            (rest.penetration, h),
-        ),
-        Check::new(
-            Assumption::Parabolic,
-            (s.half_width, r),
-            (rest.half_width, r),
-        ),
-        local_layer(rest.contact_area, r, rolling.load, &rolling.layer),
-        Check::new(
-            Assumption::AdhesiveFriction,
-            (s.friction_coefficient, 1.0),
-            (rest.friction_coefficient, 1.0),
-        ),
-    ]
+    let mut checks = contact_checks(rolling, s, s.half_width);
+    let local = local_layer(
+        rest.contact_area,
+        rolling.radius,
+        rolling.load,
+        &rolling.layer,
+    );
+    checks.insert(2, local);
+    checks
 }
 
 /// The assumptions of docs/model.md §8 on one rolling contact on the layer as a continuum:
 /// §7's, less the local layer's (the continuum is what it is measured against), and the
 /// grid's resolution of the contact.
 pub fn continuum(rolling: &Rolling, s: &RollingSolution<ContinuumVerification>) -> Vec<Check> {
-    let h = rolling.layer.thickness;
-    let r = rolling.radius;
-    let rest = &s.static_contact;
-    let mut checks = vec![
-        Check::new(
-            Assumption::InsideLayer,
-            (s.penetration, h),
-            (rest.penetration, h),
-        ),
-        Check::new(
-            Assumption::Parabolic,
-            (s.verification.extent, r),
-            (rest.half_width, r),
-        ),
-        Check::new(
-            Assumption::AdhesiveFriction,
-            (s.friction_coefficient, 1.0),
-            (rest.friction_coefficient, 1.0),
-        ),
-    ];
+    let mut checks = contact_checks(rolling, s, s.verification.extent);
     if let Some(grid) = s.verification.grid {
         checks.push(Check::new(
             Assumption::Resolution,
@@ -184,6 +154,26 @@ pub fn continuum(rolling: &Rolling, s: &RollingSolution<ContinuumVerification>) 
         ));
     }
     checks
+}
+
+/// The rows every rolling contact has, whatever the layer's law: inside the layer, the
+/// parabolic sphere (its contact reaching `extent` from the centre), adhesive friction.
+fn contact_checks<V>(rolling: &Rolling, s: &RollingSolution<V>, extent: f64) -> Vec<Check> {
+    let (h, r) = (rolling.layer.thickness, rolling.radius);
+    let rest = &s.static_contact;
+    vec![
+        Check::new(
+            Assumption::InsideLayer,
+            (s.penetration, h),
+            (rest.penetration, h),
+        ),
+        Check::new(Assumption::Parabolic, (extent, r), (rest.half_width, r)),
+        Check::new(
+            Assumption::AdhesiveFriction,
+            (s.friction_coefficient, 1.0),
+            (rest.friction_coefficient, 1.0),
+        ),
+    ]
 }
 
 /// The local-layer check of a sphere of radius `radius` under `load` at rest, whose contact

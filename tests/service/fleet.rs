@@ -327,6 +327,30 @@ async fn two_services_and_a_worker_share_answers_jobs_and_sweeps_through_redis()
         deliveries.lines().any(|n| n.trim() == "2"),
         "deliveries: {deliveries}"
     );
+    // A sweep on the layer as a continuum (a hundred times a local point's cost) is spread
+    // in parts too, and its assembled answer is the whole sweep's.
+    let speeds: Vec<String> = (0..60)
+        .map(|i| format!("{} nm/s", 0.1 * f64::from(i)))
+        .collect();
+    let continuum = json!({"kind": "sweep", "input": {
+        "base": {"layer": {"model": "continuum"}},
+        "vary": {"load": ["1 nN", "1.5 nN"], "velocity": speeds}}});
+    let id = submit(&http, &b.base, continuum.clone()).await;
+    let view = finished(&http, &a.base, &id).await;
+    assert_eq!(view["status"], "succeeded", "{view}");
+    let answer = result(&http, &a.base, &view).await;
+    assert_eq!(answer["points"].as_array().unwrap().len(), 120);
+    assert_eq!(answer["meta"]["verification"]["method"], "grid");
+    let whole: Value = post(&http, format!("{}/v1/sweeps", a.base), &continuum["input"])
+        .await
+        .json()
+        .await
+        .unwrap();
+    assert_eq!(
+        answer, whole,
+        "the continuum sweep assembled from parts is the sweep"
+    );
+
     for service in [&a, &b] {
         let parts = metric(&http, &service.base, "thirdbody_parts_total", "succeeded").await;
         assert!(parts >= 1.0, "{} solved no part", service.base);

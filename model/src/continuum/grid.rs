@@ -98,7 +98,7 @@ impl Influence {
             }
         }
         influence.own = kernel[0];
-        influence.kernel = influence.forward(&kernel, mx);
+        influence.kernel = influence.forward(&kernel, my, mx);
         influence
     }
 
@@ -116,57 +116,57 @@ impl Influence {
     pub fn deflect(&self, pressure: &[f64]) -> Vec<f64> {
         let Grid { nx, ny, .. } = self.grid;
         let (mx, my) = (2 * nx, 2 * ny);
-        let mut padded = vec![0.0; nx * my];
-        for i in 0..nx {
-            padded[i * my..i * my + ny].copy_from_slice(&pressure[i * ny..(i + 1) * ny]);
-        }
-        let mut spectrum = self.forward(&padded, nx);
+        let mut spectrum = self.forward(pressure, ny, nx);
         for (s, k) in spectrum.iter_mut().zip(&self.kernel) {
             *s *= k;
         }
-        let full = self.backward(spectrum);
+        let mut deflection = self.backward(spectrum);
         let scale = 1.0 / (mx * my) as f64;
-        (0..nx * ny)
-            .map(|k| full[(k / ny) * my + k % ny] * scale)
-            .collect()
+        deflection.iter_mut().for_each(|w| *w *= scale);
+        deflection
     }
 
-    /// The 2-D spectrum of a 2nx × 2ny real array whose rows from `filled` on are zero
-    /// (given only up to there): real FFTs along rows, then complex FFTs along the ny + 1
-    /// columns; stored column by column.
-    fn forward(&self, data: &[f64], filled: usize) -> Vec<Complex<f64>> {
+    /// The 2-D spectrum of a 2nx × 2ny real array given by its first `filled` rows of
+    /// `width` values each (the rest zero): real FFTs along rows, then complex FFTs along
+    /// the ny + 1 columns; stored column by column.
+    fn forward(&self, data: &[f64], width: usize, filled: usize) -> Vec<Complex<f64>> {
         let Grid { nx, ny, .. } = self.grid;
         let (mx, my) = (2 * nx, 2 * ny);
         let half = ny + 1;
         let mut by_column = vec![Complex::default(); half * mx];
         let mut row = vec![0.0; my];
         let mut out = vec![Complex::default(); half];
+        let mut scratch = self.rows.make_scratch_vec();
         for i in 0..filled {
-            row.copy_from_slice(&data[i * my..(i + 1) * my]);
+            row[..width].copy_from_slice(&data[i * width..(i + 1) * width]);
+            row[width..].fill(0.0);
             self.rows
-                .process(&mut row, &mut out)
+                .process_with_scratch(&mut row, &mut out, &mut scratch)
                 .expect("buffers sized for the plan");
             for (j, value) in out.iter().enumerate() {
                 by_column[j * mx + i] = *value;
             }
         }
-        for column in by_column.chunks_mut(mx) {
-            self.columns.process(column);
-        }
+        // Every column at once (they lie end to end), with one scratch buffer.
+        let mut scratch = vec![Complex::default(); self.columns.get_inplace_scratch_len()];
+        self.columns
+            .process_with_scratch(&mut by_column, &mut scratch);
         by_column
     }
 
-    /// The inverse of [`Influence::forward`] on the grid's first nx rows (the deflection
-    /// is wanted only there), unscaled (4 nx ny times the array).
+    /// The inverse of [`Influence::forward`] on the grid's first nx rows and ny columns
+    /// (the deflection is wanted only there), unscaled (4 nx ny times the array).
     fn backward(&self, mut by_column: Vec<Complex<f64>>) -> Vec<f64> {
         let Grid { nx, ny, .. } = self.grid;
         let (mx, my) = (2 * nx, 2 * ny);
         let half = ny + 1;
-        for column in by_column.chunks_mut(mx) {
-            self.columns_back.process(column);
-        }
-        let mut data = vec![0.0; nx * my];
+        let mut scratch = vec![Complex::default(); self.columns_back.get_inplace_scratch_len()];
+        self.columns_back
+            .process_with_scratch(&mut by_column, &mut scratch);
+        let mut data = vec![0.0; nx * ny];
         let mut row = vec![Complex::default(); half];
+        let mut out = vec![0.0; my];
+        let mut scratch = self.rows_back.make_scratch_vec();
         for i in 0..nx {
             for (j, value) in row.iter_mut().enumerate() {
                 *value = by_column[j * mx + i];
@@ -175,8 +175,9 @@ impl Influence {
             row[0].im = 0.0;
             row[ny].im = 0.0;
             self.rows_back
-                .process(&mut row, &mut data[i * my..(i + 1) * my])
+                .process_with_scratch(&mut row, &mut out, &mut scratch)
                 .expect("buffers sized for the plan");
+            data[i * ny..(i + 1) * ny].copy_from_slice(&out[..ny]);
         }
         data
     }

@@ -27,7 +27,7 @@ const STRIDE_UNTIL: f64 = 1e-4;
 
 /// The loosest tolerance of a step's pressure early in the march, where the history is
 /// still far from steady and an exact step would be wasted.
-const LOOSEST: f64 = 1e-3;
+const LOOSEST: f64 = 1e-2;
 
 /// The steady rolling contact and the march that reached it.
 #[derive(Clone, Debug, PartialEq)]

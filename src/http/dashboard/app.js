@@ -91,15 +91,21 @@ function rows(answer, units, prefix = "") {
   return out;
 }
 
-function showTable(answer) {
+/** The answer's table, emptied, with a head row of `names`. */
+function freshTable(names) {
   const table = $("#table");
   table.replaceChildren();
   const head = table.insertRow();
-  for (const name of ["quantity", "value", "unit"]) {
+  for (const name of names) {
     const th = document.createElement("th");
     th.textContent = name;
     head.append(th);
   }
+  return table;
+}
+
+function showTable(answer) {
+  const table = freshTable(["quantity", "value", "unit"]);
   const units = (answer.meta && answer.meta.units) || {};
   // A sweep's table is what its meta says of its points; its rows are in the downloads.
   const shown = answer.points ? { points: (answer.meta && answer.meta.counts) || answer.points.length } : answer;
@@ -239,14 +245,7 @@ async function compare(form) {
     answers.push([model, answer]);
   }
   $("#picture").replaceChildren(comparison(answers));
-  const table = $("#table");
-  table.replaceChildren();
-  const head = table.insertRow();
-  for (const name of ["quantity", "local law", "layer as a continuum"]) {
-    const th = document.createElement("th");
-    th.textContent = name;
-    head.append(th);
-  }
+  const table = freshTable(["quantity", "local law", "layer as a continuum"]);
   // The two answers have the same quantities, in the same order.
   const [local, continuum] = answers.map(([, a]) => rows(a, a.meta.units || {}));
   continuum.forEach(([name, value, unit], i) => {
