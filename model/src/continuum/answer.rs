@@ -329,6 +329,13 @@ fn on_grid(
     let pressure_centre_shift = shift(fine.rolled.pressure_centre_shift);
     let (contact_area, static_area) = (contact.contact_area, rest.contact_area);
     let across = |area: f64| 2.0 * (area / PI).sqrt() / pixel;
+    // The contact's largest extent from the centre: the lateral half-width, or an edge
+    // along x (a rolling contact reaches a little further ahead than to the side).
+    let extent = chords(contact)
+        .iter()
+        .fold(half_width, |m, (_, exit, entry)| {
+            m.max(exit.abs()).max(entry.abs())
+        });
     Ok(RollingSolution {
         penetration: contact.penetration,
         contact_area,
@@ -346,15 +353,11 @@ fn on_grid(
         boundary: boundary(contact, half_width, options.boundary_points),
         pressure: options
             .pressure_grid
-            .map(|n| pressure_grid(contact, half_width, n)),
+            .map(|n| pressure_grid(contact, extent, n)),
         verification: ContinuumVerification {
             errors,
             domain_error: d.1.max(a.1),
-            extent: chords(contact)
-                .iter()
-                .fold(half_width, |m, (_, exit, entry)| {
-                    m.max(exit.abs()).max(entry.abs())
-                }),
+            extent,
             grid: Some(GridUsed {
                 nx: contact.grid.nx,
                 ny: contact.grid.ny,

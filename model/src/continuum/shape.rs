@@ -99,14 +99,15 @@ fn closing(y: f64, row: f64, tip: f64) -> f64 {
     }
 }
 
-/// p on an n × n grid over [−w, w]² (w the lateral half-width, as the local law's map).
-pub(super) fn pressure_grid(contact: &GridContact, half_width: f64, n: usize) -> PressureGrid {
+/// p on an n × n grid over [−e, e]², e the contact's largest extent from the centre (the
+/// local law's map spans its half-width, which is its extent).
+pub(super) fn pressure_grid(contact: &GridContact, extent: f64, n: usize) -> PressureGrid {
     let axis: Vec<f64> = (0..n)
         .map(|i| {
             if n == 1 {
                 0.0
             } else {
-                -half_width + 2.0 * half_width * i as f64 / (n - 1) as f64
+                -extent + 2.0 * extent * i as f64 / (n - 1) as f64
             }
         })
         .collect();

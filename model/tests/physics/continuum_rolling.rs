@@ -251,3 +251,36 @@ fn on_a_thin_layer_the_answer_is_the_local_law_within_its_error() {
         assert!(s.verification.errors.contact_area < 0.02);
     }
 }
+
+/// The pressure map spans the contact (its square reaches the farthest edge), never
+/// negative, carries the load, and peaks ahead of the centre when rolling.
+#[test]
+fn the_pressure_map_carries_the_load_and_peaks_ahead() {
+    let rolling = Rolling::default();
+    let options = SolveOptions {
+        pressure_grid: Some(81),
+        ..SolveOptions::default()
+    };
+    let s = continuum::solve(&rolling, &options).unwrap();
+    let map = s.pressure.unwrap();
+    let step = map.x[1] - map.x[0];
+    let edges = s
+        .boundary
+        .iter()
+        .flat_map(|b| [b.exit.abs(), b.entry.abs()]);
+    let reach = edges.fold(s.half_width, f64::max);
+    assert!(
+        (map.x[80] / reach - 1.0).abs() < 1e-9,
+        "{} vs {reach}",
+        map.x[80]
+    );
+    let values = map.values.iter().flatten();
+    assert!(values.clone().all(|p| *p >= 0.0));
+    let load: f64 = values.sum::<f64>() * step * step;
+    assert!(off(load, rolling.load) < 0.05, "the map carries {load:e} N");
+    let (row, column) = (0..81)
+        .flat_map(|j| (0..81).map(move |i| (j, i)))
+        .max_by(|a, b| map.values[a.0][a.1].total_cmp(&map.values[b.0][b.1]))
+        .unwrap();
+    assert!(map.x[column] > 0.0 && map.y[row].abs() < 3.0 * step);
+}
