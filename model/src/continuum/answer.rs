@@ -22,7 +22,7 @@ use super::pressed::GridContact;
 use super::rolling::{at_rest, roll, Rolled, RolledContact};
 use super::shape::{boundary, chords, lateral_half_width, pressure_grid, resampled};
 use super::table::static_area;
-use crate::limits::ElasticContact;
+use crate::limits::{relaxed, ElasticContact};
 use crate::{Layer, ModelError, Rolling, RollingSolution, SolveOptions};
 
 /// Pixels in the radius of the smallest contact the sphere can have, the instantaneous
@@ -152,12 +152,12 @@ pub fn solve_at(
     if let Some(error) = options.violations().into_iter().next() {
         return Err(ModelError::InvalidOption(error));
     }
-    let local = crate::solve(rolling, options)?;
     let layer = &rolling.layer;
-    let thin = local.static_contact.half_width >= THIN * layer.thickness
-        && layer.poisson_ratio <= THIN_POISSON;
+    // r₀ in closed form: the local answer itself is solved only where it is the answer.
+    let r0 = relaxed(rolling.radius, rolling.load, layer).half_width;
+    let thin = r0 >= THIN * layer.thickness && layer.poisson_ratio <= THIN_POISSON;
     let solution = if thin {
-        thin_layer(rolling, local)?
+        thin_layer(rolling, crate::solve(rolling, options)?)?
     } else {
         on_grid(rolling, options, per_radius)?
     };
