@@ -191,10 +191,11 @@ pub fn three_body(system: &ThreeBody, s: &ThreeBodySolution) -> Vec<Check> {
     let x_max = system.diameters.max;
     let radius = 0.5 * x_max;
     // Contact half-width of the largest particle on the layer: √(2Rω₂) in the Kelvin layer
-    // (docs/model.md §3), √(Rω₂) for Hertz.
+    // (docs/model.md §3), √(Rω₂) for Hertz and, as its scale, for the continuum (whose
+    // contact radius is √(Φ_A) times that, Φ_A within a factor 1.5 of 1 wherever δ < H).
     let half_width = |omega: f64| match system.layer_contact {
         LayerContact::KelvinLayer => (2.0 * radius * omega).sqrt(),
-        LayerContact::Hertz => (radius * omega).sqrt(),
+        LayerContact::Hertz | LayerContact::Continuum => (radius * omega).sqrt(),
     };
     let (moving, rest) = (&s.rolling, &s.static_state);
     let (w_moving, w_rest) = (moving.max_layer_penetration, rest.max_layer_penetration);

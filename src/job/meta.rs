@@ -40,6 +40,18 @@ pub static ROLLING_REFERENCES: References = Fixed::new(&[PAPER, STRIPS, SHEAR_ST
 pub static CONTINUUM_REFERENCES: References =
     Fixed::new(&[PAPER, SHEAR_STRENGTH, LAYER, PIXELS, SOLVER]);
 
+/// The papers behind a three-body answer on the continuum layer contact: the model's and the
+/// continuum's.
+pub static THREE_BODY_CONTINUUM_REFERENCES: References = Fixed::new(&[
+    PAPER,
+    SHEAR_STRENGTH,
+    THREE_BODY,
+    ASPERITIES,
+    LAYER,
+    PIXELS,
+    SOLVER,
+]);
+
 const PAPER: Reference = Reference {
     role: "model: three-body contact with particles rolling over a Kelvin layer (eqs. 1–13)",
     citation: "Contact problem of a system of particles rolling over a viscoelastic layer \

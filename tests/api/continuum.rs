@@ -85,6 +85,8 @@ async fn where_only_the_local_law_is_offered_the_continuum_is_an_error_naming_it
     let refused = problem(app.post("/v1/three-body", &input).await, 422).await;
     assert_eq!(refused["errors"][0]["field"], "layer.model");
     assert_eq!(refused["errors"][0]["value"], "continuum");
+    let said = refused["errors"][0]["message"].as_str().unwrap();
+    assert!(said.contains(r#""layer_contact": "continuum""#), "{said}");
     let unknown = json!({"layer": {"model": "winkler"}});
     let refused = problem(app.post("/v1/rolling", &unknown).await, 422).await;
     assert!(
@@ -118,4 +120,46 @@ async fn a_continuum_sweep_runs_as_a_job_and_each_point_carries_its_error() {
     let error = verification["contact_area_error"].as_f64().unwrap();
     assert!(error > 0.0 && error <= 0.02, "{error}");
     assert!(answer["meta"]["references"].to_string().contains("Carbone"));
+}
+
+/// Issue 24: a three-body system on the continuum layer contact, as a job with progress over
+/// its layer curves' nodes; its answer carries the layer contacts' error and the
+/// continuum's references, and its μ is several times below the local law's (§8).
+#[tokio::test]
+async fn a_three_body_system_on_the_continuum_runs_as_a_job_with_progress() {
+    let app = spawn_app(&[]).await;
+    let input = json!({"operating": {"total_load": "1 mN"}, "layer_contact": "continuum"});
+    let location = app
+        .submit(&json!({"kind": "three_body", "input": input}))
+        .await;
+    let job = app
+        .wait_for_job(&location, |job| job["status"] == "succeeded")
+        .await;
+    let total = job["progress"]["total"].as_u64().unwrap();
+    assert!(total > 20, "{job}");
+    assert_eq!(job["progress"]["done"].as_u64(), Some(total), "{job}");
+    let answer = app.result(&job).await;
+    assert_eq!(answer["meta"]["input"]["layer_contact"], "continuum");
+    let verification = &answer["meta"]["verification"];
+    let error = verification["layer_contact_error"].as_f64().unwrap();
+    assert!(error > 0.0 && error < 0.05, "{error}");
+    assert!(verification.get("layer_table_error").is_none());
+    assert!(answer["meta"]["references"].to_string().contains("Carbone"));
+    let local = json!({"operating": {"total_load": "1 mN"}});
+    let local: Value = app
+        .post("/v1/three-body", &local)
+        .await
+        .json()
+        .await
+        .unwrap();
+    let mu = |a: &Value| a["friction_coefficient"]["rolling"].as_f64().unwrap();
+    assert!(
+        mu(&local) > 3.0 * mu(&answer),
+        "{} {}",
+        mu(&local),
+        mu(&answer)
+    );
+    assert!((answer["loads"]["total"].as_f64().unwrap() / 1e-3 - 1.0).abs() < 1e-9);
+    let rows: Vec<&str> = rows(&answer["meta"]["validity"]);
+    assert!(!rows.contains(&"local_layer"), "{rows:?}");
 }

@@ -79,6 +79,20 @@ try {
   await page.locator("#form-three-body").getByRole("button", { name: "Solve" }).click();
   await page.waitForFunction(() => (document.querySelector("#picture svg title") || {}).textContent?.startsWith("Three-body"));
   await page.screenshot({ path: `${shots}/three-body.png`, fullPage: true });
+  const localMu = await page.locator("#table tr", { hasText: "friction_coefficient" }).first().textContent();
+
+  // The same system on the continuum layer contact: its μ several times lower, its error said.
+  await page.selectOption("#form-three-body select[name='layer_contact']", "continuum");
+  await page.locator("#form-three-body").getByRole("button", { name: "Solve" }).click();
+  await page.waitForFunction((before) => {
+    const row = [...document.querySelectorAll("#table tr")].find((r) => r.textContent.includes("friction_coefficient"));
+    return row && row.textContent !== before;
+  }, localMu, { timeout: 30000 });
+  const continuumMu = await page.locator("#table tr", { hasText: "friction_coefficient" }).first().textContent();
+  const first = (text) => Number((text.match(/\d\.\d+(e-?\d+)?/) || ["NaN"])[0]);
+  if (!(first(localMu) > 3 * first(continuumMu))) fail(`three-body μ: local ${localMu}, continuum ${continuumMu}`);
+  await page.screenshot({ path: `${shots}/three-body-continuum.png`, fullPage: true });
+  await page.selectOption("#form-three-body select[name='layer_contact']", "kelvin_layer");
 
   // A 200-point sweep as a job: the progress bar reaches 100 %.
   await page.getByRole("tab", { name: "Sweep" }).click();
@@ -121,7 +135,7 @@ try {
 
   if (errors.length) fail(`console errors: ${errors.join(" | ")}`);
   if (outside.length) fail(`requests left the server: ${outside.join(", ")}`);
-  if (!process.exitCode) console.log(`dashboard: rolling (both laws, compared), three-body, a 200-point sweep, a sweep with a refused point and Figure 6 work; screenshots in ${shots}`);
+  if (!process.exitCode) console.log(`dashboard: rolling (both laws, compared), three-body (both laws), a 200-point sweep, a sweep with a refused point and Figure 6 work; screenshots in ${shots}`);
 } finally {
   await browser.close();
   child.kill();

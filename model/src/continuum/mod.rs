@@ -12,6 +12,7 @@
 mod answer;
 mod axisymmetric;
 mod compliance;
+mod curve;
 mod grid;
 mod pressed;
 mod rolling;
@@ -24,6 +25,7 @@ pub use answer::{
 };
 pub use axisymmetric::{static_contact, StaticContinuum};
 pub use compliance::{contact_modulus, layer_correction, layer_factor, young_modulus};
+pub use curve::PenetrationCurve;
 pub use grid::{Grid, Influence};
 pub use pressed::{area_between, press, row_edges, GridContact, Pressing, Springs, Surface};
 pub use rolling::{roll, Rolled, RolledContact};

@@ -5,6 +5,7 @@
 use std::f64::consts::PI;
 use std::sync::Arc;
 
+use crate::continuum::PenetrationCurve;
 use crate::roots::brent;
 use crate::similarity::SimilarityTable;
 use crate::ModelError;
@@ -63,6 +64,8 @@ pub enum LayerLaw {
     },
     /// Hertz with E_s2a: F = (4/3)E_s2a R^{1/2} δ^{3/2}, A₂ = πRδ.
     Hertz { modulus: f64 },
+    /// The layer as a continuum (docs/model.md §8) at one speed, through its curve.
+    Continuum { curve: Arc<PenetrationCurve> },
 }
 
 impl LayerLaw {
@@ -91,6 +94,17 @@ impl LayerLaw {
                 4.0 / 3.0 * modulus * radius.sqrt() * delta * delta.sqrt(),
                 PI * radius * delta,
             ),
+            LayerLaw::Continuum { curve } => curve.contact(radius, delta),
+        }
+    }
+
+    /// A bound on the relative error of [`LayerLaw::contact`]'s force and area: the
+    /// continuum curve's there; the closed forms and the table (whose error the
+    /// verification reports apart) count as exact.
+    pub fn error(&self, radius: f64, delta: f64) -> f64 {
+        match self {
+            LayerLaw::Continuum { curve } if delta > 0.0 => curve.error_at(radius, delta),
+            _ => 0.0,
         }
     }
 }
@@ -108,6 +122,8 @@ pub struct Squeeze {
     pub upper_area: f64,
     /// A₂ (m²).
     pub layer_area: f64,
+    /// A bound on the relative error of F and A₂ from the layer's law ([`LayerLaw::error`]).
+    pub layer_error: f64,
 }
 
 /// Splits the interference ω of a particle of diameter x: solves ω₂ + ω₁(F_layer(ω₂)) = ω
@@ -143,6 +159,7 @@ pub fn squeeze(
         force,
         upper_area: upper.area(radius, upper_interference),
         layer_area,
+        layer_error: layer.error(radius, delta),
     })
 }
 

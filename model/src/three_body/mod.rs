@@ -13,12 +13,16 @@ pub use distribution::Diameters;
 
 use std::sync::Arc;
 
+use super::continuum::ContinuumVerification;
+use super::continuum::PenetrationCurve;
 use super::quadrature::{gauss_legendre, GaussRule};
 use super::roots::brent;
-use super::similarity::SimilarityTable;
 use super::tables;
 use super::text::quantity;
-use super::{Layer, ModelError, OptionError, Parameter, ParameterError, Quadrature, SolveOption};
+use super::{
+    Layer, ModelError, OptionError, Parameter, ParameterError, Quadrature, Rolling,
+    RollingSolution, SolveOption,
+};
 
 /// Diameter nodes used when a job does not ask for a number: the particle sums then agree
 /// with 512 nodes to better than 1e-10 (tested).
@@ -89,6 +93,9 @@ pub enum LayerContact {
     KelvinLayer,
     /// Hertz with E_s2a (the paper's eq. 6 reading); independent of speed.
     Hertz,
+    /// The layer as a continuum (docs/model.md §8) at the job's speed, the particle rigid
+    /// as in the Kelvin-layer contact: through [`LayerCurves`].
+    Continuum,
 }
 
 /// What fixes the separation d.
@@ -336,6 +343,10 @@ pub struct ContactState {
     pub max_layer_penetration: f64,
     /// μ = (τ_a A_s2a + τ_s A_s1s2)/W (eq. 12 summed).
     pub friction_coefficient: f64,
+    /// A bound on the relative error of A_s2a and W_a from the layer contacts' law: their
+    /// errors ([`Squeeze::layer_error`]) weighted by what each contact adds to the sums (0
+    /// for the closed-form laws).
+    pub layer_error: f64,
 }
 
 impl ContactState {
@@ -367,6 +378,10 @@ pub struct ThreeBodyVerification {
     pub quadrature_error_estimate: f64,
     /// Relative error of the `kelvin_layer` table against direct solves, when one is used.
     pub layer_table_error: Option<f64>,
+    /// For the `continuum` layer contact: a bound on the relative error of A_s2a and W_a
+    /// from the continuum contacts (their curves' errors, weighted over the sizes), with
+    /// and without rolling, the worse.
+    pub layer_contact_error: Option<f64>,
     pub converged: bool,
 }
 
@@ -378,10 +393,93 @@ pub struct ThreeBodySolution {
     pub verification: ThreeBodyVerification,
 }
 
-/// Solves the three-body system (docs/model.md §4).
+/// The continuum layer's contacts a system with the `continuum` layer contact needs: at its
+/// speed and at rest (one curve when it is at rest), each up to the largest c = √(Rδ) a
+/// particle can reach, √((x_max/2)·max(H, x_max)) (δ ≤ ω ≤ x_max, and δ ≥ H is refused).
+#[derive(Clone, Debug)]
+pub struct LayerCurves {
+    pub rolling: Arc<PenetrationCurve>,
+    pub resting: Arc<PenetrationCurve>,
+}
+
+impl LayerCurves {
+    /// The continuum problems whose answers make the curves of `system`, the rolling
+    /// curve's first ([`PenetrationCurve::problems`]).
+    pub fn problems(system: &ThreeBody) -> Vec<Rolling> {
+        let (layer, reach) = (&system.layer, Self::reach(system));
+        let mut problems = PenetrationCurve::problems(layer, system.velocity, reach);
+        if system.velocity > 0.0 {
+            problems.extend(PenetrationCurve::problems(layer, 0.0, reach));
+        }
+        problems
+    }
+
+    /// The curves from the answers to [`LayerCurves::problems`], in their order.
+    pub fn from_answers(
+        system: &ThreeBody,
+        problems: &[Rolling],
+        answers: &[RollingSolution<ContinuumVerification>],
+    ) -> LayerCurves {
+        let layer = &system.layer;
+        let split = problems
+            .iter()
+            .position(|p| p.velocity != system.velocity)
+            .unwrap_or(problems.len());
+        let curve = |range: std::ops::Range<usize>, velocity: f64| {
+            Arc::new(PenetrationCurve::from_answers(
+                layer,
+                velocity,
+                &problems[range.clone()],
+                &answers[range],
+            ))
+        };
+        let rolling = curve(0..split, system.velocity);
+        let resting = if split < problems.len() {
+            curve(split..problems.len(), 0.0)
+        } else {
+            rolling.clone()
+        };
+        LayerCurves { rolling, resting }
+    }
+
+    /// The curves of `system`, solved here one problem after another.
+    pub fn build(system: &ThreeBody) -> Result<LayerCurves, ModelError> {
+        let problems = Self::problems(system);
+        let answers = problems
+            .iter()
+            .map(PenetrationCurve::solve)
+            .collect::<Result<Vec<_>, _>>()?;
+        Ok(Self::from_answers(system, &problems, &answers))
+    }
+
+    fn reach(system: &ThreeBody) -> f64 {
+        let x_max = system.diameters.max;
+        (0.5 * x_max * system.layer.thickness.max(x_max)).sqrt()
+    }
+}
+
+/// Solves the three-body system (docs/model.md §4); with the `continuum` layer contact,
+/// its curves are built here ([`LayerCurves::build`]; [`solve_with`] takes them built).
 pub fn solve(
     system: &ThreeBody,
     options: &ThreeBodyOptions,
+) -> Result<ThreeBodySolution, ModelError> {
+    if let Some(e) = system.violations().into_iter().next() {
+        return Err(e.into());
+    }
+    let curves = match system.layer_contact {
+        LayerContact::Continuum => Some(LayerCurves::build(system)?),
+        _ => None,
+    };
+    solve_with(system, options, curves.as_ref())
+}
+
+/// [`solve`] with the continuum layer's curves given (needed for, and used only by, the
+/// `continuum` layer contact).
+pub fn solve_with(
+    system: &ThreeBody,
+    options: &ThreeBodyOptions,
+    curves: Option<&LayerCurves>,
 ) -> Result<ThreeBodySolution, ModelError> {
     if let Some(e) = system.violations().into_iter().next() {
         return Err(e.into());
@@ -397,15 +495,49 @@ pub fn solve(
         _ => None,
     };
     let layer_table_error = table.as_ref().map(|t| t.error());
-    let rolling = Model::new(system, system.velocity, table, options.diameter_nodes);
-    let fixed = Model::new(system, 0.0, None, options.diameter_nodes);
+    let layer = &system.layer;
+    let (rolling_law, resting_law) = match (system.layer_contact, curves) {
+        (LayerContact::KelvinLayer, _) => (
+            LayerLaw::Kelvin {
+                stiffness: layer.stiffness(),
+                relaxation_length: system.velocity * layer.relaxation_time,
+                table,
+            },
+            LayerLaw::Kelvin {
+                stiffness: layer.stiffness(),
+                relaxation_length: 0.0,
+                table: None,
+            },
+        ),
+        (LayerContact::Hertz, _) => {
+            let hertz = LayerLaw::Hertz {
+                modulus: Model::layer_modulus(system),
+            };
+            (hertz.clone(), hertz)
+        }
+        (LayerContact::Continuum, Some(curves)) => (
+            LayerLaw::Continuum {
+                curve: curves.rolling.clone(),
+            },
+            LayerLaw::Continuum {
+                curve: curves.resting.clone(),
+            },
+        ),
+        (LayerContact::Continuum, None) => {
+            return Err(ModelError::OutOfModel(
+                "the continuum layer contact needs its curves (LayerCurves)".to_string(),
+            ))
+        }
+    };
+    let rolling = Model::new(system, rolling_law, options.diameter_nodes);
+    let fixed = Model::new(system, resting_law, options.diameter_nodes);
     let (state, iterations, residual) = rolling.operate()?;
-    let (static_state, ..) =
-        if system.velocity > 0.0 && system.layer_contact == LayerContact::KelvinLayer {
-            fixed.operate()?
-        } else {
-            (state, iterations, residual)
-        };
+    let (static_state, ..) = if system.velocity > 0.0 && system.layer_contact != LayerContact::Hertz
+    {
+        fixed.operate()?
+    } else {
+        (state, iterations, residual)
+    };
     let coarse = Model {
         nodes: gauss_legendre((options.diameter_nodes / 2).max(2)),
         ..rolling.clone()
@@ -428,6 +560,8 @@ pub fn solve(
             load_residual: residual,
             quadrature_error_estimate,
             layer_table_error,
+            layer_contact_error: (system.layer_contact == LayerContact::Continuum)
+                .then(|| state.layer_error.max(static_state.layer_error)),
             converged: true,
         },
     };
@@ -457,6 +591,11 @@ pub fn solve(
     }
 }
 
+/// (1 − ν²)/E.
+fn compliance(modulus: f64, poisson_ratio: f64) -> f64 {
+    (1.0 - poisson_ratio * poisson_ratio) / modulus
+}
+
 /// The system at one speed, ready to be evaluated at any separation.
 #[derive(Clone, Debug)]
 struct Model<'a> {
@@ -471,25 +610,12 @@ struct Model<'a> {
 }
 
 impl<'a> Model<'a> {
-    fn new(
-        system: &'a ThreeBody,
-        velocity: f64,
-        table: Option<Arc<SimilarityTable>>,
-        nodes: usize,
-    ) -> Self {
-        let compliance = |e: f64, nu: f64| (1.0 - nu * nu) / e;
+    fn new(system: &'a ThreeBody, layer_law: LayerLaw, nodes: usize) -> Self {
         let upper = &system.upper;
         let layer = &system.layer;
-        let particle = system
-            .particle
-            .elastic_modulus
-            .map_or(0.0, |e| compliance(e, system.particle.poisson_ratio));
-        let upper_modulus =
-            1.0 / (compliance(upper.elastic_modulus, upper.poisson_ratio) + particle);
-        // E_s2a of the layer and the particle (docs/model.md §4): a finite particle modulus enters
-        // the Hertz layer contact; the Kelvin layer contact (§3) takes the particle rigid.
-        let layer_modulus =
-            1.0 / (compliance(layer.elastic_modulus, layer.poisson_ratio) + particle);
+        let upper_modulus = 1.0
+            / (compliance(upper.elastic_modulus, upper.poisson_ratio)
+                + Self::particle_compliance(system));
         let pair_modulus = 1.0
             / (compliance(upper.elastic_modulus, upper.poisson_ratio)
                 + compliance(layer.elastic_modulus, layer.poisson_ratio));
@@ -506,16 +632,7 @@ impl<'a> Model<'a> {
                     modulus: upper_modulus,
                 },
             },
-            layer: match system.layer_contact {
-                LayerContact::KelvinLayer => LayerLaw::Kelvin {
-                    stiffness: layer.stiffness(),
-                    relaxation_length: velocity * layer.relaxation_time,
-                    table,
-                },
-                LayerContact::Hertz => LayerLaw::Hertz {
-                    modulus: layer_modulus,
-                },
-            },
+            layer: layer_law,
             zmc: system
                 .asperities
                 .map(|a| Zmc::new(a, pair_modulus, soft_poisson)),
@@ -527,16 +644,36 @@ impl<'a> Model<'a> {
         }
     }
 
+    /// (1 − ν_a²)/E_a of the particles (0 when rigid).
+    fn particle_compliance(system: &ThreeBody) -> f64 {
+        system
+            .particle
+            .elastic_modulus
+            .map_or(0.0, |e| compliance(e, system.particle.poisson_ratio))
+    }
+
+    /// E_s2a of the layer and the particle (docs/model.md §4): a finite particle modulus
+    /// enters the Hertz layer contact; the Kelvin-layer and continuum contacts take the
+    /// particle rigid.
+    fn layer_modulus(system: &ThreeBody) -> f64 {
+        let layer = &system.layer;
+        1.0 / (compliance(layer.elastic_modulus, layer.poisson_ratio)
+            + Self::particle_compliance(system))
+    }
+
     /// Every quantity of the system at separation d.
     fn state(&self, separation: f64) -> Result<ContactState, ModelError> {
         let system = self.system;
         let count = system.nominal_area * system.areal_density;
         let d = &system.diameters;
         let (mut a1, mut a2, mut load) = (0.0, 0.0, 0.0);
+        // Σ A₂ε and Σ Fε, ε each contact's layer error.
+        let (mut a2_error, mut load_error) = (0.0, 0.0);
         if d.is_single_size() {
             if d.mean > separation {
                 let s = squeeze(&self.upper, &self.layer, d.mean, d.mean - separation)?;
                 (a1, a2, load) = (s.upper_area, s.layer_area, s.force);
+                (a2_error, load_error) = (a2 * s.layer_error, load * s.layer_error);
             }
         } else {
             let lo = separation.max(d.min);
@@ -560,6 +697,8 @@ impl<'a> Model<'a> {
                     a1 += weight * s.upper_area;
                     a2 += weight * s.layer_area;
                     load += weight * s.force;
+                    a2_error += weight * s.layer_area * s.layer_error;
+                    load_error += weight * s.force * s.layer_error;
                 }
             }
         }
@@ -591,6 +730,11 @@ impl<'a> Model<'a> {
             max_layer_penetration: largest,
             friction_coefficient: (tau_a * areas.particle_layer + tau_s * areas.surface_surface)
                 / loads.total,
+            layer_error: if a2 > 0.0 {
+                (a2_error / a2).max(load_error / load)
+            } else {
+                0.0
+            },
         })
     }
 

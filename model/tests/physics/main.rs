@@ -8,4 +8,5 @@ mod numerical_honesty;
 mod reference_table;
 mod rolling_limits;
 mod similarity;
+mod three_body_continuum;
 mod trends;

@@ -205,7 +205,9 @@ impl FitInput {
     /// Reads the fit under `checker`; `max_points` bounds the number of points.
     pub fn read(&self, checker: &mut Checker, max_points: usize) -> Problem {
         let input = self;
-        let base = checker.nested(field!(input.layer), |c, layer| layer.read_local(c));
+        let base = checker.nested(field!(input.layer), |c, layer| {
+            layer.read_local(c, "a fit takes the paper's local law")
+        });
         checker.parameters(base.violations());
         let (free, bounds) = checker.nested(field!(input.parameters), |c, p| {
             read_parameters(p, &base, c)

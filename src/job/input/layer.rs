@@ -69,15 +69,15 @@ impl LayerInput {
         }
     }
 
-    /// [`LayerInput::read`] where only the local law is offered (three-body systems and
-    /// fits): `model: "continuum"` is an error naming the field.
-    pub fn read_local(&self, checker: &mut Checker) -> Layer {
+    /// [`LayerInput::read`] where the layer's law is chosen elsewhere (a three-body
+    /// system's `layer_contact`, named by `instead`): `model: "continuum"` is an error
+    /// naming the field and saying where to ask.
+    pub fn read_local(&self, checker: &mut Checker, instead: &str) -> Layer {
         if self.model == Some(LayerModel::Continuum) {
             checker.invalid(
                 "model",
                 "continuum".into(),
-                "\"local\": here the layer is the paper's local law (the continuum is offered \
-                 for rolling jobs and their sweeps)",
+                &format!("\"local\" or absent: {instead}"),
             );
         }
         self.read(checker)

@@ -14,14 +14,18 @@ use utoipa::ToSchema;
 use super::input::LayerModel;
 use super::input::{self, field, Checker, Field, Quantity};
 use super::kind::SMALL_ANSWER;
-use super::meta::REFERENCES;
 use super::points::{self, SweepSummary};
 use super::rolling::{RollingInput, RollingJob, Solved};
-use super::three_body::{operating_fields, slot, ThreeBodyInput, ThreeBodyJob};
+use super::three_body::{
+    operating_fields, references as three_body_references, slot, solve_kept, ThreeBodyInput,
+    ThreeBodyJob,
+};
 use super::validity::Subject;
 use super::{Control, JobError, Kind, Limits, Meta, OnRefusal, References, Swept, Validated, Work};
 use crate::model::tables::Use;
-use crate::model::three_body::{self, Diameters, OperatingPoint, ThreeBody, ThreeBodySolution};
+use crate::model::three_body::{
+    Diameters, LayerContact, OperatingPoint, ThreeBody, ThreeBodySolution,
+};
 use crate::model::{Parameter, Rolling, SolveOptions, MODEL_VERSION};
 use crate::render::{self, Fields, Output, Table, UnitTable};
 use crate::{described, unit_table};
@@ -187,7 +191,7 @@ impl Kind for SweepJob {
     fn references(&self) -> &'static References {
         match &self.points {
             SweepOfPoints::Rolling(s) => s.base.references(),
-            SweepOfPoints::ThreeBody(_) => &REFERENCES,
+            SweepOfPoints::ThreeBody(s) => three_body_references(&s.base.system),
         }
     }
 
@@ -202,6 +206,11 @@ impl Kind for SweepJob {
                 "sweep of rolling on the continuum"
             }
             SweepOfPoints::Rolling(_) => "sweep of rolling",
+            SweepOfPoints::ThreeBody(s)
+                if s.base.system.layer_contact == LayerContact::Continuum =>
+            {
+                "sweep of three_body on the continuum"
+            }
             SweepOfPoints::ThreeBody(_) => "sweep of three_body",
         }
     }
@@ -264,7 +273,7 @@ impl Kind for SweepJob {
                 let kept = control.kept(
                     |p| format!("{MODEL_VERSION} three_body {p:?} {options:?}"),
                     |_| std::mem::size_of::<ThreeBodySolution>(),
-                    |p| three_body::solve(p, options),
+                    |p| solve_kept(p, options, control),
                 );
                 let swept = control.map_each(&systems, on_refusal, |p| {
                     ThreeBodySweepPoint::new(p, &kept(p)?)

@@ -12,15 +12,17 @@ use utoipa::ToSchema;
 
 use super::input::units::Dimension;
 use super::input::{self, field, Checker, LayerInput, QuadratureKind, Quantity};
-use super::meta::REFERENCES;
+use super::meta::{REFERENCES, THREE_BODY_CONTINUUM_REFERENCES};
 use super::points::{self, PointNotes, PointNotesFields, PointStatus, Row, SweepVerification};
 use super::validity::{self, PointValidity, Subject, ValidityOutput};
 use super::{Control, JobError, Kind, Limits, Meta, References, Validated, Work};
+use crate::model::continuum::{ContinuumVerification, PenetrationCurve};
 use crate::model::three_body::{
-    self, Asperities, ContactState, Diameters, LayerContact, OperatingPoint, Particle, ThreeBody,
-    ThreeBodyOptions, ThreeBodySolution, UpperContact, UpperSurface, DEFAULT_DIAMETER_NODES,
+    self, Asperities, ContactState, Diameters, LayerContact, LayerCurves, OperatingPoint, Particle,
+    ThreeBody, ThreeBodyOptions, ThreeBodySolution, UpperContact, UpperSurface,
+    DEFAULT_DIAMETER_NODES,
 };
-use crate::model::{Parameter, SolveOption};
+use crate::model::{ModelError, Parameter, Rolling, RollingSolution, SolveOption, MODEL_VERSION};
 use crate::render::{fields, Column, Output, Table, UnitTable};
 use crate::{described, unit_table};
 
@@ -101,6 +103,10 @@ pub enum LayerContactKind {
     KelvinLayer,
     /// Hertz (the paper's eq. 6 reading).
     Hertz,
+    /// The layer as a continuum (docs/model.md §8) at the job's speed: each particle's
+    /// contact is the single-particle continuum answer, through a curve over the contact's
+    /// size built once per layer and speed (about a second).
+    Continuum,
 }
 
 /// Asperities of the rough pair.
@@ -362,7 +368,13 @@ impl ThreeBodyJob {
                 OperatingPoint::Separation(f64::NAN)
             }
         };
-        let layer = checker.nested(field!(input.layer), |c, l| l.read_local(c));
+        let layer = checker.nested(field!(input.layer), |c, l| {
+            l.read_local(
+                c,
+                "a three-body system takes the layer as a continuum through \"layer_contact\": \
+                 \"continuum\"",
+            )
+        });
         let options = checker.nested(field!(input.options), |c, o| o.read(c));
         let system = ThreeBody {
             diameters,
@@ -373,6 +385,7 @@ impl ThreeBodyJob {
             layer,
             layer_contact: match input.layer_contact {
                 Some(LayerContactKind::Hertz) => LayerContact::Hertz,
+                Some(LayerContactKind::Continuum) => LayerContact::Continuum,
                 _ => LayerContact::KelvinLayer,
             },
             asperities,
@@ -404,6 +417,7 @@ impl ThreeBodyJob {
             layer_contact: Some(match s.layer_contact {
                 LayerContact::KelvinLayer => LayerContactKind::KelvinLayer,
                 LayerContact::Hertz => LayerContactKind::Hertz,
+                LayerContact::Continuum => LayerContactKind::Continuum,
             }),
             asperities: s.asperities.as_ref().map(AsperitiesInput::of),
             velocity: Quantity::si(s.velocity),
@@ -433,17 +447,84 @@ impl Kind for ThreeBodyJob {
     }
 
     fn references(&self) -> &'static References {
-        &REFERENCES
+        references(&self.system)
     }
 
+    /// The system, and on the continuum each node of its layer's curves.
     fn work(&self) -> Work {
-        Work::Known(1)
+        Work::Known(1 + self.continuum_problems().len())
+    }
+
+    /// A system on the continuum costs a second, a thousand times one on the local law.
+    fn cost_class(&self) -> &'static str {
+        match self.system.layer_contact {
+            LayerContact::Continuum => "three_body on the continuum",
+            _ => Self::NAME,
+        }
     }
 
     fn run(&self, meta: Meta, control: &Control) -> Result<ThreeBodyOutput, JobError> {
-        let solution = control.solve(|| three_body::solve(&self.system, &self.options))?;
+        let problems = self.continuum_problems();
+        let curves = if problems.is_empty() {
+            None
+        } else {
+            let answers = control.map(&problems, kept_node(control))?;
+            Some(LayerCurves::from_answers(&self.system, &problems, &answers))
+        };
+        let solution = control
+            .solve(|| three_body::solve_with(&self.system, &self.options, curves.as_ref()))?;
         ThreeBodyOutput::new(&self.system, &solution, meta)
     }
+}
+
+impl ThreeBodyJob {
+    /// The continuum problems of the system's layer curves (none off the continuum).
+    fn continuum_problems(&self) -> Vec<Rolling> {
+        match self.system.layer_contact {
+            LayerContact::Continuum => LayerCurves::problems(&self.system),
+            _ => Vec::new(),
+        }
+    }
+}
+
+/// The papers behind `system`'s answer: the continuum's besides the model's when its layer
+/// contact is the continuum.
+pub fn references(system: &ThreeBody) -> &'static References {
+    match system.layer_contact {
+        LayerContact::Continuum => &THREE_BODY_CONTINUUM_REFERENCES,
+        _ => &REFERENCES,
+    }
+}
+
+/// Solves one node of a continuum layer curve, kept in `control`'s memo: every system on
+/// the same layer at the same speed shares its nodes (a sweep's points, a retry).
+pub fn kept_node(
+    control: &Control,
+) -> impl Fn(&Rolling) -> Result<RollingSolution<ContinuumVerification>, ModelError> + Sync + '_ {
+    control.kept(
+        |p: &Rolling| format!("{MODEL_VERSION} continuum curve node {p:?}"),
+        |_| std::mem::size_of::<RollingSolution<ContinuumVerification>>(),
+        PenetrationCurve::solve,
+    )
+}
+
+/// `system` solved, its continuum curves (if any) built here from nodes kept in `control`'s
+/// memo, one after another (a sweep's points are solved in parallel already).
+pub fn solve_kept(
+    system: &ThreeBody,
+    options: &ThreeBodyOptions,
+    control: &Control,
+) -> Result<ThreeBodySolution, ModelError> {
+    let curves = match system.layer_contact {
+        LayerContact::Continuum => {
+            let problems = LayerCurves::problems(system);
+            let node = kept_node(control);
+            let answers = problems.iter().map(node).collect::<Result<Vec<_>, _>>()?;
+            Some(LayerCurves::from_answers(system, &problems, &answers))
+        }
+        _ => None,
+    };
+    three_body::solve_with(system, options, curves.as_ref())
 }
 
 /// `{"separation": d}`, `{"total_load": W}` or `{"particle_load": P}`.
@@ -544,6 +625,12 @@ described! {
         /// Relative error of the kelvin_layer table against direct solves (when used).
         #[serde(default, skip_serializing_if = "Option::is_none")]
         pub layer_table_error: Option<f64> => [unit ""],
+        /// On the continuum layer contact: a bound on the relative error of the particles'
+        /// layer areas and loads from the continuum contacts (each contact's discretisation
+        /// error and its curve's interpolation, weighted over the sizes), with and without
+        /// rolling, the worse.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        pub layer_contact_error: Option<f64> => [unit ""],
         pub converged: bool => [],
     }
 }
@@ -560,12 +647,18 @@ impl ThreeBodyVerificationOutput {
             quadrature_error_estimate: self
                 .quadrature_error_estimate
                 .max(other.quadrature_error_estimate),
-            layer_table_error: match (self.layer_table_error, other.layer_table_error) {
-                (Some(a), Some(b)) => Some(a.max(b)),
-                (a, b) => a.or(b),
-            },
+            layer_table_error: worse(self.layer_table_error, other.layer_table_error),
+            layer_contact_error: worse(self.layer_contact_error, other.layer_contact_error),
             converged: self.converged && other.converged,
         }
+    }
+}
+
+/// The larger of two optional errors; the one given when only one is.
+fn worse(a: Option<f64>, b: Option<f64>) -> Option<f64> {
+    match (a, b) {
+        (Some(a), Some(b)) => Some(a.max(b)),
+        (a, b) => a.or(b),
     }
 }
 
@@ -613,6 +706,7 @@ impl From<&ThreeBodySolution> for ThreeBodyVerificationOutput {
             relative_load_residual: v.load_residual,
             quadrature_error_estimate: v.quadrature_error_estimate,
             layer_table_error: v.layer_table_error,
+            layer_contact_error: v.layer_contact_error,
             converged: v.converged,
         }
     }

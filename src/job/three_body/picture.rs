@@ -7,6 +7,7 @@ use serde::Deserialize;
 use super::{ThreeBodyJob, ThreeBodyResult};
 use crate::job::picture::{shown, Asked, Picture, PictureError};
 use crate::model::text::count;
+use crate::model::three_body::LayerContact;
 use crate::render::svg::{Axis, Chart, Layer};
 
 /// What the picture shows of a three-body answer.
@@ -19,7 +20,8 @@ pub struct ThreeBodyPicture {
 
 impl Picture for ThreeBodyPicture {
     fn chart(self) -> Result<Chart, PictureError> {
-        let d = self.meta.job::<ThreeBodyJob>()?.system.diameters;
+        let system = self.meta.job::<ThreeBodyJob>()?.system;
+        let d = system.diameters;
         let state = &self.result.state;
         let separation = state.separation;
         let density = |x: f64| {
@@ -87,7 +89,17 @@ impl Picture for ThreeBodyPicture {
                 share("particle–upper", areas.particle_upper),
                 share("surface–surface", areas.surface_surface),
                 format!("particle–layer: {}", shown(areas.particle_layer, "m^2")),
+                format!("layer: {}", law_name(system.layer_contact)),
             ],
         })
+    }
+}
+
+/// The layer contact law, in a user's words.
+fn law_name(law: LayerContact) -> &'static str {
+    match law {
+        LayerContact::KelvinLayer => "local law (the paper's)",
+        LayerContact::Hertz => "Hertz (eq. 6)",
+        LayerContact::Continuum => "continuum",
     }
 }
