@@ -10,13 +10,13 @@ use std::time::{Duration, Instant};
 
 use serde_json::{json, Value};
 use thirdbody::job::{Control, Job, JobError, Limits};
-use thirdbody::model::fit::{Measured, Point, Setting};
+use thirdbody::model::fit::{Law, Measured, Point, Setting};
 use thirdbody::model::three_body::{OperatingPoint, ThreeBody, ThreeBodyOptions};
 use thirdbody::model::Layer;
 use thirdbody::render::Format;
 
 /// The answer to the fit `input`, as JSON.
-fn fit(input: Value) -> Result<Value, JobError> {
+pub fn fit(input: Value) -> Result<Value, JobError> {
     let job = Job::from_value(json!({"kind": "fit", "input": input}), &Limits::default())?;
     let answer = job.run(job.meta(), &Control::default())?;
     Ok(serde_json::from_slice(&answer.render(Format::Json).unwrap()).unwrap())
@@ -32,21 +32,21 @@ fn model(layer: &Layer, measured: Measured, radius: f64, load: f64, speed: f64) 
         velocity: speed * 1e-9,
         measured,
     };
-    point.value(layer).unwrap()
+    point.value(layer, Law::Local).unwrap()
 }
 
 /// Normal deviates from a seeded xorshift generator (Box–Muller).
-struct Noise(u64);
+pub struct Noise(pub u64);
 
 impl Noise {
-    fn uniform(&mut self) -> f64 {
+    pub fn uniform(&mut self) -> f64 {
         self.0 ^= self.0 << 13;
         self.0 ^= self.0 >> 7;
         self.0 ^= self.0 << 17;
         ((self.0 >> 11) as f64 + 0.5) / (1u64 << 53) as f64
     }
 
-    fn normal(&mut self) -> f64 {
+    pub fn normal(&mut self) -> f64 {
         let (u, v) = (self.uniform(), self.uniform());
         (-2.0 * u.ln()).sqrt() * (2.0 * std::f64::consts::PI * v).cos()
     }
@@ -75,7 +75,7 @@ fn friction_series(layer: &Layer, load: f64, sigma: f64, noise: &mut Noise, give
            "points": points})
 }
 
-fn value(answer: &Value, name: &str) -> f64 {
+pub fn value(answer: &Value, name: &str) -> f64 {
     answer["parameters"][name]["value"].as_f64().unwrap()
 }
 
@@ -256,7 +256,7 @@ fn system_friction(layer: &Layer, total_load: f64, speed: f64) -> f64 {
         velocity: speed * 1e-9,
         measured: Measured::FrictionCoefficient,
     };
-    point.value(layer).unwrap()
+    point.value(layer, Law::Local).unwrap()
 }
 
 #[test]

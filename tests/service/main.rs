@@ -5,6 +5,7 @@
 mod cli;
 mod deploy;
 mod fit;
+mod fit_continuum;
 mod fleet;
 mod honest_answers;
 mod jobs;

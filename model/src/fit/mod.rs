@@ -11,7 +11,7 @@ pub mod forward;
 pub mod lm;
 pub mod stats;
 
-pub use forward::{Measured, Point, Sensitivity, Setting};
+pub use forward::{Law, Measured, Point, Sensitivity, Setting};
 
 use nalgebra::{DMatrix, DVector};
 
@@ -93,11 +93,13 @@ impl FitParameter {
     }
 }
 
-/// Which parameters a fit varies, over a layer that gives the others.
+/// Which parameters a fit varies, over a layer that gives the others, and the layer's law
+/// the model is solved with.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Parameterization {
     pub base: Layer,
     pub free: Vec<FitParameter>,
+    pub law: Law,
 }
 
 impl Parameterization {
@@ -200,7 +202,11 @@ impl Problem {
         }
         self.data
             .iter()
-            .find_map(|d| d.point.value_and_sensitivity(&layer).err())
+            .find_map(|d| {
+                d.point
+                    .value_and_sensitivity(&layer, self.parameterization.law)
+                    .err()
+            })
             .unwrap_or_else(|| {
                 ModelError::OutOfModel(
                     "the weighted residuals overflow at every start: a measured value or an \
@@ -363,7 +369,7 @@ impl<E> Residuals<'_, E> {
         let mut cost = 0.0;
         for d in &self.problem.data {
             (self.check)()?;
-            let Ok(y) = d.point.value(&layer) else {
+            let Ok(y) = d.point.value(&layer, self.problem.parameterization.law) else {
                 return Ok(None);
             };
             cost += ((y - d.value) / d.sigma()).powi(2);
@@ -384,7 +390,8 @@ impl<E> LeastSquares for Residuals<'_, E> {
         let mut jacobian = DMatrix::zeros(n, m);
         for (i, d) in self.problem.data.iter().enumerate() {
             (self.check)()?;
-            let Ok((y, s)) = d.point.value_and_sensitivity(&layer) else {
+            let law = self.problem.parameterization.law;
+            let Ok((y, s)) = d.point.value_and_sensitivity(&layer, law) else {
                 return Ok(None);
             };
             let weight = 1.0 / d.sigma();
@@ -416,6 +423,7 @@ mod tests {
         let p = Parameterization {
             base,
             free: vec![FitParameter::RelaxationTime, FitParameter::Kappa],
+            law: Law::Local,
         };
         let layer = p.layer(&[0.2, 3.0]);
         assert_eq!(layer.relaxation_time, 0.2);
@@ -423,6 +431,7 @@ mod tests {
         let p = Parameterization {
             base,
             free: vec![FitParameter::ElasticModulus, FitParameter::Stiffness],
+            law: Law::Local,
         };
         let layer = p.layer(&[6e9, 3e16]);
         assert!((layer.thickness - 2e-7).abs() < 1e-22);
@@ -430,6 +439,7 @@ mod tests {
             let p = Parameterization {
                 base,
                 free: vec![parameter],
+                law: Law::Local,
             };
             let value = parameter.of(&base) * 1.5;
             let layer = p.layer(&[value]);
@@ -454,7 +464,7 @@ mod tests {
                 };
                 Datum {
                     point,
-                    value: point.value(layer).unwrap(),
+                    value: point.value(layer, Law::Local).unwrap(),
                     uncertainty: Some(1e-3),
                 }
             })
@@ -471,6 +481,7 @@ mod tests {
                     ..*truth
                 },
                 free: vec![FitParameter::RelaxationTime, FitParameter::RetardationTime],
+                law: Law::Local,
             },
             bounds: vec![
                 Bounds {

@@ -5,10 +5,10 @@ use serde::{Deserialize, Serialize};
 use serde_json::json;
 use utoipa::ToSchema;
 
-use crate::job::input::{field, Checker, Field, LayerInput, Quantity};
+use crate::job::input::{field, Checker, Field, LayerInput, LayerModel, Quantity};
 use crate::job::three_body::{OperatingInput, ThreeBodyInput, ThreeBodyJob};
 use crate::model::fit::{
-    Bounds, Datum, FitParameter, Measured, Parameterization, Point, Problem, Setting,
+    Bounds, Datum, FitParameter, Law, Measured, Parameterization, Point, Problem, Setting,
 };
 use crate::model::text::quantity;
 use crate::model::three_body::{OperatingPoint, ThreeBody, ThreeBodyOptions};
@@ -205,9 +205,11 @@ impl FitInput {
     /// Reads the fit under `checker`; `max_points` bounds the number of points.
     pub fn read(&self, checker: &mut Checker, max_points: usize) -> Problem {
         let input = self;
-        let base = checker.nested(field!(input.layer), |c, layer| {
-            layer.read_local(c, "a fit takes the paper's local law")
-        });
+        let base = checker.nested(field!(input.layer), |c, layer| layer.read(c));
+        let law = match input.layer.as_ref().and_then(|l| l.model) {
+            Some(LayerModel::Continuum) => Law::Continuum,
+            _ => Law::Local,
+        };
         checker.parameters(base.violations());
         let (free, bounds) = checker.nested(field!(input.parameters), |c, p| {
             read_parameters(p, &base, c)
@@ -222,7 +224,7 @@ impl FitInput {
         }
         let data = read_series(input.series.as_deref(), max_points, checker);
         let problem = Problem {
-            parameterization: Parameterization { base, free },
+            parameterization: Parameterization { base, free, law },
             bounds,
             data,
         };
@@ -248,7 +250,12 @@ impl FitInput {
             })
             .collect();
         FitInput {
-            layer: Some(LayerInput::of(&problem.parameterization.base, None)),
+            // The local law unnamed, as before the continuum was offered (the canonical
+            // form, and so the cache key, of a local fit is unchanged).
+            layer: Some(LayerInput::of(
+                &problem.parameterization.base,
+                (problem.parameterization.law == Law::Continuum).then_some(LayerModel::Continuum),
+            )),
             series: Some(series),
             parameters: Some(ParametersInput::of(problem)),
         }
@@ -356,9 +363,11 @@ fn read_parameters(
     }
     // The starts must make a valid layer (T_ε ≥ T_σ above all).
     let starts: Vec<f64> = all.iter().map(|b| b.start).collect();
+    // Only its layers are read here, which the law does not change.
     let parameterization = Parameterization {
         base: *base,
         free: free.clone(),
+        law: Law::Local,
     };
     if starts.iter().all(|x| x.is_finite()) && base.violations().is_empty() {
         // The starts as a person reads them: each parameter's name and value with its unit.

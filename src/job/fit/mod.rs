@@ -27,10 +27,10 @@ pub use output::{
 
 use super::input as wire;
 use super::kind::SMALL_ANSWER;
-use super::meta::ROLLING_REFERENCES;
+use super::meta::{CONTINUUM_REFERENCES, ROLLING_REFERENCES};
 use super::{Control, FieldError, JobError, Kind, Limits, Meta, References, Validated, Work};
 use crate::model::fit::stats;
-use crate::model::fit::{self, Datum, FitError, Fitted, Point, Problem, Setting};
+use crate::model::fit::{self, Datum, FitError, Fitted, Law, Point, Problem, Setting};
 use crate::model::Layer;
 
 /// A validated fit.
@@ -67,7 +67,18 @@ impl Kind for FitJob {
     }
 
     fn references(&self) -> &'static References {
-        &ROLLING_REFERENCES
+        match self.problem.parameterization.law {
+            Law::Local => &ROLLING_REFERENCES,
+            Law::Continuum => &CONTINUUM_REFERENCES,
+        }
+    }
+
+    /// A fit on the continuum costs a thousand times one on the local law.
+    fn cost_class(&self) -> &'static str {
+        match self.problem.parameterization.law {
+            Law::Local => Self::NAME,
+            Law::Continuum => "fit on the continuum",
+        }
     }
 
     fn work(&self) -> Work {
@@ -96,7 +107,8 @@ impl Kind for FitJob {
         let curves_control = if stop.is_none() { control } else { &drawing };
         let mut curves = Vec::new();
         for (index, points) in self.series_data().enumerate() {
-            curves.push(curve(index, points, &layer, curves_control)?);
+            let law = self.problem.parameterization.law;
+            curves.push(curve(index, points, &layer, law, curves_control)?);
         }
         Ok(FitOutput {
             parameter_names: self.names(),
@@ -375,6 +387,7 @@ fn curve(
     series: usize,
     points: &[Datum],
     layer: &Layer,
+    law: Law,
     control: &Control,
 ) -> Result<Curve, JobError> {
     let first = points.first().map_or_else(
@@ -449,7 +462,7 @@ fn curve(
     }
     let mut curve_points = Vec::with_capacity(grid.len());
     for p in grid {
-        let y = control.solve(|| p.value(layer))?;
+        let y = control.solve(|| p.value(layer, law))?;
         let (friction_coefficient, contact_area) = by_quantity(p.measured, y);
         curve_points.push(CurvePoint {
             at: where_measured(&p),
