@@ -94,6 +94,13 @@ pub trait Kind: fmt::Debug + PartialEq + Send + Sync + Sized + 'static {
         false
     }
 
+    /// Why the job is not answered synchronously, if so: one that takes minutes belongs in
+    /// `POST /v1/jobs`, where its progress shows and a cancel stops it, rather than on a
+    /// request that would wait out the solve deadline for a 504. None by default.
+    fn asynchronous_only(&self) -> Option<JobError> {
+        None
+    }
+
     /// Bytes the answer's JSON and CSV take together, at most: an asynchronous job's store
     /// makes room for its result before accepting it ([`crate::engine::store::JobStore`]).
     /// An answer of a few kilobytes by default; kinds whose answer grows with their input
@@ -163,6 +170,7 @@ trait Dispatch: fmt::Debug + Send + Sync {
     fn work(&self) -> Work;
     fn cost_class(&self) -> &'static str;
     fn small(&self) -> bool;
+    fn asynchronous_only(&self) -> Option<JobError>;
     fn result_bytes(&self) -> u64;
     fn run(&self, meta: Meta, control: &Control) -> Result<Answer, Unfinished>;
     fn points(&self) -> Option<usize>;
@@ -200,6 +208,10 @@ impl<K: Kind> Dispatch for K {
 
     fn small(&self) -> bool {
         Kind::small(self)
+    }
+
+    fn asynchronous_only(&self) -> Option<JobError> {
+        Kind::asynchronous_only(self)
     }
 
     fn result_bytes(&self) -> u64 {
@@ -309,6 +321,11 @@ impl Job {
     /// Whether the job is small enough to run on the caller's thread ([`Kind::small`]).
     pub fn is_small(&self) -> bool {
         self.kind.small()
+    }
+
+    /// Why the job is not answered synchronously, if so ([`Kind::asynchronous_only`]).
+    pub fn asynchronous_only(&self) -> Option<JobError> {
+        self.kind.asynchronous_only()
     }
 
     /// Runs the job to its answer, whose `meta` is `meta` (see [`Job::meta`]); a run

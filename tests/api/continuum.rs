@@ -163,3 +163,26 @@ async fn a_three_body_system_on_the_continuum_runs_as_a_job_with_progress() {
     let rows: Vec<&str> = rows(&answer["meta"]["validity"]);
     assert!(!rows.contains(&"local_layer"), "{rows:?}");
 }
+
+/// A fit of rolling points on the continuum takes minutes: `POST /v1/fits` refuses it at
+/// once, naming `layer.model` and `POST /v1/jobs`, where it runs; at rest it is answered now.
+#[tokio::test]
+async fn a_rolling_fit_on_the_continuum_is_sent_to_the_jobs_and_one_at_rest_answered_now() {
+    let app = spawn_app(&[]).await;
+    let fit = |speed: &str| {
+        json!({"layer": {"model": "continuum", "thickness": "5 nm"},
+               "series": [{"radius": "25 nm", "velocity": speed, "points": [
+                   {"load": "0.2 nN", "value": 0.0254}, {"load": "1 nN", "value": 0.01459},
+                   {"load": "5 nN", "value": 0.00807}]}],
+               "parameters": {"elastic_modulus": {}, "thickness": {}}})
+    };
+    let refused = problem(app.post("/v1/fits", &fit("4 nm/s")).await, 422).await;
+    assert_eq!(refused["errors"][0]["field"], "layer.model");
+    let said = refused["errors"][0]["message"].as_str().unwrap();
+    assert!(said.contains("POST /v1/jobs"), "{said}");
+    let at_rest = app.post("/v1/fits", &fit("0 nm/s")).await;
+    assert_eq!(at_rest.status(), 200);
+    let answer: Value = at_rest.json().await.unwrap();
+    assert_eq!(answer["meta"]["input"]["layer"]["model"], "continuum");
+    assert!(answer["parameters"]["thickness"]["value"].as_f64().unwrap() > 0.0);
+}

@@ -13,7 +13,9 @@ solve_endpoint!(
     /// the best values with standard errors, 95 % intervals and correlations, χ², the
     /// residuals, the fitted curves, and which parameters the data determine. Answered
     /// within the solve deadline; a larger fit belongs in `POST /v1/jobs` (kind `fit`), which
-    /// reports progress and can be cancelled. With `Accept: text/csv`: one row per point.
+    /// reports progress and can be cancelled; a fit of rolling points on the layer as a
+    /// continuum (`layer.model`), which takes minutes, is refused here with 422 and runs
+    /// there. With `Accept: text/csv`: one row per point.
     "/v1/fits",
     "solve_fit",
     FitJob,

@@ -304,7 +304,11 @@ impl SolveRequest {
             .await?;
         let limits = state.config().limits;
         let validate = offload(state, text.len(), move || {
-            Ok(Job::from_input(kind, input, &limits)?.keyed())
+            let job = Job::from_input(kind, input, &limits)?;
+            match job.asynchronous_only() {
+                Some(refusal) => Err(refusal.into()),
+                None => Ok(job.keyed()),
+            }
         });
         let (solved, cache) = state.engine().answer(text, validate).await?;
         self.answering.respond(&solved, Some(cache))

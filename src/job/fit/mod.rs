@@ -73,6 +73,28 @@ impl Kind for FitJob {
         }
     }
 
+    /// A fit of rolling points on the continuum takes minutes (three or four grid answers a
+    /// point for every evaluation of the model); at rest it is as quick as on the local law.
+    fn asynchronous_only(&self) -> Option<JobError> {
+        let problem = &self.problem;
+        let slow = problem.parameterization.law == Law::Continuum
+            && problem.data.iter().any(|d| {
+                d.point.velocity > 0.0 || matches!(d.point.setting, Setting::System { .. })
+            });
+        slow.then(|| {
+            JobError::Invalid(vec![FieldError {
+                field: "layer.model".to_string(),
+                value: "continuum".into(),
+                allowed: "\"local\" for an answer now".to_string(),
+                message: "layer.model: a fit of rolling points (or of a system) on the layer \
+                          as a continuum takes minutes: submit it to POST /v1/jobs as \
+                          {\"kind\": \"fit\", \"input\": ...}, which shows its progress \
+                          and can be cancelled"
+                    .to_string(),
+            }])
+        })
+    }
+
     /// A fit on the continuum costs a thousand times one on the local law.
     fn cost_class(&self) -> &'static str {
         match self.problem.parameterization.law {
