@@ -30,6 +30,12 @@ const PER_DECADE: f64 = 4.0;
 /// is the instantaneous half-space's within about 0.5 % (measured at the defaults).
 const FIRST: f64 = 1e-3;
 
+/// Decades of c the table spans at most: at a speed so slow that V T_σ is this many decades
+/// below the largest contact, the table starts there instead (33 nodes; the contacts
+/// smaller still carry nothing of the sums, and their error is reported, see
+/// [`PenetrationCurve::error_at`]).
+const MOST_DECADES: f64 = 8.0;
+
 /// The sphere the nodes are solved for (any radius gives the same Φ; one this large keeps
 /// δ a minute share of the layer and the contact far smaller than the sphere).
 const REFERENCE_RADIUS: f64 = 1e-3;
@@ -75,7 +81,8 @@ impl PenetrationCurve {
         } else {
             layer.thickness
         };
-        let (bottom, top) = (FIRST * scale, 2.0 * reach.max(FIRST * scale));
+        let top = 2.0 * reach.max(FIRST * scale);
+        let bottom = (FIRST * scale).max(top * 10f64.powf(-MOST_DECADES));
         let decades = (top / bottom).log10();
         let n = (decades * PER_DECADE).ceil().max(3.0) as usize;
         (0..=n)
@@ -105,6 +112,10 @@ impl PenetrationCurve {
         problems: &[Rolling],
         answers: &[RollingSolution<ContinuumVerification>],
     ) -> PenetrationCurve {
+        debug_assert!(
+            problems.len() == answers.len() && problems.len() >= 4,
+            "a curve takes an answer to each of its problems, at least four"
+        );
         let modulus = contact_modulus(layer);
         let nodes: Vec<Node> = problems
             .iter()
@@ -169,9 +180,22 @@ impl PenetrationCurve {
     }
 
     /// A bound on the relative error of the force and the area the curve gives anywhere:
-    /// the worst of [`PenetrationCurve::error_at`].
+    /// the worst of [`PenetrationCurve::error_at`] (at a node, below the first, beyond the
+    /// last).
     pub fn error(&self) -> f64 {
-        self.nodes.iter().map(|n| n.error).fold(0.0, f64::max)
+        let (first, last) = (self.nodes[0], self.nodes[self.nodes.len() - 1]);
+        self.nodes
+            .iter()
+            .map(|n| n.error)
+            .fold(self.below(&first).max(2.0 * last.error), f64::max)
+    }
+
+    /// The error bound below the first node: its own, and the limit's difference from it.
+    fn below(&self, first: &Node) -> f64 {
+        let off = (first.ln_force - self.limit.0)
+            .abs()
+            .max((first.ln_area - self.limit.1).abs());
+        first.error + off
     }
 
     /// A bound on the relative error of the force and the area of a sphere of radius
@@ -182,10 +206,7 @@ impl PenetrationCurve {
         let ln_c = 0.5 * (radius * delta).ln();
         let (first, last) = (self.nodes[0], self.nodes[self.nodes.len() - 1]);
         if ln_c <= first.ln_c {
-            let off = (first.ln_force - self.limit.0)
-                .abs()
-                .max((first.ln_area - self.limit.1).abs());
-            return first.error + off;
+            return self.below(&first);
         }
         if ln_c >= last.ln_c {
             return 2.0 * last.error;

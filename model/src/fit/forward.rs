@@ -13,7 +13,7 @@
 //! ∂ ln A/∂ ln T_σ = ∂ ln A/∂ ln V = g_V, and ∂ ln A/∂ ln E_L = −2/3 + (g_H + g_V)/3: four
 //! solves at most, two at rest. (The local law is the case g_H = 1/2 − g_V/4.) At rest the
 //! continuum's area is the table of its axisymmetric solver's ([`continuum::static_area`]),
-//! rolling it is solved on the grid ([`Law::step`]).
+//! rolling it is solved on the grid ([`Point::step`]).
 //!
 //! A three-body system (docs/model.md §4) mixes particles of every size and the upper surface's
 //! contacts, so it has no such structure: its sensitivities are forward differences in T_σ
@@ -36,22 +36,19 @@ pub enum Law {
 }
 
 impl Law {
-    /// The relative step of the finite differences at speed `velocity`: the local solve
-    /// is accurate to ≈ 1e-12, so [`STEP`]. At rest the continuum is a table with
-    /// continuous slopes: [`STATIC_CONTINUUM_STEP`]. A rolling
-    /// continuum answer is on a pixel grid, and its area moves by up to 4e-3 of itself where
-    /// an edge crosses a pixel's centre as a parameter moves (a few 1e-4 between): a step of
-    /// [`CONTINUUM_STEP`] keeps such a jump to a tenth of a sensitivity.
-    fn step(self, velocity: f64) -> f64 {
-        match self {
-            Law::Local => STEP,
-            Law::Continuum if velocity == 0.0 => STATIC_CONTINUUM_STEP,
-            Law::Continuum => CONTINUUM_STEP,
+    /// The law a point is solved with under the fit's law: a three-body system whose layer
+    /// contact is the continuum's is on the continuum whatever the fit's law.
+    fn at(self, setting: &Setting) -> Law {
+        match setting {
+            Setting::System { system, .. } if system.layer_contact == LayerContact::Continuum => {
+                Law::Continuum
+            }
+            _ => self,
         }
     }
 }
 
-/// What was measured at a point.
+/// What was measured at a point./// What was measured at a point.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Measured {
     /// μ (eq. 12).
@@ -98,11 +95,33 @@ pub struct Sensitivity {
 /// Relative step of the finite differences in ξ and κ: the solve is accurate to ≈ 1e-12,
 /// so the difference errs by ≈ 1e-7 from rounding and ≈ 1e-5 from curvature.
 const STEP: f64 = 1e-5;
-/// The same on the continuum, at rest and rolling ([`Law::step`]).
+/// The same on the continuum, for a particle at rest and otherwise ([`Point::step`]).
 const STATIC_CONTINUUM_STEP: f64 = 1e-4;
 const CONTINUUM_STEP: f64 = 3e-2;
 
 impl Point {
+    /// Whether the point is solved on the continuum under the fit's `law` ([`Law::at`]).
+    pub fn on_continuum(&self, law: Law) -> bool {
+        law.at(&self.setting) == Law::Continuum
+    }
+
+    /// The relative step of the finite differences under `law`: the local solve is
+    /// accurate to ≈ 1e-12, so [`STEP`]. A particle at rest on the continuum is a table
+    /// with continuous slopes: [`STATIC_CONTINUUM_STEP`]. Anything else on the continuum
+    /// is solved on a pixel grid (a system's curves too, at rest or rolling), whose area
+    /// moves in steps of up to 4e-3 of itself where an edge crosses a pixel's centre as a
+    /// parameter moves (a few 1e-4 between): a step of [`CONTINUUM_STEP`] keeps such a jump
+    /// to a tenth of a sensitivity.
+    fn step(&self, law: Law) -> f64 {
+        match (law.at(&self.setting), self.setting) {
+            (Law::Local, _) => STEP,
+            (Law::Continuum, Setting::Particle { .. }) if self.velocity == 0.0 => {
+                STATIC_CONTINUUM_STEP
+            }
+            (Law::Continuum, _) => CONTINUUM_STEP,
+        }
+    }
+
     /// The model's value of what was measured, on `layer` under `law`.
     pub fn value(&self, layer: &Layer, law: Law) -> Result<f64, ModelError> {
         self.solve(layer, self.velocity, law)
@@ -125,12 +144,12 @@ impl Point {
     /// The sensitivities of a particle, through the similarity structure (see the module
     /// doc): on the local law from g_V and ∂ ln α/∂κ, on the continuum from g_H as well.
     fn structured(&self, layer: &Layer, y: f64, law: Law) -> Result<Sensitivity, ModelError> {
-        let log_step = (1.0 + law.step(self.velocity)).ln();
+        let log_step = (1.0 + self.step(law)).ln();
         // At rest α = 1 whatever ξ and κ: only A₀ and τ_a depend on the layer.
         let (g, dk) = if self.velocity == 0.0 {
             (0.0, 0.0)
         } else {
-            let faster = self.solve(layer, self.velocity * (1.0 + law.step(self.velocity)), law)?;
+            let faster = self.solve(layer, self.velocity * (1.0 + self.step(law)), law)?;
             let g = (faster / y).ln() / log_step;
             (g, self.kappa_sensitivity(layer, y, law)?)
         };
@@ -139,7 +158,7 @@ impl Point {
             Law::Local => 0.5 - 0.25 * g,
             Law::Continuum => {
                 let thicker = Layer {
-                    thickness: layer.thickness * (1.0 + law.step(self.velocity)),
+                    thickness: layer.thickness * (1.0 + self.step(law)),
                     ..*layer
                 };
                 (self.solve(&thicker, self.velocity, law)? / y).ln() / log_step
@@ -159,7 +178,7 @@ impl Point {
 
     /// The sensitivities by forward differences in each of T_σ (κ fixed), κ, E_L and H.
     fn differenced(&self, layer: &Layer, y: f64, law: Law) -> Result<Sensitivity, ModelError> {
-        let step = law.step(self.velocity);
+        let step = self.step(law);
         let log_step = (1.0 + step).ln();
         let along = |changed: Layer| -> Result<f64, ModelError> {
             Ok((self.solve(&changed, self.velocity, law)? / y).ln() / log_step)
@@ -191,7 +210,12 @@ impl Point {
     /// ∂ ln y/∂κ at fixed T_σ, by a forward difference.
     fn kappa_sensitivity(&self, layer: &Layer, y: f64, law: Law) -> Result<f64, ModelError> {
         let kappa = layer.kappa();
-        let dkappa = law.step(self.velocity) * kappa.max(1e-3);
+        // On the continuum κ moves the grid (its pixel follows the stiff layer's contact),
+        // so its step is never below the grid's: relative to 1 + κ, not to κ.
+        let dkappa = match law.at(&self.setting) {
+            Law::Local => self.step(law) * kappa.max(1e-3),
+            Law::Continuum => self.step(law) * (1.0 + kappa),
+        };
         let stiffer = Layer {
             retardation_time: layer.relaxation_time * (1.0 + kappa + dkappa),
             ..*layer
@@ -240,7 +264,7 @@ impl Point {
                     layer: *layer,
                     velocity,
                     operating: OperatingPoint::TotalLoad(total_load),
-                    layer_contact: match law {
+                    layer_contact: match law.at(&self.setting) {
                         Law::Local => system.layer_contact,
                         Law::Continuum => LayerContact::Continuum,
                     },
@@ -262,8 +286,8 @@ mod tests {
     /// The sensitivities, through the chain rule of each parameterization, match finite
     /// differences of the value in the parameter itself: on the local law to 1e-4, on the
     /// continuum at rest to 1e-3. (Rolling on the continuum the grid's area moves in steps
-    /// of up to 4e-3 ([`Law::step`]), so no difference quotient is exact enough to check
-    /// against; the rolling continuum fit is tested whole, model/tests/physics/fits.rs.)
+    /// of up to 4e-3 ([`Point::step`]), so no difference quotient is exact enough to check
+    /// against; the rolling continuum fit is tested whole, tests/service/fit_continuum.rs.)
     #[test]
     fn sensitivities_match_finite_differences_in_every_parameter() {
         let base = Layer::default();

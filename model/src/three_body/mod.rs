@@ -343,10 +343,12 @@ pub struct ContactState {
     pub max_layer_penetration: f64,
     /// μ = (τ_a A_s2a + τ_s A_s1s2)/W (eq. 12 summed).
     pub friction_coefficient: f64,
-    /// A bound on the relative error of A_s2a and W_a from the layer contacts' law: their
-    /// errors ([`Squeeze::layer_error`]) weighted by what each contact adds to the sums (0
-    /// for the closed-form laws).
+    /// A bound on the relative error of A_s2a and W_a from the layer contacts' law at this
+    /// separation: their errors ([`Squeeze::layer_error`]) weighted by what each contact
+    /// adds to the sums (0 for the closed-form laws).
     pub layer_error: f64,
+    /// The same for W_a alone.
+    pub layer_load_error: f64,
 }
 
 impl ContactState {
@@ -379,8 +381,9 @@ pub struct ThreeBodyVerification {
     /// Relative error of the `kelvin_layer` table against direct solves, when one is used.
     pub layer_table_error: Option<f64>,
     /// For the `continuum` layer contact: a bound on the relative error of A_s2a and W_a
-    /// from the continuum contacts (their curves' errors, weighted over the sizes), with
-    /// and without rolling, the worse.
+    /// from the continuum contacts (their curves' errors, weighted over the sizes; at a
+    /// given load, the load's error added, which moves the separation), with and without
+    /// rolling, the worse.
     pub layer_contact_error: Option<f64>,
     pub converged: bool,
 }
@@ -395,7 +398,9 @@ pub struct ThreeBodySolution {
 
 /// The continuum layer's contacts a system with the `continuum` layer contact needs: at its
 /// speed and at rest (one curve when it is at rest), each up to the largest c = √(Rδ) a
-/// particle can reach, √((x_max/2)·max(H, x_max)) (δ ≤ ω ≤ x_max, and δ ≥ H is refused).
+/// particle can reach, √((x_max/2)·max(H, x_max)): δ ≤ ω ≤ x_max for every separation
+/// the operating point's root may try, and H keeps a layer thicker than the particles
+/// covered to its thickness.
 #[derive(Clone, Debug)]
 pub struct LayerCurves {
     pub rolling: Arc<PenetrationCurve>,
@@ -560,8 +565,15 @@ pub fn solve_with(
             load_residual: residual,
             quadrature_error_estimate,
             layer_table_error,
-            layer_contact_error: (system.layer_contact == LayerContact::Continuum)
-                .then(|| state.layer_error.max(static_state.layer_error)),
+            layer_contact_error: (system.layer_contact == LayerContact::Continuum).then(|| {
+                // At a given load the force's error moves the separation, and the areas
+                // follow the load (A_s2a grows about as W does): the two errors add.
+                let bound = |s: &ContactState| match system.operating {
+                    OperatingPoint::Separation(_) => s.layer_error,
+                    _ => s.layer_error + s.layer_load_error,
+                };
+                bound(&state).max(bound(&static_state))
+            }),
             converged: true,
         },
     };
@@ -735,6 +747,7 @@ impl<'a> Model<'a> {
             } else {
                 0.0
             },
+            layer_load_error: if load > 0.0 { load_error / load } else { 0.0 },
         })
     }
 

@@ -67,29 +67,30 @@ impl Kind for FitJob {
     }
 
     fn references(&self) -> &'static References {
-        match self.problem.parameterization.law {
-            Law::Local => &ROLLING_REFERENCES,
-            Law::Continuum => &CONTINUUM_REFERENCES,
+        if self.on_continuum() {
+            &CONTINUUM_REFERENCES
+        } else {
+            &ROLLING_REFERENCES
         }
     }
 
     /// A fit of rolling points on the continuum takes minutes (three or four grid answers a
     /// point for every evaluation of the model); at rest it is as quick as on the local law.
     fn asynchronous_only(&self) -> Option<JobError> {
-        let problem = &self.problem;
-        let slow = problem.parameterization.law == Law::Continuum
-            && problem.data.iter().any(|d| {
-                d.point.velocity > 0.0 || matches!(d.point.setting, Setting::System { .. })
-            });
+        let law = self.problem.parameterization.law;
+        let slow = self.problem.data.iter().any(|d| {
+            let p = &d.point;
+            p.on_continuum(law) && (p.velocity > 0.0 || matches!(p.setting, Setting::System { .. }))
+        });
         slow.then(|| {
             JobError::Invalid(vec![FieldError {
                 field: "layer.model".to_string(),
                 value: "continuum".into(),
                 allowed: "\"local\" for an answer now".to_string(),
                 message: "layer.model: a fit of rolling points (or of a system) on the layer \
-                          as a continuum takes minutes: submit it to POST /v1/jobs as \
-                          {\"kind\": \"fit\", \"input\": ...}, which shows its progress \
-                          and can be cancelled"
+                          as a continuum (layer.model, or a system's layer_contact) takes \
+                          minutes: submit it to POST /v1/jobs as {\"kind\": \"fit\", \
+                          \"input\": ...}, which shows its progress and can be cancelled"
                     .to_string(),
             }])
         })
@@ -97,9 +98,10 @@ impl Kind for FitJob {
 
     /// A fit on the continuum costs a thousand times one on the local law.
     fn cost_class(&self) -> &'static str {
-        match self.problem.parameterization.law {
-            Law::Local => Self::NAME,
-            Law::Continuum => "fit on the continuum",
+        if self.on_continuum() {
+            "fit on the continuum"
+        } else {
+            Self::NAME
         }
     }
 
@@ -173,6 +175,13 @@ impl Kind for FitJob {
 }
 
 impl FitJob {
+    /// Whether any point is solved on the continuum (the fit's `layer.model`, or a system's
+    /// `layer_contact`).
+    fn on_continuum(&self) -> bool {
+        let law = self.problem.parameterization.law;
+        self.problem.data.iter().any(|d| d.point.on_continuum(law))
+    }
+
     fn names(&self) -> Vec<&'static str> {
         let free = &self.problem.parameterization.free;
         free.iter().map(|p| p.name()).collect()

@@ -627,8 +627,9 @@ described! {
         pub layer_table_error: Option<f64> => [unit ""],
         /// On the continuum layer contact: a bound on the relative error of the particles'
         /// layer areas and loads from the continuum contacts (each contact's discretisation
-        /// error and its curve's interpolation, weighted over the sizes), with and without
-        /// rolling, the worse.
+        /// error and its curve's interpolation, weighted over the sizes; at a given load the
+        /// load's error added, as it moves the separation), with and without rolling, the
+        /// worse.
         #[serde(default, skip_serializing_if = "Option::is_none")]
         pub layer_contact_error: Option<f64> => [unit ""],
         pub converged: bool => [],
