@@ -35,6 +35,13 @@ impl ElasticContact {
     }
 }
 
+/// Hertz's force (4/3)E*√R d^{3/2} of a rigid sphere of radius `radius` pressed to depth
+/// `depth` into a half-space of plane-strain modulus `modulus` (Johnson eq. 4.23): the
+/// three-body contacts' and the continuum curve's scale.
+pub fn hertz_force(modulus: f64, radius: f64, depth: f64) -> f64 {
+    4.0 / 3.0 * modulus * radius.sqrt() * depth * depth.sqrt()
+}
+
 /// V = 0 on the relaxed layer: δ₀ = √(P/(πkR)), A₀ = 2√(πRP/k),
 /// μ₀ = √(πRHE_L/P)/(1000(1+ν)).
 pub fn relaxed(radius: f64, load: f64, layer: &Layer) -> ElasticContact {

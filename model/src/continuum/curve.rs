@@ -19,6 +19,7 @@ use std::f64::consts::PI;
 use super::answer::{solve, ContinuumVerification};
 use super::compliance::contact_modulus;
 use super::table::static_area;
+use crate::limits::hertz_force;
 use crate::roots::brent;
 use crate::{Layer, ModelError, Quadrature, Rolling, RollingSolution, SolveOptions};
 
@@ -122,7 +123,7 @@ impl PenetrationCurve {
             .zip(answers)
             .map(|(problem, answer)| {
                 let (radius, delta) = (problem.radius, answer.penetration);
-                let hertz = 4.0 / 3.0 * modulus * radius.sqrt() * delta * delta.sqrt();
+                let hertz = hertz_force(modulus, radius, delta);
                 let e = answer.verification.errors;
                 Node {
                     ln_c: 0.5 * (radius * delta).ln(),
@@ -222,7 +223,7 @@ impl PenetrationCurve {
         }
         let (ln_force, ln_area) = self.ratios(0.5 * (radius * delta).ln());
         (
-            4.0 / 3.0 * self.modulus * radius.sqrt() * delta * delta.sqrt() * ln_force.exp(),
+            hertz_force(self.modulus, radius, delta) * ln_force.exp(),
             PI * radius * delta * ln_area.exp(),
         )
     }

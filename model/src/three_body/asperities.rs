@@ -4,6 +4,7 @@
 
 use std::f64::consts::{FRAC_1_SQRT_2, PI};
 
+use crate::limits::hertz_force;
 use crate::quadrature::gauss_legendre;
 
 /// Heights are integrated to this many standard deviations above the separation.
@@ -62,10 +63,7 @@ impl Zmc {
         if w <= 0.0 {
             (0.0, 0.0)
         } else if w < w1 {
-            (
-                PI * beta * w,
-                4.0 / 3.0 * self.modulus * beta.sqrt() * w * w.sqrt(),
-            )
+            (PI * beta * w, hertz_force(self.modulus, beta, w))
         } else if w < w2 {
             let t = (w - w1) / (w2 - w1);
             let area = PI * beta * w * (1.0 - 2.0 * t * t * t + 3.0 * t * t);

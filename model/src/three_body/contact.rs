@@ -6,6 +6,7 @@ use std::f64::consts::PI;
 use std::sync::Arc;
 
 use crate::continuum::PenetrationCurve;
+use crate::limits::hertz_force;
 use crate::roots::brent;
 use crate::similarity::SimilarityTable;
 use crate::ModelError;
@@ -23,9 +24,7 @@ impl UpperLaw {
     /// Force (N) at interference ω₁.
     pub fn force(&self, radius: f64, omega: f64) -> f64 {
         match *self {
-            UpperLaw::Elastic { modulus } => {
-                4.0 / 3.0 * modulus * radius.sqrt() * omega * omega.sqrt()
-            }
+            UpperLaw::Elastic { modulus } => hertz_force(modulus, radius, omega),
             UpperLaw::Plastic { hardness } => hardness * self.area(radius, omega),
         }
     }
@@ -90,10 +89,9 @@ impl LayerLaw {
                     2.0 * PI * radius * delta * phi_a,
                 )
             }
-            LayerLaw::Hertz { modulus } => (
-                4.0 / 3.0 * modulus * radius.sqrt() * delta * delta.sqrt(),
-                PI * radius * delta,
-            ),
+            LayerLaw::Hertz { modulus } => {
+                (hertz_force(*modulus, radius, delta), PI * radius * delta)
+            }
             LayerLaw::Continuum { curve } => curve.contact(radius, delta),
         }
     }

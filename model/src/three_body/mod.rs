@@ -419,8 +419,26 @@ impl LayerCurves {
         problems
     }
 
+    /// The curves of `system` from `solve_all`, which answers [`LayerCurves::problems`] in
+    /// their order (in parallel, from a memo, or one after another, as the caller has it).
+    pub fn solved_by<E>(
+        system: &ThreeBody,
+        solve_all: impl FnOnce(&[Rolling]) -> Result<Vec<RollingSolution<ContinuumVerification>>, E>,
+    ) -> Result<LayerCurves, E> {
+        let problems = Self::problems(system);
+        let answers = solve_all(&problems)?;
+        Ok(Self::from_answers(system, &problems, &answers))
+    }
+
+    /// The curves of `system`, solved here one problem after another.
+    pub fn build(system: &ThreeBody) -> Result<LayerCurves, ModelError> {
+        Self::solved_by(system, |problems| {
+            problems.iter().map(PenetrationCurve::solve).collect()
+        })
+    }
+
     /// The curves from the answers to [`LayerCurves::problems`], in their order.
-    pub fn from_answers(
+    fn from_answers(
         system: &ThreeBody,
         problems: &[Rolling],
         answers: &[RollingSolution<ContinuumVerification>],
@@ -445,16 +463,6 @@ impl LayerCurves {
             rolling.clone()
         };
         LayerCurves { rolling, resting }
-    }
-
-    /// The curves of `system`, solved here one problem after another.
-    pub fn build(system: &ThreeBody) -> Result<LayerCurves, ModelError> {
-        let problems = Self::problems(system);
-        let answers = problems
-            .iter()
-            .map(PenetrationCurve::solve)
-            .collect::<Result<Vec<_>, _>>()?;
-        Ok(Self::from_answers(system, &problems, &answers))
     }
 
     fn reach(system: &ThreeBody) -> f64 {

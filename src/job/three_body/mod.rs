@@ -464,12 +464,11 @@ impl Kind for ThreeBodyJob {
     }
 
     fn run(&self, meta: Meta, control: &Control) -> Result<ThreeBodyOutput, JobError> {
-        let problems = self.continuum_problems();
-        let curves = if problems.is_empty() {
-            None
-        } else {
-            let answers = control.map(&problems, kept_node(control))?;
-            Some(LayerCurves::from_answers(&self.system, &problems, &answers))
+        let curves = match self.system.layer_contact {
+            LayerContact::Continuum => Some(LayerCurves::solved_by(&self.system, |problems| {
+                control.map(problems, kept_node(control))
+            })?),
+            _ => None,
         };
         let solution = control
             .solve(|| three_body::solve_with(&self.system, &self.options, curves.as_ref()))?;
@@ -516,12 +515,9 @@ pub fn solve_kept(
     control: &Control,
 ) -> Result<ThreeBodySolution, ModelError> {
     let curves = match system.layer_contact {
-        LayerContact::Continuum => {
-            let problems = LayerCurves::problems(system);
-            let node = kept_node(control);
-            let answers = problems.iter().map(node).collect::<Result<Vec<_>, _>>()?;
-            Some(LayerCurves::from_answers(system, &problems, &answers))
-        }
+        LayerContact::Continuum => Some(LayerCurves::solved_by(system, |problems| {
+            problems.iter().map(kept_node(control)).collect()
+        })?),
         _ => None,
     };
     three_body::solve_with(system, options, curves.as_ref())
