@@ -78,22 +78,37 @@ impl Kind for FitJob {
     /// point for every evaluation of the model); at rest it is as quick as on the local law.
     fn asynchronous_only(&self) -> Option<JobError> {
         let law = self.problem.parameterization.law;
-        let slow = self.problem.data.iter().any(|d| {
+        let slow = self.problem.data.iter().position(|d| {
             let p = &d.point;
             p.on_continuum(law) && (p.velocity > 0.0 || matches!(p.setting, Setting::System { .. }))
-        });
-        slow.then(|| {
-            JobError::Invalid(vec![FieldError {
-                field: "layer.model".to_string(),
-                value: "continuum".into(),
-                allowed: "\"local\" for an answer now".to_string(),
-                message: "layer.model: a fit of rolling points (or of a system) on the layer \
-                          as a continuum (layer.model, or a system's layer_contact) takes \
-                          minutes: submit it to POST /v1/jobs as {\"kind\": \"fit\", \
-                          \"input\": ...}, which shows its progress and can be cancelled"
-                    .to_string(),
-            }])
-        })
+        })?;
+        // The field that put it on the continuum: the layer's law, or the system's contact.
+        let field = match law {
+            Law::Continuum => "layer.model".to_string(),
+            Law::Local => {
+                let series = self
+                    .series
+                    .iter()
+                    .scan(0, |end, &n| {
+                        *end += n;
+                        Some(*end)
+                    })
+                    .position(|end| slow < end)
+                    .unwrap_or(0);
+                format!("series[{series}].system.layer_contact")
+            }
+        };
+        let message = format!(
+            "{field}: a fit of rolling points (or of a system) on the layer as a continuum \
+             takes minutes: submit it to POST /v1/jobs as {{\"kind\": \"fit\", \"input\": \
+             ...}}, which shows its progress and can be cancelled"
+        );
+        Some(JobError::Invalid(vec![FieldError {
+            field,
+            value: "continuum".into(),
+            allowed: "the local law for an answer now".to_string(),
+            message,
+        }]))
     }
 
     /// A fit on the continuum costs a thousand times one on the local law.
