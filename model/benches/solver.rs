@@ -11,6 +11,7 @@ use criterion::{criterion_group, criterion_main, Criterion};
 use thirdbody_model::continuum;
 use thirdbody_model::rolling::penetration_contact;
 use thirdbody_model::similarity::SimilarityTable;
+use thirdbody_model::spectrum::Terms;
 use thirdbody_model::tables::{self, Use};
 use thirdbody_model::three_body::{
     self, Asperities, LayerContact, OperatingPoint, ThreeBody, ThreeBodyOptions,
@@ -94,7 +95,7 @@ fn three_body(c: &mut Criterion) {
     group.bench_function("similarity_table_build", |b| {
         b.iter(|| {
             SimilarityTable::build(black_box(4.0), |xi| {
-                penetration_contact(xi, 4.0, Quadrature::default())
+                penetration_contact(&Terms::one(4.0, xi), Quadrature::default())
             })
             .unwrap()
         })

@@ -3,6 +3,7 @@
 
 use std::fmt;
 
+use super::spectrum::Terms;
 use super::text::quantity;
 
 /// A thin Kelvin layer bonded to a rigid base (docs/model.md eq. 4): locally
@@ -19,6 +20,9 @@ pub struct Layer {
     pub retardation_time: f64,
     /// T_σ (s), > 0.
     pub relaxation_time: f64,
+    /// The further terms of a Prony series beyond the Kelvin one, as (κ_j = E_j/E_L, τ_j)
+    /// (none for the paper's layer; docs/model.md §9, [`crate::spectrum`]).
+    pub arms: Terms,
 }
 
 impl Default for Layer {
@@ -30,6 +34,7 @@ impl Default for Layer {
             poisson_ratio: 0.35,
             retardation_time: 0.5,
             relaxation_time: 0.1,
+            arms: Terms::default(),
         }
     }
 }
@@ -90,6 +95,11 @@ impl Layer {
                 ),
             });
         }
+        for (strength, time) in self.arms.iter() {
+            let modulus = strength * self.elastic_modulus;
+            errors.extend(Parameter::PronyModulus.check(modulus).err());
+            errors.extend(Parameter::PronyTime.check(time).err());
+        }
         errors
     }
 }
@@ -142,6 +152,22 @@ pub enum Parameter {
     FrictionCoefficient,
     /// A, as measured.
     ContactArea,
+    /// E_j, the modulus of one term of a Prony series.
+    PronyModulus,
+    /// τ_j, the time of one term of a Prony series.
+    PronyTime,
+    /// T, the layer's temperature (absolute).
+    Temperature,
+    /// T_ref, the temperature at which a series' times hold.
+    ReferenceTemperature,
+    /// C₁ of the WLF shift.
+    WlfC1,
+    /// C₂ of the WLF shift.
+    WlfC2,
+    /// A fit's factor on every modulus.
+    ModulusScale,
+    /// A fit's factor on every time.
+    ShiftFactor,
 }
 
 impl Parameter {
@@ -153,14 +179,14 @@ impl Parameter {
             | TipRadius | HeightStd | Separation => "m",
             Load | TotalLoad | ParticleLoad => "N",
             Velocity => "m/s",
-            ElasticModulus | UpperModulus | UpperHardness | ParticleModulus | AsperityHardness => {
-                "Pa"
-            }
+            ElasticModulus | UpperModulus | UpperHardness | ParticleModulus | AsperityHardness
+            | PronyModulus => "Pa",
             PoissonRatio | UpperPoissonRatio | ParticlePoissonRatio => "",
-            RetardationTime | RelaxationTime => "s",
+            RetardationTime | RelaxationTime | PronyTime => "s",
+            Temperature | ReferenceTemperature | WlfC2 => "K",
             ArealDensity | AsperityDensity => "m^-2",
             NominalArea | ContactArea => "m^2",
-            Kappa | FrictionCoefficient => "",
+            Kappa | FrictionCoefficient | WlfC1 | ModulusScale | ShiftFactor => "",
             Stiffness => "Pa/m",
         }
     }
@@ -247,6 +273,14 @@ impl fmt::Display for Parameter {
             Parameter::Stiffness => "stiffness",
             Parameter::FrictionCoefficient => "friction coefficient",
             Parameter::ContactArea => "contact area",
+            Parameter::PronyModulus => "Prony term modulus",
+            Parameter::PronyTime => "Prony term time",
+            Parameter::Temperature => "temperature",
+            Parameter::ReferenceTemperature => "reference temperature",
+            Parameter::WlfC1 => "WLF C1",
+            Parameter::WlfC2 => "WLF C2",
+            Parameter::ModulusScale => "modulus scale",
+            Parameter::ShiftFactor => "shift factor",
         })
     }
 }

@@ -13,6 +13,7 @@ pub mod rolling;
 mod roots;
 pub mod similarity;
 mod special;
+pub mod spectrum;
 pub mod strip;
 pub mod tables;
 pub mod text;

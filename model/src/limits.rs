@@ -48,15 +48,10 @@ pub fn relaxed(radius: f64, load: f64, layer: &Layer) -> ElasticContact {
     ElasticContact::new(radius, load, layer.stiffness(), layer)
 }
 
-/// V → ∞ on the instantaneous layer of stiffness k(1 + κ): δ_∞ = δ₀√(T_σ/T_ε),
-/// A_∞ = A₀√(T_σ/T_ε).
+/// V → ∞ on the instantaneous layer of stiffness k(1 + κ) (k(1 + Σκ_j) for a Prony series):
+/// δ_∞ = δ₀√(T_σ/T_ε), A_∞ = A₀√(T_σ/T_ε).
 pub fn instantaneous(radius: f64, load: f64, layer: &Layer) -> ElasticContact {
-    ElasticContact::new(
-        radius,
-        load,
-        layer.stiffness() * (1.0 + layer.kappa()),
-        layer,
-    )
+    ElasticContact::new(radius, load, layer.instantaneous().stiffness(), layer)
 }
 
 /// The first-order effect of slow rolling (V T_ε ≪ r₀).
@@ -70,10 +65,11 @@ pub struct SlowRolling {
     pub rolling_resistance_coefficient: f64,
 }
 
-/// Small-V asymptotics: the exit edge moves to a = −b + V(T_ε − T_σ) on every strip.
+/// Small-V asymptotics: the exit edge moves to a = −b + V(T_ε − T_σ) on every strip
+/// (a = −b + VΣκ_jτ_j for a Prony series, [`Layer::lag_time`]).
 pub fn slow_rolling(radius: f64, load: f64, velocity: f64, layer: &Layer) -> SlowRolling {
     let r0 = relaxed(radius, load, layer);
-    let lag = velocity * (layer.retardation_time - layer.relaxation_time);
+    let lag = velocity * layer.lag_time();
     SlowRolling {
         contact_area: r0.contact_area - 2.0 * lag * r0.half_width,
         centroid_shift: lag / 2.0,

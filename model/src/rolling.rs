@@ -11,6 +11,7 @@ use std::sync::Arc;
 use super::limits::{relaxed, ElasticContact};
 use super::quadrature::{Spacing, StripRule};
 use super::similarity::{ExactRatios, Ratios, SimilarityTable};
+use super::spectrum::Terms;
 use super::strip::Strip;
 use super::{Layer, ModelError, OptionError, Parameter, Quadrature, SolveOption};
 
@@ -247,12 +248,14 @@ pub(super) fn solve_with(
     let reference = relaxed(rolling.radius, rolling.load, layer);
     let r0 = reference.half_width;
     let xi = rolling.velocity * layer.relaxation_time / r0;
-    let kappa = layer.kappa();
+    let viscosity = layer.viscosity(rolling.velocity / r0);
     for (what, value) in [
         ("the static contact half-width √(2Rδ₀)", r0),
         ("V T_σ / r₀", xi),
+        ("V τ_j / r₀", viscosity.longest()),
     ] {
-        if !value.is_finite() || (value == 0.0 && what != "V T_σ / r₀") {
+        if !value.is_finite() || (value == 0.0 && what == "the static contact half-width √(2Rδ₀)")
+        {
             return Err(ModelError::NotRepresentable {
                 what: what.to_string(),
             });
@@ -261,9 +264,9 @@ pub(super) fn solve_with(
 
     let contact = match table {
         Some(table) if xi > 0.0 => Contact::tabulated(xi, table)?,
-        _ => Contact::exact(xi, kappa, options.quadrature)?,
+        _ => Contact::exact(&viscosity, options.quadrature)?,
     };
-    let section = Section::new(contact.half_width, xi, kappa);
+    let section = Section::new(contact.half_width, viscosity);
     let half_width = contact.half_width * r0;
     let contact_area = contact.area * r0 * r0;
     let pressure_centre_shift = contact.pressure_centre * r0;
@@ -292,19 +295,20 @@ pub(super) fn solve_with(
 
 /// The contact at a given penetration δ rather than a given load (the forward map of the
 /// three-body model, docs/model.md §4, and the builder of the similarity tables), as the
-/// ratios of the similarity law ([`Ratios`]), which depend only on ξ = V T_σ/√(2Rδ) and κ,
-/// with the quadrature error estimate a rolling answer would report there, under `quadrature`
-/// (its nodes spaced for ξ, [`Spacing::for_speed`]). Φ_P runs from 1 (ξ = 0) to 1 + κ
-/// (ξ → ∞); Φ_A is 1 at both ends and dips in between.
+/// ratios of the similarity law ([`Ratios`]), which depend only on the viscous terms in units
+/// of the half-width √(2Rδ) (for the Kelvin layer ξ = V T_σ/√(2Rδ) and κ,
+/// [`crate::Layer::viscosity`]), with the quadrature error estimate a rolling answer would
+/// report there, under `quadrature` (its nodes spaced for the shortest term,
+/// [`Spacing::for_speed`]). Φ_P runs from 1 (ξ = 0) to 1 + Σκ_j (ξ → ∞); Φ_A is 1 at both
+/// ends and dips in between.
 pub fn penetration_contact(
-    xi: f64,
-    kappa: f64,
+    viscosity: &Terms,
     quadrature: Quadrature,
 ) -> Result<ExactRatios, ModelError> {
-    let spacing = Spacing::for_speed(xi);
+    let spacing = Spacing::for_speed(viscosity.shortest());
     let rule = StripRule::shared(quadrature, spacing)?;
     let companion = StripRule::shared(quadrature.companion(), spacing)?;
-    let section = Section::new(1.0, xi, kappa);
+    let section = Section::new(1.0, *viscosity);
     let mut roots = vec![f64::NAN; rule.len()];
     let integrals = section.integrate(&rule, Some(&mut roots))?;
     // At a given penetration there is no load equation, and so no residual to carry.
@@ -404,10 +408,11 @@ struct Contact {
 impl Contact {
     /// By strip sums: the load root ([`Shape::nested`]), then the pressure moment, then the
     /// same integrals under the companion rule for the quadrature error estimate.
-    fn exact(xi: f64, kappa: f64, quadrature: Quadrature) -> Result<Contact, ModelError> {
-        let (shape, coarse) = Shape::nested(xi, kappa, quadrature)?;
-        let companion = StripRule::shared(quadrature.companion(), Spacing::for_speed(xi))?;
-        let section = shape.section(xi, kappa);
+    fn exact(viscosity: &Terms, quadrature: Quadrature) -> Result<Contact, ModelError> {
+        let (shape, coarse) = Shape::nested(viscosity, quadrature)?;
+        let spacing = Spacing::for_speed(viscosity.shortest());
+        let companion = StripRule::shared(quadrature.companion(), spacing)?;
+        let section = shape.section(viscosity);
         let (pressure_moment, quadrature_error_estimate) = section.moment_and_error(
             &shape.rule,
             &shape.exit_roots,
@@ -442,7 +447,7 @@ impl Contact {
     fn tabulated(xi: f64, table: &SimilarityTable) -> Result<Contact, ModelError> {
         let at_rest = table.log_ratios(xi).log_load;
         let root = load_root(
-            log_bracket(table.kappa()),
+            log_bracket(1.0 + table.kappa()),
             -0.25 * at_rest,
             Some((0.0, at_rest)),
             ELASTIC_SLOPE,
@@ -517,30 +522,29 @@ impl Shape {
     /// twice as much per pass, needs one or two passes instead of five. The iterations
     /// reported count every rule's.
     fn nested(
-        xi: f64,
-        kappa: f64,
+        viscosity: &Terms,
         quadrature: Quadrature,
     ) -> Result<(Shape, Option<Shape>), ModelError> {
         /// Rules of fewer strips start cold.
         const NESTED_FROM: usize = 16;
-        let rule = StripRule::shared(quadrature, Spacing::for_speed(xi))?;
+        let rule = StripRule::shared(quadrature, Spacing::for_speed(viscosity.shortest()))?;
         let companion = quadrature.companion();
         // An elastic contact (at rest, or no viscosity) has its root at t = 0, found in one
         // pass: nothing to start.
-        let elastic = xi == 0.0 || kappa == 0.0;
+        let elastic = viscosity.is_empty();
         if elastic || companion.size() >= rule.len() || rule.len() < NESTED_FROM {
             let cold = Start::cold(rule.len());
-            return Ok((Shape::solve(xi, kappa, rule, cold)?, None));
+            return Ok((Shape::solve(viscosity, rule, cold)?, None));
         }
-        let (coarse, _) = Shape::nested(xi, kappa, companion)?;
-        let section = coarse.section(xi, kappa);
+        let (coarse, _) = Shape::nested(viscosity, companion)?;
+        let section = coarse.section(viscosity);
         let start = Start {
             t: coarse.half_width.ln(),
             slope: coarse.slope,
             roots: RootGuide::new(&section, &coarse.rule, &coarse.exit_roots)
                 .guesses(&section, &rule),
         };
-        let mut fine = Shape::solve(xi, kappa, rule, start)?;
+        let mut fine = Shape::solve(viscosity, rule, start)?;
         fine.iterations += coarse.iterations;
         fine.integrals.exit_root_iterations += coarse.integrals.exit_root_iterations;
         Ok((fine, Some(coarse)))
@@ -548,7 +552,7 @@ impl Shape {
 
     /// Solves ln P̂(e^t) = ln(π/4) for t = ln r̂ ([`load_root`]) from `start`; the exit roots
     /// of every strip are warm-started from the previous step.
-    fn solve(xi: f64, kappa: f64, rule: Arc<StripRule>, start: Start) -> Result<Shape, ModelError> {
+    fn solve(viscosity: &Terms, rule: Arc<StripRule>, start: Start) -> Result<Shape, ModelError> {
         let target = FRAC_PI_4.ln();
         let mut rho = start.roots;
         let mut exit_root_iterations = 0;
@@ -557,7 +561,8 @@ impl Shape {
         let mut before: Option<(f64, Vec<f64>)> = None;
         let mut last: Option<f64> = None;
         let what = "penetration (load equation P(δ) = P)";
-        let root = load_root(log_bracket(kappa), start.t, None, start.slope, what, |t| {
+        let bracket = log_bracket(1.0 + viscosity.strength());
+        let root = load_root(bracket, start.t, None, start.slope, what, |t| {
             let roots = last.map(|t1| (t1, rho.clone()));
             if let (Some(t1), Some((t0, rho0))) = (last, &before) {
                 // Each root is a smooth function of t: linear extrapolation from the last
@@ -568,7 +573,7 @@ impl Shape {
                 }
             }
             (before, last) = (roots, Some(t));
-            let integrals = Section::new(t.exp(), xi, kappa).integrate(&rule, Some(&mut rho))?;
+            let integrals = Section::new(t.exp(), *viscosity).integrate(&rule, Some(&mut rho))?;
             exit_root_iterations += integrals.exit_root_iterations;
             Ok((integrals.load.ln() - target, integrals))
         })?;
@@ -586,8 +591,8 @@ impl Shape {
     }
 
     /// The contact region at the solved half-width.
-    fn section(&self, xi: f64, kappa: f64) -> Section {
-        Section::new(self.half_width, xi, kappa)
+    fn section(&self, viscosity: &Terms) -> Section {
+        Section::new(self.half_width, *viscosity)
     }
 }
 
@@ -602,10 +607,11 @@ struct LoadRoot<T> {
     slope: f64,
 }
 
-/// The bracket δ ∈ [0.9 δ_∞, 1.05 δ₀] of docs/model.md §3, in t = ln r̂ (r̂ = √(δ/δ₀)).
-fn log_bracket(kappa: f64) -> (f64, f64) {
+/// The bracket δ ∈ [0.9 δ_∞, 1.05 δ₀] of docs/model.md §3, in t = ln r̂ (r̂ = √(δ/δ₀)),
+/// for a layer whose instantaneous modulus is `stiffening` times its relaxed one.
+fn log_bracket(stiffening: f64) -> (f64, f64) {
     (
-        0.5 * 0.9_f64.ln() - 0.25 * (1.0 + kappa).ln(),
+        0.5 * 0.9_f64.ln() - 0.25 * stiffening.ln(),
         0.5 * 1.05_f64.ln(),
     )
 }
@@ -665,9 +671,10 @@ fn load_root<T>(
     }
 }
 
-/// Exit roots known at some strips, as guesses for others. At given ξ and κ a strip's root
-/// depends only on β = b/λ_σ, smoothly: ρ ≈ (2/3)κβ/(1 + κ) for fast strips and ≈ κ/β for
-/// slow ones, so ρ(1 + β)²/β is nearly constant at both ends and smooth in u = β/(1 + β)
+/// Exit roots known at some strips, as guesses for others. At given viscous terms a strip's
+/// root depends only on β = b/λ (λ the terms' mean length, [`Terms::mean_scale`]), smoothly
+/// (for one arm: ρ ≈ (2/3)κβ/(1 + κ) for fast strips and ≈ κ/β for
+/// slow ones), so ρ(1 + β)²/β is nearly constant at both ends and smooth in u = β/(1 + β)
 /// ∈ (0, 1) (≈ β for fast strips, its slow-strip expansion is one in 1/β ≈ 1 − u). The cubic
 /// in u through the four known strips nearest lands close enough to save the Newton steps
 /// of a cold start, across rules and across nearby penetrations.
@@ -745,8 +752,8 @@ impl RootGuide {
 #[derive(Clone, Copy, Debug)]
 struct Section {
     half_width: f64,
-    relaxation_length: f64,
-    kappa: f64,
+    /// The viscous terms (κ_j, V τ_j/r₀).
+    viscosity: Terms,
 }
 
 /// Integrals over the contact, in units of r₀ and k/R.
@@ -769,25 +776,24 @@ impl Integrals {
 }
 
 impl Section {
-    fn new(half_width: f64, relaxation_length: f64, kappa: f64) -> Self {
+    fn new(half_width: f64, viscosity: Terms) -> Self {
         Section {
             half_width,
-            relaxation_length,
-            kappa,
+            viscosity,
         }
     }
 
-    /// β = b/λ_σ of the strip with entry edge b (in units of r₀), infinite at rest.
+    /// β = b/λ of the strip with entry edge b (in units of r₀), λ the terms' mean length
+    /// (λ_σ for the Kelvin layer); infinite at rest.
     fn beta(&self, entry: f64) -> f64 {
-        entry / self.relaxation_length
+        entry / self.viscosity.mean_scale()
     }
 
     /// The strip at lateral position y = r sin θ, whose entry edge is b = r cos θ.
-    fn strip(&self, cos_theta: f64) -> Strip {
+    fn strip(&self, cos_theta: f64) -> Strip<'_> {
         Strip {
             entry: self.half_width * cos_theta,
-            relaxation_length: self.relaxation_length,
-            kappa: self.kappa,
+            terms: &self.viscosity,
         }
     }
 
@@ -942,8 +948,7 @@ impl Section {
                 }
                 let strip = Strip {
                     entry: chord.sqrt(),
-                    relaxation_length: self.relaxation_length,
-                    kappa: self.kappa,
+                    terms: &self.viscosity,
                 };
                 let rho = strip.exit_root(None)?.rho;
                 Ok(axis
@@ -972,9 +977,10 @@ mod tests {
         let quadrature = Quadrature::default();
         for kappa in [0.5, 4.0, 100.0] {
             for xi in [1e-5, 1e-3, 0.07, 0.5, 3.0, 100.0] {
+                let viscosity = Terms::one(kappa, xi);
                 let rule = StripRule::shared(quadrature, Spacing::for_speed(xi)).unwrap();
-                let cold = Shape::solve(xi, kappa, rule.clone(), Start::cold(rule.len())).unwrap();
-                let (nested, coarse) = Shape::nested(xi, kappa, quadrature).unwrap();
+                let cold = Shape::solve(&viscosity, rule.clone(), Start::cold(rule.len())).unwrap();
+                let (nested, coarse) = Shape::nested(&viscosity, quadrature).unwrap();
                 let coarse = coarse.expect("the default rule's companion is coarser");
                 assert!(coarse.rule.len() < rule.len());
                 let relative = (nested.half_width / cold.half_width - 1.0).abs();
@@ -1005,7 +1011,7 @@ mod tests {
                 let rule =
                     |nodes| StripRule::shared(Quadrature::Gauss { nodes }, Spacing::for_speed(xi));
                 let (fine, coarse) = (rule(64).unwrap(), rule(32).unwrap());
-                let section = Section::new(0.9, xi, kappa);
+                let section = Section::new(0.9, Terms::one(kappa, xi));
                 let mut known = vec![f64::NAN; coarse.len()];
                 section.integrate(&coarse, Some(&mut known)).unwrap();
                 let guesses = RootGuide::new(&section, &coarse, &known).guesses(&section, &fine);
@@ -1029,8 +1035,7 @@ mod tests {
         let n = solution.boundary.len();
         let r0 = solution.static_contact.half_width;
         let r = solution.half_width / r0;
-        let xi = rolling.velocity * rolling.layer.relaxation_time / r0;
-        let section = Section::new(r, xi, rolling.layer.kappa());
+        let section = Section::new(r, rolling.layer.viscosity(rolling.velocity / r0));
         for (j, point) in solution.boundary.iter().enumerate().skip(n / 2 + 1) {
             let theta = -FRAC_PI_2 + PI * j as f64 / (n - 1) as f64;
             let strip = section.strip(theta.cos());

@@ -1,17 +1,26 @@
-//! One strip y = const of a sphere rolling over a Kelvin layer: the exact solution of
-//! docs/model.md §3 (eq. 5 integrated along x with p = 0 at the entry edge).
+//! One strip y = const of a sphere rolling over a viscoelastic layer: the exact solution of
+//! docs/model.md §3 (eq. 5 integrated along x with p = 0 at the entry edge), for the
+//! Kelvin layer and for a Prony series (§9), whose pressure is a sum of one such term per
+//! Maxwell arm.
 //!
 //! Every function here works in any consistent length unit and returns its quantity divided
 //! by the stiffness factor it carries (k/R for loads, k/2R for pressures): the caller scales.
 //! The exit edge is carried as ρ = 1 + a/b ∈ [0, 2): ρ = 0 is the symmetric static strip
 //! a = −b, so the small asymmetry of slow rolling is resolved to full relative precision.
+//!
+//! With p̂ = p·2R/k, the pressure is p̂ = b² − x² + Σ_j σ̂_j, where arm j (strength
+//! κ_j = E_j/E_∞, relaxation length λ_j = V τ_j) carries σ̂_j = 2κ_jλ_j[(x + λ_j) −
+//! (b + λ_j)e^{(x−b)/λ_j}], the solution of σ̂_j − λ_j σ̂_j′ = 2κ_jλ_j x with σ̂_j(b) = 0.
+//! The Kelvin layer is the one arm κ, λ_σ.
 
 use super::quadrature::gauss_legendre_16;
 use super::special::{exprel2, exprel3, exprel_kernels};
+use super::spectrum::{Terms, CAPACITY};
 use super::ModelError;
 
-/// Strips with β = b/λ_σ below this are "fast": their pressure is nearly the instantaneous
-/// elastic one, and the exit root and the moment are written around that limit.
+/// Arms with β = b/λ below this are "fast" in a strip: their stress is nearly the
+/// instantaneous elastic one, and the exit root and the load and moment are written around
+/// that limit.
 const FAST_STRIP: f64 = 1.0;
 
 /// A Newton step this small (relative to ρ) leaves an error below rounding.
@@ -19,15 +28,14 @@ const NEWTON_SETTLED: f64 = 1e-9;
 /// Newton steps allowed for one exit root before the solver reports non-convergence.
 const MAX_ROOT_ITERATIONS: u32 = 100;
 
-/// The viscous state of one strip: its entry half-chord b and the relaxation length V T_σ.
+/// The viscous state of one strip: its entry half-chord b and the layer's viscous terms.
 #[derive(Clone, Copy, Debug)]
-pub struct Strip {
+pub struct Strip<'a> {
     /// Entry edge b = √(2Rδ − y²) (> 0).
     pub entry: f64,
-    /// λ_σ = V T_σ (0 for a sphere at rest).
-    pub relaxation_length: f64,
-    /// κ = (T_ε − T_σ)/T_σ ≥ 0 ([`super::Layer::kappa`]).
-    pub kappa: f64,
+    /// (κ_j, λ_j = V τ_j) of every arm, in the strip's length unit (none at rest:
+    /// [`crate::Layer::viscosity`]).
+    pub terms: &'a Terms,
 }
 
 /// An exit root and the Newton steps it took.
@@ -38,53 +46,48 @@ pub struct ExitRoot {
     pub iterations: u32,
 }
 
-impl Strip {
-    /// Whether the strip is elastic (at rest, or a layer without viscosity): then a = −b.
-    fn is_elastic(&self) -> bool {
-        self.relaxation_length == 0.0 || self.kappa == 0.0
-    }
-
-    /// λ_ε = V T_ε = (1 + κ) λ_σ.
-    pub fn retardation_length(&self) -> f64 {
-        (1.0 + self.kappa) * self.relaxation_length
-    }
-
+impl Strip<'_> {
     /// The exit edge: the root ρ ∈ (0, 2) of g(ρ) = −G(s)/(s − 1), s = ρ − 1 (docs/model.md §3),
     ///
-    /// g(ρ) = ρ + 2κ [E₁(z) + σ E₂(z)],  σ = ρ − 2,  z = βσ,  β = b/λ_σ,
+    /// g(ρ) = ρ + Σ_j 2κ_j [E₁(z_j) + σ E₂(z_j)],  σ = ρ − 2,  z_j = β_jσ,  β_j = b/λ_j,
     ///
-    /// with E₁ = exprel and E₂ = [`exprel2`] (see [`exprel_kernels`]). For fast strips (β < 1) the terms 2κ and
+    /// with E₁ = exprel and E₂ = [`exprel2`] (see [`exprel_kernels`]). For fast arms (β < 1) the terms 2κ and
     /// 2κσE₂ nearly cancel; there the identical form
-    /// g(ρ) = ρ(1 + κ + κβ) − 2κβ + 2κβ(1 + β)σ²E₃(z), E₃ = [`exprel3`], is used instead.
-    /// g′(ρ) = 1 + 2κ(β + 1)E₁′(z) > 0 and g is
+    /// κ[ρ(1 + β) − 2β + 2β(1 + β)σ²E₃(z)], E₃ = [`exprel3`], is used instead.
+    /// g′(ρ) = 1 + Σ 2κ_j(β_j + 1)E₁′(z_j) > 0 and every term is
     /// convex, g(0) < 0 < g(2): exactly one root, and Newton steps from any point land on the
     /// right of it and then descend monotonically. A bisection bracket guards every step.
     /// `guess` (e.g. the root of the same strip at a nearby load) only saves iterations.
     pub fn exit_root(&self, guess: Option<f64>) -> Result<ExitRoot, ModelError> {
-        if self.is_elastic() {
+        if self.terms.is_empty() {
             return Ok(ExitRoot {
                 rho: 0.0,
                 iterations: 0,
             });
         }
-        let (beta, kappa) = (self.beta(), self.kappa);
+        let b = self.entry;
         let g = |rho: f64| {
             let sigma = rho - 2.0;
-            let z = beta * sigma;
-            let (e1, e2, e1_prime) = exprel_kernels(z);
-            let value = if beta < FAST_STRIP {
-                rho * (1.0 + kappa + kappa * beta) - 2.0 * kappa * beta
-                    + 2.0 * kappa * beta * (1.0 + beta) * sigma * sigma * exprel3(z)
-            } else {
-                rho + 2.0 * kappa * (e1 + sigma * e2)
-            };
-            let slope = 1.0 + 2.0 * kappa * (beta + 1.0) * e1_prime;
-            (value, slope)
+            self.terms
+                .iter()
+                .fold((rho, 1.0), |(value, slope), (kappa, lambda)| {
+                    let beta = b / lambda;
+                    let z = beta * sigma;
+                    let (e1, e2, e1_prime) = exprel_kernels(z);
+                    let term = if beta < FAST_STRIP {
+                        kappa
+                            * (rho * (1.0 + beta) - 2.0 * beta
+                                + 2.0 * beta * (1.0 + beta) * sigma * sigma * exprel3(z))
+                    } else {
+                        2.0 * kappa * (e1 + sigma * e2)
+                    };
+                    (value + term, slope + 2.0 * kappa * (beta + 1.0) * e1_prime)
+                })
         };
         let (mut lo, mut hi) = (0.0_f64, 2.0_f64);
         let mut rho = guess
             .filter(|r| *r > lo && *r < hi)
-            .unwrap_or_else(|| asymptotic_exit(beta, kappa));
+            .unwrap_or_else(|| self.asymptotic_exit());
         for iterations in 1..=MAX_ROOT_ITERATIONS {
             let (value, slope) = g(rho);
             let step = value / slope;
@@ -116,106 +119,163 @@ impl Strip {
         })
     }
 
-    /// Strip load q·R/k, with q = ∫ₐᵇ p dx = (k/R)[(b−a)²(2b+a)/6 + V T_ε (b² − a²)/2].
+    /// Strip load q·R/k, with q = ∫ₐᵇ p dx, at the exit root ρ: the elastic part
+    /// (b−a)²(2b+a)/6 and half of each arm's ∫σ̂_j, which its equation integrated over
+    /// [a, b] gives as λ_j[κ_j(b² − a²) − σ̂_j(a)] = λ_j s_j, s_j the arm's shortfall at the
+    /// exit ([`Strip::shortfalls`]). For the Kelvin layer this is the exact
+    /// (k/R)[(b−a)²(2b+a)/6 + V T_ε (b² − a²)/2].
     pub fn load(&self, rho: f64) -> f64 {
         let b = self.entry;
         let b2 = b * b;
-        b2 * b * (2.0 - rho).powi(2) * (1.0 + rho) / 6.0
-            + self.retardation_length() * b2 * rho * (2.0 - rho) / 2.0
+        let elastic = b2 * b * (2.0 - rho).powi(2) * (1.0 + rho) / 6.0;
+        let shortfalls = self.shortfalls(rho);
+        let viscous: f64 = self
+            .terms
+            .iter()
+            .zip(shortfalls)
+            .map(|((_, lambda), shortfall)| lambda * shortfall)
+            .sum();
+        elastic + 0.5 * viscous
     }
 
-    /// Strip moment m·R/k, with m = ∫ₐᵇ x p dx, at the exit root ρ.
+    /// Each arm's shortfall s_j = κ_j(b² − a²) − σ̂_j(a) at the exit edge a: how far its
+    /// stress there is below its instantaneous elastic one. Since p(a) = 0,
+    /// Σ s_j = (1 + Σκ_j)(b² − a²) exactly; the arm of the shortest λ takes its s from that
+    /// sum (for the Kelvin layer the whole s = (1 + κ)(b² − a²), so no exponential enters),
+    /// whose terms it then outweighs, and its error is multiplied by the smallest λ. The
+    /// others are written not to cancel: κ_j(b² − a²) − σ̂_j(a) directly for slow arms, where
+    /// σ̂_j(a) < 0, and (κ_j/λ_j) t²[b + 2(1 + β_j) t E₃(t/λ_j)], t = a − b, for fast ones,
+    /// where both terms approach κ_j(b² − a²).
+    fn shortfalls(&self, rho: f64) -> [f64; CAPACITY] {
+        let b = self.entry;
+        let a = (rho - 1.0) * b;
+        let chord_squares = b * b * rho * (2.0 - rho); // b² − a²
+        let mut shortfalls = [0.0; CAPACITY];
+        let slowest = self
+            .terms
+            .iter()
+            .enumerate()
+            .min_by(|x, y| x.1 .1.total_cmp(&y.1 .1))
+            .map_or(0, |(j, _)| j);
+        let mut others = 0.0;
+        for (j, (kappa, lambda)) in self.terms.iter().enumerate() {
+            if j == slowest {
+                continue;
+            }
+            shortfalls[j] = if b / lambda < FAST_STRIP {
+                viscous_pressure(b, kappa, lambda, a - b)
+            } else {
+                kappa * chord_squares - arm_stress(b, kappa, lambda, a)
+            };
+            others += shortfalls[j];
+        }
+        shortfalls[slowest] = (1.0 + self.terms.strength()) * chord_squares - others;
+        shortfalls
+    }
+
+    /// Strip moment m·R/k, with m = ∫ₐᵇ x p dx, at the exit root ρ: the elastic part
+    /// (b² − a²)²/8 and half of each arm's ∫xσ̂_j.
     ///
-    /// Slow strips use the exact m = (k/2R)[(b² − a²)²/4 + (2/3) V T_ε (b³ − a³)] − V T_σ q
-    /// (from p(a) = p(b) = 0), written so that its two large terms, which cancel as κ → 0
-    /// (the strip turns symmetric and m → 0), never meet: with a + b = ρb and Δλ = κλ_σ,
-    /// m = (k/2R)(b − a)[(b − a)(a + b)²/4 + (a + b)λ_σ(a − λ_ε) + (2/3)Δλ(a² + ab + b²)],
-    /// every term of which carries a factor ρ or κ. For fast strips its terms grow like λ_σ while m stays finite,
-    /// so there m is split into the instantaneous part (1 + κ)(b² − a²)²/4 (exact) and the
-    /// small viscous correction of [`Strip::viscous_pressure`], integrated by 16-point
-    /// Gauss–Legendre (exact to rounding: the integrand is entire and varies on the scale
-    /// λ_σ > b).
+    /// Slow arms use the arm's equation times x, integrated by parts:
+    /// ∫xσ̂_j = λ_j[−aσ̂_j(a) − ∫σ̂_j] + (2/3)κ_jλ_j(b³ − a³), every term of which carries
+    /// κ_j, and none of which cancels as the strip turns symmetric (for the Kelvin layer this
+    /// is the exact m = (k/2R)[(b² − a²)²/4 + (2/3) V T_ε (b³ − a³)] − V T_σ q). For fast
+    /// arms its terms grow like λ_j while the integral stays finite, so there it is split into
+    /// the instantaneous part κ_j(b² − a²)²/4 (exact) and the small viscous correction of
+    /// [`viscous_pressure`], integrated by 16-point Gauss–Legendre (exact to rounding: the
+    /// integrand is entire and varies on the scale λ_j > b).
     pub fn moment(&self, rho: f64) -> f64 {
         let b = self.entry;
         let chord_squares = b * b * rho * (2.0 - rho); // b² − a²
-        if self.beta() < FAST_STRIP {
-            let a = (rho - 1.0) * b;
-            let (half, mid) = (0.5 * (b - a), 0.5 * (b + a));
-            let (nodes, weights) = gauss_legendre_16();
-            let correction: f64 = nodes
-                .iter()
-                .zip(weights)
-                .map(|(t, w)| {
-                    let x = mid + half * t;
-                    w * x * self.viscous_pressure(x - b)
-                })
-                .sum::<f64>()
-                * half;
-            return 0.5 * ((1.0 + self.kappa) * chord_squares * chord_squares / 4.0 - correction);
-        }
-        let (lambda, chord, sum) = (self.relaxation_length, b * (2.0 - rho), rho * b); // b − a, a + b
         let a = (rho - 1.0) * b;
-        0.5 * chord
-            * (chord * sum * sum / 4.0
-                + sum * lambda * (a - self.retardation_length())
-                + 2.0 / 3.0 * self.kappa * lambda * b * b * (rho * rho - rho + 1.0))
+        let (half, mid) = (0.5 * (b - a), 0.5 * (b + a));
+        let cubes = b * b * b * (2.0 - rho) * (rho * rho - rho + 1.0); // b³ − a³
+        let shortfalls = self.shortfalls(rho);
+        let viscous: f64 = self
+            .terms
+            .iter()
+            .zip(shortfalls)
+            .map(|((kappa, lambda), shortfall)| {
+                if b / lambda < FAST_STRIP {
+                    let (nodes, weights) = gauss_legendre_16();
+                    let correction: f64 = nodes
+                        .iter()
+                        .zip(weights)
+                        .map(|(t, w)| {
+                            let x = mid + half * t;
+                            w * x * viscous_pressure(b, kappa, lambda, x - b)
+                        })
+                        .sum::<f64>()
+                        * half;
+                    kappa * chord_squares * chord_squares / 4.0 - correction
+                } else {
+                    let stress = kappa * chord_squares - shortfall; // σ̂_j(a)
+                    let integral = lambda * shortfall; // ∫σ̂_j
+                    lambda * (-a * stress - integral) + 2.0 / 3.0 * kappa * lambda * cubes
+                }
+            })
+            .sum();
+        0.5 * (chord_squares * chord_squares / 4.0 + viscous)
     }
 
-    /// β = b/λ_σ (infinite at rest).
-    fn beta(&self) -> f64 {
-        self.entry / self.relaxation_length
-    }
-
-    /// The amount by which the viscosity lowers the pressure below the instantaneous elastic
-    /// one, (1 + κ)(b² − x²) − p·2R/k = (κ/λ_σ) t² [b + 2(1 + β) t E₃(t/λ_σ)], t = x − b.
-    fn viscous_pressure(&self, t: f64) -> f64 {
-        let lambda = self.relaxation_length;
-        self.kappa / lambda
-            * t
-            * t
-            * (self.entry + 2.0 * (1.0 + self.beta()) * t * exprel3(t / lambda))
-    }
-
-    /// Pressure p·2R/k at x (any x; zero outside [a, b]):
-    /// p = (k/2R){b² − x² + 2Δλ[(x + λ_σ) − (b + λ_σ)e^{(x−b)/λ_σ}]}, Δλ = κλ_σ,
-    /// with the bracket written as −(x − b) u E₂(u) − b·expm1(u), u = (x − b)/λ_σ, so it does not
-    /// cancel. `rho` is the strip's exit root.
+    /// Pressure p·2R/k at x (any x; zero outside [a, b]): b² − x² + Σ_j σ̂_j(x). `rho` is
+    /// the strip's exit root.
     pub fn pressure(&self, x: f64, rho: f64) -> f64 {
         let b = self.entry;
         let a = (rho - 1.0) * b;
         if !(x > a && x < b) {
             return 0.0;
         }
-        let elastic = b * b - x * x;
-        if self.is_elastic() {
-            return elastic;
-        }
-        let lambda = self.relaxation_length;
-        let u = (x - b) / lambda;
-        // λu² E₂(u) = (x − b)·u E₂(u): u² itself would overflow for very slow strips.
-        let bracket = -(x - b) * (u * exprel2(u)) - b * u.exp_m1();
-        (elastic + 2.0 * self.kappa * lambda * bracket).max(0.0)
+        let viscous: f64 = self
+            .terms
+            .iter()
+            .map(|(kappa, lambda)| arm_stress(b, kappa, lambda, x))
+            .sum();
+        (b * b - x * x + viscous).max(0.0)
+    }
+
+    /// A starting point for the exit root from its two limits: ρ → (2/3)Σκ_jβ_j/(1 + Σκ_j)
+    /// for fast strips (β → 0) and ρ → Σκ_j/β_j for slow ones (β → ∞); the smaller is the
+    /// better guess in between.
+    fn asymptotic_exit(&self) -> f64 {
+        let b = self.entry;
+        let (fast, slow) = self
+            .terms
+            .iter()
+            .fold((0.0, 0.0), |(fast, slow), (kappa, lambda)| {
+                (fast + kappa * b / lambda, slow + kappa * lambda / b)
+            });
+        let fast = 2.0 / 3.0 * fast / (1.0 + self.terms.strength());
+        fast.min(slow).clamp(f64::MIN_POSITIVE, 1.9)
     }
 }
 
-/// A starting point for the exit root from its two limits: ρ → (2/3)κβ/(1+κ) for fast strips
-/// (β → 0) and ρ → κ/β for slow ones (β → ∞); the smaller is the better guess in between.
-fn asymptotic_exit(beta: f64, kappa: f64) -> f64 {
-    let fast = 2.0 / 3.0 * kappa * beta / (1.0 + kappa);
-    let slow = kappa / beta;
-    fast.min(slow).clamp(f64::MIN_POSITIVE, 1.9)
+/// σ̂ = 2κλ[(x + λ) − (b + λ)e^{(x−b)/λ}] of one arm, with the bracket written as
+/// −(x − b) u E₂(u) − b·expm1(u), u = (x − b)/λ, so it does not cancel.
+fn arm_stress(b: f64, kappa: f64, lambda: f64, x: f64) -> f64 {
+    let u = (x - b) / lambda;
+    // λu² E₂(u) = (x − b)·u E₂(u): u² itself would overflow for very slow strips.
+    let bracket = -(x - b) * (u * exprel2(u)) - b * u.exp_m1();
+    2.0 * kappa * lambda * bracket
+}
+
+/// The amount by which one arm's stress falls short of its instantaneous elastic one,
+/// κ(b² − x²) − σ̂ = (κ/λ) t² [b + 2(1 + β) t E₃(t/λ)], t = x − b, β = b/λ.
+fn viscous_pressure(b: f64, kappa: f64, lambda: f64, t: f64) -> f64 {
+    kappa / lambda * t * t * (b + 2.0 * (1.0 + b / lambda) * t * exprel3(t / lambda))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    fn strip(beta: f64, kappa: f64) -> Strip {
-        Strip {
-            entry: 1.0,
-            relaxation_length: 1.0 / beta,
-            kappa,
-        }
+    /// One Kelvin arm of strength κ whose strip has β = b/λ_σ (b = 1).
+    fn arm(beta: f64, kappa: f64) -> Terms {
+        Terms::of([(kappa, 1.0 / beta)]).unwrap()
+    }
+
+    fn strip(terms: &Terms) -> Strip<'_> {
+        Strip { entry: 1.0, terms }
     }
 
     /// G(s) of docs/model.md §3 written literally, for checking the root where it does not cancel.
@@ -229,7 +289,7 @@ mod tests {
     fn exit_root_solves_the_literal_exit_equation() {
         for &beta in &[0.3, 1.0, 3.0, 10.0, 40.0] {
             for &kappa in &[0.1, 1.0, 4.0, 20.0] {
-                let root = strip(beta, kappa).exit_root(None).unwrap();
+                let root = strip(&arm(beta, kappa)).exit_root(None).unwrap();
                 let s = root.rho - 1.0;
                 assert!(s > -1.0 && s < 1.0);
                 let h = 1e-7;
@@ -248,7 +308,7 @@ mod tests {
     fn exit_root_takes_its_fast_and_slow_limits() {
         let kappa = 4.0;
         for &beta in &[1e-6, 1e-4] {
-            let rho = strip(beta, kappa).exit_root(None).unwrap().rho;
+            let rho = strip(&arm(beta, kappa)).exit_root(None).unwrap().rho;
             let fast = 2.0 / 3.0 * kappa * beta / (1.0 + kappa);
             assert!(
                 (rho / fast - 1.0).abs() < 10.0 * beta,
@@ -256,7 +316,7 @@ mod tests {
             );
         }
         for &beta in &[1e4, 1e6] {
-            let rho = strip(beta, kappa).exit_root(None).unwrap().rho;
+            let rho = strip(&arm(beta, kappa)).exit_root(None).unwrap().rho;
             assert!((rho * beta / kappa - 1.0).abs() < 10.0 / beta, "β = {beta}");
         }
     }
@@ -264,7 +324,9 @@ mod tests {
     #[test]
     fn pressure_vanishes_at_both_edges_and_is_positive_between() {
         for &beta in &[0.05, 1.0, 50.0, 1e4] {
-            let s = strip(beta, 4.0);
+            let terms = arm(beta, 4.0);
+            let s = strip(&terms);
+            let (kappa, lambda) = (4.0, 1.0 / beta);
             let rho = s.exit_root(None).unwrap().rho;
             let a = (rho - 1.0) * s.entry;
             let peak = (0..=1000)
@@ -272,12 +334,9 @@ mod tests {
                 .fold(0.0, f64::max);
             // Evaluate the closed form exactly at the edges (bypassing the support test).
             let at = |x: f64| {
-                let u = (x - s.entry) / s.relaxation_length;
+                let u = (x - s.entry) / lambda;
                 s.entry * s.entry - x * x
-                    + 2.0
-                        * s.kappa
-                        * s.relaxation_length
-                        * (-s.relaxation_length * u * u * exprel2(u) - s.entry * u.exp_m1())
+                    + 2.0 * kappa * lambda * (-lambda * u * u * exprel2(u) - s.entry * u.exp_m1())
             };
             assert_eq!(at(s.entry), 0.0);
             assert!(at(a).abs() < 1e-12 * peak, "β = {beta}: p(a) = {}", at(a));
@@ -289,18 +348,34 @@ mod tests {
     }
 
     /// ∫ₐᵇ p dx and ∫ₐᵇ x p dx by composite Gauss–Legendre on a mesh graded towards the entry
-    /// edge (where slow strips have a boundary layer of width V T_σ), against the closed forms.
+    /// edge (where slow arms have a boundary layer of width V τ_j), against the closed forms,
+    /// for the Kelvin layer and for Prony series whose arms are fast, slow or both in one
+    /// strip.
     #[test]
     fn exact_strip_load_and_moment_equal_a_quadrature_of_the_pressure() {
         let (x16, w16) = crate::quadrature::gauss_legendre_16();
-        for &beta in &[0.1, 1.0, 10.0, 100.0] {
-            let s = strip(beta, 4.0);
+        let mut series: Vec<Terms> = [0.1, 1.0, 10.0, 100.0]
+            .iter()
+            .map(|&beta| arm(beta, 4.0))
+            .collect();
+        series.push(Terms::of([(4.0, 10.0), (0.5, 0.01)]).unwrap());
+        series.push(Terms::of([(0.3, 0.02), (2.0, 0.7), (1.0, 30.0), (0.05, 1e3)]).unwrap());
+        for terms in &series {
+            let s = strip(terms);
             let rho = s.exit_root(None).unwrap().rho;
             let (a, b) = ((rho - 1.0) * s.entry, s.entry);
-            // Panels: geometric grading towards b down to a width of 1e-3 λ_σ.
+            // p vanishes at the exit edge whatever the arms.
+            let peak = s.pressure(0.5 * (a + b), rho);
+            let at_exit = b * b - a * a
+                + terms
+                    .iter()
+                    .map(|(k, l)| arm_stress(b, k, l, a))
+                    .sum::<f64>();
+            assert!(at_exit.abs() < 1e-12 * peak, "{terms:?}: p(a) = {at_exit}");
+            // Panels: geometric grading towards b down to a width of 1e-3 of the shortest λ.
             let mut edges = vec![a];
             let mut gap = (b - a) / 2.0;
-            while gap > 1e-3 * s.relaxation_length.min(b - a) {
+            while gap > 1e-3 * terms.shortest().min(b - a) {
                 edges.push(b - gap);
                 gap /= 2.0;
             }
@@ -319,12 +394,32 @@ mod tests {
             let exact_moment = s.moment(rho);
             assert!(
                 (load / exact_load - 1.0).abs() < 1e-11,
-                "β = {beta}: load {load} vs {exact_load}"
+                "{terms:?}: load {load} vs {exact_load}"
             );
             assert!(
                 (moment - exact_moment).abs() < 1e-11 * exact_load * b,
-                "β = {beta}: moment {moment} vs {exact_moment}"
+                "{terms:?}: moment {moment} vs {exact_moment}"
             );
+        }
+    }
+
+    /// Arms of equal time act as one arm of their summed strength.
+    #[test]
+    fn arms_of_one_time_are_one_arm() {
+        for &lambda in &[0.05, 0.8, 20.0] {
+            let split = Terms::of([(1.5, lambda), (2.5, lambda)]).unwrap();
+            let whole = Terms::of([(4.0, lambda)]).unwrap();
+            let (s, w) = (strip(&split), strip(&whole));
+            let (rs, rw) = (
+                s.exit_root(None).unwrap().rho,
+                w.exit_root(None).unwrap().rho,
+            );
+            assert!(
+                (rs / rw - 1.0).abs() < 1e-13,
+                "λ = {lambda}: ρ {rs} vs {rw}"
+            );
+            assert!((s.load(rs) / w.load(rw) - 1.0).abs() < 1e-13);
+            assert!((s.moment(rs) / w.moment(rw) - 1.0).abs() < 1e-12);
         }
     }
 }

@@ -11,7 +11,8 @@ use std::sync::{Arc, Mutex, OnceLock};
 
 use super::rolling::{penetration_contact, solve_with};
 use super::similarity::SimilarityTable;
-use super::{ModelError, Quadrature, Rolling, RollingSolution, SolveOptions};
+use super::spectrum::Terms;
+use super::{Layer, ModelError, Quadrature, Rolling, RollingSolution, SolveOptions};
 
 /// Tables kept at once; the least recently used goes beyond this. A table holds 55–80 kB
 /// (its panels' coefficients), so at most ≈ 2.5 MB.
@@ -42,7 +43,7 @@ pub fn get_or_build(
     // Fail on an invalid rule before building.
     quadrature.check().map_err(ModelError::InvalidOption)?;
     let table = Arc::new(SimilarityTable::build(kappa, |xi| {
-        penetration_contact(xi, kappa, quadrature)
+        penetration_contact(&Terms::one(kappa, xi), quadrature)
     })?);
     let mut tables = lock();
     let key = (kappa.to_bits(), quadrature);
@@ -54,6 +55,19 @@ pub fn get_or_build(
     }
     tables.push((key, table.clone()));
     Ok(table)
+}
+
+/// The table of a layer's whole Prony series under `quadrature`, indexed by its Kelvin term's
+/// ξ = V T_σ/√(2Rδ) (every term's V τ_j/√(2Rδ) is ξ τ_j/T_σ, so one variable still fixes
+/// the contact). Not kept: its key would be the whole series, which a three-body solve
+/// builds once for all its sizes. Its certified error says how well one table's points
+/// follow the series.
+pub fn of_series(layer: &Layer, quadrature: Quadrature) -> Result<SimilarityTable, ModelError> {
+    quadrature.check().map_err(ModelError::InvalidOption)?;
+    let terms = layer.terms();
+    SimilarityTable::build(layer.stiffening() - 1.0, |xi| {
+        penetration_contact(&terms.scaled(xi / layer.relaxation_time), quadrature)
+    })
 }
 
 /// How a rolling solve may use the similarity tables.
@@ -102,7 +116,7 @@ pub fn solve(
 ) -> Result<RollingSolution, ModelError> {
     let kappa = rolling.layer.kappa();
     let table = match tables {
-        _ if !tabulable(kappa, options) => None,
+        _ if !tabulable(rolling, options) => None,
         Use::Exact => None,
         Use::IfBuilt => built(kappa, options.quadrature),
         // Never build for an invalid input: its solve reports what is wrong.
@@ -121,17 +135,20 @@ pub fn solve(
 /// answer solved exactly asks to have built for the answers after it.
 pub fn wanted(rolling: &Rolling, options: &SolveOptions) -> Option<f64> {
     let kappa = rolling.layer.kappa();
-    (tabulable(kappa, options)
+    (tabulable(rolling, options)
         && built(kappa, options.quadrature).is_none()
         && rolling.violations().is_empty())
     .then_some(kappa)
 }
 
-/// Whether a rolling job may be answered through a table at all: its layer is viscous, and
-/// it keeps the default rule (a job that names its own rule is studying that rule's strip
-/// sums).
-fn tabulable(kappa: f64, options: &SolveOptions) -> bool {
-    kappa > 0.0 && options.quadrature == Quadrature::default()
+/// Whether a rolling job may be answered through a table at all: its layer is a viscous
+/// Kelvin layer (a table is one κ's: a Prony series of more terms is solved by strip sums),
+/// and it keeps the default rule (a job that names its own rule is studying that rule's
+/// strip sums).
+fn tabulable(rolling: &Rolling, options: &SolveOptions) -> bool {
+    rolling.layer.kappa() > 0.0
+        && rolling.layer.arms.is_empty()
+        && options.quadrature == Quadrature::default()
 }
 
 /// A table under its key: κ (its bits) and the strip rule.

@@ -12,6 +12,7 @@ mod jobs;
 mod limits;
 mod ops;
 mod pictures;
+mod prony;
 mod results;
 mod solve;
 mod storage;

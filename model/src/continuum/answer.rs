@@ -23,7 +23,7 @@ use super::rolling::{at_rest, roll, Rolled, RolledContact};
 use super::shape::{boundary, chords, lateral_half_width, pressure_grid, resampled};
 use super::table::static_area;
 use crate::limits::{relaxed, ElasticContact};
-use crate::{Layer, ModelError, Rolling, RollingSolution, SolveOptions};
+use crate::{ModelError, Rolling, RollingSolution, SolveOptions};
 
 /// Pixels in the radius of the smallest contact the sphere can have, the instantaneous
 /// elastic one (V → ∞), on the fine grid: every rolling contact is at least 24 pixels
@@ -230,14 +230,11 @@ fn on_grid(
         layer,
     } = *rolling;
     let a0 = (static_area(radius, load, &layer) / PI).sqrt();
-    // The contact at V → ∞: the layer with the instantaneous modulus E T_ε/T_σ.
-    let stiff = Layer {
-        elastic_modulus: layer.elastic_modulus * (1.0 + layer.kappa()),
-        ..layer
-    };
+    // The contact at V → ∞: the layer with the instantaneous modulus.
+    let stiff = layer.instantaneous();
     let smallest = (static_area(radius, load, &stiff) / PI).sqrt();
     let wake = if velocity > 0.0 {
-        (3.0 * velocity * layer.retardation_time).min(6.0 * a0)
+        (3.0 * velocity * layer.creep().terms.longest()).min(6.0 * a0)
     } else {
         0.0
     };

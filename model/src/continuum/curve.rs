@@ -73,12 +73,9 @@ impl PenetrationCurve {
     /// bonded layer (Hertz δ = a²/R, the local law a²/(2R), a thin incompressible layer
     /// a²/(4R)), so c ≥ a/2 and a node with a = 2·reach reaches c ≥ reach.
     pub fn problems(layer: &Layer, velocity: f64, reach: f64) -> Vec<Rolling> {
-        let stiff = Layer {
-            elastic_modulus: layer.elastic_modulus * (1.0 + layer.kappa()),
-            ..*layer
-        };
+        let stiff = layer.instantaneous();
         let scale = if velocity > 0.0 {
-            (velocity * layer.relaxation_time).min(layer.thickness)
+            (velocity * layer.terms().shortest()).min(layer.thickness)
         } else {
             layer.thickness
         };
@@ -138,7 +135,7 @@ impl PenetrationCurve {
             .collect();
         let limit = (
             if velocity > 0.0 {
-                layer.kappa().ln_1p()
+                layer.stiffening().ln()
             } else {
                 0.0
             },

@@ -1,9 +1,10 @@
 //! Steady rolling over the layer on the pixel grid (docs/model.md §8, "Steady rolling"). In
 //! the sphere's frame the material moves towards −x, and the layer deflects under the
-//! remembered pressure p_m = θ p + (1 − θ) ∫_x^∞ e^{−(x′−x)/λ_ε} p(x′) dx′/λ_ε, θ = T_σ/T_ε,
-//! λ_ε = V T_ε. For pressure constant on pixels the memory is exact: a pixel's own weight
-//! 1 − e^{−h/2λ}, the pixel m ≥ 1 ahead e^{−(m−½)h/λ}(1 − e^{−h/λ}), summed by one recursion
-//! per row.
+//! remembered pressure p_m = c₀ p + Σ_k c_k ∫_x^∞ e^{−(x′−x)/λ_k} p(x′) dx′/λ_k, λ_k = V θ_k,
+//! from the layer's creep spectrum ([`crate::spectrum::Creep`]; for the Kelvin layer one
+//! term, c₀ = T_σ/T_ε, θ = T_ε). For pressure constant on pixels the memory is exact: a
+//! pixel's own weight 1 − e^{−h/2λ}, the pixel m ≥ 1 ahead e^{−(m−½)h/λ}(1 − e^{−h/λ}),
+//! summed by one recursion per row and term.
 //!
 //! The problem is not symmetric (the memory looks only ahead), and updating the contact set
 //! of the whole steady problem at once cycles. So the sphere is marched through the layer a
@@ -104,37 +105,37 @@ pub fn roll(rolled: &Rolled, start: Vec<f64>, tolerance: f64) -> Result<RolledCo
     if velocity == 0.0 {
         return Ok(rolled_contact(press(&at_rest, Some(start), exact)?, 0));
     }
-    let theta = layer.relaxation_time / layer.retardation_time;
-    let lambda = velocity * layer.retardation_time;
-    let decay = (-pixel / lambda).exp();
-    let own = -(-0.5 * pixel / lambda).exp_m1();
-    let next = (-0.5 * pixel / lambda).exp() * -(-pixel / lambda).exp_m1();
-    let instant = theta + (1.0 - theta) * own;
-    // The history each pixel's material brings, Σ_{m ≥ 1} w_m p(x + m h): from the pixel
-    // ahead (k + ny), its pressure there and the history it had there.
-    let brought =
-        |k: usize, pressure: &[f64], tail: &[f64]| next * pressure[k + ny] + decay * tail[k + ny];
-    // One pixel of travel carries every pixel's material one pixel on.
-    let carry = |pressure: &[f64], tail: &[f64]| -> Vec<f64> {
-        let mut carried = vec![0.0; nx * ny];
-        for (k, c) in carried.iter_mut().enumerate().take(ny * (nx - 1)) {
-            *c = brought(k, pressure, tail);
-        }
-        carried
-    };
+    let creep = layer.creep();
+    let memories: Vec<Memory> = creep
+        .terms
+        .iter()
+        .map(|(share, time)| Memory::new(share, velocity * time, pixel))
+        .collect();
+    let instant = creep.instant + memories.iter().map(|m| m.share * m.own).sum::<f64>();
     let mut stride = (nx / 16).max(1);
     // The start: as if the pressure had always been `start` (front row first).
     let mut pressure = start;
-    let mut tail = vec![0.0; nx * ny];
-    for k in (0..ny * (nx - 1)).rev() {
-        tail[k] = brought(k, &pressure, &tail);
-    }
+    let mut tails: Vec<Vec<f64>> = memories
+        .iter()
+        .map(|memory| {
+            let mut tail = vec![0.0; nx * ny];
+            for k in (0..ny * (nx - 1)).rev() {
+                tail[k] = memory.brought(k, ny, &pressure, &tail);
+            }
+            tail
+        })
+        .collect();
     let mut step_tolerance = LOOSEST;
     let mut last_change = f64::INFINITY;
     let max_steps = MAX_STEPS_PER_PIXEL * nx;
     for step in 1..=max_steps {
-        let mut memory = surface.deflect(&tail);
-        memory.iter_mut().for_each(|m| *m *= 1.0 - theta);
+        let mut remembered = vec![0.0; nx * ny];
+        for (memory, tail) in memories.iter().zip(&tails) {
+            for (r, t) in remembered.iter_mut().zip(tail) {
+                *r += memory.share * t;
+            }
+        }
+        let memory = surface.deflect(&remembered);
         let rolling = Pressing {
             instant,
             memory: Some(&memory),
@@ -155,8 +156,10 @@ pub fn roll(rolled: &Rolled, start: Vec<f64>, tolerance: f64) -> Result<RolledCo
             stride = (stride / 2).max(1);
         }
         last_change = change;
-        for _ in 0..stride {
-            tail = carry(&contact.pressure, &tail);
+        for (memory, tail) in memories.iter().zip(tails.iter_mut()) {
+            for _ in 0..stride {
+                *tail = memory.carry(nx, ny, &contact.pressure, tail);
+            }
         }
         pressure.clone_from(&contact.pressure);
         if change <= tolerance * total && step_tolerance <= exact {
@@ -168,6 +171,45 @@ pub fn roll(rolled: &Rolled, start: Vec<f64>, tolerance: f64) -> Result<RolledCo
         what: "continuum rolling contact (march)",
         iterations: max_steps as u32,
     })
+}
+
+/// One retardation term of the layer's creep ([`crate::spectrum::Creep`]) on a row of
+/// pixels: the share c_k of the response it carries, and its exact weights for pressure
+/// constant on pixels, with λ = V θ_k.
+struct Memory {
+    share: f64,
+    /// e^{−h/λ}: what a pixel's history keeps over one pixel of travel.
+    decay: f64,
+    /// 1 − e^{−h/2λ}: a pixel's own weight.
+    own: f64,
+    /// e^{−h/2λ}(1 − e^{−h/λ}): the weight of the pixel just ahead.
+    next: f64,
+}
+
+impl Memory {
+    fn new(share: f64, lambda: f64, pixel: f64) -> Memory {
+        Memory {
+            share,
+            decay: (-pixel / lambda).exp(),
+            own: -(-0.5 * pixel / lambda).exp_m1(),
+            next: (-0.5 * pixel / lambda).exp() * -(-pixel / lambda).exp_m1(),
+        }
+    }
+
+    /// The history pixel k's material brings, Σ_{m ≥ 1} w_m p(x + m h): from the pixel
+    /// ahead (k + ny), its pressure there and the history it had there.
+    fn brought(&self, k: usize, ny: usize, pressure: &[f64], tail: &[f64]) -> f64 {
+        self.next * pressure[k + ny] + self.decay * tail[k + ny]
+    }
+
+    /// One pixel of travel carries every pixel's material one pixel on.
+    fn carry(&self, nx: usize, ny: usize, pressure: &[f64], tail: &[f64]) -> Vec<f64> {
+        let mut carried = vec![0.0; nx * ny];
+        for (k, c) in carried.iter_mut().enumerate().take(ny * (nx - 1)) {
+            *c = self.brought(k, ny, pressure, tail);
+        }
+        carried
+    }
 }
 
 /// The contact with its centroid (between its row edges, as its area) and centre of

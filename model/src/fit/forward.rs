@@ -83,7 +83,9 @@ pub struct Point {
     pub measured: Measured,
 }
 
-/// ∂ ln y/∂ ln p at fixed T_σ, κ, E_L and H, except `kappa`: ∂ ln y/∂κ.
+/// ∂ ln y/∂ ln p at fixed T_σ, κ, E_L and H, except `kappa`: ∂ ln y/∂κ. `relaxation_time`
+/// scales every time of the layer (its Prony series' too) and `elastic_modulus` every
+/// modulus: both hold the series' shape.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Sensitivity {
     pub relaxation_time: f64,
@@ -186,12 +188,10 @@ impl Point {
         let (relaxation_time, kappa) = if self.velocity == 0.0 {
             (0.0, 0.0)
         } else {
-            let slower = Layer {
-                relaxation_time: layer.relaxation_time * (1.0 + step),
-                retardation_time: layer.retardation_time * (1.0 + step),
-                ..*layer
-            };
-            (along(slower)?, self.kappa_sensitivity(layer, y, law)?)
+            (
+                along(layer.with_times_scaled(1.0 + step))?,
+                self.kappa_sensitivity(layer, y, law)?,
+            )
         };
         Ok(Sensitivity {
             relaxation_time,
@@ -288,9 +288,18 @@ mod tests {
     /// continuum at rest to 1e-3. (Rolling on the continuum the grid's area moves in steps
     /// of up to 4e-3 ([`Point::step`]), so no difference quotient is exact enough to check
     /// against; the rolling continuum fit is tested whole, tests/service/fit_continuum.rs.)
+    /// On a layer of a four-term Prony series the factors on all moduli and all times are
+    /// checked as well (its single Kelvin times are not offered for it).
     #[test]
     fn sensitivities_match_finite_differences_in_every_parameter() {
-        let base = Layer::default();
+        let material =
+            Layer::from_prony(3e9, 100e-9, 0.35, &[(6e9, 0.01), (4.5e9, 0.1), (3e9, 1.0)]).unwrap();
+        for base in [Layer::default(), material] {
+            sensitivities_match_on(base);
+        }
+    }
+
+    fn sensitivities_match_on(base: Layer) {
         let particle = Setting::Particle {
             radius: 25e-9,
             load: 1e-9,
@@ -318,6 +327,9 @@ mod tests {
                 Law::Continuum => (1e-3, 1e-3),
             };
             for parameter in FitParameter::ALL {
+                if !base.arms.is_empty() && parameter.is_kelvin_time() {
+                    continue;
+                }
                 let p = Parameterization {
                     base,
                     free: vec![parameter],

@@ -35,17 +35,26 @@ pub enum FitParameter {
     Thickness,
     /// k = E_L/H (Pa/m).
     Stiffness,
+    /// A factor on every modulus of the layer (E_L and a Prony series' E_j), relative to
+    /// the fit's base layer.
+    ModulusScale,
+    /// A factor a on every time of the layer (T_ε, T_σ and a Prony series' τ_j), relative
+    /// to the fit's base layer: the shift factor of time–temperature superposition, log₁₀ a
+    /// decades.
+    ShiftFactor,
 }
 
 impl FitParameter {
     /// Every parameter, in the order of the wire's names.
-    pub const ALL: [FitParameter; 6] = [
+    pub const ALL: [FitParameter; 8] = [
         FitParameter::RelaxationTime,
         FitParameter::RetardationTime,
         FitParameter::Kappa,
         FitParameter::ElasticModulus,
         FitParameter::Thickness,
         FitParameter::Stiffness,
+        FitParameter::ModulusScale,
+        FitParameter::ShiftFactor,
     ];
 
     /// The name on the wire.
@@ -57,6 +66,8 @@ impl FitParameter {
             FitParameter::ElasticModulus => "elastic_modulus",
             FitParameter::Thickness => "thickness",
             FitParameter::Stiffness => "k",
+            FitParameter::ModulusScale => "modulus_scale",
+            FitParameter::ShiftFactor => "shift_factor",
         }
     }
 
@@ -69,6 +80,8 @@ impl FitParameter {
             FitParameter::ElasticModulus => Parameter::ElasticModulus,
             FitParameter::Thickness => Parameter::Thickness,
             FitParameter::Stiffness => Parameter::Stiffness,
+            FitParameter::ModulusScale => Parameter::ModulusScale,
+            FitParameter::ShiftFactor => Parameter::ShiftFactor,
         }
     }
 
@@ -76,11 +89,21 @@ impl FitParameter {
     pub fn is_time_scale(self) -> bool {
         matches!(
             self,
-            FitParameter::RelaxationTime | FitParameter::RetardationTime | FitParameter::Kappa
+            FitParameter::RelaxationTime
+                | FitParameter::RetardationTime
+                | FitParameter::Kappa
+                | FitParameter::ShiftFactor
         )
     }
 
-    /// The parameter's value in `layer`.
+    /// Whether it sets a single Kelvin time or κ: a Prony series of more terms is fitted by
+    /// [`FitParameter::ShiftFactor`] instead, which moves all its times.
+    pub fn is_kelvin_time(self) -> bool {
+        self.is_time_scale() && self != FitParameter::ShiftFactor
+    }
+
+    /// The parameter's value in `layer` (the factors: 1, as they are relative to the
+    /// layer they act on).
     pub fn of(self, layer: &Layer) -> f64 {
         match self {
             FitParameter::RelaxationTime => layer.relaxation_time,
@@ -89,6 +112,7 @@ impl FitParameter {
             FitParameter::ElasticModulus => layer.elastic_modulus,
             FitParameter::Thickness => layer.thickness,
             FitParameter::Stiffness => layer.stiffness(),
+            FitParameter::ModulusScale | FitParameter::ShiftFactor => 1.0,
         }
     }
 }
@@ -117,6 +141,7 @@ impl Parameterization {
     pub fn layer(&self, values: &[f64]) -> Layer {
         let mut layer = self.base;
         let (mut kappa, mut stiffness) = (self.base.kappa(), self.base.stiffness());
+        let mut shift = 1.0;
         for (&parameter, &value) in self.free.iter().zip(values) {
             match parameter {
                 FitParameter::RelaxationTime => layer.relaxation_time = value,
@@ -125,6 +150,10 @@ impl Parameterization {
                 FitParameter::ElasticModulus => layer.elastic_modulus = value,
                 FitParameter::Thickness => layer.thickness = value,
                 FitParameter::Stiffness => stiffness = value,
+                FitParameter::ModulusScale => {
+                    layer.elastic_modulus = self.base.elastic_modulus * value
+                }
+                FitParameter::ShiftFactor => shift = value,
             }
         }
         if self.kappa_mode() {
@@ -132,6 +161,9 @@ impl Parameterization {
         }
         if self.stiffness_mode() {
             layer.thickness = layer.elastic_modulus / stiffness;
+        }
+        if shift != 1.0 {
+            layer = layer.with_times_scaled(shift);
         }
         layer
     }
@@ -142,16 +174,20 @@ impl Parameterization {
         self.free
             .iter()
             .map(|&parameter| match parameter {
+                // Every time scaled, κ held: s.relaxation_time by its definition.
                 FitParameter::RelaxationTime if self.kappa_mode() => s.relaxation_time,
+                FitParameter::ShiftFactor => s.relaxation_time,
                 // T_ε held: κ = T_ε/T_σ − 1 falls as T_σ rises.
                 FitParameter::RelaxationTime => s.relaxation_time - s.kappa * (1.0 + kappa),
                 FitParameter::RetardationTime => s.kappa * (1.0 + kappa),
                 FitParameter::Kappa => s.kappa * kappa,
                 // k held: H = E_L/k rises with E_L.
-                FitParameter::ElasticModulus if self.stiffness_mode() => {
+                FitParameter::ElasticModulus | FitParameter::ModulusScale
+                    if self.stiffness_mode() =>
+                {
                     s.elastic_modulus + s.thickness
                 }
-                FitParameter::ElasticModulus => s.elastic_modulus,
+                FitParameter::ElasticModulus | FitParameter::ModulusScale => s.elastic_modulus,
                 FitParameter::Thickness => s.thickness,
                 FitParameter::Stiffness => -s.thickness,
             })
@@ -443,10 +479,13 @@ mod tests {
             };
             let value = parameter.of(&base) * 1.5;
             let layer = p.layer(&[value]);
-            assert!(
-                (parameter.of(&layer) / value - 1.0).abs() < 1e-15,
-                "{parameter:?}"
-            );
+            // The factors act on the layer's moduli and times, and read 1 on any layer.
+            let (got, expected) = match parameter {
+                FitParameter::ModulusScale => (layer.elastic_modulus, 1.5 * base.elastic_modulus),
+                FitParameter::ShiftFactor => (layer.retardation_time, 1.5 * base.retardation_time),
+                _ => (parameter.of(&layer), value),
+            };
+            assert!((got / expected - 1.0).abs() < 1e-15, "{parameter:?}");
         }
     }
 

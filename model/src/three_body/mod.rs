@@ -502,6 +502,12 @@ pub fn solve_with(
     }
     let kappa = system.layer.kappa();
     let table = match system.layer_contact {
+        LayerContact::KelvinLayer if system.velocity > 0.0 && !system.layer.arms.is_empty() => {
+            Some(Arc::new(tables::of_series(
+                &system.layer,
+                options.quadrature,
+            )?))
+        }
         LayerContact::KelvinLayer if system.velocity > 0.0 && kappa > 0.0 => {
             Some(tables::get_or_build(kappa, options.quadrature)?)
         }

@@ -5,6 +5,7 @@ mod continuum;
 mod continuum_rolling;
 mod honest_edges;
 mod numerical_honesty;
+mod prony;
 mod reference_table;
 mod rolling_limits;
 mod similarity;

@@ -32,6 +32,7 @@ fn layer(
         poisson_ratio,
         retardation_time,
         relaxation_time,
+        ..Layer::default()
     }
 }
 
@@ -838,6 +839,7 @@ fn extreme_scales_give_finite_results_or_errors_not_panics() {
 
 /// (P̂, Â, ∬x dA, ∬x p dA) in units of r₀ for a contact of half-width r̂ (units of r₀).
 fn graded_integrals(half_width: f64, xi: f64, kappa: f64) -> [f64; 4] {
+    let viscosity = thirdbody_model::spectrum::Terms::one(kappa, xi);
     let (x16, w16) = thirdbody_model::quadrature::gauss_legendre_16();
     // φ = π/2 − θ, y = r cos φ, b = r sin φ, dy = r sin φ dφ. Panels [φ/2, φ] down to
     // φ ~ 1e-4 min(ξ/r, 1), then one panel [0, φ_min].
@@ -856,8 +858,7 @@ fn graded_integrals(half_width: f64, xi: f64, kappa: f64) -> [f64; 4] {
             let weight = 0.5 * (hi - lo) * w * phi.sin();
             let strip = thirdbody_model::strip::Strip {
                 entry: half_width * phi.sin(),
-                relaxation_length: xi,
-                kappa,
+                terms: &viscosity,
             };
             let rho = strip.exit_root(None).unwrap().rho;
             let b = strip.entry;

@@ -5,6 +5,7 @@
 
 use thirdbody_model::limits;
 use thirdbody_model::rolling::penetration_contact;
+use thirdbody_model::spectrum::Terms;
 use thirdbody_model::tables::{self, Use};
 use thirdbody_model::{self as model, Layer, Quadrature, Rolling, RollingSolution, SolveOptions};
 
@@ -87,7 +88,8 @@ fn the_ratios_at_a_given_penetration_match_the_strip_solver_between_the_table_po
         let mut worst: f64 = 0.0;
         for i in 0..=300 {
             let xi = 10f64.powf(-10.0 + 20.0 * f64::from(i) / 300.0 + 0.0123);
-            let (exact, quadrature_error) = penetration_contact(xi, kappa, quadrature).unwrap();
+            let (exact, quadrature_error) =
+                penetration_contact(&Terms::one(kappa, xi), quadrature).unwrap();
             let got = table.ratios(xi);
             for (t, e) in [
                 (got.load, exact.load),

@@ -51,6 +51,7 @@ prop_compose! {
             poisson_ratio,
             retardation_time: relaxation_time * ratio,
             relaxation_time,
+            ..Layer::default()
         }
     }
 }

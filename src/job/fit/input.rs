@@ -126,8 +126,10 @@ pub struct PointInput {
     pub uncertainty: Option<Quantity>,
 }
 
-/// The parameters to fit; at most one of `retardation_time` and `kappa`, and of `thickness`
-/// and `k`.
+/// The parameters to fit; at most one of `retardation_time` and `kappa`, of `thickness`
+/// and `k`, of `relaxation_time` and `shift_factor`, and of `elastic_modulus` and
+/// `modulus_scale`. A layer given as a Prony series of more than one term is fitted by
+/// `shift_factor` and `modulus_scale` (its shape held), not by its single times.
 #[derive(Clone, Debug, Default, PartialEq, Deserialize, Serialize, ToSchema)]
 #[serde(deny_unknown_fields)]
 pub struct ParametersInput {
@@ -143,6 +145,12 @@ pub struct ParametersInput {
     pub thickness: Option<BoundsInput>,
     /// k = E_L/H (Pa/m; H then follows E_L).
     pub k: Option<BoundsInput>,
+    /// A factor on every modulus of the layer (E_L, and each E_j of a Prony series),
+    /// relative to `layer` (default start 1).
+    pub modulus_scale: Option<BoundsInput>,
+    /// The shift factor a: every time of the layer (T_ε, T_σ, each τ_j) times a, relative
+    /// to `layer` (default start 1); log₁₀ a is the shift in decades.
+    pub shift_factor: Option<BoundsInput>,
 }
 
 /// Where a parameter starts and the bounds it stays within.
@@ -172,6 +180,8 @@ impl ParametersInput {
             field!(input.elastic_modulus),
             field!(input.thickness),
             field!(input.k),
+            field!(input.modulus_scale),
+            field!(input.shift_factor),
         ];
         FitParameter::ALL
             .into_iter()
@@ -195,6 +205,8 @@ impl ParametersInput {
                 FitParameter::ElasticModulus => input.elastic_modulus = bounds,
                 FitParameter::Thickness => input.thickness = bounds,
                 FitParameter::Stiffness => input.k = bounds,
+                FitParameter::ModulusScale => input.modulus_scale = bounds,
+                FitParameter::ShiftFactor => input.shift_factor = bounds,
             }
         }
         input
@@ -308,10 +320,19 @@ fn read_parameters(
     for (a, b) in [
         (FitParameter::RetardationTime, FitParameter::Kappa),
         (FitParameter::Thickness, FitParameter::Stiffness),
+        (FitParameter::RelaxationTime, FitParameter::ShiftFactor),
+        (FitParameter::ElasticModulus, FitParameter::ModulusScale),
     ] {
         if named(a) && named(b) {
             let allowed = format!("at most one of {} and {}", a.name(), b.name());
             checker.invalid(b.name(), json!({}), &allowed);
+        }
+    }
+    if !base.arms.is_empty() {
+        for (parameter, _) in given.iter().filter(|(p, _)| p.is_kelvin_time()) {
+            let allowed = "absent for a layer given as a Prony series of more than one term: \
+                           fit shift_factor (all its times) and modulus_scale (all its moduli)";
+            checker.invalid(parameter.name(), json!({}), allowed);
         }
     }
     let mut free = Vec::new();

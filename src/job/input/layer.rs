@@ -3,8 +3,13 @@
 use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
+use serde_json::json;
+
+use super::units::{names_celsius, parse_quantity, Dimension};
 use super::{field, Checker, Quantity};
+use crate::model::spectrum::{wlf_decades, Terms, MAX_TERMS};
 use crate::model::{Layer, Parameter};
+use crate::render::format_number;
 
 /// How the layer gives way under the sphere (docs/model.md §8).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize, Serialize, ToSchema)]
@@ -21,22 +26,58 @@ pub enum LayerModel {
     Continuum,
 }
 
-/// The Kelvin layer.
+/// One term of a Prony series: E_j e^{−t/τ_j} of the relaxation modulus.
+#[derive(Clone, Debug, Default, PartialEq, Deserialize, Serialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct PronyTerm {
+    /// E_j (Pa, > 0).
+    #[schema(value_type = Object, example = "12 GPa")]
+    pub modulus: Option<Quantity>,
+    /// τ_j (s, > 0).
+    #[schema(value_type = Object, example = "100 ms")]
+    pub time: Option<Quantity>,
+}
+
+/// The time–temperature shift of Williams, Landel and Ferry: at temperature T every time of
+/// the series is multiplied by a_T, log₁₀ a_T = −C₁(T − T_ref)/(C₂ + T − T_ref).
+#[derive(Clone, Debug, Default, PartialEq, Deserialize, Serialize, ToSchema)]
+#[serde(deny_unknown_fields)]
+pub struct WlfInput {
+    /// T_ref, where the series' times hold (K, or a string in °C such as "25 °C").
+    pub reference_temperature: Option<Quantity>,
+    /// C₁ (dimensionless, > 0; 17.44 is the "universal" value).
+    pub c1: Option<Quantity>,
+    /// C₂ (K, > 0; a temperature difference, so in K: 51.6 is the "universal" value).
+    pub c2: Option<Quantity>,
+}
+
+/// The layer: the paper's Kelvin layer (T_ε, T_σ), or a Prony series from material data.
 #[derive(Clone, Debug, Default, PartialEq, Deserialize, Serialize, ToSchema)]
 #[serde(deny_unknown_fields)]
 pub struct LayerInput {
     /// How the layer gives way: `local` (default, the paper's law) or `continuum`.
     pub model: Option<LayerModel>,
-    /// E_L, relaxed longitudinal modulus (Pa; default 3 GPa).
+    /// E_L, relaxed longitudinal modulus (Pa; default 3 GPa); with a Prony series its E_∞.
     pub elastic_modulus: Option<Quantity>,
     /// H, layer thickness (m; default 100 nm).
     pub thickness: Option<Quantity>,
     /// ν, Poisson ratio (dimensionless; default 0.35).
     pub poisson_ratio: Option<Quantity>,
-    /// T_ε, retardation time (s, ≥ T_σ; default 0.5 s).
+    /// T_ε, retardation time (s, ≥ T_σ; default 0.5 s). Not with a Prony series.
     pub retardation_time: Option<Quantity>,
-    /// T_σ, relaxation time (s; default 0.1 s).
+    /// T_σ, relaxation time (s; default 0.1 s). Not with a Prony series.
     pub relaxation_time: Option<Quantity>,
+    /// A Prony series instead of (T_ε, T_σ): E(t) = E_∞ + Σ E_j e^{−t/τ_j}, E_∞ being
+    /// `elastic_modulus` (docs/model.md §9). 1 to 24 terms.
+    pub prony: Option<Vec<PronyTerm>>,
+    /// The same series as CSV text, a row (τ_j, E_j) per term: numbers in s and Pa, or
+    /// quantities with units ("100 ms", "12 GPa"); comma, semicolon or tab separated; a
+    /// first row that is not numbers is a header.
+    pub prony_csv: Option<String>,
+    /// Shift the times from `wlf.reference_temperature` to `temperature` (WLF).
+    pub wlf: Option<WlfInput>,
+    /// T, the layer's temperature in this job (K, or "40 °C"); needs `wlf`.
+    pub temperature: Option<Quantity>,
 }
 
 impl LayerInput {
@@ -44,28 +85,200 @@ impl LayerInput {
     pub fn read(&self, checker: &mut Checker) -> Layer {
         let input = self;
         let d = Layer::default();
-        Layer {
-            elastic_modulus: checker.quantity(
-                field!(input.elastic_modulus),
-                Parameter::ElasticModulus,
-                d.elastic_modulus,
-            ),
-            thickness: checker.quantity(field!(input.thickness), Parameter::Thickness, d.thickness),
-            poisson_ratio: checker.quantity(
-                field!(input.poisson_ratio),
-                Parameter::PoissonRatio,
-                d.poisson_ratio,
-            ),
-            retardation_time: checker.quantity(
-                field!(input.retardation_time),
-                Parameter::RetardationTime,
-                d.retardation_time,
-            ),
-            relaxation_time: checker.quantity(
-                field!(input.relaxation_time),
-                Parameter::RelaxationTime,
-                d.relaxation_time,
-            ),
+        let elastic_modulus = checker.quantity(
+            field!(input.elastic_modulus),
+            Parameter::ElasticModulus,
+            d.elastic_modulus,
+        );
+        let thickness =
+            checker.quantity(field!(input.thickness), Parameter::Thickness, d.thickness);
+        let poisson_ratio = checker.quantity(
+            field!(input.poisson_ratio),
+            Parameter::PoissonRatio,
+            d.poisson_ratio,
+        );
+        let layer = match self.series(checker) {
+            Some(terms) => {
+                for (field, given) in [
+                    ("retardation_time", &self.retardation_time),
+                    ("relaxation_time", &self.relaxation_time),
+                ] {
+                    if let Some(given) = given {
+                        let allowed = "absent with a Prony series (its first term gives the times)";
+                        checker.invalid(field, given.sent(), allowed);
+                    }
+                }
+                Layer::from_prony(elastic_modulus, thickness, poisson_ratio, &terms).unwrap_or(d)
+            }
+            None => Layer {
+                elastic_modulus,
+                thickness,
+                poisson_ratio,
+                retardation_time: checker.quantity(
+                    field!(input.retardation_time),
+                    Parameter::RetardationTime,
+                    d.retardation_time,
+                ),
+                relaxation_time: checker.quantity(
+                    field!(input.relaxation_time),
+                    Parameter::RelaxationTime,
+                    d.relaxation_time,
+                ),
+                arms: Terms::default(),
+            },
+        };
+        match self.shift(checker) {
+            Some(decades) => layer.with_times_scaled(10f64.powf(decades)),
+            None => layer,
+        }
+    }
+
+    /// The Prony series (E_j, τ_j) given as `prony` or `prony_csv`, if any; a term out of
+    /// range is reported at its own field and left out.
+    fn series(&self, checker: &mut Checker) -> Option<Vec<(f64, f64)>> {
+        let terms = match (&self.prony, &self.prony_csv) {
+            (Some(_), Some(csv)) => {
+                let allowed = "absent when prony is given (one series, one way)";
+                checker.invalid("prony_csv", json!(csv), allowed);
+                return None;
+            }
+            (Some(terms), None) => terms
+                .iter()
+                .enumerate()
+                .filter_map(|(i, term)| {
+                    checker.item("prony", i, term, |checker, term| {
+                        let modulus =
+                            checker.required(field!(term.modulus), Parameter::PronyModulus, "");
+                        let time = checker.required(field!(term.time), Parameter::PronyTime, "");
+                        let ok = [
+                            ("modulus", Parameter::PronyModulus, modulus),
+                            ("time", Parameter::PronyTime, time),
+                        ]
+                        .into_iter()
+                        .fold(true, |ok, (name, parameter, x)| match parameter.check(x) {
+                            Ok(()) => ok,
+                            // Unreadable or missing: already reported.
+                            Err(_) if x.is_nan() => false,
+                            Err(e) => {
+                                checker.out_of_range(name, x, parameter.unit(), &e.allowed);
+                                false
+                            }
+                        });
+                        ok.then_some((modulus, time))
+                    })
+                })
+                .collect(),
+            (None, Some(csv)) => read_csv(csv, checker)?,
+            (None, None) => return None,
+        };
+        let count = self.prony.as_ref().map_or(terms.len(), Vec::len);
+        let field = if self.prony.is_some() {
+            "prony"
+        } else {
+            "prony_csv"
+        };
+        if count == 0 || count > MAX_TERMS {
+            let allowed = format!("a series of 1 to {MAX_TERMS} terms");
+            checker.invalid(field, json!(count), &allowed);
+            return None;
+        }
+        Some(terms)
+    }
+
+    /// The WLF shift in decades, if asked for (`wlf` with `temperature`).
+    fn shift(&self, checker: &mut Checker) -> Option<f64> {
+        let input = self;
+        if self.wlf.is_none() {
+            if let Some(given) = &self.temperature {
+                let allowed = "absent without wlf (a temperature shifts the times only by WLF)";
+                checker.invalid("temperature", given.sent(), allowed);
+            }
+            return None;
+        }
+        let temperature = checker.required(
+            field!(input.temperature),
+            Parameter::Temperature,
+            "with wlf",
+        );
+        let (reference, c1, c2) = checker.nested(field!(input.wlf), |checker, wlf: &WlfInput| {
+            let reference = checker.required(
+                field!(wlf.reference_temperature),
+                Parameter::ReferenceTemperature,
+                "",
+            );
+            let c1 = checker.required(field!(wlf.c1), Parameter::WlfC1, "");
+            let c2 = checker.required(field!(wlf.c2), Parameter::WlfC2, "");
+            if let Some(Quantity::Text(t)) = &wlf.c2 {
+                if names_celsius(t) {
+                    let allowed = "a temperature difference in K (a number, or \"51.6 K\")";
+                    checker.invalid("c2", json!(t), allowed);
+                }
+            }
+            for (name, parameter, x) in [
+                (
+                    "reference_temperature",
+                    Parameter::ReferenceTemperature,
+                    reference,
+                ),
+                ("c1", Parameter::WlfC1, c1),
+                ("c2", Parameter::WlfC2, c2),
+            ] {
+                if let (false, Err(e)) = (x.is_nan(), parameter.check(x)) {
+                    checker.out_of_range(name, x, parameter.unit(), &e.allowed);
+                }
+            }
+            (reference, c1, c2)
+        });
+        if let (false, Err(e)) = (
+            temperature.is_nan(),
+            Parameter::Temperature.check(temperature),
+        ) {
+            checker.out_of_range("temperature", temperature, "K", &e.allowed);
+        }
+        if [temperature, reference, c1, c2]
+            .iter()
+            .any(|x| !x.is_finite())
+        {
+            return None;
+        }
+        let decades = wlf_decades(c1, c2, reference, temperature);
+        if decades.is_none() {
+            let allowed = format!(
+                "above T_ref − C₂ = {} K, the pole of the WLF law",
+                format_number(reference - c2)
+            );
+            checker.out_of_range("temperature", temperature, "K", &allowed);
+        }
+        decades
+    }
+
+    /// The input that gives `layer` under `model`: every field, in SI (`model` absent
+    /// where only the local law is offered). A layer of more than one term is written as
+    /// its Prony series, at the job's temperature (any WLF shift applied).
+    pub fn of(layer: &Layer, model: Option<LayerModel>) -> LayerInput {
+        let kelvin = layer.arms.is_empty();
+        LayerInput {
+            model,
+            elastic_modulus: Quantity::si(layer.elastic_modulus),
+            thickness: Quantity::si(layer.thickness),
+            poisson_ratio: Quantity::si(layer.poisson_ratio),
+            retardation_time: kelvin
+                .then(|| Quantity::si(layer.retardation_time))
+                .flatten(),
+            relaxation_time: kelvin
+                .then(|| Quantity::si(layer.relaxation_time))
+                .flatten(),
+            prony: (!kelvin).then(|| {
+                layer
+                    .prony()
+                    .into_iter()
+                    .map(|(modulus, time)| PronyTerm {
+                        modulus: Quantity::si(modulus),
+                        time: Quantity::si(time),
+                    })
+                    .collect()
+            }),
+            ..LayerInput::default()
         }
     }
 
@@ -82,17 +295,59 @@ impl LayerInput {
         }
         self.read(checker)
     }
+}
 
-    /// The input that gives `layer` under `model`: every field, in SI (`model` absent
-    /// where only the local law is offered).
-    pub fn of(layer: &Layer, model: Option<LayerModel>) -> LayerInput {
-        LayerInput {
-            model,
-            elastic_modulus: Quantity::si(layer.elastic_modulus),
-            thickness: Quantity::si(layer.thickness),
-            poisson_ratio: Quantity::si(layer.poisson_ratio),
-            retardation_time: Quantity::si(layer.retardation_time),
-            relaxation_time: Quantity::si(layer.relaxation_time),
+/// The rows (τ_j, E_j) of a Prony series as CSV text, as (E_j, τ_j); each bad cell is
+/// reported once, naming its row, and the series is then `None`.
+fn read_csv(csv: &str, checker: &mut Checker) -> Option<Vec<(f64, f64)>> {
+    let rows: Vec<(usize, Vec<&str>)> = csv
+        .lines()
+        .enumerate()
+        .filter(|(_, line)| !line.trim().is_empty())
+        .map(|(i, line)| (i + 1, line.split([',', ';', '\t']).map(str::trim).collect()))
+        .collect();
+    let numeric = |cell: &str, dimension| parse_quantity(cell, dimension).is_ok();
+    let header = rows.first().is_some_and(|(_, cells)| {
+        !cells
+            .iter()
+            .zip([Dimension::TIME, Dimension::PRESSURE])
+            .all(|(cell, d)| numeric(cell, d))
+    });
+    let mut terms = Vec::new();
+    let mut bad = false;
+    for (line, cells) in rows.iter().skip(usize::from(header)) {
+        let mut complain = |what: String| {
+            let allowed = format!(
+                "row {line}: {what}; expected rows \"τ_j, E_j\" such as \"0.1, 12e9\" or \"100 ms, 12 GPa\""
+            );
+            checker.invalid("prony_csv", json!(cells.join(",")), &allowed);
+            bad = true;
+        };
+        if cells.len() != 2 {
+            complain(format!("{} cells", cells.len()));
+            continue;
+        }
+        let mut read =
+            |cell: &str, parameter: Parameter, dimension| match parse_quantity(cell, dimension) {
+                Ok(x) if parameter.check(x).is_ok() => Some(x),
+                Ok(x) => {
+                    let allowed = parameter.allowed();
+                    complain(format!(
+                        "{parameter} {} is out of range ({allowed})",
+                        format_number(x)
+                    ));
+                    None
+                }
+                Err(e) => {
+                    complain(format!("\"{cell}\" {e}"));
+                    None
+                }
+            };
+        let time = read(cells[0], Parameter::PronyTime, Dimension::TIME);
+        let modulus = read(cells[1], Parameter::PronyModulus, Dimension::PRESSURE);
+        if let (Some(time), Some(modulus)) = (time, modulus) {
+            terms.push((modulus, time));
         }
     }
+    (!bad).then_some(terms)
 }

@@ -4,25 +4,28 @@
 //! A unit is a product of SI symbols (m, g, s, N, Pa), each with an optional SI prefix and an
 //! integer power (`^2`, `²`, `^-1`, `⁻²`), joined by `/`, `*`, `·` or spaces; `1/m^2` works.
 //! The parser tracks dimensions, so `"radius": "3 GPa"` is refused as a pressure.
+//! Temperatures are in K, or in °C (`"40 °C"`, also `℃` and `degC`), which is shifted by
+//! 273.15 K: the fields that take a temperature are absolute ones.
 
 use std::fmt;
 
-/// Powers of (metre, kilogram, second).
+/// Powers of (metre, kilogram, second, kelvin).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Dimension([i8; 3]);
+pub struct Dimension([i8; 4]);
 
 impl Dimension {
-    pub const NONE: Dimension = Dimension([0, 0, 0]);
-    pub const LENGTH: Dimension = Dimension([1, 0, 0]);
-    pub const AREA: Dimension = Dimension([2, 0, 0]);
-    pub const PER_AREA: Dimension = Dimension([-2, 0, 0]);
-    pub const TIME: Dimension = Dimension([0, 0, 1]);
-    pub const SPEED: Dimension = Dimension([1, 0, -1]);
-    pub const FORCE: Dimension = Dimension([1, 1, -2]);
-    pub const PRESSURE: Dimension = Dimension([-1, 1, -2]);
+    pub const NONE: Dimension = Dimension([0, 0, 0, 0]);
+    pub const LENGTH: Dimension = Dimension([1, 0, 0, 0]);
+    pub const AREA: Dimension = Dimension([2, 0, 0, 0]);
+    pub const PER_AREA: Dimension = Dimension([-2, 0, 0, 0]);
+    pub const TIME: Dimension = Dimension([0, 0, 1, 0]);
+    pub const SPEED: Dimension = Dimension([1, 0, -1, 0]);
+    pub const FORCE: Dimension = Dimension([1, 1, -2, 0]);
+    pub const PRESSURE: Dimension = Dimension([-1, 1, -2, 0]);
+    pub const TEMPERATURE: Dimension = Dimension([0, 0, 0, 1]);
 
     /// The named dimensions, with their SI unit and an example as people type it.
-    const NAMED: [(Dimension, &'static str, &'static str, &'static str); 8] = [
+    const NAMED: [(Dimension, &'static str, &'static str, &'static str); 9] = [
         (Dimension::NONE, "a plain number", "", "0.35"),
         (Dimension::LENGTH, "a length", "m", "25 nm"),
         (Dimension::AREA, "an area", "m²", "1 mm^2"),
@@ -31,6 +34,7 @@ impl Dimension {
         (Dimension::SPEED, "a speed", "m/s", "4 nm/s"),
         (Dimension::FORCE, "a force", "N", "1.2 nN"),
         (Dimension::PRESSURE, "a pressure", "Pa", "3 GPa"),
+        (Dimension::TEMPERATURE, "a temperature", "K", "25 °C"),
     ];
 
     fn named(self) -> Option<(&'static str, &'static str, &'static str)> {
@@ -86,7 +90,7 @@ impl fmt::Display for Dimension {
         if let Some((name, _, _)) = self.named() {
             return f.write_str(name);
         }
-        let parts: Vec<String> = ["m", "kg", "s"]
+        let parts: Vec<String> = ["m", "kg", "s", "K"]
             .iter()
             .zip(self.0)
             .filter(|(_, p)| *p != 0)
@@ -124,7 +128,7 @@ impl fmt::Display for UnitError {
             UnitError::NoNumber => f.write_str("does not start with a number"),
             UnitError::UnknownUnit(u) => write!(
                 f,
-                "has an unknown unit \"{u}\" (SI symbols m, g, s, N, Pa with SI prefixes)"
+                "has an unknown unit \"{u}\" (SI symbols m, g, s, N, Pa, K with SI prefixes, or °C)"
             ),
             UnitError::Power(u) => write!(
                 f,
@@ -168,13 +172,19 @@ const PREFIXES: [(&str, i32); 22] = [
 ];
 
 /// SI symbols with the power of ten to SI base units and their dimension.
-const SYMBOLS: [(&str, i32, Dimension); 5] = [
+const SYMBOLS: [(&str, i32, Dimension); 6] = [
     ("Pa", 0, Dimension::PRESSURE),
     ("N", 0, Dimension::FORCE),
     ("m", 0, Dimension::LENGTH),
-    ("g", -3, Dimension([0, 1, 0])),
+    ("g", -3, Dimension([0, 1, 0, 0])),
     ("s", 0, Dimension::TIME),
+    ("K", 0, Dimension::TEMPERATURE),
 ];
+
+/// The spellings of degrees Celsius, a temperature 273.15 K above its number.
+const CELSIUS: [&str; 3] = ["°C", "℃", "degC"];
+/// 0 °C in K.
+const CELSIUS_ZERO: f64 = 273.15;
 
 /// Reads `text` as a quantity of dimension `expected` and returns its value in SI units;
 /// a number without a unit is taken as SI.
@@ -199,6 +209,16 @@ pub fn parse_quantity(text: &str, expected: Dimension) -> Result<f64, UnitError>
         None => (number, 0),
     };
     let unit = text[split..].trim();
+    if CELSIUS.contains(&unit) {
+        if expected != Dimension::TEMPERATURE {
+            return Err(UnitError::WrongDimension {
+                found: Dimension::TEMPERATURE,
+                expected,
+            });
+        }
+        let celsius: f64 = number.parse().map_err(|_| UnitError::NoNumber)?;
+        return Ok(celsius + CELSIUS_ZERO);
+    }
     // A bare number in a string is SI, as a JSON number is.
     let (power, found) = if unit.is_empty() {
         (0, expected)
@@ -211,6 +231,12 @@ pub fn parse_quantity(text: &str, expected: Dimension) -> Result<f64, UnitError>
     format!("{mantissa}e{}", exponent.saturating_add(power))
         .parse()
         .map_err(|_| UnitError::NoNumber)
+}
+
+/// Whether `text` is a number in degrees Celsius (`"25 °C"`).
+pub fn names_celsius(text: &str) -> bool {
+    let text = text.trim();
+    CELSIUS.contains(&text[number_length(text)..].trim())
 }
 
 /// Whether `text` is a number without a unit (`"50"`, `" 2.5e-8 "`): SI, as a JSON number
@@ -357,6 +383,10 @@ mod tests {
             ("210 kN/mm^2", Dimension::PRESSURE, 210e9),
             ("0.35", Dimension::NONE, 0.35),
             (" -4 nm/s ", Dimension::SPEED, -4e-9),
+            ("300 K", Dimension::TEMPERATURE, 300.0),
+            ("25 °C", Dimension::TEMPERATURE, 298.15),
+            ("-10℃", Dimension::TEMPERATURE, 263.15),
+            ("40 degC", Dimension::TEMPERATURE, 313.15),
         ];
         for (text, dim, expected) in cases {
             let got = parse_quantity(text, dim).unwrap_or_else(|e| panic!("{text}: {e}"));
@@ -387,6 +417,13 @@ mod tests {
         );
         assert_eq!(err.to_string(), "is a pressure");
         assert!(parse_quantity("25 nm", Dimension::SPEED).is_err());
+        assert_eq!(
+            parse_quantity("25 °C", Dimension::TIME),
+            Err(UnitError::WrongDimension {
+                found: Dimension::TEMPERATURE,
+                expected: Dimension::TIME
+            })
+        );
     }
 
     #[test]
@@ -454,6 +491,6 @@ mod tests {
             Dimension::LENGTH.describe(),
             "a length (a number in m, or a string such as \"25 nm\")"
         );
-        assert_eq!(Dimension([1, 1, 0]).to_string(), "m·kg");
+        assert_eq!(Dimension([1, 1, 0, 0]).to_string(), "m·kg");
     }
 }

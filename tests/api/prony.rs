@@ -1,0 +1,217 @@
+//! Layers from material data over HTTP (docs/model.md §9): a Prony series as JSON or CSV,
+//! its WLF shift to the job's temperature, both layer laws, fits of a modulus scale and a
+//! shift factor, and problems naming the field for what cannot be read.
+
+use serde_json::{json, Value};
+use thirdbody::model::{Layer, Rolling, SolveOptions};
+
+use crate::helpers::{problem, spawn_app, TestApp};
+
+/// The answer of a rolling job with `layer`, as JSON.
+async fn rolling(app: &TestApp, layer: Value) -> Value {
+    let input = json!({"radius": "25 nm", "load": "1 nN", "velocity": "4 nm/s", "layer": layer});
+    let response = app.post("/v1/rolling", &input).await;
+    assert_eq!(response.status(), 200, "{layer}");
+    response.json().await.unwrap()
+}
+
+/// δ, A, x_c, x_p and μ of two answers within `tolerance` (relative) of each other.
+fn assert_same(a: &Value, b: &Value, tolerance: f64) {
+    for name in [
+        "penetration",
+        "contact_area",
+        "centroid_shift",
+        "pressure_centre_shift",
+        "friction_coefficient",
+    ] {
+        let (x, y) = (a[name].as_f64().unwrap(), b[name].as_f64().unwrap());
+        assert!((x / y - 1.0).abs() <= tolerance, "{name}: {x:e} vs {y:e}");
+    }
+}
+
+/// A four-term series as a DMA fit gives one: (τ_j in s, E_j in Pa).
+const SERIES: [(f64, f64); 4] = [(0.01, 6e9), (0.1, 4.5e9), (1.0, 3e9), (10.0, 1.5e9)];
+
+fn series_json(factor: f64) -> Value {
+    SERIES
+        .iter()
+        .map(|(t, e)| json!({"time": t * factor, "modulus": e}))
+        .collect()
+}
+
+/// E_∞ = E_L, E₁ = κE_L, τ₁ = T_σ is the paper's layer: to 1e-9 on the local law (the
+/// series is solved by strip sums, the Kelvin layer through its similarity table), within
+/// the answers' own errors on the continuum.
+#[tokio::test]
+async fn a_one_term_series_is_the_papers_layer_on_both_laws() {
+    let app = spawn_app(&[]).await;
+    for model in ["local", "continuum"] {
+        let kelvin = rolling(&app, json!({"model": model})).await;
+        let prony = rolling(
+            &app,
+            json!({"model": model, "elastic_modulus": "3 GPa",
+                   "prony": [{"modulus": "12 GPa", "time": "100 ms"}]}),
+        )
+        .await;
+        let tolerance = match model {
+            "local" => 1e-9,
+            _ => ["penetration_error", "contact_area_error"]
+                .iter()
+                .map(|e| kelvin["meta"]["verification"][e].as_f64().unwrap())
+                .fold(0.0, f64::max),
+        };
+        assert_same(&prony, &kelvin, tolerance);
+        let layer = &prony["meta"]["input"]["layer"];
+        assert_eq!(layer["prony"][0]["time"], 0.1, "{layer}");
+    }
+}
+
+#[tokio::test]
+async fn a_series_reads_the_same_as_json_and_as_csv() {
+    let app = spawn_app(&[]).await;
+    let json_answer = rolling(&app, json!({"prony": series_json(1.0)})).await;
+    let csv: String = std::iter::once("tau_s,E_Pa".to_string())
+        .chain(SERIES.iter().map(|(t, e)| format!("{t},{e}")))
+        .collect::<Vec<_>>()
+        .join("\n");
+    let csv_answer = rolling(&app, json!({"prony_csv": csv})).await;
+    assert_same(&csv_answer, &json_answer, 0.0);
+    // Units in the cells, semicolons, no header.
+    let typed = "10 ms; 6 GPa\n100 ms; 4.5 GPa\n1 s; 3 GPa\n10 s; 1.5 GPa\n";
+    let typed_answer = rolling(&app, json!({"prony_csv": typed})).await;
+    assert_same(&typed_answer, &json_answer, 0.0);
+    // The canonical form writes the series back.
+    let prony = &json_answer["meta"]["input"]["layer"]["prony"];
+    assert_eq!(prony.as_array().unwrap().len(), 4, "{prony}");
+    // Rolling over four decades of times: the area lies between the relaxed and the
+    // instantaneous contacts.
+    let area = json_answer["contact_area"].as_f64().unwrap();
+    let at_rest = json_answer["static"]["contact_area"].as_f64().unwrap();
+    let stiffening: f64 = 1.0 + SERIES.iter().map(|(_, e)| e / 3e9).sum::<f64>();
+    assert!(area < at_rest && area > at_rest / stiffening.sqrt());
+}
+
+#[tokio::test]
+async fn a_wlf_shift_of_some_decades_is_the_series_with_its_times_scaled() {
+    let app = spawn_app(&[]).await;
+    let (c1, c2) = (17.44, 51.6);
+    for (reference, temperature, t_ref_k, t_k) in [
+        ("25 °C", "35 °C", 298.15, 308.15),
+        ("300 K", "290 K", 300.0, 290.0),
+    ] {
+        let shifted = rolling(
+            &app,
+            json!({"prony": series_json(1.0), "temperature": temperature,
+                   "wlf": {"reference_temperature": reference, "c1": c1, "c2": c2}}),
+        )
+        .await;
+        let decades: f64 = -c1 * (t_k - t_ref_k) / (c2 + t_k - t_ref_k);
+        let scaled = rolling(&app, json!({"prony": series_json(10f64.powf(decades))})).await;
+        assert_same(&shifted, &scaled, 1e-12);
+    }
+    // Warmer is faster relaxation: at one speed the contact is larger (softer).
+    let at = |t: &'static str| {
+        json!({"prony": series_json(1.0), "temperature": t,
+               "wlf": {"reference_temperature": "25 °C", "c1": c1, "c2": c2}})
+    };
+    let warm = rolling(&app, at("60 °C")).await;
+    let cold = rolling(&app, at("0 °C")).await;
+    assert!(warm["contact_area"].as_f64() > cold["contact_area"].as_f64());
+}
+
+#[tokio::test]
+async fn what_cannot_be_read_gets_a_problem_naming_the_field() {
+    let app = spawn_app(&[]).await;
+    let cases = [
+        (
+            json!({"prony": series_json(1.0), "relaxation_time": "100 ms"}),
+            "layer.relaxation_time",
+            "Prony",
+        ),
+        (
+            json!({"prony_csv": "0.1,12e9\n0.2\n1 s,twelve"}),
+            "layer.prony_csv",
+            "row 2",
+        ),
+        (
+            json!({"prony": [{"modulus": "-1 GPa", "time": "1 s"}]}),
+            "layer.prony[0].modulus",
+            "> 0",
+        ),
+        (
+            json!({"prony": (0..25).map(|i| json!({"modulus": 1e9, "time": 10f64.powi(i - 12)})).collect::<Vec<_>>()}),
+            "layer.prony",
+            "24 terms",
+        ),
+        (json!({"temperature": "40 °C"}), "layer.temperature", "wlf"),
+        (
+            json!({"temperature": "-30 °C", "wlf": {"reference_temperature": "25 °C", "c1": 17.44, "c2": 51.6}}),
+            "layer.temperature",
+            "pole",
+        ),
+        (
+            json!({"temperature": "30 °C", "wlf": {"reference_temperature": "25 °C", "c1": 17.44}}),
+            "layer.wlf.c2",
+            "required",
+        ),
+    ];
+    for (layer, field, says) in cases {
+        let input = json!({"layer": layer});
+        let body = problem(app.post("/v1/rolling", &input).await, 422).await;
+        let error = body["errors"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|e| e["field"] == field)
+            .unwrap_or_else(|| panic!("no error at {field}: {body}"));
+        let message = error["message"].as_str().unwrap();
+        assert!(message.contains(says), "{field}: {message}");
+    }
+}
+
+/// Noise-free friction from a layer twice as stiff and ten times slower than the series as
+/// given: the fit finds both factors to 1e-4, with the series' shape held.
+#[tokio::test]
+async fn a_fit_finds_the_modulus_scale_and_shift_factor_of_a_series() {
+    let app = spawn_app(&[]).await;
+    let terms: Vec<(f64, f64)> = SERIES.iter().map(|&(t, e)| (e, t)).collect();
+    let base = Layer::from_prony(3e9, 100e-9, 0.35, &terms).unwrap();
+    let truth = Layer {
+        elastic_modulus: 2.0 * base.elastic_modulus,
+        ..base.with_times_scaled(10.0)
+    };
+    let points: Vec<Value> = [0.0, 0.03, 0.1, 0.3, 1.0, 3.0, 10.0, 30.0]
+        .iter()
+        .map(|&v| {
+            let rolling = Rolling {
+                velocity: v * 1e-9,
+                layer: truth,
+                ..Rolling::default()
+            };
+            let options = SolveOptions::integrals_only(Default::default());
+            let mu = thirdbody::model::solve(&rolling, &options)
+                .unwrap()
+                .friction_coefficient;
+            json!({"velocity": format!("{v} nm/s"), "value": mu})
+        })
+        .collect();
+    let input = json!({"layer": {"prony": series_json(1.0)},
+                       "series": [{"points": points}],
+                       "parameters": {"modulus_scale": {}, "shift_factor": {}}});
+    let response = app.post("/v1/fits", &input).await;
+    assert_eq!(response.status(), 200);
+    let answer: Value = response.json().await.unwrap();
+    for (name, expected) in [("modulus_scale", 2.0), ("shift_factor", 10.0)] {
+        let value = answer["parameters"][name]["value"].as_f64().unwrap();
+        assert!((value / expected - 1.0).abs() < 1e-4, "{name}: {value}");
+    }
+    // Its single times are not what such a layer is fitted by.
+    let input = json!({"layer": {"prony": series_json(1.0)},
+                       "series": [{"points": points}],
+                       "parameters": {"relaxation_time": {}}});
+    let body = problem(app.post("/v1/fits", &input).await, 422).await;
+    assert_eq!(
+        body["errors"][0]["field"], "parameters.relaxation_time",
+        "{body}"
+    );
+}
