@@ -1,7 +1,7 @@
 //! Speed of the physics core: one rolling solve at 1e-9 relative accuracy (target: < 100 µs
 //! median), through the similarity tables, and a `kelvin_layer` three-body system with a given
 //! total load (target: < 20 ms median), and the static continuum contact (the table the
-//! local-layer row reads: target < 1 µs). The service's own benchmarks (sweeps, figures, the work
+//! local-layer row reads: target < 1 µs), and the same on a layer from a Prony series. The service's own benchmarks (sweeps, figures, the work
 //! a request adds, fits) are the service crate's `service` bench. Results and method:
 //! BENCHMARKS.md. Run with `cargo bench --bench solver`.
 
@@ -129,5 +129,39 @@ fn continuum(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, rolling, three_body, continuum);
+/// A layer from a four-term Prony series (docs/model.md §9): a local answer by strip sums
+/// (no similarity table serves a series), a three-body system (which tabulates its series
+/// once per solve), and a continuum answer (one memory per retardation time).
+fn prony(c: &mut Criterion) {
+    let mut group = c.benchmark_group("prony");
+    let layer = thirdbody_model::Layer::from_prony(
+        3e9,
+        100e-9,
+        0.35,
+        &[(6e9, 0.01), (4.5e9, 0.1), (3e9, 1.0), (1.5e9, 10.0)],
+    )
+    .unwrap();
+    let point = Rolling {
+        layer,
+        ..Rolling::default()
+    };
+    group.bench_function("local_integrals_only_4_terms", |b| {
+        let options = SolveOptions::integrals_only(Quadrature::default());
+        b.iter(|| solve(black_box(&point), &options).unwrap())
+    });
+    group.sample_size(10);
+    group.bench_function("three_body_total_load_4_terms", |b| {
+        let system = ThreeBody {
+            layer,
+            ..ThreeBody::with_defaults(OperatingPoint::TotalLoad(1e-3))
+        };
+        b.iter(|| three_body::solve(black_box(&system), &ThreeBodyOptions::default()).unwrap())
+    });
+    group.bench_function("continuum_answer_4_terms", |b| {
+        b.iter(|| continuum::solve(black_box(&point), &SolveOptions::default()).unwrap())
+    });
+    group.finish();
+}
+
+criterion_group!(benches, rolling, three_body, continuum, prony);
 criterion_main!(benches);

@@ -26,4 +26,4 @@ pub use quadrature::Quadrature;
 pub use rolling::{solve, Rolling, RollingSolution, SolveOptions};
 
 /// Version of the model's numbers: part of every cache key, bumped whenever a result changes.
-pub const MODEL_VERSION: &str = "1.4.0";
+pub const MODEL_VERSION: &str = "1.5.0";
