@@ -74,6 +74,15 @@ try {
   await page.screenshot({ path: `${shots}/rolling-compare.png`, fullPage: true });
   await page.selectOption("#form-rolling select[name='layer.model']", "local");
 
+  // A layer from a Prony series typed as CSV: its Kelvin times are then not sent.
+  const series = "10 ms, 6 GPa\n100 ms, 4.5 GPa\n1 s, 3 GPa\n10 s, 1.5 GPa";
+  await page.fill("#form-rolling textarea[name='layer.prony_csv']", series);
+  await page.locator("#form-rolling").getByRole("button", { name: "Solve" }).click();
+  await page.waitForFunction(() => [...document.querySelectorAll("#table tr")]
+    .some((row) => row.textContent.includes("friction_coefficient") && /0\.0737/.test(row.textContent)));
+  await page.screenshot({ path: `${shots}/rolling-prony.png`, fullPage: true });
+  await page.fill("#form-rolling textarea[name='layer.prony_csv']", "");
+
   // A three-body system: its distribution of diameters.
   await page.getByRole("tab", { name: "Three-body system" }).click();
   await page.locator("#form-three-body").getByRole("button", { name: "Solve" }).click();
@@ -135,7 +144,7 @@ try {
 
   if (errors.length) fail(`console errors: ${errors.join(" | ")}`);
   if (outside.length) fail(`requests left the server: ${outside.join(", ")}`);
-  if (!process.exitCode) console.log(`dashboard: rolling (both laws, compared), three-body (both laws), a 200-point sweep, a sweep with a refused point and Figure 6 work; screenshots in ${shots}`);
+  if (!process.exitCode) console.log(`dashboard: rolling (both laws, compared, a Prony series), three-body (both laws), a 200-point sweep, a sweep with a refused point and Figure 6 work; screenshots in ${shots}`);
 } finally {
   await browser.close();
   child.kill();

@@ -7,10 +7,11 @@ const $ = (selector) => document.querySelector(selector);
 // ---- Forms to job inputs -------------------------------------------------------------
 
 /** A form's fields as the input object of its job: `a.b` names nest, lists split on commas,
- *  plain numbers become numbers, anything else is sent as typed (a value with its unit). */
+ *  plain numbers become numbers, anything else is sent as typed (a value with its unit).
+ *  A layer given as a Prony series drops the Kelvin times the series replaces. */
 function inputOf(form) {
   const input = {};
-  for (const field of form.querySelectorAll("input[name], select[name]")) {
+  for (const field of form.querySelectorAll("input[name], select[name], textarea[name]")) {
     const text = field.value.trim();
     if (text === "") continue;
     const path = field.name.split(".");
@@ -24,6 +25,10 @@ function inputOf(form) {
     let node = input;
     for (const key of path.slice(0, -1)) node = node[key] ??= {};
     node[path[path.length - 1]] = value;
+  }
+  if (input.layer?.prony_csv !== undefined) {
+    delete input.layer.relaxation_time;
+    delete input.layer.retardation_time;
   }
   return input;
 }
