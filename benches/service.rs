@@ -11,6 +11,7 @@ use criterion::{criterion_group, criterion_main, Criterion};
 use serde_json::json;
 use thirdbody::engine::{self, cache::Solved};
 use thirdbody::job::{Control, Job, Kind, Limits, RollingJob, Work};
+use thirdbody::render::Format;
 
 /// A rolling sweep job on one thread, whole (validation aside): its marginal cost per point
 /// is the difference of the two sizes over the difference of their points.
@@ -27,6 +28,27 @@ fn sweep(c: &mut Criterion) {
         .unwrap();
         group.bench_function(format!("rolling_{}_points", loads * speeds), |b| {
             b.iter(|| black_box(engine::run(&job, &Control::new(None, 1)).unwrap()))
+        });
+    }
+    group.finish();
+}
+
+/// A 10,000-point rolling sweep's answer rendered as CSV (its per-point cost is the median
+/// over 10,000), and as JSON beside it.
+fn render(c: &mut Criterion) {
+    let mut group = c.benchmark_group("render");
+    group.sample_size(20);
+    let job = Job::from_value(
+        json!({"kind": "sweep", "input": {"vary": {
+            "load": (0..100).map(|i| format!("{} nN", 0.5 + 0.01 * f64::from(i))).collect::<Vec<_>>(),
+            "velocity": (0..100).map(|i| format!("{} nm/s", 0.1 * f64::from(i))).collect::<Vec<_>>()}}}),
+        &Limits::default(),
+    )
+    .unwrap();
+    let answer = engine::run(&job, &Control::new(None, 2)).unwrap();
+    for (name, format) in [("csv", Format::Csv), ("json", Format::Json)] {
+        group.bench_function(format!("sweep_10000_points_{name}"), |b| {
+            b.iter(|| black_box(answer.render(format).unwrap()))
         });
     }
     group.finish();
@@ -107,5 +129,5 @@ fn fit(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, sweep, figures, service, fit);
+criterion_group!(benches, sweep, render, figures, service, fit);
 criterion_main!(benches);

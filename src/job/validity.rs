@@ -154,7 +154,14 @@ impl PointValidity {
 
     /// The names of the assumptions that warn, as a CSV cell: space-separated.
     pub fn warned_text(&self) -> String {
-        self.warned().collect::<Vec<_>>().join(" ")
+        let mut text = String::new();
+        for name in self.warned() {
+            if !text.is_empty() {
+                text.push(' ');
+            }
+            text.push_str(name);
+        }
+        text
     }
 }
 

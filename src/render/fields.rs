@@ -356,7 +356,7 @@ mod tests {
         };
         let table = Table::new(&columns::<Row>(), [&row]);
         assert_eq!(
-            table.to_csv(),
+            table.to_csv().unwrap(),
             "x [N],maybe [s],in_static [m],static [m]\n2,,3,5\n"
         );
         let empty = Row { flat: None, ..row };

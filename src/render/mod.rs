@@ -21,7 +21,7 @@ pub use fields::{Field, Fields, UnitGroups};
 pub use fixed::{Fixed, Text, UnitTable};
 pub use negotiate::negotiate;
 pub use number::format_number;
-pub use table::{Cell, Column, Heading, Table};
+pub use table::{csv, Cell, Column, Heading, Table};
 
 /// The forms an answer can take.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -136,6 +136,12 @@ pub trait Output: Serialize + fmt::Debug + PartialEq + Send + Sync + 'static {
     /// The answer as one table, its columns declared once by the output.
     fn table(&self) -> Table;
 
+    /// The table as CSV (`None` if a number in it is not finite). An output of many rows
+    /// writes it from its rows ([`csv`]) rather than through [`Output::table`].
+    fn csv(&self) -> Option<String> {
+        self.table().to_csv()
+    }
+
     /// What a person reading the answer should be told beside it, if anything (a sweep
     /// whose points the model refused in part): the command line says it on stderr.
     fn notice(&self) -> Option<String> {
@@ -147,6 +153,7 @@ pub trait Output: Serialize + fmt::Debug + PartialEq + Send + Sync + 'static {
 trait Render: fmt::Debug + Send + Sync {
     fn json(&self, pretty: bool) -> serde_json::Result<Vec<u8>>;
     fn table(&self) -> Table;
+    fn csv(&self) -> Option<String>;
     fn notice(&self) -> Option<String>;
     fn as_any(&self) -> &dyn Any;
     fn into_any(self: Box<Self>) -> Box<dyn Any>;
@@ -169,6 +176,10 @@ impl<T: Output> Render for T {
 
     fn table(&self) -> Table {
         Output::table(self)
+    }
+
+    fn csv(&self) -> Option<String> {
+        Output::csv(self)
     }
 
     fn notice(&self) -> Option<String> {
@@ -363,17 +374,7 @@ impl Answer {
                 let json = self.json(false)?;
                 draw_svg(draw, &json).map(String::into_bytes)
             }
-            Format::Csv => {
-                let table = self.0.table();
-                let finite = table.rows.iter().flatten().all(|cell| match cell {
-                    Cell::Number(x) => x.is_finite(),
-                    Cell::Count(_) | Cell::Text(_) | Cell::Empty => true,
-                });
-                if !finite {
-                    return Err(non_finite());
-                }
-                Ok(table.to_csv().into_bytes())
-            }
+            Format::Csv => self.0.csv().map(String::into_bytes).ok_or_else(non_finite),
         }
     }
 

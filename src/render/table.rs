@@ -2,10 +2,11 @@
 //! cell), and the header and every row are written from that one declaration, so a CSV
 //! header cannot drift from its rows.
 
-use std::borrow::Cow;
+use std::borrow::{Borrow, Cow};
+use std::fmt::Write;
 
 use super::fields::Reader;
-use super::number::format_number;
+use super::number::write_number;
 
 /// One cell of a table.
 #[derive(Clone, Debug, PartialEq)]
@@ -163,26 +164,88 @@ impl Table {
 
     /// CSV (RFC 4180): one header line, each column named with its unit (`radius [m]`),
     /// then one line per row; numbers in their shortest round-trip form, text quoted.
-    pub fn to_csv(&self) -> String {
-        let mut csv = String::new();
-        let names: Vec<String> = self.headings.iter().map(Heading::label).collect();
-        csv.push_str(&names.join(","));
-        csv.push('\n');
+    /// `None` if a number is not finite (CSV has no place for it, as JSON has none).
+    pub fn to_csv(&self) -> Option<String> {
+        let mut csv = Csv::new(self.headings.iter().map(Heading::label), self.rows.len());
         for row in &self.rows {
-            let cells: Vec<String> = row.iter().map(csv_cell).collect();
-            csv.push_str(&cells.join(","));
-            csv.push('\n');
+            csv.line(row.iter());
         }
-        csv
+        csv.finish()
     }
 }
 
-fn csv_cell(cell: &Cell) -> String {
-    match cell {
-        Cell::Number(x) => format_number(*x),
-        Cell::Count(n) => n.to_string(),
-        Cell::Text(text) => format!("\"{}\"", text.replace('"', "\"\"")),
-        Cell::Empty => String::new(),
+/// The CSV of `rows` under `columns`, as [`Table::to_csv`] writes it, straight from the rows:
+/// for an answer of many rows (a sweep's) the table's cells, a vector per row, cost more
+/// than writing them.
+pub fn csv<'a, R: 'a>(columns: &[Column<R>], rows: &'a [R]) -> Option<String> {
+    let labels = columns.iter().map(|c| {
+        Heading {
+            name: c.name.to_string(),
+            unit: Cow::Borrowed(c.unit),
+        }
+        .label()
+    });
+    let mut csv = Csv::new(labels, rows.len());
+    for row in rows {
+        csv.line(columns.iter().map(|c| c.cell(row)));
+    }
+    csv.finish()
+}
+
+/// CSV being written: one buffer, each number straight into it.
+struct Csv {
+    text: String,
+    finite: bool,
+}
+
+impl Csv {
+    /// The header line of `labels`, room for `rows` rows.
+    fn new(labels: impl Iterator<Item = String>, rows: usize) -> Csv {
+        let mut text = String::new();
+        let mut columns = 0;
+        for label in labels {
+            if columns > 0 {
+                text.push(',');
+            }
+            text.push_str(&label);
+            columns += 1;
+        }
+        text.push('\n');
+        // About 24 bytes a cell (a number of 17 digits and its exponent).
+        text.reserve(24 * columns.max(1) * rows);
+        Csv { text, finite: true }
+    }
+
+    fn line<C: Borrow<Cell>>(&mut self, cells: impl Iterator<Item = C>) {
+        for (i, cell) in cells.enumerate() {
+            if i > 0 {
+                self.text.push(',');
+            }
+            match cell.borrow() {
+                Cell::Number(x) => {
+                    self.finite &= x.is_finite();
+                    write_number(&mut self.text, *x);
+                }
+                Cell::Count(n) => {
+                    let _ = write!(self.text, "{n}");
+                }
+                Cell::Text(text) => {
+                    self.text.push('"');
+                    if text.contains('"') {
+                        self.text.push_str(&text.replace('"', "\"\""));
+                    } else {
+                        self.text.push_str(text);
+                    }
+                    self.text.push('"');
+                }
+                Cell::Empty => {}
+            }
+        }
+        self.text.push('\n');
+    }
+
+    fn finish(self) -> Option<String> {
+        self.finite.then_some(self.text)
     }
 }
 
@@ -214,12 +277,21 @@ mod tests {
             },
         ];
         let mut table = Table::new(&COLUMNS, &rows);
-        assert_eq!(
-            table.to_csv(),
-            "index,x [m],label\n7,2.5e-8,\"a\"\n7,0.5,\"say \"\"b\"\"\"\n"
-        );
+        let expected = "index,x [m],label\n7,2.5e-8,\"a\"\n7,0.5,\"say \"\"b\"\"\"\n";
+        assert_eq!(table.to_csv().as_deref(), Some(expected));
+        // Written from the rows, the same text.
+        assert_eq!(csv(&COLUMNS, &rows).as_deref(), Some(expected));
+        // A number that is not finite has no CSV.
+        let infinite = [Row {
+            x: f64::INFINITY,
+            label: "c",
+        }];
+        assert_eq!(csv(&COLUMNS, &infinite), None);
         table.rename(1, "load", "N");
-        assert!(table.to_csv().starts_with("index,load [N],label\n"));
+        assert!(table
+            .to_csv()
+            .unwrap()
+            .starts_with("index,load [N],label\n"));
         assert_eq!(table.headings[1].unit, "N");
     }
 }

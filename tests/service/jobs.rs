@@ -299,7 +299,7 @@ fn a_sweep_is_the_product_of_its_lists_in_order_and_equals_single_solves() {
     let csv = {
         let out: SweepOutput =
             run(json!({"kind": "sweep", "input": {"vary": {"velocity": [0, 4e-9]}}}));
-        out.table().to_csv()
+        out.table().to_csv().unwrap()
     };
     let lines: Vec<&str> = csv.lines().collect();
     assert_eq!(lines.len(), 3);
@@ -370,7 +370,7 @@ fn figures_3_to_9_hold_the_series_of_model_section_5() {
     for s in &f.series {
         assert_eq!(s.points.first(), s.points.last());
     }
-    let csv = f.table().to_csv();
+    let csv = f.table().to_csv().unwrap();
     assert_eq!(csv.lines().next(), Some("series,label,x [m],y [m]"));
     assert_eq!(csv.lines().count(), 1 + 4 * 202);
 }

@@ -313,7 +313,7 @@ fn where_the_asperities_carry_the_load_alone_the_system_is_answered_with_a_warni
         .map(|a| a["name"].as_str().unwrap())
         .collect();
     assert!(warned.contains(&"particles_in_contact") && warned.contains(&"asperity_gap"));
-    let csv = out.table().to_csv();
+    let csv = out.table().to_csv().unwrap();
     let row = csv.lines().nth(1).unwrap();
     assert!(
         row.contains(",,\"warn\""),
@@ -480,7 +480,7 @@ fn three_body_sweeps_vary_the_operating_point_speed_and_mean_diameter() {
     let direct = solve3(&single).unwrap();
     let result = first.result.as_ref().expect("the point is answered");
     assert_eq!(result.state.separation, direct.rolling.separation);
-    let csv = out.table().to_csv();
+    let csv = out.table().to_csv().unwrap();
     assert!(csv.starts_with("total_load [N],velocity [m/s],mean_diameter [m],separation [m]"));
     assert_eq!(csv.lines().count(), 9);
     // Two operating lists at once are refused.

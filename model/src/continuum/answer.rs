@@ -5,7 +5,8 @@
 //! the pixels a side) and a coarse one reaching twice as far behind. The grid is sized from
 //! the static continuum contact radius a₀ (the table of [`super::static_area`]):
 //! a₀·[`MARGIN`] to each side and ahead (the rolling contact is never wider than the static
-//! one), and behind that the wake where the layer is still recovering, min(3 V T_ε, 6 a₀).
+//! one), and behind that the wake where the layer is still recovering, min(3 V θ, 6 a₀), θ
+//! the layer's longest retardation time (T_ε; none for an elastic layer).
 //! The pixel is a twelfth of the smallest contact's radius (the instantaneous elastic one,
 //! V → ∞), at most the layer's thickness. The answer is the fine grid's; the others' differences from it are its error.
 //!

@@ -30,11 +30,9 @@ pub enum LayerModel {
 #[derive(Clone, Debug, Default, PartialEq, Deserialize, Serialize, ToSchema)]
 #[serde(deny_unknown_fields)]
 pub struct PronyTerm {
-    /// E_j (Pa, > 0).
-    #[schema(value_type = Object, example = "12 GPa")]
+    /// E_j (Pa, > 0). Required.
     pub modulus: Option<Quantity>,
-    /// τ_j (s, > 0).
-    #[schema(value_type = Object, example = "100 ms")]
+    /// τ_j (s, > 0). Required.
     pub time: Option<Quantity>,
 }
 

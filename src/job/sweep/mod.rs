@@ -620,4 +620,13 @@ impl Output for SweepOutput {
             SweepPoints::ThreeBody(points) => ThreeBodySweepPoint::table(points),
         }
     }
+
+    /// A rolling sweep's rows written straight from its points (10,000 of them by
+    /// default at most).
+    fn csv(&self) -> Option<String> {
+        match &self.points {
+            SweepPoints::Rolling(points) => render::csv(SweepPoint::columns(), points),
+            SweepPoints::ThreeBody(_) => self.table().to_csv(),
+        }
+    }
 }
