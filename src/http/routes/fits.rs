@@ -9,7 +9,8 @@ solve_endpoint!(
     /// Measured friction coefficients or contact areas (series of points, each an operating
     /// condition and a value, with an optional standard uncertainty) and the layer's
     /// parameters to fit (`relaxation_time`, `retardation_time` or `kappa`,
-    /// `elastic_modulus`, `thickness` or `k`, each with a start and bounds). The answer gives
+    /// `elastic_modulus`, `thickness` or `k`, `modulus_scale`, `shift_factor`, each with a
+    /// start and bounds). The answer gives
     /// the best values with standard errors, 95 % intervals and correlations, χ², the
     /// residuals, the fitted curves, and which parameters the data determine. Answered
     /// within the solve deadline; a larger fit belongs in `POST /v1/jobs` (kind `fit`), which
