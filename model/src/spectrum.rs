@@ -126,16 +126,11 @@ impl Terms {
     /// Every scale times `factor`, without the terms that then do nothing (κ_j = 0 or
     /// s_j = 0: at rest every term is relaxed).
     pub fn scaled(&self, factor: f64) -> Terms {
-        let mut out = Terms::default();
-        for (k, s) in self.iter() {
-            let s = s * factor;
-            if k > 0.0 && s > 0.0 {
-                out.strength[out.len] = k;
-                out.scale[out.len] = s;
-                out.len += 1;
-            }
-        }
-        out
+        let kept = self
+            .iter()
+            .map(|(k, s)| (k, s * factor))
+            .filter(|&(k, s)| k > 0.0 && s > 0.0);
+        Terms::filled(kept, CAPACITY).expect("no more terms than before")
     }
 }
 
