@@ -151,6 +151,13 @@ pub trait ResultCache: Send + Sync {
     /// Keeps `solved` under its key.
     async fn insert(&self, solved: Arc<Solved>);
 
+    /// Keeps `solved`, which is also the result of job `job` in the fleet's job store: a
+    /// cache on that same server refers to it there rather than hold it twice.
+    async fn insert_result_of(&self, solved: Arc<Solved>, job: uuid::Uuid) {
+        let _ = job;
+        self.insert(solved).await;
+    }
+
     /// Claims the solve of `key` among the processes sharing the cache, waiting (until
     /// `deadline`) while another holds it. One process's cache needs no claim: the engine
     /// already shares one solve among its own callers.

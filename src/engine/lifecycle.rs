@@ -15,7 +15,8 @@ use tracing::Instrument;
 use uuid::Uuid;
 
 use super::backlog::{Backlog, Ticket};
-use super::fleet::{Shared, Worker};
+use super::fleet::{placement, Health, Shared, Worker};
+use super::ids::{self, JobIds, Unknown};
 use super::metrics::{self as names, Metrics};
 use super::solver::Solver;
 use super::spill::JobResult;
@@ -84,34 +85,6 @@ impl Uncollected {
     }
 }
 
-/// Ids of asynchronous jobs: a tag of the process that accepted the job, then random bits.
-/// A process that does not know an id can tell whether it is its own (expired, or never
-/// given) or another run's (whose unfinished jobs a shutdown interrupted).
-#[derive(Clone, Copy, Debug)]
-struct JobIds {
-    instance: [u8; 4],
-}
-
-impl JobIds {
-    fn new() -> Self {
-        let tag = Uuid::new_v4();
-        let mut instance = [0; 4];
-        instance.copy_from_slice(&tag.as_bytes()[..4]);
-        JobIds { instance }
-    }
-
-    fn next(&self) -> Uuid {
-        let mut bytes = *Uuid::new_v4().as_bytes();
-        bytes[..4].copy_from_slice(&self.instance);
-        // Keep the version (4) and variant bits of the random UUID.
-        Uuid::from_bytes(bytes)
-    }
-
-    fn issued(&self, id: Uuid) -> bool {
-        id.as_bytes()[..4] == self.instance
-    }
-}
-
 /// The asynchronous jobs of an engine.
 pub(super) struct Lifecycle {
     config: EngineConfig,
@@ -158,7 +131,7 @@ impl Lifecycle {
             live: Mutex::default(),
             uncollected: Mutex::default(),
             owed: Mutex::default(),
-            ids: JobIds::new(),
+            ids: JobIds::default(),
             job_slots: Arc::new(Semaphore::new(job_threads)),
             backlog: Backlog::new(job_threads, config.job_deadline),
             tracker: TaskTracker::new(),
@@ -286,17 +259,15 @@ impl Lifecycle {
     /// points); refused when the stream holds more than 64 entries per queued job allowed.
     async fn enqueue(&self, shared: &Shared, keyed: Keyed) -> Result<JobRecord, EngineError> {
         let unavailable = |e: super::fleet::Failure| EngineError::Unavailable(e.why);
-        let backlog = shared.backlog().await.map_err(unavailable)?;
+        let job = keyed.job();
+        let (backlog, rate) = shared
+            .backlog_and_rate(job.cost_class())
+            .await
+            .map_err(unavailable)?;
         if backlog >= self.config.max_queued_jobs.saturating_mul(64) {
             return Err(EngineError::Overloaded);
         }
-        let job = keyed.job();
-        let per_part = shared.fleet.config.part_points;
-        let parts = job
-            .points()
-            .filter(|&n| n > per_part)
-            .map(|n| crate::job::parts::ranges(n, per_part))
-            .unwrap_or_default();
+        let parts = placement::plan(job.points(), rate, shared.fleet.config.part_points);
         let record = JobRecord::queued(self.ids.next(), job.kind(), job.work());
         let deadline = std::time::SystemTime::now() + self.config.job_deadline;
         shared
@@ -311,14 +282,14 @@ impl Lifecycle {
     pub(super) fn store_reachable(&self) -> Result<(), EngineError> {
         match &self.fleet {
             Some(shared) if !shared.fleet.jobs.is_up() => Err(EngineError::Unavailable(
-                "no answer from it at the last try".to_string(),
+                "Redis (jobs) cannot be reached: no answer at the last try".to_string(),
             )),
             _ => Ok(()),
         }
     }
 
     /// The reachability of each Redis role, when the engine works in a fleet.
-    pub(super) fn fleet_health(&self) -> Option<[(&'static str, bool); 2]> {
+    pub(super) fn fleet_health(&self) -> Option<[(&'static str, Health); 2]> {
         self.fleet.as_ref().map(|shared| shared.fleet.health())
     }
 
@@ -337,9 +308,19 @@ impl Lifecycle {
         Some(record)
     }
 
-    /// Whether `id` is the id of a job this process accepted (known or forgotten since).
-    pub(super) fn issued(&self, id: Uuid) -> bool {
-        self.jobs.shared() || self.ids.issued(id)
+    /// What can be told of a job `id` that the job store does not know.
+    pub(super) async fn unknown(&self, id: Uuid) -> Unknown {
+        if !ids::is_ours(id) {
+            return Unknown::NeverIssued;
+        }
+        match &self.fleet {
+            Some(shared) => match shared.fleet.epoch().await {
+                Some(since) if ids::issued_at(id) < since => Unknown::LostWithStore { since },
+                _ => Unknown::Gone,
+            },
+            None if self.ids.issued_here(id) => Unknown::Gone,
+            None => Unknown::EarlierRun,
+        }
     }
 
     /// A receiver of the status changes of the job `id`, if this process runs it.

@@ -16,6 +16,7 @@ mod coalesce;
 mod doorkeeper;
 pub mod fleet;
 pub mod heavy;
+mod ids;
 mod lifecycle;
 mod memo;
 pub mod metrics;
@@ -26,6 +27,7 @@ pub mod spill;
 pub mod store;
 
 pub use backlog::Backlogged;
+pub use ids::Unknown;
 pub use service::{Engine, EngineConfig, EngineError, Storage};
 pub use solver::{CacheStatus, Solver};
 

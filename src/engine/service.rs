@@ -223,7 +223,7 @@ impl Engine {
     }
 
     /// The reachability of each Redis role, when the engine works in a fleet.
-    pub fn fleet_health(&self) -> Option<[(&'static str, bool); 2]> {
+    pub fn fleet_health(&self) -> Option<[(&'static str, super::fleet::Health); 2]> {
         self.jobs.fleet_health()
     }
 
@@ -233,9 +233,9 @@ impl Engine {
         self.jobs.job(id).await
     }
 
-    /// Whether `id` is the id of a job this process accepted (known or forgotten since).
-    pub fn issued(&self, id: Uuid) -> bool {
-        self.jobs.issued(id)
+    /// What can be told of a job `id` that the job store does not know.
+    pub async fn unknown(&self, id: Uuid) -> super::Unknown {
+        self.jobs.unknown(id).await
     }
 
     /// A receiver of the status changes of the job `id`, if this process runs it.

@@ -143,6 +143,12 @@ impl Solver {
         self.cache.insert(solved).await;
     }
 
+    /// Keeps `solved`, the result of the fleet's job `job`, in the cache (see
+    /// [`ResultCache::insert_result_of`]).
+    pub(super) async fn keep_result_of(&self, solved: Arc<Solved>, job: uuid::Uuid) {
+        self.cache.insert_result_of(solved, job).await;
+    }
+
     /// Solves `keyed` by `deadline`, or takes its answer from the cache. Identical
     /// concurrent calls share one solve (in a fleet, one across processes). With no solver
     /// thread free the call is refused at once.

@@ -13,6 +13,7 @@ use bytes::Bytes;
 use uuid::Uuid;
 
 use super::cache::Solved;
+use super::fleet::StoredResult;
 use crate::job::registry::KindName;
 use crate::render::Format;
 
@@ -100,11 +101,12 @@ impl Drop for Spilled {
     }
 }
 
-/// Where a job's result is: in memory, or spilled to disk.
+/// Where a job's result is: in memory, spilled to disk, or in the fleet's Redis.
 #[derive(Clone, Debug)]
 pub enum JobResult {
     Ready(Arc<Solved>),
     Spilled(Arc<Spilled>),
+    Stored(Arc<StoredResult>),
 }
 
 impl JobResult {
@@ -113,6 +115,7 @@ impl JobResult {
         match self {
             JobResult::Ready(solved) => solved.complete,
             JobResult::Spilled(spilled) => spilled.complete,
+            JobResult::Stored(stored) => stored.complete,
         }
     }
 
@@ -129,14 +132,18 @@ impl JobResult {
                 let csv = tokio::fs::read(&spilled.csv).await?;
                 Ok((spilled.json().await?, Bytes::from(csv)))
             }
+            JobResult::Stored(stored) => {
+                Ok((stored.body("json").await?, stored.body("csv").await?))
+            }
         }
     }
 
-    /// Bytes held in memory, or on disk.
+    /// Bytes held in memory, or on disk (none for a result in Redis).
     pub fn weight(&self) -> u64 {
         match self {
             JobResult::Ready(solved) => solved.weight(),
             JobResult::Spilled(spilled) => spilled.bytes,
+            JobResult::Stored(_) => 0,
         }
     }
 }

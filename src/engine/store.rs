@@ -374,10 +374,10 @@ impl MemoryJobStore {
     }
 }
 
-/// Where a result is held.
+/// Where a result is held (a result in Redis weighs nothing here: it is counted in memory).
 fn place_of(result: &JobResult) -> Place {
     match result {
-        JobResult::Ready(_) => Place::Memory,
+        JobResult::Ready(_) | JobResult::Stored(_) => Place::Memory,
         JobResult::Spilled(_) => Place::Disk,
     }
 }

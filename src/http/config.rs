@@ -164,9 +164,15 @@ pub struct FleetArgs {
     #[arg(long, env = "THIRDBODY_MAX_DELIVERIES", default_value_t = 3)]
     pub max_deliveries: u32,
 
-    /// Points per part of a sweep on the fleet's stream.
+    /// Points per part of a sweep on the fleet's stream until the fleet has measured what
+    /// a point of its kind costs (then parts are sized by cost: one for a cheap sweep).
     #[arg(long, env = "THIRDBODY_PART_POINTS", default_value_t = 250)]
     pub part_points: usize,
+
+    /// When one Redis holds both the cache and the jobs: the bytes the cached answers may
+    /// take there at most (the oldest go first), so that answers never crowd out jobs.
+    #[arg(long, env = "THIRDBODY_REDIS_CACHE_BYTES", default_value_t = 64 << 20)]
+    pub redis_cache_bytes: u64,
 }
 
 impl FleetArgs {
@@ -202,6 +208,7 @@ impl FleetArgs {
             claim_idle: self.claim_idle,
             max_deliveries: self.max_deliveries,
             part_points: self.part_points,
+            shared_cache_bytes: self.redis_cache_bytes,
         }))
     }
 }

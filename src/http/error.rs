@@ -133,7 +133,10 @@ impl Kind {
             Kind::Overloaded => ("overloaded", "Every solver thread is busy"),
             Kind::TooManyStreams => ("too-many-streams", "Too many event streams are open"),
             Kind::Draining => ("draining", "The service is shutting down"),
-            Kind::Unavailable => ("unavailable", "The shared job store cannot be reached"),
+            Kind::Unavailable => (
+                "unavailable",
+                "The shared job store cannot take the job now",
+            ),
             Kind::ResultsFull => ("results-full", "No room to keep the job's result now"),
             Kind::ResultTooLarge => ("result-too-large", "The job's result is too large to keep"),
             Kind::DeadlineExceeded => ("deadline-exceeded", "The solve ran past its deadline"),
@@ -384,8 +387,8 @@ impl From<EngineError> for ApiError {
             EngineError::Unavailable(why) => ApiError::new(
                 Kind::Unavailable,
                 format!(
-                    "the job store (Redis) cannot be reached ({why}): the job was not \
-                     accepted, so that none is lost; synchronous solves still work"
+                    "{why}: the job was not accepted, so that none is lost; synchronous \
+                     solves still work"
                 ),
             ),
             EngineError::ResultsFull { what, retry_after } => {

@@ -164,7 +164,8 @@ problems!(
     /// A job the service accepted but could not finish.
     Gone {
         (410, "interrupted: the service stopped before the job finished (its id names an \
-            earlier run of the service); submit it again", false),
+            earlier run of the service), or the fleet's job store (Redis) restarted without \
+            its data after accepting it; submit it again", false),
     }
 );
 

@@ -86,15 +86,31 @@ async fn unknown_routes_jobs_and_figures_are_404_and_wrong_methods_405() {
         let not_found = problem(app.get(path).await, 404).await;
         assert_eq!(not_found["type"], problem_type("not-found"), "{path}");
     }
-    // A job id this run of the service did not give out: an earlier run's, whose
-    // unfinished jobs its shutdown interrupted (not "never submitted").
+    // A job id no run of the service gave out: never issued, not "interrupted".
     for path in [
         "/v1/jobs/00000000-0000-4000-8000-000000000000",
         "/v1/jobs/00000000-0000-4000-8000-000000000000/events",
     ] {
-        let gone = problem(app.get(path).await, 410).await;
+        let unknown = problem(app.get(path).await, 404).await;
+        assert_eq!(unknown["type"], problem_type("not-found"), "{path}");
+        let detail = unknown["detail"].as_str().unwrap();
+        assert!(detail.contains("no run of this service issued"), "{detail}");
+    }
+    // One that an earlier run gave out: its unfinished jobs were interrupted by its
+    // shutdown (here, another service in this test, standing for the earlier run).
+    let job = json!({"kind": "rolling", "input": {}});
+    let earlier = spawn_app(&[]).await;
+    let location = earlier.submit(&job).await;
+    for path in [location.clone(), format!("{location}/events")] {
+        let gone = problem(app.get(&path).await, 410).await;
         assert_eq!(gone["type"], problem_type("interrupted"), "{path}");
     }
+    // And one this run gave out, then deleted.
+    let location = app.submit(&job).await;
+    app.delete(&location).await;
+    let deleted = problem(app.get(&location).await, 404).await;
+    let detail = deleted["detail"].as_str().unwrap();
+    assert!(detail.contains("deleted, or it expired"), "{detail}");
     let response = app.get("/v1/rolling").await;
     assert_eq!(response.headers()["allow"], "POST");
     let not_allowed = problem(response, 405).await;

@@ -27,6 +27,15 @@ fn find<'a>(docs: &'a [Value], kind: &str) -> &'a Value {
         .unwrap_or_else(|| panic!("no {kind}"))
 }
 
+/// A YAML list of strings.
+fn strings(list: &Value) -> Vec<&str> {
+    list.as_sequence()
+        .unwrap()
+        .iter()
+        .map(|a| a.as_str().unwrap())
+        .collect()
+}
+
 #[test]
 fn the_kustomize_base_wires_probes_drain_redis_autoscaler_and_budget() {
     let kustomization = one("deploy/base/kustomization.yaml");
@@ -72,31 +81,50 @@ fn the_kustomize_base_wires_probes_drain_redis_autoscaler_and_budget() {
         .iter()
         .map(|l| l.as_str().unwrap())
         .collect();
-    let url = literals
-        .iter()
-        .find_map(|l| l.strip_prefix("THIRDBODY_REDIS_URL="))
-        .expect("the Redis URL is configured");
-    let redis_service = docs
-        .iter()
-        .find(|d| d["kind"] == "Service" && d["metadata"]["name"] == "thirdbody-redis")
-        .unwrap();
-    let port = redis_service["spec"]["ports"][0]["port"].as_u64().unwrap();
-    assert_eq!(url, format!("redis://thirdbody-redis:{port}"));
-    let redis = deployments
-        .iter()
-        .find(|d| d["metadata"]["name"] == "thirdbody-redis")
-        .unwrap();
-    let args: Vec<&str> = redis["spec"]["template"]["spec"]["containers"][0]["args"]
-        .as_sequence()
-        .unwrap()
-        .iter()
-        .map(|a| a.as_str().unwrap())
-        .collect();
-    // Jobs live there: never evicted, persisted.
-    assert!(args
-        .windows(2)
-        .any(|w| w == ["--maxmemory-policy", "noeviction"]));
-    assert!(args.windows(2).any(|w| w == ["--appendonly", "yes"]));
+    // Two Redis roles, each its own Service and server: the cache may evict, the jobs
+    // never are evicted and are persisted.
+    for (variable, name, policy, persisted) in [
+        (
+            "THIRDBODY_REDIS_URL",
+            "thirdbody-redis-cache",
+            "allkeys-lru",
+            "no",
+        ),
+        (
+            "THIRDBODY_REDIS_JOBS_URL",
+            "thirdbody-redis-jobs",
+            "noeviction",
+            "yes",
+        ),
+    ] {
+        let url = literals
+            .iter()
+            .find_map(|l| l.strip_prefix(&format!("{variable}=")))
+            .unwrap_or_else(|| panic!("{variable} is configured"));
+        let service = docs
+            .iter()
+            .find(|d| d["kind"] == "Service" && d["metadata"]["name"] == name)
+            .unwrap_or_else(|| panic!("no Service {name}"));
+        let port = service["spec"]["ports"][0]["port"].as_u64().unwrap();
+        assert_eq!(url, format!("redis://{name}:{port}"));
+        let redis = deployments
+            .iter()
+            .find(|d| d["metadata"]["name"] == name)
+            .unwrap_or_else(|| panic!("no Deployment {name}"));
+        assert_eq!(
+            service["spec"]["selector"],
+            redis["spec"]["selector"]["matchLabels"]
+        );
+        let args = strings(&redis["spec"]["template"]["spec"]["containers"][0]["args"]);
+        assert!(
+            args.windows(2).any(|w| w == ["--maxmemory-policy", policy]),
+            "{name}"
+        );
+        assert!(
+            args.windows(2).any(|w| w == ["--appendonly", persisted]),
+            "{name}"
+        );
+    }
 
     // The autoscaler and the budget act on the API's Deployment.
     let hpa = find(&docs, "HorizontalPodAutoscaler");
@@ -118,16 +146,37 @@ fn the_kustomize_base_wires_probes_drain_redis_autoscaler_and_budget() {
 }
 
 #[test]
-fn compose_runs_two_replicas_a_worker_redis_and_prometheus_scraping_both() {
+fn compose_runs_two_replicas_a_worker_two_redis_roles_and_prometheus_scraping_both() {
     let compose = one("deploy/compose.yaml");
     let services = compose["services"].as_mapping().unwrap();
     let get = |name: &str| &services[&Value::from(name)];
     let anchor = &compose["x-thirdbody"];
-    assert_eq!(
-        anchor["environment"]["THIRDBODY_REDIS_URL"],
-        "redis://redis:6379"
-    );
-    assert!(services.contains_key(Value::from("redis")));
+    // The cache may evict; the jobs never are evicted, and are persisted.
+    for (variable, name, policy, persisted) in [
+        ("THIRDBODY_REDIS_URL", "redis-cache", "allkeys-lru", "no"),
+        (
+            "THIRDBODY_REDIS_JOBS_URL",
+            "redis-jobs",
+            "noeviction",
+            "yes",
+        ),
+    ] {
+        assert_eq!(
+            anchor["environment"][variable],
+            format!("redis://{name}:6379").as_str()
+        );
+        let command = strings(&get(name)["command"]);
+        assert!(
+            command
+                .windows(2)
+                .any(|w| w == ["--maxmemory-policy", policy]),
+            "{name}"
+        );
+        assert!(
+            command.windows(2).any(|w| w == ["--appendonly", persisted]),
+            "{name}"
+        );
+    }
     for replica in ["thirdbody-a", "thirdbody-b"] {
         assert!(get(replica)["ports"][0]
             .as_str()

@@ -11,7 +11,7 @@ use std::time::{Duration, Instant};
 use serde_json::{json, Value};
 
 /// A child process, killed when dropped.
-struct Process(Child);
+pub(crate) struct Process(pub Child);
 
 impl Drop for Process {
     fn drop(&mut self) {
@@ -20,7 +20,7 @@ impl Drop for Process {
     }
 }
 
-fn free_port() -> u16 {
+pub(crate) fn free_port() -> u16 {
     TcpListener::bind("127.0.0.1:0")
         .unwrap()
         .local_addr()
@@ -28,7 +28,7 @@ fn free_port() -> u16 {
         .port()
 }
 
-fn redis_server_available() -> bool {
+pub(crate) fn redis_server_available() -> bool {
     Command::new("redis-server")
         .arg("--version")
         .output()
@@ -36,7 +36,7 @@ fn redis_server_available() -> bool {
 }
 
 /// A Redis server on `port`, without persistence.
-fn start_redis(port: u16) -> Process {
+pub(crate) fn start_redis(port: u16) -> Process {
     let child = Command::new("redis-server")
         .args([
             "--port",
@@ -63,7 +63,7 @@ fn start_redis(port: u16) -> Process {
 
 /// A Redis server of its own on a free port; `None` (the test saying it is skipped) when
 /// redis-server is not installed.
-fn fresh_redis() -> Option<(u16, Process)> {
+pub(crate) fn fresh_redis() -> Option<(u16, Process)> {
     if !redis_server_available() {
         eprintln!("SKIPPED: redis-server is not on PATH (`.ci/run` installs it)");
         return None;
@@ -72,7 +72,7 @@ fn fresh_redis() -> Option<(u16, Process)> {
     Some((port, start_redis(port)))
 }
 
-fn redis_cli(port: u16, args: &[&str]) -> String {
+pub(crate) fn redis_cli(port: u16, args: &[&str]) -> String {
     let out = Command::new("redis-cli")
         .args(["-p", &port.to_string()])
         .args(args)
@@ -82,7 +82,7 @@ fn redis_cli(port: u16, args: &[&str]) -> String {
 }
 
 /// Starts `thirdbody <command>` on the fleet of Redis `redis`; its log lines are collected.
-fn start(
+pub(crate) fn start(
     command: &str,
     redis: u16,
     port: Option<u16>,
@@ -91,14 +91,13 @@ fn start(
     let mut cmd = Command::new(env!("CARGO_BIN_EXE_thirdbody"));
     cmd.arg(command)
         .args(["--redis-url", &format!("redis://127.0.0.1:{redis}")])
-        .args([
-            "--claim-idle",
-            "2s",
-            "--part-points",
-            "100",
-            "--log-format",
-            "text",
-        ])
+        .args(["--claim-idle", "2s", "--log-format", "text"])
+        // Unless the test sizes them: parts of 100 points until the fleet measures a cost.
+        .args(if flags.contains(&"--part-points") {
+            &[][..]
+        } else {
+            &["--part-points", "100"][..]
+        })
         .args(["--pool-size", "2"])
         .env("RUST_LOG", "info")
         .stdout(Stdio::null())
@@ -119,12 +118,12 @@ fn start(
     (Process(child), lines)
 }
 
-struct Service {
-    base: String,
+pub(crate) struct Service {
+    pub base: String,
     _process: Process,
 }
 
-async fn serve(redis: u16, http: &reqwest::Client, flags: &[&str]) -> Service {
+pub(crate) async fn serve(redis: u16, http: &reqwest::Client, flags: &[&str]) -> Service {
     let port = free_port();
     let (process, _) = start("serve", redis, Some(port), flags);
     let base = format!("http://127.0.0.1:{port}");
@@ -142,8 +141,19 @@ async fn serve(redis: u16, http: &reqwest::Client, flags: &[&str]) -> Service {
     }
 }
 
+/// A fresh Redis and one `serve` with `flags` on it, with a client; `None` (the test
+/// saying it is skipped) when redis-server is not installed.
+pub(crate) async fn one_service(
+    flags: &[&str],
+) -> Option<(u16, Process, reqwest::Client, Service)> {
+    let (port, redis) = fresh_redis()?;
+    let http = reqwest::Client::new();
+    let service = serve(port, &http, flags).await;
+    Some((port, redis, http, service))
+}
+
 /// The value of the metric `name` (summed over its label sets matching `filter`).
-async fn metric(http: &reqwest::Client, base: &str, name: &str, filter: &str) -> f64 {
+pub(crate) async fn metric(http: &reqwest::Client, base: &str, name: &str, filter: &str) -> f64 {
     let text = http
         .get(format!("{base}/metrics"))
         .send()
@@ -158,16 +168,16 @@ async fn metric(http: &reqwest::Client, base: &str, name: &str, filter: &str) ->
         .sum()
 }
 
-async fn post(http: &reqwest::Client, url: String, body: &Value) -> reqwest::Response {
+pub(crate) async fn post(http: &reqwest::Client, url: String, body: &Value) -> reqwest::Response {
     http.post(url).json(body).send().await.unwrap()
 }
 
-async fn get_json(http: &reqwest::Client, url: String) -> Value {
+pub(crate) async fn get_json(http: &reqwest::Client, url: String) -> Value {
     http.get(url).send().await.unwrap().json().await.unwrap()
 }
 
 /// The answer of a finished job (its view links to it), read from `base`.
-async fn result(http: &reqwest::Client, base: &str, view: &Value) -> Value {
+pub(crate) async fn result(http: &reqwest::Client, base: &str, view: &Value) -> Value {
     assert!(
         view.get("result").is_none(),
         "a job's view carries no answer: {view}"
@@ -177,7 +187,7 @@ async fn result(http: &reqwest::Client, base: &str, view: &Value) -> Value {
 }
 
 /// Polls job `id` on `base` until it finished; returns its view.
-async fn finished(http: &reqwest::Client, base: &str, id: &str) -> Value {
+pub(crate) async fn finished(http: &reqwest::Client, base: &str, id: &str) -> Value {
     let start = Instant::now();
     loop {
         let view = get_json(http, format!("{base}/v1/jobs/{id}")).await;
@@ -192,8 +202,26 @@ async fn finished(http: &reqwest::Client, base: &str, id: &str) -> Value {
     }
 }
 
+/// Waits (up to `bound`) until `/readyz` on `base` satisfies `ok`; returns its answer.
+pub(crate) async fn readyz_until(
+    http: &reqwest::Client,
+    base: &str,
+    bound: Duration,
+    ok: impl Fn(&Value) -> bool,
+) -> Value {
+    let start = Instant::now();
+    loop {
+        let ready = get_json(http, format!("{base}/readyz")).await;
+        if ok(&ready) {
+            return ready;
+        }
+        assert!(start.elapsed() < bound, "readyz stayed {ready}");
+        tokio::time::sleep(Duration::from_millis(50)).await;
+    }
+}
+
 /// Waits until the process whose log is `log` is solving a part of job `id`.
-async fn taken_by(log: &Mutex<Vec<String>>, id: &str) {
+pub(crate) async fn taken_by(log: &Mutex<Vec<String>>, id: &str) {
     let start = Instant::now();
     let taken = |l: &String| l.contains("solving a part") && l.contains(id);
     while !log.lock().unwrap().iter().any(taken) {
@@ -216,7 +244,7 @@ fn heavy_sweep() -> Value {
         "vary": {"load": loads, "velocity": speeds}}})
 }
 
-async fn submit(http: &reqwest::Client, base: &str, job: Value) -> String {
+pub(crate) async fn submit(http: &reqwest::Client, base: &str, job: Value) -> String {
     let response = post(http, format!("{base}/v1/jobs"), &job).await;
     let status = response.status();
     let view: Value = response.json().await.unwrap();
@@ -403,16 +431,11 @@ async fn two_services_and_a_worker_share_answers_jobs_and_sweeps_through_redis()
 
     // Redis back: sharing resumes without a restart.
     let _redis = start_redis(redis_port);
-    let start = Instant::now();
     for base in [&a.base, &b.base] {
-        loop {
-            let ready = get_json(&http, format!("{base}/readyz")).await;
-            if ready["status"] == "ready" {
-                break;
-            }
-            assert!(start.elapsed() < Duration::from_secs(15), "{ready}");
-            tokio::time::sleep(Duration::from_millis(100)).await;
-        }
+        readyz_until(&http, base, Duration::from_secs(15), |r| {
+            r["status"] == "ready"
+        })
+        .await;
     }
     let body = json!({"load": "2.3 nN"});
     let on_a = post(&http, format!("{}/v1/rolling", a.base), &body).await;
@@ -430,12 +453,10 @@ async fn two_services_and_a_worker_share_answers_jobs_and_sweeps_through_redis()
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn a_part_whose_worker_keeps_dying_fails_its_job_saying_so() {
-    let Some((redis_port, _redis)) = fresh_redis() else {
+    // One delivery allowed: the part of a killed worker is not tried again.
+    let Some((redis_port, _redis, http, a)) = one_service(&["--max-deliveries", "1"]).await else {
         return;
     };
-    let http = reqwest::Client::new();
-    // One delivery allowed: the part of a killed worker is not tried again.
-    let a = serve(redis_port, &http, &["--max-deliveries", "1"]).await;
     let (worker, log) = start("worker", redis_port, None, &[]);
     let id = submit(&http, &a.base, heavy_sweep()).await;
     taken_by(&log, &id).await;
@@ -487,10 +508,11 @@ async fn a_worker_on_its_own_takes_a_job_from_the_stream_and_stores_its_answer()
             claim_idle: Duration::from_secs(30),
             max_deliveries: 3,
             part_points: 250,
+            shared_cache_bytes: 64 << 20,
         })
         .unwrap(),
     );
-    let store = Arc::new(RedisJobStore::new(fleet.clone(), minute));
+    let store = Arc::new(RedisJobStore::new(fleet.clone(), minute, minute));
     let cache = TieredCache::new(MemoryCache::new(1 << 24, minute), fleet.clone(), minute);
     let solver = Arc::new(Solver::new(&config, Metrics::noop(), Arc::new(cache)));
 

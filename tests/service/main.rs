@@ -7,6 +7,7 @@ mod deploy;
 mod fit;
 mod fit_continuum;
 mod fleet;
+mod fleet_faults;
 mod honest_answers;
 mod jobs;
 mod kinds;

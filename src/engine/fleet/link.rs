@@ -1,11 +1,13 @@
 //! One Redis server in one role (the answer cache, or the jobs), as this process reaches it:
-//! a connection manager that reconnects by itself, a bound on every call, and whether the
-//! server was reachable at the last call, so that callers can skip it at once while it is
-//! not (synchronous solves then answer from this process's memory, without waiting).
+//! a connection manager that reconnects by itself, a bound on every call, and the server's
+//! health as the last calls found it: reachable or not, full (refusing writes at its memory
+//! limit) or not, and how long a round trip takes (a ping every half second), so that callers
+//! can skip it at once while it is of no use (synchronous solves then answer from this
+//! process's memory, without waiting) and `/readyz` can say why.
 
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::OnceLock;
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 use metrics::Gauge;
 use redis::aio::{ConnectionManager, ConnectionManagerConfig};
@@ -15,6 +17,50 @@ use redis::{Cmd, FromRedisValue, Pipeline, RedisError, Script};
 const CALL_TIMEOUT: Duration = Duration::from_secs(1);
 /// How often an unreachable server is tried again.
 pub const RETRY_EVERY: Duration = Duration::from_millis(500);
+/// A server whose ping takes longer is slow: a synchronous solve would wait on it more than
+/// it gains (a solve costs well under a millisecond to a few).
+const SLOW: Duration = Duration::from_millis(25);
+/// How long a refusal for want of memory marks the server full, unless a write probe (every
+/// half second while it is full) finds it taking writes again sooner.
+const FULL_FOR: Duration = Duration::from_secs(10);
+
+/// A server's health, as the last calls found it.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Health {
+    Up,
+    /// Reachable, but its round trips take longer than [`SLOW`].
+    Slow(Duration),
+    /// Reachable, but refusing writes at its memory limit.
+    Full,
+    Down,
+}
+
+impl Health {
+    pub fn as_str(&self) -> &'static str {
+        match self {
+            Health::Up => "up",
+            Health::Slow(_) => "slow",
+            Health::Full => "full",
+            Health::Down => "down",
+        }
+    }
+
+    /// Why the server of `role` is not simply up, in a sentence (`None` if it is).
+    pub fn reason(&self, role: &str) -> Option<String> {
+        match self {
+            Health::Up => None,
+            Health::Slow(rtt) => Some(format!(
+                "Redis ({role}) answers slowly ({} ms a round trip): synchronous solves \
+                 answer from this process alone",
+                rtt.as_millis()
+            )),
+            Health::Full => Some(format!(
+                "Redis ({role}) is full: it refuses writes at its memory limit (maxmemory)"
+            )),
+            Health::Down => Some(format!("Redis ({role}) cannot be reached")),
+        }
+    }
+}
 
 /// Why a call to Redis failed, in a sentence, and the server's error code if it refused
 /// the command.
@@ -49,8 +95,14 @@ impl std::fmt::Display for Failure {
 pub struct Link {
     /// `cache` or `jobs`, for messages and metrics.
     pub role: &'static str,
+    url: String,
     connection: ConnectionManager,
     up: AtomicBool,
+    /// The last ping's round trip, in µs.
+    round_trip: AtomicU64,
+    /// When a write was last refused for want of memory (ms since `opened`; 0: never).
+    full_at: AtomicU64,
+    opened: Instant,
     gauge: OnceLock<Gauge>,
 }
 
@@ -67,10 +119,20 @@ impl Link {
             .map_err(|e| format!("{role} URL {url}: {e}"))?;
         Ok(Link {
             role,
+            url: url.to_string(),
             connection,
             up: AtomicBool::new(true),
+            round_trip: AtomicU64::new(0),
+            full_at: AtomicU64::new(0),
+            opened: Instant::now(),
             gauge: OnceLock::new(),
         })
+    }
+
+    /// A link of its own to the same server, for a caller that blocks on it (a worker
+    /// waiting for work): on the shared link a blocked call would hold up every other.
+    pub fn dedicated(&self) -> Result<Link, String> {
+        Link::open(self.role, &self.url)
     }
 
     /// Reports the link's state in `gauge` (1 reachable, 0 not) from now on.
@@ -82,6 +144,30 @@ impl Link {
     /// Whether the last call reached the server.
     pub fn is_up(&self) -> bool {
         self.up.load(Ordering::Relaxed)
+    }
+
+    /// The server's health (see [`Health`]).
+    pub fn health(&self) -> Health {
+        let full_at = self.full_at.load(Ordering::Relaxed);
+        let round_trip = Duration::from_micros(self.round_trip.load(Ordering::Relaxed));
+        if !self.is_up() {
+            Health::Down
+        } else if full_at > 0 && self.since_opened() < full_at + FULL_FOR.as_millis() as u64 {
+            Health::Full
+        } else if round_trip > SLOW {
+            Health::Slow(round_trip)
+        } else {
+            Health::Up
+        }
+    }
+
+    /// Whether a synchronous solve should use the server: reachable and quick.
+    pub fn is_quick(&self) -> bool {
+        matches!(self.health(), Health::Up | Health::Full)
+    }
+
+    fn since_opened(&self) -> u64 {
+        u64::try_from(self.opened.elapsed().as_millis()).unwrap_or(u64::MAX)
     }
 
     fn set_up(&self, up: bool) {
@@ -116,15 +202,31 @@ impl Link {
                 if lost {
                     self.set_up(false);
                 }
-                Err(Failure {
-                    why: format!("Redis ({}): {e}", self.role),
-                    code: e.code().map(str::to_string),
-                })
+                let code = e.code().map(str::to_string);
+                let role = self.role;
+                // Refused for want of memory, alone or inside a transaction.
+                let full = code.as_deref() == Some("OOM") || e.to_string().contains("OOM");
+                let why = if full {
+                    let now = self.since_opened().max(1);
+                    let before = self.full_at.swap(now, Ordering::Relaxed);
+                    if before == 0 || now > before + FULL_FOR.as_millis() as u64 {
+                        tracing::error!(
+                            role,
+                            "Redis is full: it refuses writes at its memory limit (maxmemory)"
+                        );
+                    }
+                    Health::Full.reason(role).unwrap_or_default()
+                } else if lost {
+                    format!("Redis ({role}) cannot be reached: {e}")
+                } else {
+                    format!("Redis ({role}) refused a command: {e}")
+                };
+                Err(Failure { why, code })
             }
             Err(_) => {
                 self.set_up(false);
                 Err(Failure::new(format!(
-                    "Redis ({}) did not answer within {CALL_TIMEOUT:?}",
+                    "Redis ({}) cannot be reached: no answer within {CALL_TIMEOUT:?}",
                     self.role
                 )))
             }
@@ -184,7 +286,30 @@ impl Link {
     pub async fn watch(&self) {
         loop {
             tokio::time::sleep(RETRY_EVERY).await;
-            let _ = self.query::<String>(&Cmd::ping()).await;
+            let sent = Instant::now();
+            if self.query::<String>(&Cmd::ping()).await.is_ok() {
+                let micros = u64::try_from(sent.elapsed().as_micros()).unwrap_or(u64::MAX);
+                let before = self.round_trip.swap(micros, Ordering::Relaxed);
+                let slow = |us: u64| Duration::from_micros(us) > SLOW;
+                if slow(micros) && !slow(before) {
+                    tracing::warn!(
+                        role = self.role,
+                        round_trip_ms = micros / 1000,
+                        "Redis answers slowly"
+                    );
+                }
+            }
+            if self.health() == Health::Full {
+                let probe = Cmd::set_options(
+                    format!("thirdbody:probe:{}", self.role),
+                    1,
+                    redis::SetOptions::default().with_expiration(redis::SetExpiry::PX(1000)),
+                );
+                if self.query::<()>(&probe).await.is_ok() {
+                    self.full_at.store(0, Ordering::Relaxed);
+                    tracing::info!(role = self.role, "Redis takes writes again");
+                }
+            }
         }
     }
 }

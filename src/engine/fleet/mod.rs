@@ -11,6 +11,7 @@
 
 mod cache;
 mod link;
+pub mod placement;
 mod store;
 pub mod worker;
 
@@ -18,8 +19,8 @@ use std::sync::Arc;
 use std::time::Duration;
 
 pub use cache::TieredCache;
-pub use link::{Failure, Link};
-pub use store::RedisJobStore;
+pub use link::{Failure, Health, Link};
+pub use store::{RedisJobStore, StoredResult};
 pub use worker::{Shared, Worker};
 
 use super::cache::MemoryCache;
@@ -37,8 +38,10 @@ pub struct FleetConfig {
     pub claim_idle: Duration,
     /// Deliveries of one part before its job fails (its processes died on each).
     pub max_deliveries: u32,
-    /// Points per part of a sweep.
+    /// Points per part of a sweep whose cost per point is not measured yet.
     pub part_points: usize,
+    /// Bytes the cached answers may take when the cache shares the jobs' server.
+    pub shared_cache_bytes: u64,
 }
 
 /// The Redis keys, all under `thirdbody:`.
@@ -47,11 +50,21 @@ mod keys {
 
     /// The work stream and its consumer group.
     pub const STREAM: &str = "thirdbody:work";
+    /// When the job store's data began (Unix ms), set by the first process to find it
+    /// missing: a store restarted without its data gets a new one.
+    pub const EPOCH: &str = "thirdbody:epoch";
+    /// Seconds per point of each cost class, as measured by the workers.
+    pub const RATES: &str = "thirdbody:rates";
     pub const GROUP: &str = "workers";
 
     pub fn answer(key: &str) -> String {
         format!("thirdbody:answer:{key}")
     }
+
+    /// On a server shared with the jobs: the cached answers by age, and their sizes (with
+    /// their total under `total`), which bound the cache's share of the server.
+    pub const ANSWERS_BY_AGE: &str = "thirdbody:answers:by-age";
+    pub const ANSWER_SIZES: &str = "thirdbody:answers:sizes";
 
     /// The fleet-wide claim on solving `key`.
     pub fn solving(key: &str) -> String {
@@ -66,6 +79,8 @@ mod keys {
         pub parts: String,
         /// Deliveries of each part, by index.
         pub deliveries: String,
+        /// A result on its way to `result`, renamed there once the job's state allows.
+        pub staged: String,
     }
 
     impl Job {
@@ -80,6 +95,7 @@ mod keys {
             result: format!("{record}:result"),
             parts: format!("{record}:parts"),
             deliveries: format!("{record}:deliveries"),
+            staged: format!("{record}:staged"),
             record,
         }
     }
@@ -111,17 +127,47 @@ impl Fleet {
         })
     }
 
-    /// Each link's reachability, by role.
-    pub fn health(&self) -> [(&'static str, bool); 2] {
+    /// Whether the cache and the jobs are on one server.
+    pub fn one_server(&self) -> bool {
+        self.config.cache_url == self.config.jobs_url
+    }
+
+    /// Each link's health, by role.
+    pub fn health(&self) -> [(&'static str, Health); 2] {
         [
-            (self.cache.role, self.cache.is_up()),
-            (self.jobs.role, self.jobs.is_up()),
+            (self.cache.role, self.cache.health()),
+            (self.jobs.role, self.jobs.health()),
         ]
     }
 
-    /// Keeps trying unreachable servers until dropped (see [`Link::watch`]).
+    /// Keeps trying unreachable servers until dropped (see [`Link::watch`]), and marks the
+    /// beginning of the job store's data when it finds none (within half a second of a
+    /// restart of Redis without its data).
     pub async fn watch(&self) {
-        tokio::join!(self.cache.watch(), self.jobs.watch());
+        let epoch = async {
+            loop {
+                let now = std::time::SystemTime::now()
+                    .duration_since(std::time::UNIX_EPOCH)
+                    .map_or(0, |d| d.as_millis() as u64);
+                let mark = redis::Cmd::set_options(
+                    keys::EPOCH,
+                    now,
+                    redis::SetOptions::default().conditional_set(redis::ExistenceCheck::NX),
+                );
+                let _ = self.jobs.query::<Option<String>>(&mark).await;
+                tokio::time::sleep(link::RETRY_EVERY).await;
+            }
+        };
+        tokio::join!(self.cache.watch(), self.jobs.watch(), epoch);
+    }
+
+    /// When the job store's data began (Unix ms), if known.
+    pub async fn epoch(&self) -> Option<u64> {
+        self.jobs
+            .query(&redis::Cmd::get(keys::EPOCH))
+            .await
+            .ok()
+            .flatten()
     }
 }
 
@@ -130,7 +176,11 @@ impl Fleet {
 pub fn storage(config: &EngineConfig, fleet: FleetConfig) -> Result<Storage, String> {
     let fleet = Arc::new(Fleet::open(fleet)?);
     let l1 = MemoryCache::for_engine(config);
-    let store = Arc::new(RedisJobStore::new(fleet.clone(), config.job_retention));
+    let store = Arc::new(RedisJobStore::new(
+        fleet.clone(),
+        config.job_retention,
+        config.job_deadline,
+    ));
     Ok(Storage {
         cache: Arc::new(TieredCache::new(l1, fleet.clone(), config.cache_ttl)),
         jobs: store.clone(),

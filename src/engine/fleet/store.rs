@@ -10,12 +10,11 @@ use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
 
 use async_trait::async_trait;
 use bytes::Bytes;
-use redis::{Cmd, Script};
+use redis::Cmd;
 use uuid::Uuid;
 
 use super::cache::millis;
 use super::{keys, Failure, Fleet};
-use crate::engine::cache::Solved;
 use crate::engine::spill::JobResult;
 use crate::engine::store::{JobRecord, JobState, JobStatus, JobStore, Refusal};
 use crate::job::parts::RenderedPart;
@@ -23,38 +22,80 @@ use crate::job::registry::KindName;
 use crate::job::{JobError, Work};
 use std::sync::Arc;
 
-/// Moves a job to a new state unless it has finished; a finished state keeps the result,
-/// drops the parts and starts the retention of every key of the job.
+/// Moves a job to a new state unless it has finished. A finished state takes the result
+/// staged beside the record (written in the same transaction, so that the bytes never pass
+/// through the script's arguments), drops the parts and starts the retention of every key of
+/// the job; a state refused drops the staged result.
+///
+/// KEYS: record, result, parts, deliveries, staged result. ARGV: status, done, error,
+/// retention (ms), now (Unix ms), whether a staged result is whole (`whole`/`partial`).
 const UPDATE: &str = r#"
 local current = redis.call('HGET', KEYS[1], 'status')
-if current ~= 'queued' and current ~= 'running' then return 0 end
+if current ~= 'queued' and current ~= 'running' then
+  redis.call('DEL', KEYS[5])
+  return 0
+end
 redis.call('HSET', KEYS[1], 'status', ARGV[1])
 if ARGV[2] ~= '' then redis.call('HSET', KEYS[1], 'done', ARGV[2]) end
 if ARGV[3] ~= '' then redis.call('HSET', KEYS[1], 'error', ARGV[3]) end
 if ARGV[1] ~= 'queued' and ARGV[1] ~= 'running' then
-  if ARGV[4] ~= '' then redis.call('HSET', KEYS[2], 'json', ARGV[4], 'csv', ARGV[5]) end
-  redis.call('HSET', KEYS[1], 'finished_at', ARGV[7])
+  if redis.call('EXISTS', KEYS[5]) == 1 then
+    redis.call('RENAME', KEYS[5], KEYS[2])
+    redis.call('HSET', KEYS[1], 'result', ARGV[6])
+  end
+  redis.call('HSET', KEYS[1], 'finished_at', ARGV[5])
   redis.call('DEL', KEYS[3])
-  for i = 1, 4 do redis.call('PEXPIRE', KEYS[i], ARGV[6]) end
+  for i = 1, 4 do redis.call('PEXPIRE', KEYS[i], ARGV[4]) end
 end
 return 1
 "#;
 
-/// Keeps a solved part (once: a part solved twice counts once); once every part is in,
-/// returns them all (to whoever stores a part then, so that a process that died while
-/// assembling is replaced by the next delivery).
-const PART_DONE: &str = r#"
+/// Counts a part just stored beside it in the parts hash (in the same transaction), once:
+/// a part solved twice counts once; acknowledges the part's stream entry unless its job is
+/// now whole (the entry then stays pending until the job is assembled and stored, so that
+/// a process that dies while assembling is replaced by the next delivery). Returns 1 once
+/// every part is in, 0 before, and -1 if the job has finished or is gone (its parts are
+/// then dropped: nobody will read them).
+///
+/// KEYS: record, parts, stream. ARGV: part index, its points, the Unix ms at which the parts
+/// expire, the stream's group, the entry's id.
+const PART_IN: &str = r#"
+local function acknowledge()
+  redis.call('XACK', KEYS[3], ARGV[4], ARGV[5])
+  redis.call('XDEL', KEYS[3], ARGV[5])
+end
 local current = redis.call('HGET', KEYS[1], 'status')
-if current ~= 'queued' and current ~= 'running' then return false end
-if redis.call('HSETNX', KEYS[3], ARGV[1], ARGV[2]) == 1 then
+if current ~= 'queued' and current ~= 'running' then
+  redis.call('DEL', KEYS[2])
+  acknowledge()
+  return -1
+end
+redis.call('PEXPIREAT', KEYS[2], ARGV[3])
+if redis.call('HSETNX', KEYS[2], 'in:' .. ARGV[1], '1') == 1 then
   redis.call('HINCRBY', KEYS[1], 'parts_done', 1)
-  redis.call('HINCRBY', KEYS[1], 'done', ARGV[3])
+  redis.call('HINCRBY', KEYS[1], 'done', ARGV[2])
   if current == 'queued' then redis.call('HSET', KEYS[1], 'status', 'running') end
 end
 local parts = tonumber(redis.call('HGET', KEYS[1], 'parts'))
-if tonumber(redis.call('HGET', KEYS[1], 'parts_done')) < parts then return false end
-return redis.call('HGETALL', KEYS[3])
+if tonumber(redis.call('HGET', KEYS[1], 'parts_done')) < parts then
+  acknowledge()
+  return 0
+end
+return 1
 "#;
+
+/// A script run inside a transaction: `EVAL` with its text, so that it needs no loading.
+pub(super) fn eval(script: &str, keys: &[&str], args: &[&[u8]]) -> Cmd {
+    let mut cmd = redis::cmd("EVAL");
+    cmd.arg(script).arg(keys.len());
+    for key in keys {
+        cmd.arg(*key);
+    }
+    for arg in args {
+        cmd.arg(*arg);
+    }
+    cmd
+}
 
 /// A job as a worker needs it.
 pub struct Runnable {
@@ -63,6 +104,9 @@ pub struct Runnable {
     pub wire: String,
     pub key: String,
     pub deadline: Instant,
+    /// When every key of the job expires at the latest, in Unix ms: its deadline plus its
+    /// retention (a job cannot run past its deadline, nor be kept past its retention).
+    pub expires: u64,
     pub parts: usize,
 }
 
@@ -70,23 +114,23 @@ pub struct Runnable {
 pub struct RedisJobStore {
     fleet: Arc<Fleet>,
     retention: Duration,
-    update: Script,
-    part_done: Script,
+    /// The longest a job of this process may be kept: its deadline and its retention.
+    lifetime: Duration,
 }
 
 impl RedisJobStore {
-    pub fn new(fleet: Arc<Fleet>, retention: Duration) -> RedisJobStore {
+    pub fn new(fleet: Arc<Fleet>, retention: Duration, deadline: Duration) -> RedisJobStore {
         RedisJobStore {
             fleet,
             retention,
-            update: Script::new(UPDATE),
-            part_done: Script::new(PART_DONE),
+            lifetime: deadline + retention,
         }
     }
 
     /// Records `record` (queued) and puts its work on the stream, one entry per range of
     /// `parts` (one entry for a job solved whole), in one transaction: a job is accepted
-    /// with its work or not at all.
+    /// with its work or not at all. The record expires at the job's deadline plus its
+    /// retention, should no process ever finish it.
     pub async fn enqueue(
         &self,
         record: &JobRecord,
@@ -99,7 +143,8 @@ impl RedisJobStore {
         let id = record.id.to_string();
         let mut pipe = redis::pipe();
         // Borrowed where they can be: the job's text may be long (a fit's data).
-        let (work, deadline) = (work_text(record.work), unix_millis(deadline).to_string());
+        let deadline = unix_millis(deadline);
+        let (work, deadline_text) = (work_text(record.work), deadline.to_string());
         let count = parts.len().max(1).to_string();
         let fields: [(&str, &str); 9] = [
             ("kind", record.kind.name()),
@@ -108,11 +153,17 @@ impl RedisJobStore {
             ("done", "0"),
             ("job", wire),
             ("key", key),
-            ("deadline", &deadline),
+            ("deadline", &deadline_text),
             ("parts", &count),
             ("parts_done", "0"),
         ];
-        pipe.atomic().hset_multiple(&job.record, &fields).ignore();
+        pipe.atomic()
+            .hset_multiple(&job.record, &fields)
+            .ignore()
+            .cmd("PEXPIREAT")
+            .arg(&job.record)
+            .arg(deadline + millis(self.retention))
+            .ignore();
         if parts.is_empty() {
             pipe.xadd(keys::STREAM, "*", &[("job", &id)]).ignore();
         }
@@ -141,10 +192,19 @@ impl RedisJobStore {
         Ok(status.as_deref().map(parse_status))
     }
 
-    /// The job `id` as a worker runs it; `None` if it is gone (deleted or expired).
-    pub async fn runnable(&self, id: Uuid) -> Result<Option<Runnable>, Failure> {
+    /// Takes part `part` of job `id` for a worker: the job as the worker runs it (`None` if
+    /// it is gone: deleted or expired) and the part's deliveries so far, counting this one,
+    /// in one round trip.
+    pub async fn take(&self, id: Uuid, part: &str) -> Result<(Option<Runnable>, u64), Failure> {
+        let keys = keys::job(id);
         let fields = ["status", "job", "key", "deadline", "parts"];
-        let cmd = Cmd::hmget(keys::job(id).record, &fields[..]);
+        let mut pipe = redis::pipe();
+        pipe.hmget(&keys.record, &fields[..])
+            .hincr(&keys.deliveries, part, 1)
+            // Until the latest a job of this process's deadline could be kept; a job's
+            // end sets its retention.
+            .pexpire(&keys.deliveries, millis(self.lifetime) as i64)
+            .ignore();
         type Fields = (
             Option<String>,
             Option<String>,
@@ -152,116 +212,156 @@ impl RedisJobStore {
             Option<u64>,
             Option<usize>,
         );
-        let fields: Fields = self.fleet.jobs.query(&cmd).await?;
+        let (fields, deliveries): (Fields, u64) = self.fleet.jobs.pipe(&pipe).await?;
         let (Some(status), Some(wire), Some(key), Some(deadline), Some(parts)) = fields else {
-            return Ok(None);
+            return Ok((None, deliveries));
         };
-        Ok(Some(Runnable {
+        let runnable = Runnable {
             status: parse_status(&status),
             wire,
             key,
             deadline: instant_of(deadline),
+            expires: deadline + millis(self.retention),
             parts,
-        }))
+        };
+        Ok((Some(runnable), deliveries))
     }
 
-    /// Counts a delivery of part `part` of job `id`; returns the deliveries so far.
-    pub async fn delivered(&self, id: Uuid, part: &str) -> Result<u64, Failure> {
-        let cmd = Cmd::hincr(keys::job(id).deliveries, part, 1);
-        self.fleet.jobs.query(&cmd).await
+    /// Takes back the delivery of a part handed back unfinished by a drain: a process that
+    /// stopped on purpose is not one that died on the part.
+    pub async fn undelivered(&self, id: Uuid, part: &str) -> Result<(), Failure> {
+        let cmd = Cmd::hincr(keys::job(id).deliveries, part, -1);
+        self.fleet.jobs.query::<i64>(&cmd).await.map(drop)
     }
 
-    /// Keeps part `index` (of `points` points) of job `id`; once every part is in, returns
-    /// them all, in order.
+    /// Keeps part `index` (of `points` points) of `job`, as plain fields of its parts hash,
+    /// and acknowledges its stream entry `entry` unless the job is now whole; returns
+    /// whether every part is in (`None`: the job finished or is gone).
     pub async fn part_done(
         &self,
         id: Uuid,
-        index: usize,
+        job: &Runnable,
+        (index, points): (usize, usize),
         part: &RenderedPart,
-        points: usize,
-    ) -> Result<Option<Vec<RenderedPart>>, Failure> {
-        let job = keys::job(id);
-        let text = serde_json::to_string(part).expect("a rendered part is JSON");
-        let index_text = index.to_string();
-        let points_text = points.to_string();
-        let all: Option<Vec<(usize, String)>> = self
-            .fleet
-            .jobs
-            .script(
-                &self.part_done,
-                &job.all(),
+        entry: &str,
+    ) -> Result<Option<bool>, Failure> {
+        let keys = keys::job(id);
+        let summary = serde_json::to_vec(&part.summary).expect("a summary is JSON");
+        let fields: [(String, &[u8]); 3] = [
+            (format!("json:{index}"), part.json.as_bytes()),
+            (format!("csv:{index}"), part.csv.as_bytes()),
+            (format!("summary:{index}"), &summary),
+        ];
+        let (index, points, expires) = (
+            index.to_string(),
+            points.to_string(),
+            job.expires.to_string(),
+        );
+        let mut pipe = redis::pipe();
+        pipe.atomic()
+            .hset_multiple(&keys.parts, &fields)
+            .ignore()
+            .add_command(eval(
+                PART_IN,
+                &[&keys.record, &keys.parts, super::keys::STREAM],
                 &[
-                    index_text.as_bytes(),
-                    text.as_bytes(),
-                    points_text.as_bytes(),
+                    index.as_bytes(),
+                    points.as_bytes(),
+                    expires.as_bytes(),
+                    super::keys::GROUP.as_bytes(),
+                    entry.as_bytes(),
                 ],
-            )
-            .await?;
-        let Some(mut all) = all else {
-            return Ok(None);
+            ));
+        let (all,): (i64,) = self.fleet.jobs.pipe(&pipe).await?;
+        Ok((all >= 0).then_some(all == 1))
+    }
+
+    /// Every part of job `id` (of `parts`), in order, read once to assemble its answer.
+    pub async fn parts(&self, id: Uuid, parts: usize) -> Result<Vec<RenderedPart>, Failure> {
+        let cmd = Cmd::hgetall(keys::job(id).parts);
+        let mut fields: HashMap<String, Vec<u8>> = self.fleet.jobs.query(&cmd).await?;
+        let unreadable =
+            |what: String| Failure::new(format!("a stored part is unreadable: {what}"));
+        let mut text = |name: String| {
+            let bytes = fields
+                .remove(&name)
+                .ok_or_else(|| unreadable(format!("no {name}")))?;
+            String::from_utf8(bytes).map_err(|e| unreadable(e.to_string()))
         };
-        all.sort_by_key(|(i, _)| *i);
-        let parts = all
-            .into_iter()
-            .map(|(_, text)| serde_json::from_str(&text))
-            .collect::<Result<Vec<RenderedPart>, _>>()
-            .map_err(|e| Failure::new(format!("a stored part is unreadable: {e}")))?;
-        Ok(Some(parts))
+        (0..parts)
+            .map(|i| {
+                Ok(RenderedPart {
+                    json: text(format!("json:{i}"))?,
+                    csv: text(format!("csv:{i}"))?,
+                    summary: serde_json::from_str(&text(format!("summary:{i}"))?)
+                        .map_err(|e| unreadable(e.to_string()))?,
+                })
+            })
+            .collect()
     }
 
     /// Moves job `id` to `state` with `done` units done (`None`: as counted so far), unless
-    /// it has finished.
+    /// it has finished. A result is written once, staged beside the record in the same
+    /// transaction as the move; a result already in the store stays where it is.
     pub async fn set_state(
         &self,
         id: Uuid,
         state: &JobState,
         done: Option<usize>,
     ) -> Result<(), Failure> {
-        let job = keys::job(id);
+        let keys = keys::job(id);
         let error = match state {
             JobState::Failed { error, .. } => {
                 serde_json::to_vec(error).expect("a job error is JSON")
             }
             _ => Vec::new(),
         };
-        let (json, csv) = match state.result() {
-            Some(result) => result
+        let mut pipe = redis::pipe();
+        pipe.atomic();
+        let mut whole = "";
+        if let Some(result) = state
+            .result()
+            .filter(|r| !matches!(r, JobResult::Stored(_)))
+        {
+            let (json, csv) = result
                 .bodies()
                 .await
-                .map_err(|e| Failure::new(format!("cannot render the result: {e}")))?,
-            None => (Bytes::new(), Bytes::new()),
-        };
+                .map_err(|e| Failure::new(format!("cannot render the result: {e}")))?;
+            let fields: [(&str, &[u8]); 2] = [("json", &json), ("csv", &csv)];
+            pipe.hset_multiple(&keys.staged, &fields).ignore();
+            whole = if result.complete() {
+                "whole"
+            } else {
+                "partial"
+            };
+        }
         let status = state.status().as_str();
         let done = done.map(|n| n.to_string()).unwrap_or_default();
         let retention = millis(self.retention).to_string();
         let now = unix_millis(SystemTime::now()).to_string();
-        self.fleet
-            .jobs
-            .script::<i64>(
-                &self.update,
-                &job.all(),
-                &[
-                    status.as_bytes(),
-                    done.as_bytes(),
-                    &error,
-                    &json,
-                    &csv,
-                    retention.as_bytes(),
-                    now.as_bytes(),
-                ],
-            )
-            .await
-            .map(drop)
+        let mut all = keys.all().to_vec();
+        all.push(&keys.staged);
+        pipe.add_command(eval(
+            UPDATE,
+            &all,
+            &[
+                status.as_bytes(),
+                done.as_bytes(),
+                &error,
+                retention.as_bytes(),
+                now.as_bytes(),
+                whole.as_bytes(),
+            ],
+        ))
+        .ignore();
+        self.fleet.jobs.pipe::<()>(&pipe).await
     }
 
-    /// The record of job `id`; `None` if unknown or expired.
+    /// The record of job `id`, without its result (which stays in Redis until a client
+    /// reads it: see [`StoredResult`]); `None` if unknown or expired.
     pub async fn record(&self, id: Uuid) -> Result<Option<JobRecord>, Failure> {
-        let job = keys::job(id);
-        let mut pipe = redis::pipe();
-        pipe.hgetall(&job.record)
-            .hmget(&job.result, &["json", "csv"][..]);
-        type Fields = (HashMap<String, Vec<u8>>, (Option<Vec<u8>>, Option<Vec<u8>>));
-        let (fields, (json, csv)): Fields = self.fleet.jobs.pipe(&pipe).await?;
+        let cmd = Cmd::hgetall(keys::job(id).record);
+        let fields: HashMap<String, Vec<u8>> = self.fleet.jobs.query(&cmd).await?;
         if fields.is_empty() {
             return Ok(None);
         }
@@ -275,34 +375,29 @@ impl RedisJobStore {
             .map_err(|e| Failure::new(format!("a stored job is unreadable: {e}")))?;
         let work = text("work").parse().map_or(Work::Unknown, Work::Known);
         // A result of a cancelled or failed job is what it finished before it stopped.
-        let result = |complete: bool| match (&json, &csv) {
-            (Some(json), Some(csv)) => {
-                let mut solved = Solved::rendered(
-                    text("key"),
-                    kind,
-                    Bytes::from(json.clone()),
-                    Bytes::from(csv.clone()),
-                );
-                solved.complete = complete;
-                Some(JobResult::Ready(Arc::new(solved)))
-            }
+        let result = || match text("result").as_str() {
+            form @ ("whole" | "partial") => Some(JobResult::Stored(Arc::new(StoredResult {
+                fleet: self.fleet.clone(),
+                id,
+                key: text("key"),
+                kind,
+                complete: form == "whole",
+            }))),
             _ => None,
         };
         let state = match parse_status(&text("status")) {
             JobStatus::Queued => JobState::Queued,
             JobStatus::Running => JobState::Running,
-            JobStatus::Cancelled => JobState::Cancelled {
-                partial: result(false),
-            },
+            JobStatus::Cancelled => JobState::Cancelled { partial: result() },
             JobStatus::Interrupted => JobState::Interrupted,
             JobStatus::Failed => JobState::Failed {
                 error: serde_json::from_slice(fields.get("error").map_or(&[][..], Vec::as_slice))
                     .unwrap_or_else(|e| {
                         JobError::Internal(format!("the job's error is unreadable: {e}"))
                     }),
-                partial: result(false),
+                partial: result(),
             },
-            JobStatus::Succeeded => match result(true) {
+            JobStatus::Succeeded => match result() {
                 Some(result) => JobState::Succeeded(result),
                 None => JobState::failed(JobError::Internal(
                     "the job's result was lost from the job store".to_string(),
@@ -318,6 +413,46 @@ impl RedisJobStore {
             done: text("done").parse().unwrap_or(0),
             finished_at,
         }))
+    }
+}
+
+/// A finished job's result, left in Redis: status reads never carry it; a client asking for
+/// it gets the one form it asks for.
+#[derive(Clone)]
+pub struct StoredResult {
+    fleet: Arc<Fleet>,
+    id: Uuid,
+    /// The job's cache key.
+    pub key: String,
+    /// The job's kind (which draws its picture).
+    pub kind: KindName,
+    /// Whether the answer is whole (see [`crate::engine::cache::Solved::complete`]).
+    pub complete: bool,
+}
+
+impl std::fmt::Debug for StoredResult {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("StoredResult")
+            .field("id", &self.id)
+            .field("key", &self.key)
+            .field("complete", &self.complete)
+            .finish()
+    }
+}
+
+impl StoredResult {
+    /// The answer as JSON (`json`) or CSV (`csv`).
+    pub async fn body(&self, field: &str) -> std::io::Result<Bytes> {
+        let cmd = Cmd::hget(keys::job(self.id).result, field);
+        let body: Option<Vec<u8>> = self
+            .fleet
+            .jobs
+            .query(&cmd)
+            .await
+            .map_err(|e| std::io::Error::other(e.why))?;
+        body.map(Bytes::from).ok_or_else(|| {
+            std::io::Error::other("the job's result expired, or was lost from the job store")
+        })
     }
 }
 
@@ -387,7 +522,7 @@ fn parse_status(text: &str) -> JobStatus {
     .unwrap_or(JobStatus::Failed)
 }
 
-fn unix_millis(time: SystemTime) -> u64 {
+pub(super) fn unix_millis(time: SystemTime) -> u64 {
     millis(time.duration_since(UNIX_EPOCH).unwrap_or_default())
 }
 

@@ -21,19 +21,20 @@ use uuid::Uuid;
 use tokio::sync::Semaphore;
 use tokio_util::sync::CancellationToken;
 
-use super::store::RedisJobStore;
-use super::{keys, Failure, Fleet};
+use super::store::{RedisJobStore, Runnable};
+use super::{keys, placement, Failure, Fleet, Link};
 use crate::engine::cache::Solved;
 use crate::engine::metrics as names;
 use crate::engine::pool::Pool;
 use crate::engine::solver::Solver;
 use crate::engine::spill::JobResult;
-use crate::engine::store::JobState;
+use crate::engine::store::{JobState, JobStatus};
 use crate::job::parts::{self, RenderedPart};
 use crate::job::{Control, Job, JobError, Keyed, Unfinished, Work};
 
-/// How long an idle worker waits before looking at the stream again.
-const IDLE: Duration = Duration::from_millis(20);
+/// How long a worker's read of the stream waits for an entry (well within a call's bound);
+/// an entry added meanwhile is taken at once.
+const WAIT: Duration = Duration::from_millis(250);
 /// How often a running entry's heartbeat looks for a cancel and counts progress.
 const HEARTBEAT: Duration = Duration::from_millis(200);
 
@@ -43,6 +44,8 @@ pub struct Shared {
     pub fleet: Arc<Fleet>,
     pub store: Arc<RedisJobStore>,
     running: Mutex<HashMap<String, Arc<Control>>>,
+    /// Seconds per point of each cost class, as this process measured them.
+    rates: Mutex<HashMap<&'static str, f64>>,
 }
 
 impl Shared {
@@ -51,7 +54,35 @@ impl Shared {
             fleet,
             store,
             running: Mutex::default(),
+            rates: Mutex::default(),
         }
+    }
+
+    /// Learns the cost per point of `class` from `points` solved in `took`, and tells the
+    /// fleet (whose processes split the next jobs of the class by it).
+    async fn learn(&self, class: &'static str, took: Duration, points: usize) {
+        let rate = {
+            let mut rates = self.rates.lock().unwrap_or_else(|p| p.into_inner());
+            let rate = placement::learn(rates.get(class).copied(), took, points);
+            rates.insert(class, rate);
+            rate
+        };
+        let mut pipe = redis::pipe();
+        pipe.hset(keys::RATES, class, rate)
+            .ignore()
+            .pexpire(keys::RATES, placement::RATE_TTL.as_millis() as i64)
+            .ignore();
+        if let Err(e) = self.fleet.jobs.pipe::<()>(&pipe).await {
+            tracing::debug!(error = %e, "a measured rate was not shared");
+        }
+    }
+
+    /// The entries on the stream not yet finished (waiting or being solved), and the
+    /// fleet's measured cost per point of `class`, in one round trip.
+    pub async fn backlog_and_rate(&self, class: &str) -> Result<(usize, Option<f64>), Failure> {
+        let mut pipe = redis::pipe();
+        pipe.xlen(keys::STREAM).hget(keys::RATES, class);
+        self.fleet.jobs.pipe(&pipe).await
     }
 
     fn running(&self) -> MutexGuard<'_, HashMap<String, Arc<Control>>> {
@@ -64,11 +95,6 @@ impl Shared {
         for control in self.running().values() {
             control.cancel();
         }
-    }
-
-    /// Entries on the stream not yet finished (waiting or being solved).
-    pub async fn backlog(&self) -> Result<usize, Failure> {
-        self.fleet.jobs.query(&Cmd::xlen(keys::STREAM)).await
     }
 }
 
@@ -144,14 +170,18 @@ impl Worker {
     /// The worker's loop: one entry at a time until the drain begins.
     pub async fn run(self) {
         let mut looked_for_orphans = Instant::now();
+        let waiting = match self.shared.fleet.jobs.dedicated() {
+            Ok(link) => link,
+            Err(e) => return tracing::error!(error = %e, "a worker cannot reach Redis"),
+        };
         while !self.draining.is_cancelled() {
             let slot = match &self.slots {
                 Some(slots) => Some(slots.clone().acquire_owned().await),
                 None => None,
             };
-            match next_entry(&self.shared.fleet, &mut looked_for_orphans).await {
+            match next_entry(&self.shared.fleet, &waiting, &mut looked_for_orphans).await {
                 Ok(Some(entry)) => self.process(entry).await,
-                Ok(None) => tokio::time::sleep(IDLE).await,
+                Ok(None) => {}
                 Err(e) => {
                     tracing::debug!(error = %e, "no work from Redis");
                     tokio::time::sleep(super::link::RETRY_EVERY).await;
@@ -166,8 +196,9 @@ impl Worker {
         let shared = &self.shared;
         let store = &shared.store;
         let id = entry.job;
-        let deliveries = match store.delivered(id, &entry.part_name()).await {
-            Ok(n) => n,
+        let (runnable, deliveries) = match store.take(id, &entry.part_name()).await {
+            Ok((Some(r), deliveries)) if !r.status.is_finished() => (r, deliveries),
+            Ok(_) => return acknowledge(&shared.fleet, &entry).await, // gone or finished
             Err(_) => return, // Redis is away: the entry stays ours, and is taken over later.
         };
         if deliveries > 1 {
@@ -176,11 +207,6 @@ impl Worker {
                 .counter(names::REDELIVERIES, &[])
                 .increment(1);
         }
-        let runnable = match store.runnable(id).await {
-            Ok(Some(r)) if !r.status.is_finished() => r,
-            Ok(_) => return acknowledge(&shared.fleet, &entry).await, // gone or finished
-            Err(_) => return,
-        };
         let max = shared.fleet.config.max_deliveries;
         if deliveries > u64::from(max) {
             let times = match deliveries - 1 {
@@ -192,18 +218,23 @@ impl Worker {
                  before finishing it (killed, or out of memory): the job is given up",
                 entry.part_name(),
             ));
-            return self.finish(&entry, JobState::failed(error), None).await;
+            self.finish(&entry, JobState::failed(error), None).await;
+            return;
         }
         let job = match Job::from_wire(&runnable.wire) {
             Ok(job) => job,
-            Err(e) => return self.finish(&entry, JobState::failed(e), None).await,
+            Err(e) => {
+                self.finish(&entry, JobState::failed(e), None).await;
+                return;
+            }
         };
         let keyed = job.keyed();
         if keyed.key() != runnable.key {
             let error = JobError::Internal(
                 "the job read back from the job store is not the job accepted".to_string(),
             );
-            return self.finish(&entry, JobState::failed(error), None).await;
+            self.finish(&entry, JobState::failed(error), None).await;
+            return;
         }
         let control = Arc::new(self.solver.control(runnable.deadline));
         shared.running().insert(entry.id.clone(), control.clone());
@@ -216,26 +247,36 @@ impl Worker {
             entry.part.is_none(),
         ));
         tracing::info!(entry = entry.id, job = %id, part = entry.part_name(), deliveries, "solving a part");
-        let _ = store.set_state(id, &JobState::Running, None).await;
+        if runnable.status == JobStatus::Queued {
+            let _ = store.set_state(id, &JobState::Running, None).await;
+        }
         let permit = self.solver.permit().await;
         let running = self.solver.running();
         let key = runnable.key.clone();
         let part = entry.part.clone();
         let (solving, meta) = keyed.clone().into_parts();
+        let started = Instant::now();
+        let kept = |solved: Solved| {
+            solved
+                .kept()
+                .map(Arc::new)
+                .map_err(|e| JobError::Internal(format!("cannot render the answer: {e}")))
+        };
+        // The CSV is rendered here too, on the solver thread, not on an async one.
         let result = Pool::run(permit, control.clone(), move |control| match part {
             None => match solving.run_keeping(meta, control) {
-                Ok(answer) => Ok(Outcome::Whole(Arc::new(Solved::new(
+                Ok(answer) => Ok(Outcome::Whole(kept(Solved::new(
                     key,
                     solving.kind(),
                     answer,
-                )?))),
+                )?)?)),
                 // What a job past its deadline finished is kept with its failure.
                 Err(Unfinished {
                     error: error @ JobError::DeadlineExceeded,
                     partial: Some(answer),
                 }) => Ok(Outcome::Stopped(
                     error,
-                    Arc::new(Solved::partial(key, solving.kind(), answer)?),
+                    kept(Solved::partial(key, solving.kind(), answer)?)?,
                 )),
                 Err(unfinished) => Err(unfinished.error),
             },
@@ -256,15 +297,23 @@ impl Worker {
             .metrics()
             .counter(names::PARTS, &[("outcome", outcome)])
             .increment(1);
+        if result.is_ok() {
+            let points = match &entry.part {
+                Some((_, range)) => range.len(),
+                None => keyed.job().points().unwrap_or(1),
+            };
+            // Told the fleet in the background: the part's answer does not wait for it.
+            let (shared, class, took) =
+                (shared.clone(), keyed.job().cost_class(), started.elapsed());
+            tokio::spawn(async move { shared.learn(class, took, points).await });
+        }
         match result {
             Ok(Outcome::Whole(solved)) => {
-                self.solver.keep(solved.clone()).await;
                 let total = match keyed.job().work() {
                     Work::Known(total) => total,
                     Work::Unknown => control.done(),
                 };
-                let state = JobState::Succeeded(JobResult::Ready(solved));
-                self.finish(&entry, state, Some(total)).await;
+                self.succeed(&entry, solved, total).await;
             }
             Ok(Outcome::Stopped(error, partial)) => {
                 let state = JobState::Failed {
@@ -274,16 +323,17 @@ impl Worker {
                 self.finish(&entry, state, Some(control.done())).await;
             }
             Ok(Outcome::Part(rendered)) => {
-                let points = entry.part.as_ref().map_or(0, |(_, r)| r.len());
-                let index = entry.part.as_ref().map_or(0, |(i, _)| *i);
-                match store.part_done(id, index, &rendered, points).await {
-                    Ok(Some(all)) => self.assemble(&entry, &keyed, &all).await,
-                    Ok(None) => acknowledge(&shared.fleet, &entry).await,
-                    Err(_) => {} // taken over later
+                let part = entry.part.as_ref().map_or((0, 0), |(i, r)| (*i, r.len()));
+                let stored = store.part_done(id, &runnable, part, &rendered, &entry.id);
+                // Acknowledged with the part, unless it was the last: then once assembled.
+                if let Ok(Some(true)) = stored.await {
+                    self.assemble(&entry, &keyed, &runnable).await;
                 }
             }
-            // Stopped by the drain: left to another process.
-            Err(JobError::Cancelled) if self.draining.is_cancelled() => {}
+            // Stopped by the drain: handed back at once, its delivery not counted.
+            Err(JobError::Cancelled) if self.draining.is_cancelled() => {
+                hand_back(shared, &entry).await;
+            }
             Err(JobError::Cancelled) => acknowledge(&shared.fleet, &entry).await,
             Err(e) => {
                 self.finish(&entry, JobState::failed(e), Some(control.done()))
@@ -292,10 +342,14 @@ impl Worker {
         }
     }
 
-    /// Assembles the split `job` from all its parts and finishes it.
-    async fn assemble(&self, entry: &Entry, keyed: &Keyed, all: &[RenderedPart]) {
+    /// Assembles the split `job` from all its parts, read once, and finishes it. A process
+    /// that dies here leaves the entry to the next delivery, which finds every part in.
+    async fn assemble(&self, entry: &Entry, keyed: &Keyed, runnable: &Runnable) {
         let job = keyed.job();
-        let state = match parts::assemble(keyed.meta(), all) {
+        let Ok(all) = self.shared.store.parts(entry.job, runnable.parts).await else {
+            return; // taken over later
+        };
+        match parts::assemble(keyed.meta(), &all) {
             Ok(assembled) => {
                 let solved = Arc::new(Solved::rendered(
                     keyed.key().to_string(),
@@ -303,37 +357,49 @@ impl Worker {
                     Bytes::from(assembled.json),
                     Bytes::from(assembled.csv),
                 ));
-                self.solver.keep(solved.clone()).await;
-                JobState::Succeeded(JobResult::Ready(solved))
+                let total = match job.work() {
+                    Work::Known(n) => n,
+                    Work::Unknown => runnable.parts,
+                };
+                self.succeed(entry, solved, total).await;
             }
-            Err(e) => JobState::failed(e),
-        };
-        let done = match (&state, job.work()) {
-            (JobState::Succeeded(_), Work::Known(n)) => Some(n),
-            _ => None,
-        };
-        self.finish(entry, state, done).await;
+            Err(e) => {
+                self.finish(entry, JobState::failed(e), None).await;
+            }
+        }
+    }
+
+    /// Finishes the job of `entry` with its answer `solved`, then caches it (by reference
+    /// to the stored result where the cache shares the job store's server).
+    async fn succeed(&self, entry: &Entry, solved: Arc<Solved>, total: usize) {
+        let state = JobState::Succeeded(JobResult::Ready(solved.clone()));
+        if self.finish(entry, state, Some(total)).await {
+            self.solver.keep_result_of(solved, entry.job).await;
+        }
     }
 
     /// Stores the job's final `state`, then acknowledges the entry (left for another worker
-    /// if the state could not be stored).
-    async fn finish(&self, entry: &Entry, state: JobState, done: Option<usize>) {
+    /// if the state could not be stored); returns whether it was stored.
+    async fn finish(&self, entry: &Entry, state: JobState, done: Option<usize>) -> bool {
         state.log_end(entry.job);
         let shared = &self.shared;
-        if shared
-            .store
-            .set_state(entry.job, &state, done)
-            .await
-            .is_ok()
-        {
+        let stored = shared.store.set_state(entry.job, &state, done).await;
+        if let Err(e) = &stored {
+            tracing::warn!(error = %e, job = %entry.job, "a job's end was not stored: it runs again");
+        } else {
             acknowledge(&shared.fleet, entry).await;
         }
+        stored.is_ok()
     }
 }
 
 /// The next entry for this worker: one whose worker went silent for the idle bound (looked
-/// for every half of it), else a new one.
-async fn next_entry(fleet: &Fleet, looked: &mut Instant) -> Result<Option<Entry>, Failure> {
+/// for every half of it), else a new one, waited for on the worker's own link `waiting`.
+async fn next_entry(
+    fleet: &Fleet,
+    waiting: &Link,
+    looked: &mut Instant,
+) -> Result<Option<Entry>, Failure> {
     let idle = fleet.config.claim_idle;
     if looked.elapsed() >= idle / 2 {
         let claim = Cmd::xautoclaim_options(
@@ -361,9 +427,10 @@ async fn next_entry(fleet: &Fleet, looked: &mut Instant) -> Result<Option<Entry>
         &[">"],
         &StreamReadOptions::default()
             .group(keys::GROUP, &fleet.consumer)
-            .count(1),
+            .count(1)
+            .block(WAIT.as_millis() as usize),
     );
-    match fleet.jobs.query::<Option<StreamReadReply>>(&read).await {
+    match waiting.query::<Option<StreamReadReply>>(&read).await {
         Ok(reply) => Ok(reply
             .and_then(|r| r.keys.into_iter().next())
             .and_then(|k| k.ids.first().and_then(Entry::read))),
@@ -391,6 +458,36 @@ async fn acknowledge(fleet: &Fleet, entry: &Entry) {
         .ignore();
     if let Err(e) = fleet.jobs.pipe::<()>(&pipe).await {
         tracing::warn!(error = %e, "an entry was not acknowledged: it will run again");
+    }
+}
+
+/// Hands `entry`, stopped unfinished by a drain, back to the fleet at once: a new entry
+/// with the same work replaces it (no wait for the idle bound) and its delivery is taken
+/// back. The parts already in stay: the job resumes where it was.
+async fn hand_back(shared: &Shared, entry: &Entry) {
+    let _ = shared
+        .store
+        .undelivered(entry.job, &entry.part_name())
+        .await;
+    let job = entry.job.to_string();
+    let mut fields = vec![("job", job)];
+    if let Some((index, range)) = &entry.part {
+        fields.push(("part", index.to_string()));
+        fields.push(("start", range.start.to_string()));
+        fields.push(("end", range.end.to_string()));
+    }
+    let mut pipe = redis::pipe();
+    let ids = [&entry.id];
+    pipe.atomic()
+        .xack(keys::STREAM, keys::GROUP, &ids)
+        .ignore()
+        .xdel(keys::STREAM, &ids)
+        .ignore()
+        .xadd(keys::STREAM, "*", &fields)
+        .ignore();
+    match shared.fleet.jobs.pipe::<()>(&pipe).await {
+        Ok(()) => tracing::info!(job = %entry.job, part = entry.part_name(), "handed a part back"),
+        Err(e) => tracing::warn!(error = %e, "a part was not handed back: it is taken over later"),
     }
 }
 

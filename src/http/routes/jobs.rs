@@ -18,7 +18,7 @@ use uuid::Uuid;
 
 use super::{Answering, FormatQuery};
 use crate::engine::store::{JobRecord, JobState, JobStatus};
-use crate::engine::Engine;
+use crate::engine::{Engine, Unknown};
 use crate::http::accept::{Accept, AcceptsJson};
 use crate::http::body::JsonBody;
 use crate::http::error::{ApiError, Problem};
@@ -114,19 +114,36 @@ impl FromRequestParts<AppState> for FoundJob {
         }
         // Unknown here may be unknown only while the fleet's store is away.
         engine.store_reachable()?;
-        if engine.issued(id) {
-            Err(ApiError::not_found(format!(
+        Err(match engine.unknown(id).await {
+            Unknown::NeverIssued => ApiError::not_found(format!(
+                "no job {id}: no run of this service issued this id (check it against the \
+                 Location of the job's submission)"
+            )),
+            Unknown::Gone => ApiError::not_found(format!(
                 "no job {id}: it was deleted, or it expired (it finished more than the \
                  retention time ago)"
-            )))
-        } else {
-            Err(ApiError::interrupted(format!(
+            )),
+            Unknown::EarlierRun => ApiError::interrupted(format!(
                 "job {id} was accepted by an earlier run of the service, which stopped before \
                  this one started: unless it had finished and been collected, it was \
                  interrupted. Submit it again"
-            )))
-        }
+            )),
+            Unknown::LostWithStore { since } => ApiError::interrupted(format!(
+                "job {id} was accepted before the job store (Redis) restarted without its \
+                 data ({} s ago): unless it had expired or been deleted before, it was lost \
+                 then. Submit it again",
+                seconds_since(since)
+            )),
+        })
     }
+}
+
+/// Whole seconds from the Unix time `unix_ms` to now.
+fn seconds_since(unix_ms: u64) -> u64 {
+    let now = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| d.as_millis() as u64);
+    now.saturating_sub(unix_ms) / 1000
 }
 
 /// Submit a job to run in the background.

@@ -187,39 +187,57 @@ impl Answering {
     }
 
     /// A job's result as [`Answering::respond`] gives an answer, wherever it is kept: a
-    /// result spilled to disk is streamed from its file (its picture drawn from it).
+    /// result spilled to disk is streamed from its file, one in the fleet's Redis read in
+    /// the form asked for only (a picture is drawn from either's JSON).
     pub async fn respond_result(&self, result: &JobResult) -> Result<Response, ApiError> {
-        let spilled = match result {
-            JobResult::Ready(solved) => return self.respond(solved, None),
-            JobResult::Spilled(spilled) => spilled.clone(),
-        };
         let unreadable = |e: std::io::Error| {
-            ApiError::internal(format!(
-                "the job's result cannot be read back from disk: {e}"
-            ))
+            ApiError::internal(format!("the job's result cannot be read back: {e}"))
         };
-        let body = match self.format {
-            Format::Svg => {
-                let json = spilled.json().await.map_err(unreadable)?;
-                let kind = spilled.kind;
+        let (key, kind, complete) = match result {
+            JobResult::Ready(solved) => return self.respond(solved, None),
+            JobResult::Spilled(spilled) => (&spilled.key, spilled.kind, spilled.complete),
+            JobResult::Stored(stored) => (&stored.key, stored.kind, stored.complete),
+        };
+        let body = match (self.format, result) {
+            (Format::Svg, _) => {
+                let json = match result {
+                    JobResult::Spilled(spilled) => spilled.json().await,
+                    _ => self.stored_body(result, Format::Json).await,
+                }
+                .map_err(unreadable)?;
                 let svg = heavy::run(move || picture(kind, &json))
                     .await
                     .map_err(|e| ApiError::internal(e.to_string()))?
                     .map_err(|e| ApiError::internal(e.to_string()))?;
                 Body::from(svg)
             }
-            format => {
+            (format, JobResult::Spilled(spilled)) => {
                 let file = tokio::fs::File::open(spilled.file(format))
                     .await
                     .map_err(unreadable)?;
                 Body::from_stream(tokio_util::io::ReaderStream::new(file))
             }
+            (format, _) => Body::from(self.stored_body(result, format).await.map_err(unreadable)?),
         };
         let mut body = Some(body);
-        self.answer(&spilled.key, spilled.complete, None, || {
+        self.answer(key, complete, None, || {
             body.take()
                 .ok_or_else(|| ApiError::internal("the body was taken twice"))
         })
+    }
+
+    /// The JSON or CSV of a result kept in the fleet's Redis.
+    async fn stored_body(
+        &self,
+        result: &JobResult,
+        format: Format,
+    ) -> std::io::Result<bytes::Bytes> {
+        let JobResult::Stored(stored) = result else {
+            return Err(std::io::Error::other("the result is not in Redis"));
+        };
+        stored
+            .body(if format == Format::Csv { "csv" } else { "json" })
+            .await
     }
 
     /// The response carrying `body` (called unless the client holds it already) for the

@@ -18,12 +18,15 @@ use crate::http::AppState;
 #[derive(Serialize, ToSchema)]
 pub struct Health {
     /// `ok` (alive), `ready` (taking work), or `degraded` (taking work, but a Redis of the
-    /// fleet is unreachable: synchronous solves answer from this process alone and job
-    /// submissions are refused with 503 until it is back).
+    /// fleet is down, slow or full: synchronous solves answer from this process alone, and
+    /// job submissions are refused with 503 while the job store cannot take them).
     pub status: &'static str,
-    /// In a fleet: each Redis role (`cache`, `jobs`) with `up` or `down`.
+    /// In a fleet: each Redis role (`cache`, `jobs`) with `up`, `slow`, `full` or `down`.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub redis: Option<BTreeMap<&'static str, &'static str>>,
+    /// Why the service is degraded, in a sentence per Redis role not `up`.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub reasons: Vec<String>,
 }
 
 /// Liveness: the process answers requests.
@@ -38,11 +41,13 @@ pub async fn healthz(_: AcceptsJson) -> Json<Health> {
     Json(Health {
         status: "ok",
         redis: None,
+        reasons: Vec::new(),
     })
 }
 
-/// Readiness: the service takes new work (`degraded` when a Redis of its fleet is
-/// unreachable: it still answers synchronous solves); 503 once it is shutting down.
+/// Readiness: the service takes new work (`degraded`, with the reasons, when a Redis of its
+/// fleet is down, slow or full: it still answers synchronous solves); 503 once it is
+/// shutting down.
 #[utoipa::path(
     get,
     path = "/readyz",
@@ -58,19 +63,26 @@ pub async fn readyz(
     if engine.is_draining() {
         return Err(ApiError::draining());
     }
-    let redis = engine.fleet_health().map(|roles| {
-        let state = |up| if up { "up" } else { "down" };
+    let roles = engine.fleet_health();
+    let redis = roles.as_ref().map(|roles| {
         roles
-            .into_iter()
-            .map(|(role, up)| (role, state(up)))
+            .iter()
+            .map(|(role, health)| (*role, health.as_str()))
             .collect()
     });
-    let degraded = engine
-        .fleet_health()
-        .is_some_and(|roles| roles.iter().any(|(_, up)| !up));
+    let reasons: Vec<String> = roles
+        .iter()
+        .flatten()
+        .filter_map(|(role, health)| health.reason(role))
+        .collect();
     Ok(Json(Health {
-        status: if degraded { "degraded" } else { "ready" },
+        status: if reasons.is_empty() {
+            "ready"
+        } else {
+            "degraded"
+        },
         redis,
+        reasons,
     }))
 }
 

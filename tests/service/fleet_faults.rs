@@ -1,0 +1,416 @@
+//! The fleet against a real redis-server that fails as real ones do: full, restarted with
+//! and without its data, slow, and its processes rolled during a long job. Each fault must be
+//! survived (no job lost, synchronous solves still answered) and told truly (`/readyz`, the
+//! problems, the status of a job no store knows).
+
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+use serde_json::{json, Value};
+
+use super::fleet::{
+    finished, free_port, fresh_redis, one_service, post, readyz_until, redis_cli,
+    redis_server_available, result, serve, start, start_redis, submit, taken_by, Process,
+};
+
+fn reasons(ready: &Value) -> String {
+    ready["reasons"].to_string()
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_full_cache_never_fails_a_job_and_a_full_job_store_is_told_truly() {
+    // One server in both roles: the answers may take 200 kB of it at most.
+    let Some((port, _redis, http, a)) = one_service(&["--redis-cache-bytes", "200000"]).await
+    else {
+        return;
+    };
+    for i in 0..60 {
+        let body = json!({"load": format!("{} nN", 1.0 + 0.01 * f64::from(i))});
+        let solved = post(&http, format!("{}/v1/rolling", a.base), &body).await;
+        assert_eq!(solved.status(), 200);
+    }
+    let total: u64 = redis_cli(port, &["HGET", "thirdbody:answers:sizes", "total"])
+        .trim()
+        .parse()
+        .unwrap();
+    assert!(total <= 200_000, "the answers take {total} bytes");
+    let kept = redis_cli(port, &["--scan", "--pattern", "thirdbody:answer:*"])
+        .lines()
+        .count();
+    assert!((1..60).contains(&kept), "{kept} answers kept of 60");
+    let id = submit(&http, &a.base, json!({"kind": "rolling", "input": {}})).await;
+    assert_eq!(finished(&http, &a.base, &id).await["status"], "succeeded");
+
+    // The server at its memory limit: every write is refused.
+    redis_cli(port, &["CONFIG", "SET", "maxmemory", "1"]);
+    let started = Instant::now();
+    let body = json!({"load": "3.3 nN"});
+    let solved = post(&http, format!("{}/v1/rolling", a.base), &body).await;
+    assert_eq!(solved.status(), 200, "a synchronous solve is answered here");
+    assert!(
+        started.elapsed() < Duration::from_secs(2),
+        "{:?}",
+        started.elapsed()
+    );
+    let refused = post(
+        &http,
+        format!("{}/v1/jobs", a.base),
+        &json!({"kind": "rolling", "input": {"load": "3.5 nN"}}),
+    )
+    .await;
+    assert_eq!(refused.status(), 503);
+    let problem: Value = refused.json().await.unwrap();
+    let detail = problem["detail"].as_str().unwrap();
+    assert!(
+        detail.contains("is full") && detail.contains("maxmemory"),
+        "{detail}"
+    );
+    let ready = readyz_until(&http, &a.base, Duration::from_secs(5), |r| {
+        r["status"] == "degraded"
+    })
+    .await;
+    assert!(reasons(&ready).contains("is full"), "{ready}");
+    // The job accepted before is still there, whole.
+    let view = finished(&http, &a.base, &id).await;
+    assert!(result(&http, &a.base, &view).await["friction_coefficient"].is_number());
+
+    // Room again: ready within a second or two, and jobs are taken.
+    redis_cli(port, &["CONFIG", "SET", "maxmemory", "0"]);
+    readyz_until(&http, &a.base, Duration::from_secs(5), |r| {
+        r["status"] == "ready"
+    })
+    .await;
+    let id = submit(
+        &http,
+        &a.base,
+        json!({"kind": "rolling", "input": {"load": "3.5 nN"}}),
+    )
+    .await;
+    assert_eq!(finished(&http, &a.base, &id).await["status"], "succeeded");
+}
+
+/// A Redis server on `port` keeping its data in an append-only file in `dir`.
+fn start_persisted_redis(port: u16, dir: &std::path::Path) -> Process {
+    let child = Command::new("redis-server")
+        .args(["--port", &port.to_string(), "--bind", "127.0.0.1"])
+        .args([
+            "--appendonly",
+            "yes",
+            "--appendfsync",
+            "always",
+            "--save",
+            "",
+        ])
+        .arg("--dir")
+        .arg(dir)
+        .stdout(Stdio::null())
+        .spawn()
+        .expect("redis-server starts");
+    let start = Instant::now();
+    while redis_cli(port, &["PING"]).trim() != "PONG" {
+        assert!(
+            start.elapsed() < Duration::from_secs(10),
+            "redis-server did not start"
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    Process(child)
+}
+
+/// Polls `url` (for up to 10 s) until it answers `status`; returns that answer's body.
+async fn answered_with(http: &reqwest::Client, url: &str, status: u16) -> Value {
+    let start = Instant::now();
+    loop {
+        let response = http.get(url).send().await.unwrap();
+        if response.status() == status {
+            return response.json().await.unwrap();
+        }
+        assert!(
+            start.elapsed() < Duration::from_secs(10),
+            "{url}: {}",
+            response.status()
+        );
+        tokio::time::sleep(Duration::from_millis(50)).await;
+    }
+}
+
+/// Stops the Redis server on `port` (saving nothing more) and waits for its process.
+fn shut_down_redis(port: u16, mut redis: Process) {
+    redis_cli(port, &["SHUTDOWN", "NOSAVE"]);
+    let _ = redis.0.wait();
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn jobs_outlive_a_restart_of_a_persisted_store_and_are_told_lost_with_one_that_was_not() {
+    if !redis_server_available() {
+        eprintln!("SKIPPED: redis-server is not on PATH (`.ci/run` installs it)");
+        return;
+    }
+    let dir = std::env::temp_dir().join(format!("thirdbody-aof-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let port = free_port();
+    let redis = start_persisted_redis(port, &dir);
+    let http = reqwest::Client::new();
+    let a = serve(port, &http, &[]).await;
+    let id = submit(
+        &http,
+        &a.base,
+        json!({"kind": "rolling", "input": {"load": "1.1 nN"}}),
+    )
+    .await;
+    let view = finished(&http, &a.base, &id).await;
+    let before = result(&http, &a.base, &view).await;
+
+    // Restarted with its data: the job and its answer are there.
+    shut_down_redis(port, redis);
+    let redis = start_persisted_redis(port, &dir);
+    let view = answered_with(&http, &format!("{}/v1/jobs/{id}", a.base), 200).await;
+    assert_eq!(view["status"], "succeeded");
+    assert_eq!(result(&http, &a.base, &view).await, before);
+
+    // Restarted without it: the job is told lost with the store, not "expired".
+    shut_down_redis(port, redis);
+    std::fs::remove_dir_all(&dir).unwrap();
+    let _redis = start_redis(port);
+    let problem = answered_with(&http, &format!("{}/v1/jobs/{id}", a.base), 410).await;
+    let detail = problem["detail"].as_str().unwrap();
+    assert!(detail.contains("restarted without its data"), "{detail}");
+    // An id no run of the service issued is told so.
+    let never = http
+        .get(format!("{}/v1/jobs/{}", a.base, uuid::Uuid::new_v4()))
+        .send()
+        .await
+        .unwrap();
+    assert_eq!(never.status(), 404);
+    let detail = never.json::<Value>().await.unwrap()["detail"].to_string();
+    assert!(detail.contains("no run of this service issued"), "{detail}");
+}
+
+/// A TCP proxy to 127.0.0.1:`upstream` that holds every chunk for `delay`, each way (a
+/// thread per direction of each connection); returns its port.
+fn latency_proxy(upstream: u16, delay: Duration) -> u16 {
+    use std::io::{Read, Write};
+    let listener = std::net::TcpListener::bind("127.0.0.1:0").unwrap();
+    let port = listener.local_addr().unwrap().port();
+    std::thread::spawn(move || {
+        for client in listener.incoming().map_while(Result::ok) {
+            let Ok(server) = std::net::TcpStream::connect(("127.0.0.1", upstream)) else {
+                continue;
+            };
+            let pairs = [
+                (client.try_clone().unwrap(), server.try_clone().unwrap()),
+                (server, client),
+            ];
+            for (mut from, mut to) in pairs {
+                std::thread::spawn(move || {
+                    let mut buffer = vec![0; 64 << 10];
+                    while let Ok(n @ 1..) = from.read(&mut buffer) {
+                        std::thread::sleep(delay);
+                        if to.write_all(&buffer[..n]).is_err() {
+                            break;
+                        }
+                    }
+                    let _ = to.shutdown(std::net::Shutdown::Both);
+                });
+            }
+        }
+    });
+    port
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_slow_redis_sends_synchronous_solves_to_the_process_and_readyz_says_why() {
+    let Some((port, _redis)) = fresh_redis() else {
+        return;
+    };
+    // 100 ms each way: 200 ms a round trip.
+    let proxy = latency_proxy(port, Duration::from_millis(100));
+    let http = reqwest::Client::new();
+    let a = serve(proxy, &http, &[]).await;
+    let ready = readyz_until(&http, &a.base, Duration::from_secs(10), |r| {
+        r["redis"]["cache"] == "slow"
+    })
+    .await;
+    assert_eq!(ready["status"], "degraded");
+    assert!(reasons(&ready).contains("answers slowly"), "{ready}");
+    for i in 0..5 {
+        let body = json!({"load": format!("{} nN", 2.0 + 0.1 * f64::from(i))});
+        let started = Instant::now();
+        let solved = post(&http, format!("{}/v1/rolling", a.base), &body).await;
+        assert_eq!(solved.status(), 200);
+        let took = started.elapsed();
+        assert!(
+            took < Duration::from_millis(150),
+            "an uncached solve took {took:?}"
+        );
+    }
+    // Jobs still go through the slow store, and end.
+    let id = submit(
+        &http,
+        &a.base,
+        json!({"kind": "rolling", "input": {"load": "2.9 nN"}}),
+    )
+    .await;
+    assert_eq!(finished(&http, &a.base, &id).await["status"], "succeeded");
+}
+
+/// A sweep on the layer as a continuum: 240 points of ~25 ms, in parts of 20 points.
+fn long_sweep() -> Value {
+    let speeds: Vec<String> = (0..60)
+        .map(|i| format!("{} nm/s", 0.1 + 0.1 * f64::from(i)))
+        .collect();
+    json!({"kind": "sweep", "input": {
+        "base": {"layer": {"model": "continuum"}},
+        "vary": {"load": ["1 nN", "1.2 nN", "1.4 nN", "1.6 nN"], "velocity": speeds}}})
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn three_rolling_restarts_during_a_long_job_hand_its_parts_back_and_it_finishes() {
+    let Some((port, _redis)) = fresh_redis() else {
+        return;
+    };
+    let http = reqwest::Client::new();
+    // One delivery per part: a hand-back charged as a delivery would fail the job.
+    let strict = ["--max-deliveries", "1", "--part-points", "20"];
+    let a = serve(port, &http, &strict).await;
+    let id = submit(&http, &a.base, long_sweep()).await;
+    let rolled = ["--shutdown-timeout", "10ms"];
+    let mut handed_back = 0;
+    for _ in 0..3 {
+        let (mut worker, log) = start("worker", port, None, &[&strict[..], &rolled[..]].concat());
+        taken_by(&log, &id).await;
+        let pid = worker.0.id().to_string();
+        Command::new("kill").args(["-TERM", &pid]).status().unwrap();
+        let status = worker.0.wait().unwrap();
+        assert!(status.success(), "the worker drained and exited: {status}");
+        handed_back += log
+            .lock()
+            .unwrap()
+            .iter()
+            .filter(|l| l.contains("handed a part back"))
+            .count();
+    }
+    assert!(handed_back >= 1, "no drain interrupted a part");
+    let view = finished(&http, &a.base, &id).await;
+    assert_eq!(view["status"], "succeeded", "{view}");
+    let answer = result(&http, &a.base, &view).await;
+    assert_eq!(answer["points"].as_array().unwrap().len(), 240);
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn no_key_is_left_without_a_time_to_live_after_deletes_and_cancels() {
+    let Some((port, _redis, http, a)) = one_service(&["--part-points", "20"]).await else {
+        return;
+    };
+    let mut ids = Vec::new();
+    for _ in 0..6 {
+        ids.push(submit(&http, &a.base, long_sweep()).await);
+    }
+    for (i, id) in ids.iter().enumerate() {
+        let url = format!("{}/v1/jobs/{id}", a.base);
+        let response = if i % 2 == 0 {
+            http.post(format!("{url}/cancel")).send().await.unwrap()
+        } else {
+            http.delete(url).send().await.unwrap()
+        };
+        assert_eq!(response.status(), 200);
+    }
+    // The stream empties as workers find its entries' jobs finished or gone.
+    let start = Instant::now();
+    while redis_cli(port, &["XLEN", "thirdbody:work"]).trim() != "0" {
+        assert!(
+            start.elapsed() < Duration::from_secs(30),
+            "the stream kept its entries"
+        );
+        tokio::time::sleep(Duration::from_millis(50)).await;
+    }
+    tokio::time::sleep(Duration::from_millis(300)).await;
+    // Owned: the stream (its entries deleted when done) and the store's epoch.
+    let owned = ["thirdbody:work", "thirdbody:epoch"];
+    let keys = redis_cli(port, &["--scan", "--pattern", "*"]);
+    assert!(keys.lines().any(|k| k.contains(":job:")), "{keys}");
+    for key in keys.lines().filter(|k| !owned.contains(k)) {
+        let ttl: i64 = redis_cli(port, &["PTTL", key]).trim().parse().unwrap();
+        assert!(ttl > 0 || ttl == -2, "{key} has no time to live ({ttl})");
+    }
+}
+
+/// Starts `thirdbody serve` alone (no Redis) on a free port; returns its base URL.
+async fn serve_alone(http: &reqwest::Client) -> (String, Process) {
+    let port = free_port();
+    let child = Command::new(env!("CARGO_BIN_EXE_thirdbody"))
+        .args([
+            "serve",
+            "--pool-size",
+            "2",
+            "--bind",
+            &format!("127.0.0.1:{port}"),
+        ])
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .expect("thirdbody starts");
+    let base = format!("http://127.0.0.1:{port}");
+    let start = Instant::now();
+    while http.get(format!("{base}/healthz")).send().await.is_err() {
+        assert!(
+            start.elapsed() < Duration::from_secs(20),
+            "serve did not start"
+        );
+        tokio::time::sleep(Duration::from_millis(50)).await;
+    }
+    (base, Process(child))
+}
+
+/// The JSON and CSV of job `job` run on `base`, as bytes.
+async fn job_bytes(http: &reqwest::Client, base: &str, job: &Value) -> (Vec<u8>, Vec<u8>) {
+    let id = submit(http, base, job.clone()).await;
+    let view = finished(http, base, &id).await;
+    assert_eq!(view["status"], "succeeded", "{view}");
+    let url = format!("{base}{}", view["result_url"].as_str().unwrap());
+    let mut forms = Vec::new();
+    for accept in ["application/json", "text/csv"] {
+        let response = http
+            .get(&url)
+            .header("accept", accept)
+            .send()
+            .await
+            .unwrap();
+        assert_eq!(response.status(), 200);
+        forms.push(response.bytes().await.unwrap().to_vec());
+    }
+    (forms.remove(0), forms.remove(0))
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn the_fleet_answers_every_kind_byte_for_byte_as_one_process_does() {
+    let Some((port, _redis, http, fleet)) = one_service(&[]).await else {
+        return;
+    };
+    let _worker = start("worker", port, None, &[]);
+    let (alone, _alone) = serve_alone(&http).await;
+    let fit: Value = serde_json::from_str(include_str!("../../examples/fit.json")).unwrap();
+    let loads: Vec<String> = (0..30)
+        .map(|i| format!("{} nN", 1.0 + 0.1 * f64::from(i)))
+        .collect();
+    let jobs = [
+        json!({"kind": "rolling", "input": {"load": "1.3 nN", "velocity": "4 nm/s"}}),
+        json!({"kind": "three_body", "input": {"operating": {"total_load": "1 mN"}}}),
+        json!({"kind": "sweep", "input": {"vary": {"load": loads, "velocity": ["0 nm/s", "4 nm/s"]}}}),
+        json!({"kind": "sweep", "input": {"kind": "three_body",
+            "vary": {"total_load": ["0.5 mN", "1 mN", "2 mN"], "velocity": ["1 nm/s", "4 nm/s"]}}}),
+        json!({"kind": "figure", "input": {"number": 6}}),
+        fit,
+    ];
+    for job in &jobs {
+        // Solved in the fleet (in parts where it splits), then alone.
+        let (json_fleet, csv_fleet) = job_bytes(&http, &fleet.base, job).await;
+        let (json_alone, csv_alone) = job_bytes(&http, &alone, job).await;
+        assert!(
+            json_fleet == json_alone,
+            "the JSON of {} differs",
+            job["kind"]
+        );
+        assert!(csv_fleet == csv_alone, "the CSV of {} differs", job["kind"]);
+    }
+}
