@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
 """The fleet on this machine (BENCHMARKS.md "A fleet that scales"): a light sweep (10,000
-rolling points, default rule) and a heavy one (three-body points) through /v1/jobs, on one
+rolling points, default rule) and two heavy ones (three-body points; rolling points on the
+layer as a continuum) through /v1/jobs, on one
 `serve` without Redis and on one `serve` with Redis plus 0, 1 and 2 `worker`s; for each,
 the wall time from submission to the result in hand, and what Redis spent on the job: its
 command time (INFO commandstats) and the bytes it took in and sent out (INFO stats), per point.
@@ -53,6 +54,13 @@ def heavy(tag):
     return {"kind": "sweep", "input": {"kind": "three_body",
             "vary": {"total_load": loads, "velocity": speeds}}}, 400
 
+def continuum(tag):
+    """60 rolling points on the layer as a continuum (4 loads x 15 speeds), ~25 ms each."""
+    loads = [f"{1 + 0.2 * i + tag * 1e-5} nN" for i in range(4)]
+    speeds = [f"{0.2 * (1 + i)} nm/s" for i in range(15)]
+    return {"kind": "sweep", "input": {"base": {"layer": {"model": "continuum"}},
+            "vary": {"load": loads, "velocity": speeds}}}, 60
+
 class Redis:
     def __init__(self, port):
         self.port = port
@@ -102,7 +110,7 @@ def layouts(binary, redis_port, runs, tags):
             time.sleep(0.5)
             base = f"http://127.0.0.1:{port}"
             name = "alone" if redis is None else f"redis + {workers} worker(s)"
-            for sweep_name, make in (("light", light), ("heavy", heavy)):
+            for sweep_name, make in (("light", light), ("heavy", heavy), ("continuum", continuum)):
                 results = [timed_job(base, *make(next(tags)), redis) for _ in range(runs)]
                 medians = [statistics.median(r[i] for r in results) for i in range(3)]
                 yield name, sweep_name, medians
@@ -132,22 +140,26 @@ def hits(binary, redis_port):
             p.wait()
 
 def chart(rows, path):
-    """Grouped horizontal bars: one group per (sweep, layout), one bar per build."""
+    """Grouped horizontal bars: one group per (sweep, layout), one bar per build; each
+    sweep's bars to its own scale (its slowest run the full width)."""
     builds = sorted({r[0] for r in rows}, key=[r[0] for r in rows].index)
+    layouts = sorted({r[1] for r in rows}, key=[r[1] for r in rows].index)
     colours = ["#9aa5b1", "#1f6feb", "#d97706", "#16a34a"]
     groups = []
-    for sweep in ("light", "heavy"):
-        for layout in sorted({r[1] for r in rows}, key=[r[1] for r in rows].index):
+    for sweep in ("light", "heavy", "continuum"):
+        top = max((r[3] for r in rows if r[2] == sweep), default=1.0)
+        for layout in layouts:
             bars = [(b, r[3]) for b in builds for r in rows if r[:3] == (b, layout, sweep)]
-            groups.append((f"{sweep}: {layout}", bars))
+            if bars:
+                groups.append((f"{sweep}: {layout}", bars, top))
     bar, gap, left, width = 14, 10, 190, 420
     height = 40 + len(groups) * (len(builds) * bar + gap) + 20 * len(builds)
-    top = max(v for _, bars in groups for _, v in bars)
     out = [f'<svg xmlns="http://www.w3.org/2000/svg" width="{left + width + 80}" height="{height}" '
            'font-family="sans-serif" font-size="12">',
-           f'<text x="10" y="20" font-weight="bold">Sweep through /v1/jobs, wall time (median, s)</text>']
+           '<text x="10" y="20" font-weight="bold">Sweep through /v1/jobs, wall time '
+           '(median, s; each sweep to its own scale)</text>']
     y = 36
-    for label, bars in groups:
+    for label, bars, top in groups:
         out.append(f'<text x="{left - 6}" y="{y + bar * len(bars) / 2 + 4}" text-anchor="end">{label}</text>')
         for build, value in bars:
             w = width * value / top

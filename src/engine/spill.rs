@@ -138,6 +138,15 @@ impl JobResult {
         }
     }
 
+    /// The answer's cache key.
+    pub fn key(&self) -> &str {
+        match self {
+            JobResult::Ready(solved) => &solved.key,
+            JobResult::Spilled(spilled) => &spilled.key,
+            JobResult::Stored(stored) => &stored.key,
+        }
+    }
+
     /// Bytes held in memory, or on disk (none for a result in Redis).
     pub fn weight(&self) -> u64 {
         match self {

@@ -362,12 +362,13 @@ async fn serve_alone(http: &reqwest::Client) -> (String, Process) {
     (base, Process(child))
 }
 
-/// The JSON and CSV of job `job` run on `base`, as bytes.
-async fn job_bytes(http: &reqwest::Client, base: &str, job: &Value) -> (Vec<u8>, Vec<u8>) {
+/// The JSON and CSV of job `job` run on `base`, as bytes, with the JSON's `ETag`.
+async fn job_bytes(http: &reqwest::Client, base: &str, job: &Value) -> (String, Vec<u8>, Vec<u8>) {
     let id = submit(http, base, job.clone()).await;
     let view = finished(http, base, &id).await;
     assert_eq!(view["status"], "succeeded", "{view}");
     let url = format!("{base}{}", view["result_url"].as_str().unwrap());
+    let mut etag = String::new();
     let mut forms = Vec::new();
     for accept in ["application/json", "text/csv"] {
         let response = http
@@ -377,9 +378,13 @@ async fn job_bytes(http: &reqwest::Client, base: &str, job: &Value) -> (Vec<u8>,
             .await
             .unwrap();
         assert_eq!(response.status(), 200);
+        if etag.is_empty() {
+            etag = response.headers()["etag"].to_str().unwrap().to_string();
+        }
         forms.push(response.bytes().await.unwrap().to_vec());
     }
-    (forms.remove(0), forms.remove(0))
+    let csv = forms.pop().unwrap();
+    (etag, forms.pop().unwrap(), csv)
 }
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
@@ -403,14 +408,15 @@ async fn the_fleet_answers_every_kind_byte_for_byte_as_one_process_does() {
         fit,
     ];
     for job in &jobs {
-        // Solved in the fleet (in parts where it splits), then alone.
-        let (json_fleet, csv_fleet) = job_bytes(&http, &fleet.base, job).await;
-        let (json_alone, csv_alone) = job_bytes(&http, &alone, job).await;
-        assert!(
-            json_fleet == json_alone,
-            "the JSON of {} differs",
-            job["kind"]
-        );
-        assert!(csv_fleet == csv_alone, "the CSV of {} differs", job["kind"]);
+        // Solved in the fleet (in parts where it splits), then alone; then in the fleet
+        // again, answered from the cache at submission.
+        let alone = job_bytes(&http, &alone, job).await;
+        for round in ["solved", "cached"] {
+            let (etag, json, csv) = job_bytes(&http, &fleet.base, job).await;
+            let kind = &job["kind"];
+            assert_eq!(etag, alone.0, "the ETag of {kind} ({round})");
+            assert!(json == alone.1, "the JSON of {kind} differs ({round})");
+            assert!(csv == alone.2, "the CSV of {kind} differs ({round})");
+        }
     }
 }

@@ -28,7 +28,8 @@ use std::sync::Arc;
 /// the job; a state refused drops the staged result.
 ///
 /// KEYS: record, result, parts, deliveries, staged result. ARGV: status, done, error,
-/// retention (ms), now (Unix ms), whether a staged result is whole (`whole`/`partial`).
+/// retention (ms), now (Unix ms), whether a staged result is whole (`whole`/`partial`), and
+/// its cache key.
 const UPDATE: &str = r#"
 local current = redis.call('HGET', KEYS[1], 'status')
 if current ~= 'queued' and current ~= 'running' then
@@ -41,7 +42,7 @@ if ARGV[3] ~= '' then redis.call('HSET', KEYS[1], 'error', ARGV[3]) end
 if ARGV[1] ~= 'queued' and ARGV[1] ~= 'running' then
   if redis.call('EXISTS', KEYS[5]) == 1 then
     redis.call('RENAME', KEYS[5], KEYS[2])
-    redis.call('HSET', KEYS[1], 'result', ARGV[6])
+    redis.call('HSET', KEYS[1], 'result', ARGV[6], 'key', ARGV[7])
   end
   redis.call('HSET', KEYS[1], 'finished_at', ARGV[5])
   redis.call('DEL', KEYS[3])
@@ -318,11 +319,12 @@ impl RedisJobStore {
         };
         let mut pipe = redis::pipe();
         pipe.atomic();
-        let mut whole = "";
+        let (mut whole, mut key) = ("", "");
         if let Some(result) = state
             .result()
             .filter(|r| !matches!(r, JobResult::Stored(_)))
         {
+            key = result.key();
             let (json, csv) = result
                 .bodies()
                 .await
@@ -351,6 +353,7 @@ impl RedisJobStore {
                 retention.as_bytes(),
                 now.as_bytes(),
                 whole.as_bytes(),
+                key.as_bytes(),
             ],
         ))
         .ignore();
@@ -360,9 +363,25 @@ impl RedisJobStore {
     /// The record of job `id`, without its result (which stays in Redis until a client
     /// reads it: see [`StoredResult`]); `None` if unknown or expired.
     pub async fn record(&self, id: Uuid) -> Result<Option<JobRecord>, Failure> {
-        let cmd = Cmd::hgetall(keys::job(id).record);
-        let fields: HashMap<String, Vec<u8>> = self.fleet.jobs.query(&cmd).await?;
-        if fields.is_empty() {
+        // The fields a status needs: not the job's text, which may be long (a fit's data).
+        const FIELDS: [&str; 8] = [
+            "kind",
+            "work",
+            "status",
+            "done",
+            "key",
+            "result",
+            "error",
+            "finished_at",
+        ];
+        let cmd = Cmd::hmget(keys::job(id).record, &FIELDS[..]);
+        let values: Vec<Option<Vec<u8>>> = self.fleet.jobs.query(&cmd).await?;
+        let fields: HashMap<&str, Vec<u8>> = FIELDS
+            .into_iter()
+            .zip(values)
+            .filter_map(|(name, value)| Some((name, value?)))
+            .collect();
+        if !fields.contains_key("status") {
             return Ok(None);
         }
         let text = |name: &str| {
@@ -469,8 +488,14 @@ impl JobStore for RedisJobStore {
             ("parts", "1".to_string()),
             ("parts_done", "0".to_string()),
         ];
-        let cmd = Cmd::hset_multiple(keys::job(record.id).record, &fields);
-        if let Err(e) = self.fleet.jobs.query::<()>(&cmd).await {
+        let key = keys::job(record.id).record;
+        let mut pipe = redis::pipe();
+        pipe.atomic()
+            .hset_multiple(&key, &fields)
+            .ignore()
+            .pexpire(&key, millis(self.lifetime) as i64)
+            .ignore();
+        if let Err(e) = self.fleet.jobs.pipe::<()>(&pipe).await {
             tracing::warn!(error = %e, id = %record.id, "a job record was not stored");
         }
         Ok(())
