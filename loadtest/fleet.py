@@ -7,7 +7,7 @@ the wall time from submission to the result in hand, and what Redis spent on the
 command time (INFO commandstats) and the bytes it took in and sent out (INFO stats), per point.
 Then the cost of a cache hit from Redis (L2) against one from the process's memory (L1).
 
-    python3 loadtest/fleet.py [--runs N] [--svg FILE] [NAME=BINARY ...]
+    python3 loadtest/fleet.py [--runs N] [--sweeps light,heavy,continuum] [--svg FILE] [NAME=BINARY ...]
 
 Builds given as NAME=BINARY are measured one after the other in the same run (default: one,
 new=target/release/thirdbody); --svg draws the medians as a bar chart. Needs redis-server."""
@@ -95,7 +95,9 @@ def timed_job(base, job, points, redis):
     return (wall, (after[0] - before[0]) / points,
             (after[1] - before[1] + after[2] - before[2]) / points)
 
-def layouts(binary, redis_port, runs, tags):
+SWEEPS = {"light": light, "heavy": heavy, "continuum": continuum}
+
+def layouts(binary, redis_port, runs, tags, sweeps):
     """Yields (layout, sweep, medians) for every layout of one build."""
     for workers in (None, 0, 1, 2):
         redis = Redis(redis_port) if workers is not None else None
@@ -110,7 +112,8 @@ def layouts(binary, redis_port, runs, tags):
             time.sleep(0.5)
             base = f"http://127.0.0.1:{port}"
             name = "alone" if redis is None else f"redis + {workers} worker(s)"
-            for sweep_name, make in (("light", light), ("heavy", heavy), ("continuum", continuum)):
+            for sweep_name in sweeps:
+                make = SWEEPS[sweep_name]
                 results = [timed_job(base, *make(next(tags)), redis) for _ in range(runs)]
                 medians = [statistics.median(r[i] for r in results) for i in range(3)]
                 yield name, sweep_name, medians
@@ -178,6 +181,7 @@ def chart(rows, path):
 def main():
     parser = argparse.ArgumentParser()
     parser.add_argument("--runs", type=int, default=3)
+    parser.add_argument("--sweeps", default="light,heavy,continuum")
     parser.add_argument("--svg")
     parser.add_argument("builds", nargs="*", default=["new=target/release/thirdbody"])
     args = parser.parse_args()
@@ -192,7 +196,7 @@ def main():
         print("| build | layout | sweep | wall (median) | Redis command time per point | Redis bytes per point |")
         print("|---|---|---|---|---|---|")
         for name, binary in builds:
-            for layout, sweep, (wall, usec, size) in layouts(binary, redis_port, args.runs, tags):
+            for layout, sweep, (wall, usec, size) in layouts(binary, redis_port, args.runs, tags, args.sweeps.split(",")):
                 rows.append((name, layout, sweep, wall))
                 print(f"| {name} | {layout} | {sweep} | {wall:.3f} s | {usec:.2f} µs | {size:,.0f} B |",
                       flush=True)
