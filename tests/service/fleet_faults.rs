@@ -420,3 +420,42 @@ async fn the_fleet_answers_every_kind_byte_for_byte_as_one_process_does() {
         }
     }
 }
+
+/// A fleet upgraded over a persisted store reads the jobs the version before finished:
+/// their records did not name their result's form, their results are where they were.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_job_finished_by_the_version_before_is_read_with_its_result() {
+    let Some((port, _redis, http, a)) = one_service(&[]).await else {
+        return;
+    };
+    let id = uuid::Uuid::new_v4();
+    let record = format!("thirdbody:job:{id}");
+    let fields = [
+        "kind",
+        "rolling",
+        "work",
+        "1",
+        "status",
+        "succeeded",
+        "done",
+        "1",
+        "key",
+        "k",
+    ];
+    redis_cli(port, &[&["HSET", &record][..], &fields[..]].concat());
+    let stored = format!("{record}:result");
+    redis_cli(
+        port,
+        &["HSET", &stored, "json", r#"{"x":1}"#, "csv", "x\n1\n"],
+    );
+    let view: Value = http
+        .get(format!("{}/v1/jobs/{id}", a.base))
+        .send()
+        .await
+        .unwrap()
+        .json()
+        .await
+        .unwrap();
+    assert_eq!(view["status"], "succeeded", "{view}");
+    assert_eq!(result(&http, &a.base, &view).await, json!({"x": 1}));
+}

@@ -231,8 +231,15 @@ impl RedisJobStore {
     /// Takes back the delivery of a part handed back unfinished by a drain: a process that
     /// stopped on purpose is not one that died on the part.
     pub async fn undelivered(&self, id: Uuid, part: &str) -> Result<(), Failure> {
-        let cmd = Cmd::hincr(keys::job(id).deliveries, part, -1);
-        self.fleet.jobs.query::<i64>(&cmd).await.map(drop)
+        let deliveries = keys::job(id).deliveries;
+        let mut pipe = redis::pipe();
+        pipe.atomic()
+            .hincr(&deliveries, part, -1)
+            .ignore()
+            // Recreated if the job was deleted meanwhile: it expires all the same.
+            .pexpire(&deliveries, millis(self.lifetime) as i64)
+            .ignore();
+        self.fleet.jobs.pipe::<()>(&pipe).await
     }
 
     /// Keeps part `index` (of `points` points) of `job`, as plain fields of its parts hash,
@@ -302,14 +309,15 @@ impl RedisJobStore {
     }
 
     /// Moves job `id` to `state` with `done` units done (`None`: as counted so far), unless
-    /// it has finished. A result is written once, staged beside the record in the same
-    /// transaction as the move; a result already in the store stays where it is.
+    /// it has finished (or is gone); returns whether it moved. A result is written once,
+    /// staged beside the record in the same transaction as the move; a result already in
+    /// the store stays where it is.
     pub async fn set_state(
         &self,
         id: Uuid,
         state: &JobState,
         done: Option<usize>,
-    ) -> Result<(), Failure> {
+    ) -> Result<bool, Failure> {
         let keys = keys::job(id);
         let error = match state {
             JobState::Failed { error, .. } => {
@@ -355,9 +363,9 @@ impl RedisJobStore {
                 whole.as_bytes(),
                 key.as_bytes(),
             ],
-        ))
-        .ignore();
-        self.fleet.jobs.pipe::<()>(&pipe).await
+        ));
+        let (moved,): (i64,) = self.fleet.jobs.pipe(&pipe).await?;
+        Ok(moved == 1)
     }
 
     /// The record of job `id`, without its result (which stays in Redis until a client
@@ -393,8 +401,13 @@ impl RedisJobStore {
         let kind = KindName::find(&text("kind"))
             .map_err(|e| Failure::new(format!("a stored job is unreadable: {e}")))?;
         let work = text("work").parse().map_or(Work::Unknown, Work::Known);
+        // A record of the version before `result` was kept says so by its result hash.
+        let form = match fields.get("result") {
+            Some(form) => String::from_utf8_lossy(form).into_owned(),
+            None => self.legacy_result_form(id, &text("status")).await?,
+        };
         // A result of a cancelled or failed job is what it finished before it stopped.
-        let result = || match text("result").as_str() {
+        let result = || match form.as_str() {
             form @ ("whole" | "partial") => Some(JobResult::Stored(Arc::new(StoredResult {
                 fleet: self.fleet.clone(),
                 id,
@@ -432,6 +445,25 @@ impl RedisJobStore {
             done: text("done").parse().unwrap_or(0),
             finished_at,
         }))
+    }
+}
+
+impl RedisJobStore {
+    /// The form of the result of a finished job recorded by the version before records
+    /// named it (their results are in the result hash all the same): `whole` for a
+    /// succeeded job's, `partial` for another's, `""` for none.
+    async fn legacy_result_form(&self, id: Uuid, status: &str) -> Result<String, Failure> {
+        if matches!(parse_status(status), JobStatus::Queued | JobStatus::Running) {
+            return Ok(String::new());
+        }
+        let cmd = Cmd::hexists(keys::job(id).result, "json");
+        let stored: bool = self.fleet.jobs.query(&cmd).await?;
+        let form = match (stored, parse_status(status)) {
+            (false, _) => "",
+            (true, JobStatus::Succeeded) => "whole",
+            (true, _) => "partial",
+        };
+        Ok(form.to_string())
     }
 }
 

@@ -238,14 +238,16 @@ impl Worker {
         }
         let control = Arc::new(self.solver.control(runnable.deadline));
         shared.running().insert(entry.id.clone(), control.clone());
-        let heartbeat = tokio::spawn(heartbeat(
+        // Kept until the entry is done with, assembly included (the last part's entry
+        // stays pending while its job is assembled and stored).
+        let _heartbeat = AbortOnDrop(tokio::spawn(heartbeat(
             shared.fleet.clone(),
             store.clone(),
             entry.id.clone(),
             id,
             control.clone(),
             entry.part.is_none(),
-        ));
+        )));
         tracing::info!(entry = entry.id, job = %id, part = entry.part_name(), deliveries, "solving a part");
         if runnable.status == JobStatus::Queued {
             let _ = store.set_state(id, &JobState::Running, None).await;
@@ -286,7 +288,6 @@ impl Worker {
         })
         .await;
         drop(running);
-        heartbeat.abort();
         shared.running().remove(&entry.id);
         let outcome = match &result {
             Ok(_) => "succeeded",
@@ -370,7 +371,8 @@ impl Worker {
     }
 
     /// Finishes the job of `entry` with its answer `solved`, then caches it (by reference
-    /// to the stored result where the cache shares the job store's server).
+    /// to the stored result where the cache shares the job store's server), unless the job
+    /// had ended otherwise meanwhile (its stored result is then another).
     async fn succeed(&self, entry: &Entry, solved: Arc<Solved>, total: usize) {
         let state = JobState::Succeeded(JobResult::Ready(solved.clone()));
         if self.finish(entry, state, Some(total)).await {
@@ -379,17 +381,21 @@ impl Worker {
     }
 
     /// Stores the job's final `state`, then acknowledges the entry (left for another worker
-    /// if the state could not be stored); returns whether it was stored.
+    /// if the state could not be stored); returns whether the job ended so (not if it had
+    /// ended otherwise before, a cancel say).
     async fn finish(&self, entry: &Entry, state: JobState, done: Option<usize>) -> bool {
         state.log_end(entry.job);
         let shared = &self.shared;
-        let stored = shared.store.set_state(entry.job, &state, done).await;
-        if let Err(e) = &stored {
-            tracing::warn!(error = %e, job = %entry.job, "a job's end was not stored: it runs again");
-        } else {
-            acknowledge(&shared.fleet, entry).await;
+        match shared.store.set_state(entry.job, &state, done).await {
+            Ok(moved) => {
+                acknowledge(&shared.fleet, entry).await;
+                moved
+            }
+            Err(e) => {
+                tracing::warn!(error = %e, job = %entry.job, "a job's end was not stored: it runs again");
+                false
+            }
         }
-        stored.is_ok()
     }
 }
 
@@ -458,6 +464,15 @@ async fn acknowledge(fleet: &Fleet, entry: &Entry) {
         .ignore();
     if let Err(e) = fleet.jobs.pipe::<()>(&pipe).await {
         tracing::warn!(error = %e, "an entry was not acknowledged: it will run again");
+    }
+}
+
+/// Stops a task when dropped.
+struct AbortOnDrop(tokio::task::JoinHandle<()>);
+
+impl Drop for AbortOnDrop {
+    fn drop(&mut self) {
+        self.0.abort();
     }
 }
 
