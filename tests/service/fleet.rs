@@ -123,9 +123,8 @@ pub(crate) struct Service {
     _process: Process,
 }
 
-pub(crate) async fn serve(redis: u16, http: &reqwest::Client, flags: &[&str]) -> Service {
-    let port = free_port();
-    let (process, _) = start("serve", redis, Some(port), flags);
+/// Waits (up to 20 s) until a service answers on `port`; returns its base URL.
+pub(crate) async fn answering(http: &reqwest::Client, port: u16) -> String {
     let base = format!("http://127.0.0.1:{port}");
     let start = Instant::now();
     while http.get(format!("{base}/healthz")).send().await.is_err() {
@@ -135,6 +134,13 @@ pub(crate) async fn serve(redis: u16, http: &reqwest::Client, flags: &[&str]) ->
         );
         tokio::time::sleep(Duration::from_millis(50)).await;
     }
+    base
+}
+
+pub(crate) async fn serve(redis: u16, http: &reqwest::Client, flags: &[&str]) -> Service {
+    let port = free_port();
+    let (process, _) = start("serve", redis, Some(port), flags);
+    let base = answering(http, port).await;
     Service {
         base,
         _process: process,

@@ -9,7 +9,7 @@ use std::time::{Duration, Instant};
 use serde_json::{json, Value};
 
 use super::fleet::{
-    finished, free_port, fresh_redis, one_service, post, readyz_until, redis_cli,
+    answering, finished, free_port, fresh_redis, one_service, post, readyz_until, redis_cli,
     redis_server_available, result, serve, start, start_redis, submit, taken_by, Process,
 };
 
@@ -350,16 +350,7 @@ async fn serve_alone(http: &reqwest::Client) -> (String, Process) {
         .stderr(Stdio::null())
         .spawn()
         .expect("thirdbody starts");
-    let base = format!("http://127.0.0.1:{port}");
-    let start = Instant::now();
-    while http.get(format!("{base}/healthz")).send().await.is_err() {
-        assert!(
-            start.elapsed() < Duration::from_secs(20),
-            "serve did not start"
-        );
-        tokio::time::sleep(Duration::from_millis(50)).await;
-    }
-    (base, Process(child))
+    (answering(http, port).await, Process(child))
 }
 
 /// The JSON and CSV of job `job` run on `base`, as bytes, with the JSON's `ETag`.

@@ -146,9 +146,7 @@ impl Fleet {
     pub async fn watch(&self) {
         let epoch = async {
             loop {
-                let now = std::time::SystemTime::now()
-                    .duration_since(std::time::UNIX_EPOCH)
-                    .map_or(0, |d| d.as_millis() as u64);
+                let now = store::unix_millis(std::time::SystemTime::now());
                 let mark = redis::Cmd::set_options(
                     keys::EPOCH,
                     now,
