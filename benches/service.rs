@@ -129,5 +129,49 @@ fn fit(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, sweep, render, figures, service, fit);
+/// One rolling request through the whole router (as `thirdbody serve` builds it, no socket):
+/// the same input every time (a cache hit after the first), and a new load every time
+/// (solved). Their difference is what a solve adds to a request in the process; the
+/// throughput ratio of the two over HTTP is `loadtest/ratio.sh`'s.
+fn http(c: &mut Criterion) {
+    use axum::body::Body;
+    use axum::http::Request;
+    use clap::Parser;
+    use thirdbody::http::{app, AppState, ServeArgs};
+    use tower::ServiceExt;
+
+    let config = ServeArgs::try_parse_from(["serve"])
+        .unwrap()
+        .validate()
+        .unwrap();
+    let runtime = tokio::runtime::Builder::new_current_thread()
+        .enable_all()
+        .build()
+        .unwrap();
+    let router = runtime.block_on(async { app(AppState::new(config).unwrap()) });
+    let post = |body: String| {
+        let request = Request::post("/v1/rolling")
+            .header("content-type", "application/json")
+            .body(Body::from(body))
+            .unwrap();
+        let response = runtime.block_on(router.clone().oneshot(request)).unwrap();
+        assert!(response.status().is_success());
+        response
+    };
+    // The layer's similarity table, which a first answer has built in the background.
+    post("{}".to_string());
+    std::thread::sleep(Duration::from_millis(200));
+    let mut group = c.benchmark_group("http");
+    group.bench_function("rolling_cached", |b| b.iter(|| post("{}".to_string())));
+    let mut load = 1e-9;
+    group.bench_function("rolling_uncached", |b| {
+        b.iter(|| {
+            load *= 1.0 + 1e-9;
+            post(format!("{{\"load\": {load:e}}}"))
+        })
+    });
+    group.finish();
+}
+
+criterion_group!(benches, sweep, render, figures, service, fit, http);
 criterion_main!(benches);

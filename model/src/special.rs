@@ -50,6 +50,19 @@ const EXPREL_PRIME: [f64; SERIES_TERMS] = {
     c
 };
 
+/// Σ zⁿ/((n+3)!(n+m)): ∫₀¹ s^{m−1} E₃(zs) ds, for m = 4, 5.
+const fn exprel3_moment_coefficients(m: usize) -> [f64; SERIES_TERMS] {
+    let mut c = EXPREL3;
+    let mut n = 0;
+    while n < SERIES_TERMS {
+        c[n] /= (n + m) as f64;
+        n += 1;
+    }
+    c
+}
+const EXPREL3_MOMENT_3: [f64; SERIES_TERMS] = exprel3_moment_coefficients(4);
+const EXPREL3_MOMENT_4: [f64; SERIES_TERMS] = exprel3_moment_coefficients(5);
+
 /// Σ cₙ zⁿ over the first `terms` coefficients, as E(z²) + z·O(z²) with the even and odd
 /// coefficients each summed by Horner's rule: two independent chains of multiply-adds
 /// instead of one, which halves the latency (the exit-root Newton steps wait on it).
@@ -106,6 +119,30 @@ pub fn exprel3(z: f64) -> f64 {
     } else {
         (z.exp_m1() - z - 0.5 * z * z) / (z * z * z)
     }
+}
+
+/// The moments ∫₀¹ s³ E₃(zs) ds and ∫₀¹ s⁴ E₃(zs) ds of [`exprel3`], for |z| ≤ 2: what a
+/// fast strip's moment integrates (its viscous correction is a cubic times E₃ along the
+/// strip), as two series, where 16-point quadrature summed E₃ at 16 points.
+/// Terms as [`exprel3`] takes them, so the remainders are below 1e-19 of the leading terms.
+#[inline]
+pub fn exprel3_moments(z: f64) -> [f64; 2] {
+    debug_assert!(
+        z.abs() <= EXPREL3_LIMIT,
+        "z = {z} is beyond the series' range"
+    );
+    let a = z.abs();
+    let terms = if a < SERIES_LIMIT {
+        14
+    } else if a < 1.0 {
+        18
+    } else {
+        22
+    };
+    [
+        series(z, &EXPREL3_MOMENT_3, terms),
+        series(z, &EXPREL3_MOMENT_4, terms),
+    ]
 }
 
 /// The three kernels a Newton step on the exit edge needs, sharing one exponential:

@@ -493,7 +493,12 @@ mod tests {
     impl Output for Blob {
         const UNITS: &'static UnitTable = unit_table!(Blob);
         fn table(&self) -> Table {
-            Table::new(&[Column::text("text", |b: &Blob| b.text.clone())], [self])
+            Table::new(
+                &[Column::text("text", |b: &Blob, text| {
+                    text.push_str(&b.text)
+                })],
+                [self],
+            )
         }
     }
 

@@ -70,12 +70,12 @@ impl PointNotes {
     }
 
     /// The CSV cell beside the status: the names of the assumptions that warn, or the
-    /// reason of a refusal.
-    pub fn note(&self) -> String {
+    /// reason of a refusal, appended to `text`.
+    pub fn write_note(&self, text: &mut String) {
         match self {
-            PointNotes::Answered(validity) => validity.warned_text(),
-            PointNotes::Refused(reason) => reason.clone(),
-            PointNotes::Missing => "not solved: the job stopped before this point".to_string(),
+            PointNotes::Answered(validity) => validity.write_warned(text),
+            PointNotes::Refused(reason) => text.push_str(reason),
+            PointNotes::Missing => text.push_str("not solved: the job stopped before this point"),
         }
     }
 }
@@ -136,10 +136,10 @@ pub struct PointNotesFields {
 /// The CSV columns of a kind of row: `fields`, the columns of its numbers, then its status
 /// and the note beside it.
 pub fn columns<R: Row>(mut fields: Vec<Column<R>>) -> Vec<Column<R>> {
-    fields.push(Column::text("status", |r| {
-        r.notes().status().as_str().to_string()
+    fields.push(Column::text("status", |r, text| {
+        text.push_str(r.notes().status().as_str())
     }));
-    fields.push(Column::text("note", |r| r.notes().note()));
+    fields.push(Column::text("note", |r, text| r.notes().write_note(text)));
     fields
 }
 

@@ -152,16 +152,15 @@ impl PointValidity {
         self.warning().map(|c| described(c.assumption).name)
     }
 
-    /// The names of the assumptions that warn, as a CSV cell: space-separated.
-    pub fn warned_text(&self) -> String {
-        let mut text = String::new();
-        for name in self.warned() {
-            if !text.is_empty() {
+    /// The names of the assumptions that warn, as a CSV cell (space-separated), appended to
+    /// `text`.
+    pub fn write_warned(&self, text: &mut String) {
+        for (i, name) in self.warned().enumerate() {
+            if i > 0 {
                 text.push(' ');
             }
             text.push_str(name);
         }
-        text
     }
 }
 

@@ -11,27 +11,38 @@ pub fn format_number(x: f64) -> String {
 }
 
 /// [`format_number`] appended to `out`, as `{}` writes a plain number and `{:e}` a
-/// scientific one. The shortest round-trip digits come from `ryu`, in its text where that is
-/// already this layout (most numbers), else laid out here byte by byte: through `format!` a
-/// number cost about 100 ns and an allocation, and a sweep's CSV is mostly numbers. (`zmij`,
-/// serde_json's, was measured too: its "e-09" exponents cost more to rewrite than it saves.)
+/// scientific one. The shortest round-trip digits come from `zmij` (Schubfach; serde_json's
+/// formatter, ~20 ns a number where `ryu` took ~29), in its text where that is already this
+/// layout (most numbers), else laid out here byte by byte: through `format!` a number cost
+/// about 100 ns and an allocation, and a sweep's CSV is mostly numbers.
 pub fn write_number(out: &mut String, x: f64) {
     if x == 0.0 || !x.is_finite() {
         // "0", "-0", "inf", "NaN": as `{}` writes them.
         let _ = write!(out, "{x}");
         return;
     }
-    let mut ryu = ryu::Buffer::new();
+    let mut shortest = zmij::Buffer::new();
     let magnitude = x.abs();
-    // `ryu` writes plain decimals from 1e-5 to 1e16 ("1.0" for 1) and `{:e}`'s form
-    // elsewhere: where that is also this layout, its text is the answer as it stands.
-    if (1e-3..1e6).contains(&magnitude) || !(1e-5..1e16).contains(&magnitude) {
-        let text = ryu.format_finite(x);
+    // `zmij` writes plain decimals from 1e-5 to 1e16 ("1.0" for 1) and `{:e}`'s form
+    // elsewhere, but with "e+" for a positive exponent: where that is also this layout, its
+    // text is the answer as it stands.
+    if (1e-3..1e6).contains(&magnitude) || magnitude < 1e-5 {
+        let text = shortest.format_finite(x);
         out.push_str(text.strip_suffix(".0").unwrap_or(text));
         return;
     }
-    // 1e-5 ≤ |x| < 1e-3 or 1e6 ≤ |x| < 1e16: `ryu`'s plain digits, laid out as `{:e}`.
-    let (digits, exponent) = Digits::of(ryu.format_finite(magnitude).as_bytes());
+    if magnitude >= 1e16 {
+        let text = shortest.format_finite(x);
+        let (mantissa, exponent) = text
+            .split_once("e+")
+            .expect("zmij writes 1e16 up as d.ddde+N");
+        out.push_str(mantissa);
+        out.push('e');
+        out.push_str(exponent);
+        return;
+    }
+    // 1e-5 ≤ |x| < 1e-3 or 1e6 ≤ |x| < 1e16: `zmij`'s plain digits, laid out as `{:e}`.
+    let (digits, exponent) = Digits::of(shortest.format_finite(magnitude).as_bytes());
     let digits = digits.as_slice();
     let mut laid = Text::default();
     if x < 0.0 {
@@ -154,7 +165,7 @@ mod tests {
         }
     }
 
-    /// What `{}` and `{:e}` write, as the numbers were formatted before `ryu`.
+    /// What `{}` and `{:e}` write, as the numbers were formatted before `ryu` and `zmij`.
     fn through_format(x: f64) -> String {
         if x == 0.0 || (1e-3..1e6).contains(&x.abs()) || !x.is_finite() {
             format!("{x}")
@@ -164,7 +175,7 @@ mod tests {
     }
 
     /// `format_number` reads back as `x`, is as short as `format!`'s text and laid out as it
-    /// is. Where 17 digits are needed, `ryu` and the standard library may end in different
+    /// is. Where 17 digits are needed, `zmij` and the standard library may end in different
     /// digits, both reading back as `x` (1 in about 20,000 random doubles).
     fn check(x: f64) -> Result<(), TestCaseError> {
         let (ours, theirs) = (format_number(x), through_format(x));

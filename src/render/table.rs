@@ -2,7 +2,7 @@
 //! cell), and the header and every row are written from that one declaration, so a CSV
 //! header cannot drift from its rows.
 
-use std::borrow::{Borrow, Cow};
+use std::borrow::Cow;
 use std::fmt::Write;
 
 use super::fields::Reader;
@@ -26,7 +26,9 @@ enum Read<R> {
     Number(fn(&R) -> f64),
     Optional(fn(&R) -> Option<f64>),
     Count(fn(&R) -> usize),
-    Text(fn(&R) -> String),
+    /// Text, written into the string given (a sweep's rows each have two: one buffer for
+    /// all, not a string a cell).
+    Text(fn(&R, &mut String)),
     /// A number read through a field's declaration ([`super::fields::columns`]).
     Field(Reader<R>),
 }
@@ -71,12 +73,12 @@ impl<R> Column<R> {
         }
     }
 
-    /// A column of text.
-    pub const fn text(name: &'static str, read: fn(&R) -> String) -> Self {
+    /// A column of text, which `write` appends to the string it is given.
+    pub const fn text(name: &'static str, write: fn(&R, &mut String)) -> Self {
         Column {
             name: Cow::Borrowed(name),
             unit: "",
-            read: Read::Text(read),
+            read: Read::Text(write),
         }
     }
 
@@ -104,7 +106,11 @@ impl<R> Column<R> {
             Read::Number(read) => Cell::Number(read(row)),
             Read::Optional(read) => read(row).map_or(Cell::Empty, Cell::Number),
             Read::Count(read) => Cell::Count(read(row)),
-            Read::Text(read) => Cell::Text(read(row)),
+            Read::Text(write) => {
+                let mut text = String::new();
+                write(row, &mut text);
+                Cell::Text(text)
+            }
             Read::Field(read) => read(row).map_or(Cell::Empty, Cell::Number),
         }
     }
@@ -168,15 +174,18 @@ impl Table {
     pub fn to_csv(&self) -> Option<String> {
         let mut csv = Csv::new(self.headings.iter().map(Heading::label), self.rows.len());
         for row in &self.rows {
-            csv.line(row.iter());
+            for (i, cell) in row.iter().enumerate() {
+                csv.cell(i, cell);
+            }
+            csv.end_line();
         }
         csv.finish()
     }
 }
 
 /// The CSV of `rows` under `columns`, as [`Table::to_csv`] writes it, straight from the rows:
-/// for an answer of many rows (a sweep's) the table's cells, a vector per row, cost more
-/// than writing them.
+/// for an answer of many rows (a sweep's) the table's cells, a vector per row and a string
+/// per text, cost more than writing them.
 pub fn csv<'a, R: 'a>(columns: &[Column<R>], rows: &'a [R]) -> Option<String> {
     let labels = columns.iter().map(|c| {
         Heading {
@@ -186,8 +195,18 @@ pub fn csv<'a, R: 'a>(columns: &[Column<R>], rows: &'a [R]) -> Option<String> {
         .label()
     });
     let mut csv = Csv::new(labels, rows.len());
+    let mut text = String::new();
     for row in rows {
-        csv.line(columns.iter().map(|c| c.cell(row)));
+        for (i, column) in columns.iter().enumerate() {
+            if let Read::Text(write) = column.read {
+                text.clear();
+                write(row, &mut text);
+                csv.text(i, &text);
+            } else {
+                csv.cell(i, &column.cell(row));
+            }
+        }
+        csv.end_line();
     }
     csv.finish()
 }
@@ -196,6 +215,10 @@ pub fn csv<'a, R: 'a>(columns: &[Column<R>], rows: &'a [R]) -> Option<String> {
 struct Csv {
     text: String,
     finite: bool,
+    /// Each column's last number (its bits) and its text. A number equal to the one above
+    /// it (a sweep's outer axis, its answers at rest, which depend on the load alone) is
+    /// copied, not formatted again: formatting is most of a sweep's CSV.
+    above: Vec<(u64, String)>,
 }
 
 impl Csv {
@@ -213,34 +236,64 @@ impl Csv {
         text.push('\n');
         // About 24 bytes a cell (a number of 17 digits and its exponent).
         text.reserve(24 * columns.max(1) * rows);
-        Csv { text, finite: true }
+        Csv {
+            text,
+            finite: true,
+            above: vec![(0, String::new()); columns],
+        }
     }
 
-    fn line<C: Borrow<Cell>>(&mut self, cells: impl Iterator<Item = C>) {
-        for (i, cell) in cells.enumerate() {
-            if i > 0 {
-                self.text.push(',');
-            }
-            match cell.borrow() {
-                Cell::Number(x) => {
-                    self.finite &= x.is_finite();
-                    write_number(&mut self.text, *x);
-                }
-                Cell::Count(n) => {
-                    let _ = write!(self.text, "{n}");
-                }
-                Cell::Text(text) => {
-                    self.text.push('"');
-                    if text.contains('"') {
-                        self.text.push_str(&text.replace('"', "\"\""));
-                    } else {
-                        self.text.push_str(text);
-                    }
-                    self.text.push('"');
-                }
-                Cell::Empty => {}
-            }
+    /// The separator before cell `column`.
+    fn separate(&mut self, column: usize) {
+        if column > 0 {
+            self.text.push(',');
         }
+    }
+
+    /// `cell` as the cell of `column` of the current line.
+    fn cell(&mut self, column: usize, cell: &Cell) {
+        match cell {
+            Cell::Number(x) => self.number(column, *x),
+            Cell::Count(n) => {
+                self.separate(column);
+                let _ = write!(self.text, "{n}");
+            }
+            Cell::Text(text) => self.text(column, text),
+            Cell::Empty => self.separate(column),
+        }
+    }
+
+    fn number(&mut self, column: usize, x: f64) {
+        self.separate(column);
+        self.finite &= x.is_finite();
+        let Some((bits, above)) = self.above.get_mut(column) else {
+            write_number(&mut self.text, x);
+            return;
+        };
+        if *bits != x.to_bits() || above.is_empty() {
+            let start = self.text.len();
+            write_number(&mut self.text, x);
+            above.clear();
+            above.push_str(&self.text[start..]);
+            *bits = x.to_bits();
+        } else {
+            self.text.push_str(above);
+        }
+    }
+
+    /// `text`, quoted, as the cell of `column`.
+    fn text(&mut self, column: usize, text: &str) {
+        self.separate(column);
+        self.text.push('"');
+        if text.contains('"') {
+            self.text.push_str(&text.replace('"', "\"\""));
+        } else {
+            self.text.push_str(text);
+        }
+        self.text.push('"');
+    }
+
+    fn end_line(&mut self) {
         self.text.push('\n');
     }
 
@@ -252,6 +305,7 @@ impl Csv {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::render::format_number;
 
     struct Row {
         x: f64,
@@ -261,7 +315,7 @@ mod tests {
     const COLUMNS: [Column<Row>; 3] = [
         Column::count("index", |_| 7),
         Column::number("x", "m", |r| r.x),
-        Column::text("label", |r| r.label.to_string()),
+        Column::text("label", |r, text| text.push_str(r.label)),
     ];
 
     #[test]
@@ -293,5 +347,29 @@ mod tests {
             .unwrap()
             .starts_with("index,load [N],label\n"));
         assert_eq!(table.headings[1].unit, "N");
+    }
+
+    /// A number equal to the one above it is copied from the line above; a different one, or
+    /// the same number in another column, is written afresh.
+    #[test]
+    fn a_number_repeated_down_a_column_is_written_as_it_was() {
+        let xs = [0.1, 0.1, -0.0, 0.0, 0.0, 1e-9, 0.1, 0.1];
+        let rows: Vec<Row> = xs.iter().map(|&x| Row { x, label: "l" }).collect();
+        let expected: String = std::iter::once("index,x [m],label\n".to_string())
+            .chain(
+                xs.iter()
+                    .map(|x| format!("7,{},\"l\"\n", format_number(*x))),
+            )
+            .collect();
+        assert_eq!(csv(&COLUMNS, &rows).as_deref(), Some(expected.as_str()));
+        assert!(expected.contains("7,-0,\"l\"\n7,0,"));
+        let twice = [
+            Column::number("a", "", |r: &Row| r.x),
+            Column::number("b", "", |r| r.x / 3.0),
+        ];
+        assert_eq!(
+            csv(&twice, &rows[..2]).as_deref(),
+            Some("a,b\n0.1,0.03333333333333333\n0.1,0.03333333333333333\n")
+        );
     }
 }

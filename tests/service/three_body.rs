@@ -334,7 +334,8 @@ fn a_three_body_sweep_across_the_asperity_only_regime_answers_every_point() {
     };
     assert_eq!(points.len(), 4);
     // 40 nm squeezes the largest particle beyond the model: that point alone is refused.
-    let reason = points[0].notes.note();
+    let mut reason = String::new();
+    points[0].notes.write_note(&mut reason);
     assert!(reason.contains("reaches the sphere's radius"), "{reason}");
     assert!(points[0].result.is_none());
     for p in &points[1..] {

@@ -188,7 +188,7 @@ impl Output for FigureOutput {
         fn columns<'a>() -> [Column<FigureRow<'a>>; 4] {
             [
                 Column::count("series", |r| r.series),
-                Column::text("label", |r| r.label.to_string()),
+                Column::text("label", |r, text| text.push_str(r.label)),
                 Column::number("x", "", |r| r.point[0]),
                 Column::number("y", "", |r| r.point[1]),
             ]

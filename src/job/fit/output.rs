@@ -297,11 +297,15 @@ impl Output for FitOutput {
             Column::optional("load", "N", |r| r.at.load),
             Column::optional("total_load", "N", |r| r.at.total_load),
             Column::number("velocity", "m/s", |r| r.at.velocity),
-            Column::text("quantity", |r| r.compared().map_or("", |c| c.0).to_string()),
+            Column::text("quantity", |r, text| {
+                text.push_str(r.compared().map_or("", |c| c.0))
+            }),
             Column::optional("measured", "", |r| r.compared().map(|c| c.2.measured)),
             Column::optional("fitted", "", |r| r.compared().map(|c| c.2.fitted)),
             Column::optional("residual", "", |r| r.compared().map(|c| c.2.residual)),
-            Column::text("unit", |r| r.compared().map_or("", |c| c.1).to_string()),
+            Column::text("unit", |r, text| {
+                text.push_str(r.compared().map_or("", |c| c.1))
+            }),
             Column::number("normalized_residual", "", |r| r.normalized_residual),
         ];
         Table::new(&COLUMNS, &self.residuals)
