@@ -254,27 +254,11 @@ fn start(command: &str, args: ServeArgs) -> Result<(Config, tokio::runtime::Runt
         ExitCode::from(INVALID_JOB)
     })?;
     init_logging(config.log_format);
-    keep_heap_pages();
     let runtime = tokio::runtime::Runtime::new().map_err(|e| {
         eprintln!("thirdbody {command}: cannot start the runtime: {e}");
         ExitCode::FAILURE
     })?;
     Ok((config, runtime))
-}
-
-/// Lets a long-lived process keep the heap pages it frees. By default glibc hands freed memory
-/// at the heap's top back to the kernel past 128 kB, and serves blocks from 128 kB (rising
-/// with use, to 32 MB) by `mmap`, returned on free: a service that assembles a 10,000-point
-/// sweep allocates and frees tens of MB per job, and faulted the same pages in again each
-/// time (80 k page faults a sweep). Blocks up to 32 MB now come from the heap, and up to
-/// 64 MB of free heap is kept; the resident size stays within the memory budget plus that.
-fn keep_heap_pages() {
-    #[cfg(all(target_os = "linux", target_env = "gnu"))]
-    // SAFETY: mallopt only sets allocator parameters; it is called before any thread starts.
-    unsafe {
-        libc::mallopt(libc::M_MMAP_THRESHOLD, 32 << 20);
-        libc::mallopt(libc::M_TRIM_THRESHOLD, 64 << 20);
-    }
 }
 
 /// `thirdbody worker`: works the fleet's stream until SIGTERM or Ctrl-C, then finishes the
