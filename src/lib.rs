@@ -16,9 +16,8 @@ pub mod render;
 /// The allocator of every process of the service (and of its tests and benchmarks, which so
 /// measure what runs): mimalloc. glibc's, under a cache that keeps replacing answers of a
 /// few kB, spent a third of an uncached request searching its fragmented free lists (in
-/// process 52 µs a request, 31 µs with mimalloc), and faulted a sweep's buffers in afresh
-/// each time (thousands of page faults a 10,000-point sweep, about twenty now). Its v2 line,
-/// without transparent huge pages: zeroing a huge page cost a short `thirdbody solve` more
-/// than its allocations saved. BENCHMARKS.md, issue 25.
+/// process 52 µs a request, 31 µs with mimalloc). Without transparent huge pages: zeroing
+/// huge pages cost a short `thirdbody solve` 0.5 ms. (Its v2 line returned freed pages after 10 ms, and a 10,000-point sweep in
+/// fleet mode took 71 ms instead of 30.) BENCHMARKS.md, issue 25.
 #[global_allocator]
 static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
