@@ -255,8 +255,8 @@ pub fn gauss_legendre(n: usize) -> GaussRule {
     rule
 }
 
-/// The 16-point Gauss–Legendre rule on [−1, 1], without even a lock (the strip solver
-/// uses it in its inner loop).
+/// The 16-point Gauss–Legendre rule on [−1, 1], without even a lock (the layer's compliance
+/// builds its rules from it, panel after panel).
 pub fn gauss_legendre_16() -> (&'static [f64], &'static [f64]) {
     static RULE: OnceLock<GaussRule> = OnceLock::new();
     let rule = RULE.get_or_init(|| gauss_legendre(16));

@@ -95,6 +95,7 @@ const PANELS: usize = 128;
 const PANEL_SAMPLES: usize = 24;
 /// Samples of a panel summed side by side ([`clenshaw_at`]); divides [`PANEL_SAMPLES`].
 const SIDE_BY_SIDE: usize = 4;
+const _: () = assert!(PANEL_SAMPLES % SIDE_BY_SIDE == 0);
 /// A panel's series stops where the coefficients left out add up to less than this part of
 /// the function's size there: far below the 1e-9 promised, and above the rounding noise of
 /// the global series, which would otherwise keep every coefficient.
@@ -395,15 +396,17 @@ fn clenshaw_at<const K: usize>(coefficients: &[[f64; 4]], xs: [f64; K]) -> [[f64
         }
     }
     let c = coefficients[0];
-    std::array::from_fn(|k| {
+    let mut sums = [[0.0; 4]; K];
+    for k in 0..K {
         let (x, b1k, b2k) = (xs[k], b1[k], b2[k]);
-        [
+        sums[k] = [
             c[0] + x * b1k[0] - b2k[0],
             c[1] + x * b1k[1] - b2k[1],
             c[2] + x * b1k[2] - b2k[2],
             c[3] + x * b1k[3] - b2k[3],
-        ]
-    })
+        ];
+    }
+    sums
 }
 
 #[cfg(test)]

@@ -104,8 +104,8 @@ pub fn exprel2(z: f64) -> f64 {
 #[inline]
 pub fn exprel3(z: f64) -> f64 {
     // Terms enough for the remainder |z|ⁿ/(n+3)! to stay below 1e-16 of 1/6 on each range
-    // (0.5¹⁴/17! ≈ 2e-19, 1/21! ≈ 2e-20, 2²²/25! ≈ 3e-19): the moments of fast strips sum
-    // E₃ at 16 points each, mostly at small |z|.
+    // (0.5¹⁴/17! ≈ 2e-19, 1/21! ≈ 2e-20, 2²²/25! ≈ 3e-19): fast strips evaluate it at every
+    // step of their exit roots and in their shortfalls, mostly at small |z|.
     let a = z.abs();
     if a < EXPREL3_LIMIT {
         let terms = if a < SERIES_LIMIT {
