@@ -17,7 +17,8 @@ pub mod render;
 /// measure what runs): mimalloc. glibc's, under a cache that keeps replacing answers of a
 /// few kB, spent a third of an uncached request searching its fragmented free lists (in
 /// process 52 µs a request, 31 µs with mimalloc). Without transparent huge pages: zeroing
-/// huge pages cost a short `thirdbody solve` 0.5 ms. (Its v2 line returned freed pages after 10 ms, and a 10,000-point sweep in
-/// fleet mode took 71 ms instead of 30.) BENCHMARKS.md, issue 25.
+/// them cost a short `thirdbody solve` 0.5 ms. (mimalloc's v2 line returned freed pages
+/// after 10 ms: a 10,000-point sweep in fleet mode took 71 ms instead of 30.) BENCHMARKS.md,
+/// issue 25.
 #[global_allocator]
 static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;

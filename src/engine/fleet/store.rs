@@ -446,19 +446,18 @@ impl RedisJobStore {
             finished_at,
         }))
     }
-}
 
-impl RedisJobStore {
     /// The form of the result of a finished job recorded by the version before records
     /// named it (their results are in the result hash all the same): `whole` for a
     /// succeeded job's, `partial` for another's, `""` for none.
     async fn legacy_result_form(&self, id: Uuid, status: &str) -> Result<String, Failure> {
-        if matches!(parse_status(status), JobStatus::Queued | JobStatus::Running) {
+        let status = parse_status(status);
+        if matches!(status, JobStatus::Queued | JobStatus::Running) {
             return Ok(String::new());
         }
         let cmd = Cmd::hexists(keys::job(id).result, "json");
         let stored: bool = self.fleet.jobs.query(&cmd).await?;
-        let form = match (stored, parse_status(status)) {
+        let form = match (stored, status) {
             (false, _) => "",
             (true, JobStatus::Succeeded) => "whole",
             (true, _) => "partial",
