@@ -8,6 +8,8 @@
 //! A value echoed back from the input is the exception: it is written exactly as sent
 //! (`render::format_number`), so that the sender finds it in what they sent.
 
+use std::fmt::Write;
+
 /// Significant digits of a number in a message: enough to compare values, few enough to
 /// read at a glance.
 pub const DIGITS: usize = 3;
@@ -49,16 +51,23 @@ fn family(unit: &str) -> Option<(&'static str, i32, Prefixes)> {
 /// reaching a hundredth of one is shown in it (0.2 µm² rather than 2e5 nm²). A unit without
 /// prefixes (`m^-2`) comes back as it is, with the factor 1.
 pub fn prefixed(unit: &str, size: f64) -> (f64, String) {
-    let Some((symbol, power, prefixes)) = family(unit) else {
-        return (1.0, unit.to_string());
-    };
+    match prefix(unit, size) {
+        Some((factor, prefix, symbol)) => (factor, format!("{prefix}{symbol}")),
+        None => (1.0, unit.to_string()),
+    }
+}
+
+/// [`prefixed`] as the factor, the prefix and the unit's symbol; `None` for a unit without
+/// prefixes.
+fn prefix(unit: &str, size: f64) -> Option<(f64, &'static str, &'static str)> {
+    let (symbol, power, prefixes) = family(unit)?;
     let size = size.abs();
     let least = if power == 2 { 1e-2 } else { 1.0 };
     let (exponent, prefix) = prefixes
         .iter()
         .find(|(exponent, _)| size >= least * 10f64.powi(exponent * power))
         .unwrap_or(&prefixes[prefixes.len() - 1]);
-    (10f64.powi(-exponent * power), format!("{prefix}{symbol}"))
+    Some((10f64.powi(-exponent * power), prefix, symbol))
 }
 
 /// `x`, a value in the SI unit `unit` (as the model names units: `m`, `N`, `Pa`, `s`, `m^2`,
@@ -72,17 +81,25 @@ pub fn quantity(x: f64, unit: &str) -> String {
 /// [`quantity`] to `digits` significant digits (a picture's legend tells close values apart
 /// with four).
 pub fn quantity_to(x: f64, unit: &str, digits: usize) -> String {
+    // Written into one string: validity notes write several on every answer.
+    let mut text = String::with_capacity(16);
     let base = family(unit).map_or(unit, |(symbol, ..)| symbol);
     if x == 0.0 || !x.is_finite() {
         // -0 reads as 0.
-        return with_unit(&format!("{}", if x == 0.0 { 0.0 } else { x }), base);
+        let _ = write!(text, "{}", if x == 0.0 { 0.0 } else { x });
+        return with_unit(text, "", base);
     }
-    let (factor, symbol) = prefixed(unit, x);
+    let (factor, prefix, symbol) = match prefix(unit, x) {
+        Some((factor, prefix, symbol)) => (factor, prefix, symbol),
+        None => (1.0, "", unit),
+    };
     let scaled = x * factor;
     if (1e-2..1e4).contains(&scaled.abs()) {
-        with_unit(&significant(scaled, digits), &symbol)
+        write_significant(&mut text, scaled, digits);
+        with_unit(text, prefix, symbol)
     } else {
-        with_unit(&scientific(x, digits), base)
+        text.push_str(&scientific(x, digits));
+        with_unit(text, "", base)
     }
 }
 
@@ -114,16 +131,22 @@ fn magnitude(x: f64) -> i32 {
 }
 
 /// `x` (finite, not 0) to `digits` significant digits in plain decimals, without trailing
-/// zeros: 5.58, 651, 1230, 0.0947.
-fn significant(x: f64, digits: usize) -> String {
+/// zeros, appended to `text`: 5.58, 651, 1230, 0.0947.
+fn write_significant(text: &mut String, x: f64, digits: usize) {
     let decimals = digits as i32 - 1 - magnitude(x);
     if decimals <= 0 {
         let step = 10f64.powi(-decimals);
-        return format!("{:.0}", (x / step).round() * step);
+        let _ = write!(text, "{:.0}", (x / step).round() * step);
+        return;
     }
-    let text = format!("{x:.prec$}", prec = decimals as usize);
+    let start = text.len();
+    let _ = write!(text, "{x:.prec$}", prec = decimals as usize);
     // Rounding may carry into a new digit (9.996 → "10.00"): the zeros go either way.
-    text.trim_end_matches('0').trim_end_matches('.').to_string()
+    let kept = text[start..]
+        .trim_end_matches('0')
+        .trim_end_matches('.')
+        .len();
+    text.truncate(start + kept);
 }
 
 /// `x` in powers of ten, to `digits` significant digits: 6.79e-82, 1e12, 5.5e-6.
@@ -154,12 +177,14 @@ fn grouped(x: f64) -> String {
     text
 }
 
-fn with_unit(number: &str, unit: &str) -> String {
-    if unit.is_empty() {
-        number.to_string()
-    } else {
-        format!("{number} {unit}")
+/// `number` followed by its unit, `prefix` and `symbol`, if it has one.
+fn with_unit(mut number: String, prefix: &str, symbol: &str) -> String {
+    if !symbol.is_empty() {
+        number.push(' ');
+        number.push_str(prefix);
+        number.push_str(symbol);
     }
+    number
 }
 
 #[cfg(test)]

@@ -17,7 +17,7 @@ use super::cache::{Claim, ResultCache, Solved};
 use super::coalesce::Coalescer;
 use super::doorkeeper::Doorkeeper;
 use super::memo::PointMemo;
-use super::metrics::{self as names, Metrics};
+use super::metrics::{self as names, Metrics, SolveDurations};
 use super::pool::Pool;
 use super::{EngineConfig, EngineError};
 use crate::job::{Control, JobError, Keyed, Unfinished};
@@ -76,6 +76,7 @@ pub struct Solver {
     /// Work jobs leave for later (tables to build); `None` if its thread could not start.
     background: Option<Arc<Background>>,
     metrics: Metrics,
+    solve_durations: SolveDurations,
     cache_hits: Counter,
     cache_misses: Counter,
     jobs_running: Gauge,
@@ -106,6 +107,7 @@ impl Solver {
             cache_hits: metrics.counter(names::CACHE_HITS, &[]),
             cache_misses: metrics.counter(names::CACHE_MISSES, &[]),
             jobs_running: metrics.gauge(names::JOBS_RUNNING),
+            solve_durations: SolveDurations::new(metrics.clone()),
             metrics,
         }
     }
@@ -277,12 +279,8 @@ impl Solver {
             }) => "deadline_exceeded",
             Err(_) => "failed",
         };
-        self.metrics
-            .fixed_histogram(
-                names::SOLVE_DURATION,
-                &[("kind", kind.name()), ("outcome", outcome)],
-            )
-            .record(start.elapsed());
+        self.solve_durations
+            .record(kind.name(), outcome, start.elapsed());
         result
     }
 }

@@ -5,13 +5,13 @@
 
 pub mod fields;
 pub mod fixed;
+mod json;
 mod negotiate;
 mod number;
 pub mod svg;
 mod table;
 
 use std::any::Any;
-use std::cell::RefCell;
 use std::fmt;
 
 use serde::{Serialize, Serializer};
@@ -125,6 +125,10 @@ impl RenderError {
     pub fn new(message: impl Into<String>) -> RenderError {
         RenderError(message.into())
     }
+
+    fn non_finite() -> RenderError {
+        RenderError("the result holds a non-finite number".to_string())
+    }
 }
 
 /// The answer of a job kind: JSON through serde, and one table for CSV.
@@ -151,7 +155,7 @@ pub trait Output: Serialize + fmt::Debug + PartialEq + Send + Sync + 'static {
 
 /// What [`Answer`] needs of an output, object-safe.
 trait Render: fmt::Debug + Send + Sync {
-    fn json(&self, pretty: bool) -> serde_json::Result<Vec<u8>>;
+    fn json(&self, pretty: bool) -> Result<Vec<u8>, RenderError>;
     fn table(&self) -> Table;
     fn csv(&self) -> Option<String>;
     fn notice(&self) -> Option<String>;
@@ -161,17 +165,8 @@ trait Render: fmt::Debug + Send + Sync {
 }
 
 impl<T: Output> Render for T {
-    fn json(&self, pretty: bool) -> serde_json::Result<Vec<u8>> {
-        if pretty {
-            let mut json = Vec::with_capacity(SCRATCH_KEPT);
-            self.serialize(&mut serde_json::Serializer::with_formatter(
-                &mut json,
-                Rows::default(),
-            ))?;
-            Ok(json)
-        } else {
-            scratch(|buffer| serde_json::to_writer(buffer, self))
-        }
+    fn json(&self, pretty: bool) -> Result<Vec<u8>, RenderError> {
+        json::write(self, pretty)
     }
 
     fn table(&self) -> Table {
@@ -197,152 +192,6 @@ impl<T: Output> Render for T {
     fn same(&self, other: &dyn Any) -> bool {
         other.downcast_ref::<T>() == Some(self)
     }
-}
-
-/// JSON for people: objects indented a field a line, as `serde_json`'s pretty form, but each
-/// element of a list on one line of its own. A sweep then reads a point a line (a table, as
-/// in its CSV) rather than twenty lines a point, and is written in a quarter less time.
-#[derive(Debug, Default)]
-struct Rows {
-    /// Indentation of the innermost indented container.
-    level: usize,
-    /// Containers opened inside a one-line list element, still open (0: indenting).
-    inline: usize,
-    /// Of the indented containers open, whether each is a list.
-    lists: Vec<bool>,
-    /// Whether the innermost indented container has a value yet.
-    has_value: bool,
-}
-
-impl Rows {
-    fn open<W: ?Sized + std::io::Write>(&mut self, w: &mut W, list: bool) -> std::io::Result<()> {
-        if self.inline > 0 || self.lists.last() == Some(&true) {
-            self.inline += 1;
-        } else {
-            self.level += 1;
-            self.lists.push(list);
-            self.has_value = false;
-        }
-        w.write_all(if list { b"[" } else { b"{" })
-    }
-
-    fn close<W: ?Sized + std::io::Write>(&mut self, w: &mut W, list: bool) -> std::io::Result<()> {
-        if self.inline > 0 {
-            self.inline -= 1;
-        } else {
-            self.level -= 1;
-            self.lists.pop();
-            if self.has_value {
-                self.newline(w)?;
-            }
-        }
-        w.write_all(if list { b"]" } else { b"}" })
-    }
-
-    /// Before a field or an element: a comma unless it is the first, and a new line when
-    /// indenting.
-    fn next<W: ?Sized + std::io::Write>(&mut self, w: &mut W, first: bool) -> std::io::Result<()> {
-        if !first {
-            w.write_all(b",")?;
-        }
-        if self.inline == 0 {
-            self.newline(w)?;
-        }
-        Ok(())
-    }
-
-    fn newline<W: ?Sized + std::io::Write>(&self, w: &mut W) -> std::io::Result<()> {
-        w.write_all(b"\n")?;
-        for _ in 0..self.level {
-            w.write_all(b"  ")?;
-        }
-        Ok(())
-    }
-
-    fn valued(&mut self) {
-        if self.inline == 0 {
-            self.has_value = true;
-        }
-    }
-}
-
-impl serde_json::ser::Formatter for Rows {
-    fn begin_array<W: ?Sized + std::io::Write>(&mut self, w: &mut W) -> std::io::Result<()> {
-        self.open(w, true)
-    }
-
-    fn end_array<W: ?Sized + std::io::Write>(&mut self, w: &mut W) -> std::io::Result<()> {
-        self.close(w, true)
-    }
-
-    fn begin_array_value<W: ?Sized + std::io::Write>(
-        &mut self,
-        w: &mut W,
-        first: bool,
-    ) -> std::io::Result<()> {
-        self.next(w, first)
-    }
-
-    fn end_array_value<W: ?Sized + std::io::Write>(&mut self, _: &mut W) -> std::io::Result<()> {
-        self.valued();
-        Ok(())
-    }
-
-    fn begin_object<W: ?Sized + std::io::Write>(&mut self, w: &mut W) -> std::io::Result<()> {
-        self.open(w, false)
-    }
-
-    fn end_object<W: ?Sized + std::io::Write>(&mut self, w: &mut W) -> std::io::Result<()> {
-        self.close(w, false)
-    }
-
-    fn begin_object_key<W: ?Sized + std::io::Write>(
-        &mut self,
-        w: &mut W,
-        first: bool,
-    ) -> std::io::Result<()> {
-        self.next(w, first)
-    }
-
-    fn begin_object_value<W: ?Sized + std::io::Write>(&mut self, w: &mut W) -> std::io::Result<()> {
-        w.write_all(if self.inline == 0 { b": " } else { b":" })
-    }
-
-    fn end_object_value<W: ?Sized + std::io::Write>(&mut self, _: &mut W) -> std::io::Result<()> {
-        self.valued();
-        Ok(())
-    }
-}
-
-thread_local! {
-    /// A buffer each thread writes answers into, kept between answers.
-    static SCRATCH: RefCell<Vec<u8>> = const { RefCell::new(Vec::new()) };
-}
-
-/// Buffers larger than this are not kept for the next answer.
-const SCRATCH_KEPT: usize = 64 << 10;
-
-/// What `write` writes, copied out of this thread's scratch buffer into a vector of its exact
-/// size. Written into a fresh vector, a 7 kB rolling answer grew through seven reallocations
-/// and their copies, and the large ones made the allocator consolidate its free lists: on an
-/// uncached request's path (BENCHMARKS.md, issue 12). An answer written while another is
-/// (one holding the other) gets a fresh vector.
-fn scratch(
-    write: impl FnOnce(&mut Vec<u8>) -> serde_json::Result<()>,
-) -> serde_json::Result<Vec<u8>> {
-    SCRATCH.with(|cell| {
-        let Ok(mut buffer) = cell.try_borrow_mut() else {
-            let mut fresh = Vec::new();
-            write(&mut fresh)?;
-            return Ok(fresh);
-        };
-        buffer.clear();
-        let written = write(&mut buffer).map(|()| buffer.to_vec());
-        if buffer.capacity() > SCRATCH_KEPT {
-            *buffer = Vec::new();
-        }
-        written
-    })
 }
 
 /// Draws an answer from its JSON (each job kind has its own).
@@ -374,7 +223,11 @@ impl Answer {
                 let json = self.json(false)?;
                 draw_svg(draw, &json).map(String::into_bytes)
             }
-            Format::Csv => self.0.csv().map(String::into_bytes).ok_or_else(non_finite),
+            Format::Csv => self
+                .0
+                .csv()
+                .map(String::into_bytes)
+                .ok_or_else(RenderError::non_finite),
         }
     }
 
@@ -384,18 +237,9 @@ impl Answer {
         String::from_utf8(json).map_err(|e| RenderError(e.to_string()))
     }
 
-    /// serde_json writes a non-finite float as `null`, and the answers never hold `null`
-    /// (absent options are skipped): a `null` can only be such a float, which the model
-    /// promises never to return. It is an error here rather than a silent `null`.
+    /// The answer as JSON; a non-finite number in it is an error ([`json::write`]).
     fn json(&self, pretty: bool) -> Result<Vec<u8>, RenderError> {
-        let json = self
-            .0
-            .json(pretty)
-            .map_err(|e| RenderError(format!("cannot write the result: {e}")))?;
-        if has_null(&json) {
-            return Err(non_finite());
-        }
-        Ok(json)
+        self.0.json(pretty)
     }
 
     /// The answer's table (the rows of its CSV).
@@ -449,52 +293,10 @@ pub fn draw_svg(draw: Draw, json: &[u8]) -> Result<String, RenderError> {
         .map_err(|e| RenderError(format!("cannot draw the answer: {e}")))
 }
 
-fn non_finite() -> RenderError {
-    RenderError("the result holds a non-finite number".to_string())
-}
-
-/// Whether JSON text holds a `null` value. Outside strings the letter `n` can only start
-/// `null` (`true`, `false` and numbers have none), so one pass that skips strings finds it.
-fn has_null(json: &[u8]) -> bool {
-    // Nearly every answer has no `null` anywhere, in a string or not: one vectorised search
-    // settles it (a byte-by-byte scan of a 5 kB answer cost a third of its rendering).
-    if memchr::memmem::find(json, b"null").is_none() {
-        return false;
-    }
-    let (mut in_string, mut escaped) = (false, false);
-    for &b in json {
-        if in_string {
-            match b {
-                _ if escaped => escaped = false,
-                b'\\' => escaped = true,
-                b'"' => in_string = false,
-                _ => {}
-            }
-        } else if b == b'"' {
-            in_string = true;
-        } else if b == b'n' {
-            return true;
-        }
-    }
-    false
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::unit_table;
-
-    #[test]
-    fn a_null_value_is_found_and_a_null_inside_a_string_is_not() {
-        assert!(has_null(br#"{"a":null}"#));
-        assert!(has_null(br#"{"a":[1,null]}"#));
-        assert!(has_null(b"[null]"));
-        assert!(has_null(b"{\n  \"a\": null\n}"));
-        assert!(!has_null(br#"{"a":"nullable","b":1}"#));
-        assert!(!has_null(br#"{"a":"x: null"}"#));
-        assert!(!has_null(br#"{"a":"quote \" null","b":true}"#));
-        assert!(!has_null(br#"{"a":"back\\","b":false}"#));
-    }
 
     #[test]
     fn provenance_goes_where_each_format_still_parses() {
@@ -579,9 +381,9 @@ mod tests {
             points: vec![0.125; 20_000],
         });
         let json = large.render(Format::Json).unwrap();
-        assert!(json.len() > SCRATCH_KEPT);
+        assert!(json.len() > json::SCRATCH_KEPT);
         assert!(json.ends_with(b",0.125]}"));
-        SCRATCH.with_borrow(|buffer| assert!(buffer.capacity() <= SCRATCH_KEPT));
+        json::SCRATCH.with_borrow(|s| assert!(s.buffer.capacity() <= json::SCRATCH_KEPT));
         assert_eq!(
             holder.render(Format::Json).unwrap(),
             br#"{"inner":{"x":0.5},"points":[0.25,0.25]}"#
