@@ -27,14 +27,16 @@ rate() {
   wrk -t1 -c16 -d5s "$@" | awk '/^RESULT/ {print $2}'
 }
 
-# The CPU time (clock ticks, user + system) process $1 has used.
+# The CPU time (clock ticks, user + system) process $1 has used (the fields after the
+# process's name, which may hold spaces).
 ticks() {
-  awk '{print $14 + $15}' "/proc/$1/stat"
+  sed 's/.*) //' "/proc/$1/stat" | awk '{print $12 + $13}'
 }
 
-# µs of CPU per request: ticks $1 over a 5 s run at $2 requests/s.
+# µs of CPU per request: ticks $1 over a 5 s run at $2 requests/s ("n/a" if none answered).
 per_request() {
-  awk -v t="$1" -v r="$2" -v hz="$(getconf CLK_TCK)" 'BEGIN { printf "%.1f", 1e6 * t / hz / (5 * r) }'
+  awk -v t="$1" -v r="$2" -v hz="$(getconf CLK_TCK)" \
+    'BEGIN { if (r > 0) printf "%.1f", 1e6 * t / hz / (5 * r); else printf "n/a" }'
 }
 
 for round in $(seq "$ROUNDS"); do
@@ -56,6 +58,6 @@ for round in $(seq "$ROUNDS"); do
     cached_cpu=$(per_request "$((middle - start))" "$cached")
     uncached_cpu=$(per_request "$((end - middle))" "$uncached")
     awk -v b="$binary" -v c="$cached" -v u="$uncached" -v cc="$cached_cpu" -v uc="$uncached_cpu" \
-      'BEGIN { printf "%s %d %d %.1f %% cpu %s %s us\n", b, c, u, 100 * u / c, cc, uc }'
+      'BEGIN { printf "%s %d %d %.1f %% cpu %s %s us\n", b, c, u, (c > 0 ? 100 * u / c : 0), cc, uc }'
   done
 done

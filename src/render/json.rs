@@ -101,8 +101,8 @@ pub(super) struct Numbers {
 /// A magnitude and its text, after a minus sign that a negative number's copy starts from.
 #[derive(Clone, Copy)]
 struct Slot {
-    /// The magnitude's bits, inverted: an empty place (all zero) holds a NaN's, which no
-    /// number written has.
+    /// The magnitude's bits, inverted: a magnitude's sign bit is clear, so its inverted bits
+    /// are never those of an empty place (all zero).
     inverted: u64,
     /// The text is `text[1..=len]`.
     len: u8,
@@ -149,6 +149,41 @@ fn refuse_null() -> io::Result<()> {
     ))
 }
 
+/// Writes JSON the answer embeds already written (its canonical input, fixed texts, a part
+/// of a sweep), refusing it if it holds a `null` as [`refuse_null`] does.
+fn write_raw<W: ?Sized + Write>(w: &mut W, fragment: &str) -> io::Result<()> {
+    if has_null(fragment.as_bytes()) {
+        return refuse_null();
+    }
+    w.write_all(fragment.as_bytes())
+}
+
+/// Whether JSON text holds a `null` value. Outside strings the letter `n` can only start
+/// `null` (`true`, `false` and numbers have none), so one pass that skips strings finds it.
+fn has_null(json: &[u8]) -> bool {
+    // Nearly every text has no `null` anywhere, in a string or not: one vectorised search
+    // settles it.
+    if memchr::memmem::find(json, b"null").is_none() {
+        return false;
+    }
+    let (mut in_string, mut escaped) = (false, false);
+    for &b in json {
+        if in_string {
+            match b {
+                _ if escaped => escaped = false,
+                b'\\' => escaped = true,
+                b'"' => in_string = false,
+                _ => {}
+            }
+        } else if b == b'"' {
+            in_string = true;
+        } else if b == b'n' {
+            return true;
+        }
+    }
+    false
+}
+
 /// serde_json's compact form, its numbers through [`Numbers`].
 struct Compact<'a> {
     numbers: &'a mut Numbers,
@@ -161,6 +196,14 @@ impl Formatter for Compact<'_> {
 
     fn write_null<W: ?Sized + Write>(&mut self, _: &mut W) -> io::Result<()> {
         refuse_null()
+    }
+
+    fn write_raw_fragment<W: ?Sized + Write>(
+        &mut self,
+        w: &mut W,
+        fragment: &str,
+    ) -> io::Result<()> {
+        write_raw(w, fragment)
     }
 }
 
@@ -248,6 +291,14 @@ impl Formatter for Rows<'_> {
 
     fn write_null<W: ?Sized + Write>(&mut self, _: &mut W) -> io::Result<()> {
         refuse_null()
+    }
+
+    fn write_raw_fragment<W: ?Sized + Write>(
+        &mut self,
+        w: &mut W,
+        fragment: &str,
+    ) -> io::Result<()> {
+        write_raw(w, fragment)
     }
 
     fn begin_array<W: ?Sized + Write>(&mut self, w: &mut W) -> io::Result<()> {
@@ -343,5 +394,27 @@ mod tests {
             }
         }
         assert_eq!(write(&("null", 1.5), false).unwrap(), br#"["null",1.5]"#);
+        // JSON embedded as written (a canonical input, a fixed text) is held to the same.
+        let raw = |text: &str| serde_json::value::RawValue::from_string(text.into()).unwrap();
+        for pretty in [false, true] {
+            let refused = write(&[raw("[1,null]")], pretty).unwrap_err();
+            assert_eq!(refused, RenderError::non_finite());
+            let kept = write(&[raw(r#"{"a":"x: null"}"#)], pretty).unwrap();
+            assert!(String::from_utf8(kept)
+                .unwrap()
+                .contains(r#"{"a":"x: null"}"#));
+        }
+    }
+
+    #[test]
+    fn a_null_value_is_found_and_a_null_inside_a_string_is_not() {
+        assert!(has_null(br#"{"a":null}"#));
+        assert!(has_null(br#"{"a":[1,null]}"#));
+        assert!(has_null(b"[null]"));
+        assert!(has_null(b"{\n  \"a\": null\n}"));
+        assert!(!has_null(br#"{"a":"nullable","b":1}"#));
+        assert!(!has_null(br#"{"a":"x: null"}"#));
+        assert!(!has_null(br#"{"a":"quote \" null","b":true}"#));
+        assert!(!has_null(br#"{"a":"back\\","b":false}"#));
     }
 }
