@@ -3,7 +3,9 @@
 
 use std::cell::RefCell;
 use std::io::{self, Write};
+use std::sync::LazyLock;
 
+use memchr::memmem;
 use serde::Serialize;
 use serde_json::ser::Formatter;
 
@@ -162,8 +164,10 @@ fn write_raw<W: ?Sized + Write>(w: &mut W, fragment: &str) -> io::Result<()> {
 /// `null` (`true`, `false` and numbers have none), so one pass that skips strings finds it.
 fn has_null(json: &[u8]) -> bool {
     // Nearly every text has no `null` anywhere, in a string or not: one vectorised search
-    // settles it.
-    if memchr::memmem::find(json, b"null").is_none() {
+    // settles it, by a searcher built once (building it cost more than searching a short
+    // text).
+    static NULL: LazyLock<memmem::Finder<'static>> = LazyLock::new(|| memmem::Finder::new("null"));
+    if NULL.find(json).is_none() {
         return false;
     }
     let (mut in_string, mut escaped) = (false, false);
