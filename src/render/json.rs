@@ -188,27 +188,35 @@ fn has_null(json: &[u8]) -> bool {
     false
 }
 
+/// The values both layouts write alike: numbers through the formatter's [`Numbers`], `null`
+/// refused, embedded JSON searched for `null` as it is copied.
+macro_rules! answer_values {
+    () => {
+        fn write_f64<W: ?Sized + Write>(&mut self, w: &mut W, value: f64) -> io::Result<()> {
+            self.numbers.write(w, value)
+        }
+
+        fn write_null<W: ?Sized + Write>(&mut self, _: &mut W) -> io::Result<()> {
+            refuse_null()
+        }
+
+        fn write_raw_fragment<W: ?Sized + Write>(
+            &mut self,
+            w: &mut W,
+            fragment: &str,
+        ) -> io::Result<()> {
+            write_raw(w, fragment)
+        }
+    };
+}
+
 /// serde_json's compact form, its numbers through [`Numbers`].
 struct Compact<'a> {
     numbers: &'a mut Numbers,
 }
 
 impl Formatter for Compact<'_> {
-    fn write_f64<W: ?Sized + Write>(&mut self, w: &mut W, value: f64) -> io::Result<()> {
-        self.numbers.write(w, value)
-    }
-
-    fn write_null<W: ?Sized + Write>(&mut self, _: &mut W) -> io::Result<()> {
-        refuse_null()
-    }
-
-    fn write_raw_fragment<W: ?Sized + Write>(
-        &mut self,
-        w: &mut W,
-        fragment: &str,
-    ) -> io::Result<()> {
-        write_raw(w, fragment)
-    }
+    answer_values!();
 }
 
 /// JSON for people: objects indented a field a line, as `serde_json`'s pretty form, but each
@@ -289,21 +297,7 @@ impl<'a> Rows<'a> {
 }
 
 impl Formatter for Rows<'_> {
-    fn write_f64<W: ?Sized + Write>(&mut self, w: &mut W, value: f64) -> io::Result<()> {
-        self.numbers.write(w, value)
-    }
-
-    fn write_null<W: ?Sized + Write>(&mut self, _: &mut W) -> io::Result<()> {
-        refuse_null()
-    }
-
-    fn write_raw_fragment<W: ?Sized + Write>(
-        &mut self,
-        w: &mut W,
-        fragment: &str,
-    ) -> io::Result<()> {
-        write_raw(w, fragment)
-    }
+    answer_values!();
 
     fn begin_array<W: ?Sized + Write>(&mut self, w: &mut W) -> io::Result<()> {
         self.open(w, true)
