@@ -15,9 +15,9 @@ function fail(message) {
   process.exitCode = 1;
 }
 
-/** Starts the service on 127.0.0.1:0 and resolves with its base URL (from its log). */
-function serve() {
-  const child = spawn(bin, ["serve", "--bind", "127.0.0.1:0", "--log-format", "json"], {
+/** Starts the service on 127.0.0.1:0 (with `flags`) and resolves with its base URL (from its log). */
+function serve(flags = []) {
+  const child = spawn(bin, ["serve", "--bind", "127.0.0.1:0", "--log-format", "json", ...flags], {
     stdio: ["ignore", "ignore", "pipe"],
   });
   return new Promise((resolve, reject) => {
@@ -32,6 +32,10 @@ function serve() {
 }
 
 const { child, base } = await serve();
+// A second service whose jobs must end within 300 ms: a long sweep there fails.
+const strict = await serve(["--job-deadline", "300ms"]);
+// The answer area of a tab's panel, and a part of it.
+const area = (panel, part = "") => `#panel-${panel} .answer-area${part ? " ." + part : ""}`;
 const browser = await chromium.launch({
   executablePath: process.env.CHROMIUM || "/usr/bin/chromium",
   args: ["--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
@@ -40,7 +44,14 @@ const browser = await chromium.launch({
 try {
   const page = await browser.newPage({ viewport: { width: 1366, height: 900 } });
   const errors = [];
-  page.on("console", (message) => { if (message.type() === "error") errors.push(message.text()); });
+  // Refusals the test asks for on purpose are logged by chromium as failed loads: counted
+  // apart, and checked against those asked for.
+  const refusals = [];
+  page.on("console", (message) => {
+    if (message.type() !== "error") return;
+    const refusal = message.text().match(/^Failed to load resource: the server responded with a status of (4\d\d)/);
+    (refusal ? refusals : errors).push(refusal ? refusal[1] : message.text());
+  });
   page.on("pageerror", (error) => errors.push(String(error)));
   const outside = [];
   page.on("request", (request) => {
@@ -53,23 +64,37 @@ try {
   const csp = (await page.request.get(`${base}/`)).headers()["content-security-policy"];
   if (csp !== "default-src 'self'") fail(`Content-Security-Policy is ${csp}`);
   await page.locator("#form-rolling").getByRole("button", { name: "Solve" }).click();
-  await page.waitForSelector("#picture svg .series");
-  const mu = await page.locator("#table tr", { hasText: "friction_coefficient" }).first().textContent();
+  await page.waitForSelector(`${area("rolling", "picture")} svg .series`);
+  const mu = await page.locator(`${area("rolling", "table")} tr`, { hasText: "friction_coefficient" }).first().textContent();
   if (!/0\.0947/.test(mu)) fail(`the default friction coefficient is shown as ${mu}`);
   await page.screenshot({ path: `${shots}/rolling.png`, fullPage: true });
+
+  // An error after a success: the message names the field, and the old answer is gone.
+  await page.fill("#form-rolling input[name='load']", "-1 nN");
+  await page.locator("#form-rolling").getByRole("button", { name: "Solve" }).click();
+  await page.waitForSelector(`${area("rolling", "status")}.error`);
+  const refusal = await page.locator(area("rolling", "status")).textContent();
+  if (!refusal.includes("load")) fail(`the refusal of a negative load reads ${refusal}`);
+  const stale = await page.locator(`${area("rolling", "table")} tr, ${area("rolling", "picture")} svg, ${area("rolling", "warnings")} p`).count();
+  if (stale !== 0) fail(`${stale} rows, pictures or warnings of the earlier answer stay under the error`);
+  const beside = await page.locator("#form-rolling label:has(input[name='load'][aria-invalid='true']) .field-error").textContent();
+  if (!beside.includes("> 0 N")) fail(`beside the load field: ${beside}`);
+  await page.screenshot({ path: `${shots}/rolling-error.png`, fullPage: true });
+  await page.fill("#form-rolling input[name='load']", "1 nN");
 
   // The same particle on the layer as a continuum: about 8.3 nm², its accuracy said.
   await page.selectOption("#form-rolling select[name='layer.model']", "continuum");
   await page.locator("#form-rolling").getByRole("button", { name: "Solve" }).click();
-  await page.waitForFunction(() => document.querySelector("#status").textContent.includes("continuum"));
-  const area = await page.locator("#table tr", { hasText: "contact_area" }).first().textContent();
-  if (!/8\.[1-4]\d*\s*nm²/.test(area)) fail(`the continuum's contact area is shown as ${area}`);
+  await page.waitForFunction((s) => document.querySelector(s).textContent.includes("continuum"), area("rolling", "status"));
+  const continuumArea = await page.locator(`${area("rolling", "table")} tr`, { hasText: "contact_area" }).first().textContent();
+  if (!/8\.[1-4]\d*\s*nm²/.test(continuumArea)) fail(`the continuum's contact area is shown as ${continuumArea}`);
+  if (await page.locator("#form-rolling [aria-invalid], #form-rolling .field-error").count()) fail("the load stays marked invalid after a success");
   await page.screenshot({ path: `${shots}/rolling-continuum.png`, fullPage: true });
 
   // Both laws together: two regions on one plane, their numbers side by side.
   await page.getByRole("button", { name: "Compare both laws" }).click();
-  await page.waitForFunction(() => document.querySelectorAll("#picture svg polygon.series").length === 2);
-  const compared = await page.locator("#table tr", { hasText: "friction_coefficient" }).first().textContent();
+  await page.waitForFunction((s) => document.querySelectorAll(`${s} svg polygon.series`).length === 2, area("rolling", "picture"));
+  const compared = await page.locator(`${area("rolling", "table")} tr`, { hasText: "friction_coefficient" }).first().textContent();
   if (!/0\.0947/.test(compared) || !/0\.0091/.test(compared)) fail(`the compared μ reads ${compared}`);
   await page.screenshot({ path: `${shots}/rolling-compare.png`, fullPage: true });
   await page.selectOption("#form-rolling select[name='layer.model']", "local");
@@ -78,74 +103,151 @@ try {
   const series = "10 ms, 6 GPa\n100 ms, 4.5 GPa\n1 s, 3 GPa\n10 s, 1.5 GPa";
   await page.fill("#form-rolling textarea[name='layer.prony_csv']", series);
   await page.locator("#form-rolling").getByRole("button", { name: "Solve" }).click();
-  await page.waitForFunction(() => [...document.querySelectorAll("#table tr")]
-    .some((row) => row.textContent.includes("friction_coefficient") && /0\.0737/.test(row.textContent)));
+  await page.waitForFunction((s) => [...document.querySelectorAll(`${s} tr`)]
+    .some((row) => row.textContent.includes("friction_coefficient") && /0\.0737/.test(row.textContent)), area("rolling", "table"));
   await page.screenshot({ path: `${shots}/rolling-prony.png`, fullPage: true });
   await page.fill("#form-rolling textarea[name='layer.prony_csv']", "");
 
   // A three-body system: its distribution of diameters.
   await page.getByRole("tab", { name: "Three-body system" }).click();
   await page.locator("#form-three-body").getByRole("button", { name: "Solve" }).click();
-  await page.waitForFunction(() => (document.querySelector("#picture svg title") || {}).textContent?.startsWith("Three-body"));
+  await page.waitForFunction((s) => (document.querySelector(`${s} svg title`) || {}).textContent?.startsWith("Three-body"), area("three-body", "picture"));
   await page.screenshot({ path: `${shots}/three-body.png`, fullPage: true });
-  const localMu = await page.locator("#table tr", { hasText: "friction_coefficient" }).first().textContent();
+  const localMu = await page.locator(`${area("three-body", "table")} tr`, { hasText: "friction_coefficient" }).first().textContent();
 
   // The same system on the continuum layer contact: its μ several times lower, its error said.
   await page.selectOption("#form-three-body select[name='layer_contact']", "continuum");
   await page.locator("#form-three-body").getByRole("button", { name: "Solve" }).click();
-  await page.waitForFunction((before) => {
-    const row = [...document.querySelectorAll("#table tr")].find((r) => r.textContent.includes("friction_coefficient"));
+  await page.waitForFunction(([s, before]) => {
+    const row = [...document.querySelectorAll(`${s} tr`)].find((r) => r.textContent.includes("friction_coefficient"));
     return row && row.textContent !== before;
-  }, localMu, { timeout: 30000 });
-  const continuumMu = await page.locator("#table tr", { hasText: "friction_coefficient" }).first().textContent();
+  }, [area("three-body", "table"), localMu], { timeout: 30000 });
+  const continuumMu = await page.locator(`${area("three-body", "table")} tr`, { hasText: "friction_coefficient" }).first().textContent();
   const first = (text) => Number((text.match(/\d\.\d+(e-?\d+)?/) || ["NaN"])[0]);
   if (!(first(localMu) > 3 * first(continuumMu))) fail(`three-body μ: local ${localMu}, continuum ${continuumMu}`);
   await page.screenshot({ path: `${shots}/three-body-continuum.png`, fullPage: true });
   await page.selectOption("#form-three-body select[name='layer_contact']", "kelvin_layer");
 
-  // A 200-point sweep as a job: the progress bar reaches 100 %.
+  // A 200-point sweep as a job: the progress bar reaches 100 %, its points fill a table
+  // that sorts by a column.
   await page.getByRole("tab", { name: "Sweep" }).click();
   const loads = Array.from({ length: 10 }, (_, i) => `${(0.5 + 0.25 * i).toFixed(2)} nN`).join(", ");
   const speeds = Array.from({ length: 20 }, (_, i) => `${i} nm/s`).join(", ");
   await page.fill("input[name='vary.load']", loads);
   await page.fill("input[name='vary.velocity']", speeds);
   await page.getByRole("button", { name: "Run" }).click();
-  await page.waitForFunction(() => {
+  await page.waitForFunction((s) => {
     const bar = document.querySelector("#progress");
-    return bar.max === 200 && bar.value === 200 && document.querySelector("#picture svg .series");
-  }, null, { timeout: 60000 });
+    return bar.max === 200 && bar.value === 200 && document.querySelector(`${s} svg .series`);
+  }, area("sweep", "picture"), { timeout: 60000 });
   const progress = await page.locator("#progress-text").textContent();
   if (!progress.includes("200 / 200 (100 %)")) fail(`progress reads ${progress}`);
+  const pointRows = await page.locator(`${area("sweep", "table")} tbody tr`).count();
+  if (pointRows !== 200) fail(`the sweep's table has ${pointRows} rows, not its 200 points`);
+  const muHead = page.locator(`${area("sweep", "table")} th`, { hasText: "friction_coefficient" }).first();
+  const muColumn = await muHead.evaluate((th) => th.cellIndex);
+  const column = () => page.$$eval(`${area("sweep", "table")} tbody tr`, (rows, i) => rows.map((r) => Number(r.cells[i].textContent)), muColumn);
+  await muHead.click();
+  const ascending = await column();
+  if (ascending.some((v, i) => i > 0 && v < ascending[i - 1])) fail(`sorted by μ the column reads ${ascending.slice(0, 5)}…`);
+  await muHead.click();
+  const descending = await column();
+  if (descending[0] !== Math.max(...ascending) || (await muHead.getAttribute("aria-sort")) !== "descending") fail(`sorted again by μ the column starts ${descending[0]}`);
   await page.screenshot({ path: `${shots}/sweep.png`, fullPage: true });
 
-  // A sweep with a point the model refuses: the other points are answered, the refusal said.
+  // A sweep with a point the model refuses: the other points are answered, the refusal said
+  // in the warnings and on the point's row.
   await page.fill("input[name='vary.load']", "1 nN, 1 mN, 2 nN");
   await page.fill("input[name='vary.velocity']", "4 nm/s");
   await page.getByRole("button", { name: "Run" }).click();
-  await page.waitForFunction(() => document.querySelector("#warnings").textContent.includes("refused"), null, { timeout: 60000 });
-  const refused = await page.locator("#warnings").textContent();
+  await page.waitForFunction((s) => document.querySelector(s).textContent.includes("refused"), area("sweep", "warnings"), { timeout: 60000 });
+  const refused = await page.locator(area("sweep", "warnings")).textContent();
   if (!refused.includes("1 of 3 points refused")) fail(`the refused point reads ${refused}`);
-  const answered = await page.locator("#table tr", { hasText: "points.warn" }).first().textContent();
-  if (!/2/.test(answered)) fail(`the sweep's table reads ${answered}`);
+  const refusedRow = await page.locator(`${area("sweep", "table")} tbody tr`, { hasText: "refused" }).first().textContent();
+  if (!refusedRow.includes("rigid base")) fail(`the refused point's row reads ${refusedRow}`);
   await page.screenshot({ path: `${shots}/sweep-refused.png`, fullPage: true });
 
-  // Figure 6 from the gallery.
+  // A long sweep cancelled: the bar and the status say so, in the colours of an end that
+  // is not a success.
+  const manySpeeds = Array.from({ length: 100 }, (_, i) => `${i} nm/s`).join(", ");
+  await page.fill("input[name='vary.load']", "1 nN, 2 nN, 3 nN");
+  await page.fill("input[name='vary.velocity']", manySpeeds);
+  await page.selectOption("#form-sweep select[name='base.layer.model']", "continuum");
+  await page.getByRole("button", { name: "Run" }).click();
+  await page.waitForFunction((s) => document.querySelector(s).textContent.includes("running"), area("sweep", "status"), { timeout: 30000 });
+  await page.getByRole("button", { name: "Cancel" }).click();
+  // Its end: the points it finished drawn, or none finished (a cancel before the first).
+  await page.waitForFunction((s) => {
+    const said = document.querySelector(`${s} .status`).textContent;
+    return document.querySelector("#progress-text").textContent.startsWith("cancelled")
+      && (said.includes("No point was finished") || (said.includes("partial") && document.querySelector(`${s} .picture svg`)));
+  }, area("sweep"), { timeout: 30000 });
+  const cancelled = await page.locator(area("sweep", "status")).textContent();
+  if (!cancelled.includes("Job cancelled after")) fail(`the cancelled sweep's status reads ${cancelled}`);
+  if ((await page.locator("#progress").getAttribute("class")) !== "cancelled") fail("the cancelled sweep's bar is not marked cancelled");
+  await page.screenshot({ path: `${shots}/sweep-cancelled.png`, fullPage: true });
+
+  // A job that does not exist (a link to one dropped, or from another server) reads as an
+  // error, not as an answer.
+  await page.evaluate(() => {
+    const sweep = areaOf(document.querySelector("#form-sweep"));
+    follow(sweep, sweep.begin("Following…"), "00000000-0000-4000-8000-000000000000");
+  });
+  await page.waitForSelector(`${area("sweep", "status")}.error`, { timeout: 30000 });
+  const unknown = await page.locator(area("sweep", "status")).textContent();
+  if (!unknown.startsWith("Not found")) fail(`an unknown job reads ${unknown}`);
+  if (await page.locator(`${area("sweep", "table")} tr`).count()) fail("an unknown job leaves a table on screen");
+
+  // Switching tabs shows each tab's own answer: the sweep's error is not under Figures.
   await page.getByRole("tab", { name: "Figures 3–9" }).click();
+  if (await page.locator(`${area("figures", "status")}`).textContent()) fail("the Figures tab shows another tab's status");
+  if (!(await page.locator(area("three-body", "picture")).isHidden())) fail("the three-body picture shows under Figures");
+
+  // Figure 6 from the gallery.
   await page.getByRole("button", { name: "Figure 6" }).click();
-  await page.waitForFunction(() => (document.querySelector("#picture svg title") || {}).textContent?.startsWith("Fig. 6"));
-  const entries = await page.locator("#picture svg .legend .entry").count();
+  await page.waitForFunction((s) => (document.querySelector(`${s} svg title`) || {}).textContent?.startsWith("Fig. 6"), area("figures", "picture"));
+  const entries = await page.locator(`${area("figures", "picture")} svg .legend .entry`).count();
   if (entries !== 10) fail(`Figure 6 has ${entries} legend entries, not 10`);
   await page.screenshot({ path: `${shots}/figure-6.png`, fullPage: true });
 
-  // The keyboard reaches the forms: Tab from the page start lands on a link or a control.
+  // The keyboard reaches the forms: Tab from the page start lands on a link or a control,
+  // and the arrow keys move between the tabs.
   await page.keyboard.press("Tab");
   const focused = await page.evaluate(() => document.activeElement.tagName);
   if (!["A", "BUTTON", "INPUT"].includes(focused)) fail(`Tab focuses a ${focused}`);
+  await page.getByRole("tab", { name: "Figures 3–9" }).focus();
+  await page.keyboard.press("ArrowRight");
+  const wrapped = await page.evaluate(() => [document.activeElement.id, document.activeElement.getAttribute("aria-selected")]);
+  if (wrapped[0] !== "tab-rolling" || wrapped[1] !== "true") fail(`ArrowRight from the last tab reaches ${wrapped}`);
+  if (await page.locator("#panel-rolling").isHidden()) fail("the rolling panel stays hidden when its tab is selected by key");
+
+  // A job that cannot end within the server's deadline fails: the bar and the status say so.
+  const second = await browser.newPage({ viewport: { width: 1366, height: 900 } });
+  second.on("pageerror", (error) => errors.push(String(error)));
+  await second.goto(`${strict.base}/`);
+  await second.getByRole("tab", { name: "Sweep" }).click();
+  await second.fill("input[name='vary.load']", "1 nN, 2 nN, 3 nN");
+  await second.fill("input[name='vary.velocity']", manySpeeds);
+  await second.selectOption("#form-sweep select[name='base.layer.model']", "continuum");
+  await second.getByRole("button", { name: "Run" }).click();
+  await second.waitForFunction((s) => {
+    const said = document.querySelector(`${s} .status`).textContent;
+    return said.includes("No point was finished") || (said.includes("partial") && document.querySelector(`${s} .picture svg`));
+  }, area("sweep"), { timeout: 30000 });
+  if (!(await second.locator(`${area("sweep", "status")}.error`).count())) fail("the failed sweep's status is not shown as an error");
+  const failed = await second.locator(area("sweep", "status")).textContent();
+  if (!failed.startsWith("Job failed") || !/deadline/i.test(failed)) fail(`the failed sweep's status reads ${failed}`);
+  const failedBar = await second.locator("#progress-text").textContent();
+  if (!failedBar.startsWith("failed at") || (await second.locator("#progress").getAttribute("class")) !== "failed") fail(`the failed sweep's bar reads ${failedBar}`);
+  await second.screenshot({ path: `${shots}/sweep-failed.png`, fullPage: true });
 
   if (errors.length) fail(`console errors: ${errors.join(" | ")}`);
+  // The negative load (422), the unknown job's events and its record (404 each).
+  if (refusals.sort().join() !== "404,404,422") fail(`refused requests: ${refusals.join()}`);
   if (outside.length) fail(`requests left the server: ${outside.join(", ")}`);
-  if (!process.exitCode) console.log(`dashboard: rolling (both laws, compared, a Prony series), three-body (both laws), a 200-point sweep, a sweep with a refused point and Figure 6 work; screenshots in ${shots}`);
+  if (!process.exitCode) console.log(`dashboard: rolling (both laws, compared, a Prony series), three-body (both laws), an error after a success, a 200-point sweep sorted, a refused point, a cancelled, a failed and an unknown job, Figure 6 and the tabs by keyboard work; screenshots in ${shots}`);
 } finally {
   await browser.close();
   child.kill();
+  strict.child.kill();
 }

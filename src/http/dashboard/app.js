@@ -49,35 +49,130 @@ function requestOf(form) {
 
 /** `value` (SI `unit`) in the unit a person reads: 25 nm, 1 mN, 0.208 µm² (as the pictures). */
 function readable(value, unit) {
+  const [size, name] = scaleFor(value, unit);
+  return [value / size, name];
+}
+
+/** The unit a person reads `value` (SI `unit`) in, as [its size in SI, its name]. */
+function scaleFor(value, unit) {
   const bases = { m: ["m", 1], N: ["N", 1], "m/s": ["m/s", 1], "m^2": ["m²", 2], "m²": ["m²", 2] };
   if (unit === "Pa") {
     for (const [size, name] of [[1e9, "GPa"], [1e6, "MPa"], [1e3, "kPa"]]) {
-      if (Math.abs(value) >= size) return [value / size, name];
+      if (Math.abs(value) >= size) return [size, name];
     }
-    return [value, "Pa"];
+    return [1, "Pa"];
   }
   const base = bases[unit];
-  if (!base || value === 0) return [value, base ? base[0] : unit || ""];
+  if (!base || value === 0) return [1, base ? base[0] : unit || ""];
   const [name, power] = base;
   for (const [size, prefix] of [[1, ""], [1e-3, "m"], [1e-6, "µ"], [1e-9, "n"], [1e-12, "p"]]) {
     const scale = size ** power;
     const least = power === 2 ? 1e-2 : 1;
     if (Math.abs(value) >= least * scale || prefix === "p") {
-      return [value / scale, name === "m/s" ? `${prefix}m/s` : prefix + name];
+      return [scale, name === "m/s" ? `${prefix}m/s` : prefix + name];
     }
   }
-  return [value, unit];
+  return [1, unit];
 }
 
-function status(text, error = false) {
-  const p = $("#status");
-  p.textContent = text;
-  p.className = error ? "error" : "";
+// ---- Answer areas ------------------------------------------------------------------
+
+/** One tab's answer: its status line, warnings, picture, table and downloads. Each tab owns
+ *  one, so that switching tabs never shows another tab's answer; each request writes only to
+ *  the area that made it, and only while it is the last one asked there, so a slow earlier
+ *  answer never lands over a later one. */
+class Area {
+  constructor(root) {
+    this.root = root;
+    this.asked = 0;
+  }
+
+  part(name) {
+    return this.root.querySelector(`.${name}`);
+  }
+
+  /** A new request: says `text` and returns the token that keeps its writes current. */
+  begin(text) {
+    this.asked += 1;
+    this.markFields([]);
+    this.root.setAttribute("aria-busy", "true");
+    this.status(text, "busy");
+    return this.asked;
+  }
+
+  /** Whether the request of `token` is still the last one asked here. */
+  current(token) {
+    return token === this.asked;
+  }
+
+  /** The status line; `kind` "error" for what went wrong. */
+  status(text, kind = "") {
+    const line = this.part("status");
+    line.textContent = text;
+    line.className = `status ${kind}`.trim();
+    if (kind !== "busy") this.root.removeAttribute("aria-busy");
+  }
+
+  /** Everything but the status line emptied. */
+  clear() {
+    for (const name of ["warnings", "picture", "table", "downloads"]) this.part(name).replaceChildren();
+  }
+
+  /** An error in place of the answer it replaces: an old table never stands under it. */
+  problem(problem) {
+    this.clear();
+    this.status(problemText(problem), "error");
+    this.markFields(problem.errors || []);
+  }
+
+  /** Each field an error names (`vary.load[2]` is the field `vary.load`) marked invalid, with
+   *  what it allows beside it; the marks of earlier errors removed. */
+  markFields(errors) {
+    const form = this.root.closest("[role=tabpanel]").querySelector("form");
+    if (!form) return;
+    for (const note of form.querySelectorAll(".field-error")) note.remove();
+    for (const field of form.querySelectorAll("[aria-invalid]")) {
+      field.removeAttribute("aria-invalid");
+      field.removeAttribute("aria-describedby");
+    }
+    errors.forEach((error, i) => {
+      const field = form.elements.namedItem(String(error.field).replace(/\[\d+\]/g, ""));
+      if (!(field instanceof HTMLElement)) return;
+      const note = document.createElement("span");
+      note.className = "field-error";
+      note.id = `${form.id}-error-${i}`;
+      note.textContent = `${JSON.stringify(error.value)}: expected ${error.allowed}`;
+      field.setAttribute("aria-invalid", "true");
+      field.setAttribute("aria-describedby", note.id);
+      field.closest("label").append(note);
+    });
+  }
 }
 
-function showProblem(problem) {
+/** The area of the tab panel holding `node`. */
+function areaOf(node) {
+  return node.closest("[role=tabpanel]").area;
+}
+
+/** A problem in one line: its title, then what each field did wrong or its detail. */
+function problemText(problem) {
   const fields = (problem.errors || []).map((e) => e.message).join("; ");
-  status(`${problem.title}: ${fields || problem.detail}`, true);
+  return `${problem.title}: ${fields || problem.detail}`;
+}
+
+/** A response's JSON body (`ok` true), or the problem it carries (`ok` false). A reply that is
+ *  not JSON (a proxy's page, an empty 502) or a success without a body reads as a problem
+ *  named by its status, never as an answer. */
+async function readJson(response) {
+  let body = null;
+  if ((response.headers.get("content-type") || "").includes("json")) {
+    body = await response.json().catch(() => null);
+  }
+  if (response.ok && body) return { ok: true, body };
+  if (!response.ok && body && body.title) return { ok: false, body };
+  const title = response.ok ? "Unreadable answer" : `${response.status} ${response.statusText || "Error"}`;
+  const detail = response.ok ? "the server's answer is not JSON" : "the server gave no description of the problem";
+  return { ok: false, body: { title, status: response.status, detail } };
 }
 
 /** Scalars of an answer (nested objects flattened, lists left out) with their units. */
@@ -96,33 +191,103 @@ function rows(answer, units, prefix = "") {
   return out;
 }
 
-/** The answer's table, emptied, with a head row of `names`. */
-function freshTable(names) {
-  const table = $("#table");
+/** The area's table, emptied, with a head row of `names`. */
+function freshTable(area, names) {
+  const table = area.part("table");
   table.replaceChildren();
-  const head = table.insertRow();
+  const head = table.createTHead().insertRow();
   for (const name of names) {
     const th = document.createElement("th");
+    th.scope = "col";
     th.textContent = name;
     head.append(th);
   }
   return table;
 }
 
-function showTable(answer) {
-  const table = freshTable(["quantity", "value", "unit"]);
-  const units = (answer.meta && answer.meta.units) || {};
-  // A sweep's table is what its meta says of its points; its rows are in the downloads.
-  const shown = answer.points ? { points: (answer.meta && answer.meta.counts) || answer.points.length } : answer;
-  for (const [name, value, unit] of rows(shown, units)) {
-    const row = table.insertRow();
+/** An answer's scalars, or a sweep's points. */
+function showTable(area, answer) {
+  if (Array.isArray(answer.points)) return showPoints(area, answer);
+  const table = freshTable(area, ["quantity", "value", "unit"]);
+  const body = table.createTBody();
+  for (const [name, value, unit] of rows(answer, (answer.meta && answer.meta.units) || {})) {
+    const row = body.insertRow();
     for (const cell of [name, value, unit]) row.insertCell().textContent = cell;
   }
 }
 
+/** Rows of a sweep's table at most: the CSV and JSON downloads hold every point. */
+const SHOWN_POINTS = 500;
+
+/** A sweep's points as a table, a column per scalar of its first point (units in the head),
+ *  sorted by a column when its head is clicked (again: the other way). */
+function showPoints(area, answer) {
+  const units = {};
+  for (const [path, unit] of Object.entries((answer.meta && answer.meta.units) || {})) {
+    if (path.startsWith("points[].")) units[path.slice("points[].".length)] = unit;
+  }
+  const first = answer.points.find((p) => p && typeof p === "object") || {};
+  const columns = rows(first, units).map(([path]) => path).filter((path) => !path.startsWith("validity."));
+  const statusColumn = typeof first.status === "string";
+  // A column is shown in the unit of its largest value.
+  const scales = Object.fromEntries(columns.map((c) => {
+    const largest = answer.points.reduce((most, p) => Math.max(most, Math.abs(valueAt(p, c)) || 0), 0);
+    return [c, scaleFor(largest, units[c])];
+  }));
+  const names = [...(statusColumn ? ["status"] : []), ...columns.map((c) => scales[c][1] ? `${c} [${scales[c][1]}]` : c)];
+  const table = freshTable(area, names);
+  const body = table.createTBody();
+  const draw = (order) => {
+    body.replaceChildren();
+    for (const point of order.slice(0, SHOWN_POINTS)) {
+      const row = body.insertRow();
+      if (statusColumn) row.insertCell().textContent = point.status + (point.reason ? `: ${point.reason}` : "");
+      for (const c of columns) {
+        const value = valueAt(point, c);
+        row.insertCell().textContent = typeof value === "number" ? Number((value / scales[c][0]).toPrecision(6)) : "";
+      }
+    }
+    if (order.length > SHOWN_POINTS) {
+      const row = body.insertRow();
+      const cell = row.insertCell();
+      cell.colSpan = names.length;
+      cell.textContent = `first ${SHOWN_POINTS} of ${order.length} points: every point is in the CSV and JSON downloads`;
+    }
+  };
+  let sorted = { by: null, sign: 1 };
+  [...table.tHead.rows[0].cells].forEach((th, i) => {
+    const column = statusColumn ? (i === 0 ? "status" : columns[i - 1]) : columns[i];
+    th.tabIndex = 0;
+    th.setAttribute("aria-sort", "none");
+    const sort = () => {
+      sorted = { by: column, sign: sorted.by === column ? -sorted.sign : 1 };
+      const order = answer.points.slice().sort((a, b) => sorted.sign * compareValues(valueAt(a, column), valueAt(b, column)));
+      for (const other of table.tHead.rows[0].cells) other.setAttribute("aria-sort", "none");
+      th.setAttribute("aria-sort", sorted.sign > 0 ? "ascending" : "descending");
+      draw(order);
+    };
+    th.addEventListener("click", sort);
+    th.addEventListener("keydown", (e) => { if (e.key === "Enter" || e.key === " ") { e.preventDefault(); sort(); } });
+  });
+  draw(answer.points);
+}
+
+/** The value at a dotted `path` of `object`. */
+function valueAt(object, path) {
+  return path.split(".").reduce((node, key) => (node == null ? undefined : node[key]), object);
+}
+
+/** Numbers before text, text in order, missing values last. */
+function compareValues(a, b) {
+  if (a === undefined || a === null) return b === undefined || b === null ? 0 : 1;
+  if (b === undefined || b === null) return -1;
+  if (typeof a === "number" && typeof b === "number") return a - b;
+  return String(a).localeCompare(String(b));
+}
+
 /** The answer's warnings, in place of those shown (or after them, `after`: comparing). */
-function showWarnings(answer, after = false) {
-  const box = $("#warnings");
+function showWarnings(area, answer, after = false) {
+  const box = area.part("warnings");
   if (!after) box.replaceChildren();
   const meta = answer.meta || {};
   const notes = (meta.warnings || []).map((w) => w.message);
@@ -145,17 +310,17 @@ function showWarnings(answer, after = false) {
   }
 }
 
-/** Puts an SVG document into the page (inline, so the page's CSP allows it). */
-function showPicture(svgText) {
+/** Puts an SVG document into the area (inline, so the page's CSP allows it). */
+function showPicture(area, svgText) {
   const doc = new DOMParser().parseFromString(svgText, "image/svg+xml");
   const svg = doc.documentElement;
   svg.setAttribute("role", "img");
-  $("#picture").replaceChildren(document.importNode(svg, true));
+  area.part("picture").replaceChildren(document.importNode(svg, true));
 }
 
 /** Download buttons: each fetches the answer in its form and saves it. */
-function showDownloads(fetchIn, name) {
-  const box = $("#downloads");
+function showDownloads(area, fetchIn, name) {
+  const box = area.part("downloads");
   box.replaceChildren();
   for (const [label, accept, ext] of [["JSON", "application/json", "json"], ["CSV", "text/csv", "csv"], ["SVG", "image/svg+xml", "svg"]]) {
     const button = document.createElement("button");
@@ -163,6 +328,7 @@ function showDownloads(fetchIn, name) {
     button.textContent = `Download ${label}`;
     button.addEventListener("click", async () => {
       const response = await fetchIn(accept);
+      if (!response.ok) return area.status(`Download ${label}: ${problemText((await readJson(response)).body)}`, "error");
       const blob = await response.blob();
       const link = document.createElement("a");
       link.href = URL.createObjectURL(blob);
@@ -172,6 +338,17 @@ function showDownloads(fetchIn, name) {
     });
     box.append(button);
   }
+}
+
+/** An answer in its area: table, warnings, picture (when `picture` fetches one) and downloads. */
+async function showAnswer(area, token, answer, picture, downloads, name) {
+  area.clear();
+  showTable(area, answer);
+  showWarnings(area, answer);
+  const svg = await picture();
+  if (!area.current(token)) return;
+  if (svg.ok) showPicture(area, await svg.text());
+  showDownloads(area, downloads, name);
 }
 
 /** What a continuum answer's verification says of its accuracy, in a sentence. */
@@ -238,30 +415,32 @@ function comparison(answers) {
 
 /** Solves the rolling form under both laws: their regions drawn together, their numbers side by side. */
 async function compare(form) {
+  const area = areaOf(form);
   const { url, body } = requestOf(form);
-  status("Solving under both laws…");
+  const token = area.begin("Solving under both laws…");
   const answers = [];
   for (const model of ["local", "continuum"]) {
     const asked = structuredClone(body);
     (asked.layer ??= {}).model = model;
-    const response = await post(url, asked);
-    const answer = await response.json();
-    if (!response.ok) return showProblem(answer);
-    answers.push([model, answer]);
+    const read = await readJson(await post(url, asked));
+    if (!area.current(token)) return;
+    if (!read.ok) return area.problem(read.body);
+    answers.push([model, read.body]);
   }
-  $("#picture").replaceChildren(comparison(answers));
-  const table = freshTable(["quantity", "local law", "layer as a continuum"]);
+  area.clear();
+  area.part("picture").replaceChildren(comparison(answers));
+  const table = freshTable(area, ["quantity", "local law", "layer as a continuum"]);
+  const rowsOf = table.createTBody();
   // The two answers have the same quantities, in the same order.
   const [local, continuum] = answers.map(([, a]) => rows(a, a.meta.units || {}));
   continuum.forEach(([name, value, unit], i) => {
-    const row = table.insertRow();
+    const row = rowsOf.insertRow();
     const [, theirs, theirUnit] = local[i];
     for (const cell of [name, `${theirs} ${theirUnit}`, `${value} ${unit}`]) row.insertCell().textContent = cell;
   });
-  showWarnings(answers[0][1]);
-  showWarnings(answers[1][1], true);
-  status(`Both laws solved.${accuracy(answers[1][1])}`);
-  $("#downloads").replaceChildren();
+  showWarnings(area, answers[0][1]);
+  showWarnings(area, answers[1][1], true);
+  area.status(`Both laws solved.${accuracy(answers[1][1])}`);
 }
 
 async function post(url, body, accept = "application/json") {
@@ -269,131 +448,211 @@ async function post(url, body, accept = "application/json") {
 }
 
 async function solve(form) {
+  const area = areaOf(form);
   const { url, body } = requestOf(form);
-  status("Solving…");
+  const token = area.begin("Solving…");
   const response = await post(url, body);
-  const answer = await response.json();
-  if (!response.ok) return showProblem(answer);
-  status(`Solved (${response.headers.get("x-cache") || "miss"}).${accuracy(answer)}`);
-  showTable(answer);
-  showWarnings(answer);
-  const picture = await post(url, body, "image/svg+xml");
-  if (picture.ok) showPicture(await picture.text());
-  showDownloads((accept) => post(url, body, accept), form.dataset.kind);
+  const read = await readJson(response);
+  if (!area.current(token)) return;
+  if (!read.ok) return area.problem(read.body);
+  area.status(`Solved (${response.headers.get("x-cache") || "miss"}).${accuracy(read.body)}`);
+  await showAnswer(area, token, read.body, () => post(url, body, "image/svg+xml"), (accept) => post(url, body, accept), form.dataset.kind);
 }
 
 // ---- Jobs: progress from the event stream, cancel -------------------------------------
 
+/** The job the sweep tab follows (its event stream), if one runs. */
 let following = null;
 
 async function runJob(form) {
+  const area = areaOf(form);
   const { url, body } = requestOf(form);
-  status("Submitting…");
-  const response = await post(url, body);
-  const view = await response.json();
-  if (!response.ok) return showProblem(view);
-  follow(view.id);
+  const token = area.begin("Submitting…");
+  showProgress({ status: "queued", progress: { done: 0, total: 0 } });
+  if (following) following.close();
+  const read = await readJson(await post(url, body));
+  if (!area.current(token)) return;
+  if (!read.ok) {
+    showProgress(null);
+    return area.problem(read.body);
+  }
+  area.clear();
+  follow(area, token, read.body.id);
 }
 
-function follow(id) {
-  const progress = $("#progress");
+/** The progress bar and its text for a job's `view`: how far, and how it ended when it did
+ *  not succeed (a failed or cancelled job's bar says so, in its colour). `null` empties it. */
+function showProgress(view) {
+  const bar = $("#progress");
   const text = $("#progress-text");
+  if (!view) {
+    bar.value = 0;
+    bar.className = "";
+    text.textContent = "";
+    return;
+  }
+  const { done, total } = view.progress;
+  bar.max = Math.max(total, 1);
+  bar.value = done;
+  const count = total ? `${done} / ${total} (${Math.round((100 * done) / total)} %)` : `${done}`;
+  const ended = view.status === "failed" || view.status === "cancelled";
+  bar.className = ended ? view.status : "";
+  text.textContent = ended ? `${view.status} at ${count}` : count;
+}
+
+function follow(area, token, id) {
   const cancel = $("#cancel");
   cancel.disabled = false;
-  cancel.onclick = () => fetch(`/v1/jobs/${id}/cancel`, { method: "POST", headers: { accept: "application/json" } });
-  if (following) following.close();
+  cancel.onclick = async () => {
+    cancel.disabled = true;
+    const read = await readJson(await fetch(`/v1/jobs/${id}/cancel`, { method: "POST", headers: { accept: "application/json" } }));
+    if (!read.ok && area.current(token)) area.status(`Cancel: ${problemText(read.body)}`, "error");
+  };
   const events = new EventSource(`/v1/jobs/${id}/events`);
   following = events;
-  const update = (view) => {
-    const { done, total } = view.progress;
-    progress.max = Math.max(total, 1);
-    progress.value = done;
-    text.textContent = total ? `${done} / ${total} (${Math.round((100 * done) / total)} %)` : `${done}`;
-    status(`Job ${view.status}.`);
-  };
-  events.addEventListener("progress", (e) => update(JSON.parse(e.data)));
-  events.addEventListener("completion", async (e) => {
+  const stop = () => {
     events.close();
-    following = null;
+    if (following === events) following = null;
     cancel.disabled = true;
+  };
+  events.addEventListener("progress", (e) => {
+    if (!area.current(token)) return stop();
     const view = JSON.parse(e.data);
-    update(view);
-    if (view.problem) showProblem(view.problem);
-    // A failed or cancelled sweep may still link to the points it finished.
-    if (!view.result_url) return;
-    const result = view.result_url;
-    const response = await fetch(result, { headers: { accept: "application/json" } });
-    const answer = await response.json();
-    if (!response.ok) return showProblem(answer);
-    showTable(answer);
-    showWarnings(answer);
-    if (view.partial) {
-      const why = view.problem ? `: ${view.problem.detail}` : "";
-      status(`Job ${view.status}${why}. A partial answer: the points it finished.`, view.status === "failed");
-    }
-    const picture = await fetch(`${result}?format=svg`);
-    if (picture.ok) showPicture(await picture.text());
-    showDownloads((accept) => fetch(result, { headers: { accept } }), `job-${id}`);
+    showProgress(view);
+    area.status(`Job ${view.status}…`, "busy");
   });
+  // The stream closed for good (the job unknown, the server gone): what the job's URL says.
+  events.addEventListener("error", async () => {
+    if (events.readyState !== EventSource.CLOSED) return;
+    stop();
+    const read = await readJson(await fetch(`/v1/jobs/${id}`, { headers: { accept: "application/json" } }));
+    if (!area.current(token)) return;
+    if (!read.ok) return area.problem(read.body);
+    finished(area, token, read.body);
+  });
+  events.addEventListener("completion", (e) => {
+    stop();
+    if (area.current(token)) finished(area, token, JSON.parse(e.data));
+  });
+}
+
+/** A job's end: its answer, or what went wrong and the points it finished anyway. */
+async function finished(area, token, view) {
+  showProgress(view);
+  const { done, total } = view.progress;
+  const ending = {
+    succeeded: ["Job succeeded.", ""],
+    failed: [`Job failed: ${view.problem ? problemText(view.problem) : "no reason given"}.`, "error"],
+    cancelled: [`Job cancelled after ${done} of ${total} points.`, "ended"],
+  }[view.status] || [`Job ${view.status}.`, ""];
+  area.status(ending[0], ending[1]);
+  if (!view.result_url) {
+    area.clear();
+    return area.status(`${ending[0]} No point was finished.`, ending[1]);
+  }
+  const result = view.result_url;
+  const read = await readJson(await fetch(result, { headers: { accept: "application/json" } }));
+  if (!area.current(token)) return;
+  if (!read.ok) return area.problem({ ...read.body, title: `${ending[0]} Its answer cannot be read (${read.body.title})` });
+  const partial = view.partial ? " The answer below is partial: the points it finished." : "";
+  area.status(ending[0] + partial, ending[1]);
+  await showAnswer(area, token, read.body, () => fetch(`${result}?format=svg`), (accept) => fetch(result, { headers: { accept } }), `job-${view.id}`);
 }
 
 // ---- Copying a form as a command ----------------------------------------------------
 
 async function copy(form, what) {
+  const area = areaOf(form);
   const { url, body, job } = requestOf(form);
   const text = what === "job"
     ? JSON.stringify(job, null, 2)
     : `curl -s -X POST ${location.origin}${url} -H 'content-type: application/json' -d '${JSON.stringify(body)}'`;
   try {
     await navigator.clipboard.writeText(text);
-    status(`Copied ${what === "job" ? "the job as JSON" : "the curl command"}.`);
+    area.status(`Copied ${what === "job" ? "the job as JSON" : "the curl command"}.`);
   } catch {
-    status(text);
+    area.status(text);
   }
 }
 
 // ---- Figures, tabs, start-up ---------------------------------------------------------
 
-async function figure(n) {
-  status(`Figure ${n}…`);
-  const response = await fetch(`/v1/figures/${n}?format=svg`);
-  if (!response.ok) return showProblem(await response.json());
-  showPicture(await response.text());
-  const answer = await (await fetch(`/v1/figures/${n}`, { headers: { accept: "application/json" } })).json();
-  showTable({ figure: answer.figure, series: answer.series.length, meta: answer.meta });
-  $("#warnings").replaceChildren();
-  status(`Figure ${n}: ${answer.title}`);
-  showDownloads((accept) => fetch(`/v1/figures/${n}`, { headers: { accept } }), `figure-${n}`);
+async function figure(area, n) {
+  const token = area.begin(`Figure ${n}…`);
+  const url = `/v1/figures/${n}`;
+  const read = await readJson(await fetch(url, { headers: { accept: "application/json" } }));
+  if (!area.current(token)) return;
+  if (!read.ok) return area.problem(read.body);
+  const answer = read.body;
+  area.status(`Figure ${n}: ${answer.title}`);
+  area.clear();
+  const table = freshTable(area, ["quantity", "value", "unit"]).createTBody();
+  for (const [name, value] of [["figure", answer.figure], ["series", answer.series.length]]) {
+    const row = table.insertRow();
+    for (const cell of [name, value, ""]) row.insertCell().textContent = cell;
+  }
+  const svg = await fetch(`${url}?format=svg`);
+  if (!area.current(token)) return;
+  if (!svg.ok) return area.problem((await readJson(svg)).body);
+  showPicture(area, await svg.text());
+  showDownloads(area, (accept) => fetch(url, { headers: { accept } }), `figure-${n}`);
 }
 
-function selectTab(tab) {
+/** Selects `tab` and shows its panel (and its own answer); `focus` moves the keyboard there. */
+function selectTab(tab, focus = false) {
   for (const other of document.querySelectorAll("[role=tab]")) {
     const selected = other === tab;
     other.setAttribute("aria-selected", String(selected));
+    other.tabIndex = selected ? 0 : -1;
     document.getElementById(other.getAttribute("aria-controls")).hidden = !selected;
   }
+  if (focus) tab.focus();
+}
+
+/** The tabs as the ARIA pattern has them: arrows, Home and End move between them. */
+function tabKeys(event) {
+  const tabs = [...document.querySelectorAll("[role=tab]")];
+  const at = tabs.indexOf(event.target);
+  const to = { ArrowRight: at + 1, ArrowLeft: at - 1, Home: 0, End: tabs.length - 1 }[event.key];
+  if (to === undefined) return;
+  event.preventDefault();
+  selectTab(tabs[(to + tabs.length) % tabs.length], true);
+}
+
+/** Runs `work`; an exception (the server unreachable) reads as an error in `area`. */
+function guarded(area, work) {
+  work().catch((e) => area.status(`The request failed: ${e.message || e}`, "error"));
 }
 
 document.addEventListener("DOMContentLoaded", () => {
+  const template = $("#answer-area");
+  for (const panel of document.querySelectorAll("[role=tabpanel]")) {
+    const root = template.content.firstElementChild.cloneNode(true);
+    panel.append(root);
+    panel.area = new Area(root);
+  }
   for (const tab of document.querySelectorAll("[role=tab]")) {
     tab.addEventListener("click", () => selectTab(tab));
+    tab.addEventListener("keydown", tabKeys);
   }
+  selectTab(document.querySelector("[role=tab][aria-selected=true]"));
   for (const form of document.querySelectorAll("form")) {
     form.addEventListener("submit", (event) => {
       event.preventDefault();
-      (form.dataset.kind === "sweep" ? runJob(form) : solve(form)).catch((e) => status(String(e), true));
+      guarded(areaOf(form), () => (form.dataset.kind === "sweep" ? runJob(form) : solve(form)));
     });
     for (const button of form.querySelectorAll("[data-copy]")) {
       button.addEventListener("click", () => copy(form, button.dataset.copy));
     }
   }
-  $("#compare").addEventListener("click", () => compare($("#form-rolling")).catch((e) => status(String(e), true)));
+  const rolling = $("#form-rolling");
+  $("#compare").addEventListener("click", () => guarded(areaOf(rolling), () => compare(rolling)));
   const buttons = $("#figure-buttons");
   for (let n = 3; n <= 9; n++) {
     const button = document.createElement("button");
     button.type = "button";
     button.textContent = `Figure ${n}`;
-    button.addEventListener("click", () => figure(n).catch((e) => status(String(e), true)));
+    button.addEventListener("click", () => guarded(areaOf(buttons), () => figure(areaOf(buttons), n)));
     buttons.append(button);
   }
 });
