@@ -155,6 +155,49 @@ try {
   if (descending[0] !== Math.max(...ascending) || (await muHead.getAttribute("aria-sort")) !== "descending") fail(`sorted again by μ the column starts ${descending[0]}`);
   await page.screenshot({ path: `${shots}/sweep.png`, fullPage: true });
 
+  // The sweep's plot to explore: a line per load, then any quantity against any varied input.
+  const plot = `${area("sweep", "picture")} svg.plot`;
+  const lines = await page.locator(`${plot} path.series`).count();
+  if (lines !== 10) fail(`the sweep's plot draws ${lines} lines, not one per load (10)`);
+  await page.selectOption(`${area("sweep", "picture")} select[name='y']`, "contact_area");
+  await page.selectOption(`${area("sweep", "picture")} select[name='x']`, "load");
+  const yLabel = await page.locator(`${plot} .y-label`).textContent();
+  if (yLabel !== "contact_area [nm²]") fail(`the plot's y axis reads ${yLabel}`);
+  const perSpeed = await page.locator(`${plot} path.series`).count();
+  if (perSpeed !== 20) fail(`against the load the plot draws ${perSpeed} lines, not one per speed (20)`);
+  if (!(await page.locator(`${area("sweep", "picture")} .colour-bar`).count())) fail("20 lines are not told by a colour bar");
+  // Hover reads the nearest point with its units.
+  const dot = await page.locator(`${plot} circle.point`).nth(5).boundingBox();
+  await page.mouse.move(dot.x + dot.width / 2, dot.y + dot.height / 2);
+  const tip = await page.locator(`${plot} g.tip`).textContent();
+  if ((await page.locator(`${plot} g.tip`).getAttribute("visibility")) !== "visible" || !/load = [\d.]+ nN/.test(tip) || !/contact_area = [\d.]+ nm²/.test(tip)) fail(`hovering a point reads ${tip}`);
+  // A drag zooms in, Reset zoom goes back.
+  const xTicks = () => page.$$eval(`${plot} .axes text`, (nodes) => nodes.map((n) => n.textContent).join(" "));
+  const whole = await xTicks();
+  const frame = await page.locator(plot).boundingBox();
+  await page.mouse.move(frame.x + frame.width * 0.3, frame.y + frame.height * 0.2);
+  await page.mouse.down();
+  await page.mouse.move(frame.x + frame.width * 0.6, frame.y + frame.height * 0.6, { steps: 5 });
+  await page.mouse.up();
+  const zoomed = await xTicks();
+  if (zoomed === whole) fail("a drag over the plot does not zoom");
+  await page.getByRole("button", { name: "Reset zoom" }).click();
+  if ((await xTicks()) !== whole) fail("Reset zoom does not restore the axes");
+  await page.check(`${area("sweep", "picture")} input[name='logY']`);
+  if (!(await page.locator(`${plot} .y-label`).textContent()).endsWith("(log)")) fail("log y does not make the y axis logarithmic");
+  // Two varied inputs: a heat map, a cell per point.
+  await page.selectOption(`${area("sweep", "picture")} select[name='view']`, "heat");
+  const cells = await page.locator(`${plot} rect.cell`).count();
+  if (cells !== 200) fail(`the heat map has ${cells} cells, not 200`);
+  await page.screenshot({ path: `${shots}/sweep-heat-map.png`, fullPage: true });
+
+  // A one-point sweep is drawn: its point.
+  await page.fill("input[name='vary.load']", "1 nN");
+  await page.fill("input[name='vary.velocity']", "4 nm/s");
+  await page.getByRole("button", { name: "Run" }).click();
+  await page.waitForFunction((s) => document.querySelectorAll(`${s} circle.point`).length === 1
+    && document.querySelector("#progress-text").textContent.includes("1 / 1"), plot, { timeout: 30000 });
+
   // A sweep with a point the model refuses: the other points are answered, the refusal said
   // in the warnings and on the point's row.
   await page.fill("input[name='vary.load']", "1 nN, 1 mN, 2 nN");

@@ -340,14 +340,19 @@ function showDownloads(area, fetchIn, name) {
   }
 }
 
-/** An answer in its area: table, warnings, picture (when `picture` fetches one) and downloads. */
+/** An answer in its area: table, warnings, picture and downloads. A sweep's picture is drawn
+ *  here to be explored ([`SweepPlot`]); any other's is the server's, which `picture` fetches. */
 async function showAnswer(area, token, answer, picture, downloads, name) {
   area.clear();
   showTable(area, answer);
   showWarnings(area, answer);
-  const svg = await picture();
-  if (!area.current(token)) return;
-  if (svg.ok) showPicture(area, await svg.text());
+  if (Array.isArray(answer.points) && answer.points.length) {
+    new SweepPlot(area.part("picture"), answer);
+  } else {
+    const svg = await picture();
+    if (!area.current(token)) return;
+    if (svg.ok) showPicture(area, await svg.text());
+  }
   showDownloads(area, downloads, name);
 }
 

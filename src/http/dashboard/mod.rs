@@ -11,6 +11,7 @@ use super::AppState;
 
 const PAGE: &str = include_str!("index.html");
 const SCRIPT: &str = include_str!("app.js");
+const PLOT: &str = include_str!("plot.js");
 const STYLE: &str = include_str!("app.css");
 const ICON: &str = include_str!("icon.svg");
 
@@ -24,6 +25,10 @@ pub fn router() -> Router<AppState> {
         .route(
             "/assets/app.js",
             get(|| asset("text/javascript; charset=utf-8", SCRIPT)),
+        )
+        .route(
+            "/assets/plot.js",
+            get(|| asset("text/javascript; charset=utf-8", PLOT)),
         )
         .route(
             "/assets/app.css",
