@@ -47,8 +47,8 @@ pub fn shown(value: f64, unit: &str) -> String {
     quantity_to(value, unit, 4)
 }
 
-/// The symbol of a condition in a legend (`V = 4 nm/s`): the paper's, by the condition's name
-/// on the wire.
+/// The symbol of a condition in a legend (`V = 4 nm/s`) or of a fitted parameter of the
+/// layer (`E_L = 2.5 GPa`): the paper's, by its name on the wire.
 pub fn symbol(name: &str) -> &str {
     match name {
         "velocity" => "V",
@@ -57,6 +57,10 @@ pub fn symbol(name: &str) -> &str {
         "mean_diameter" => "x_a",
         "total_load" => "W",
         "separation" => "d",
+        "elastic_modulus" => "E_L",
+        "relaxation_time" => "T_σ",
+        "retardation_time" => "T_ε",
+        "thickness" => "H",
         other => other,
     }
 }

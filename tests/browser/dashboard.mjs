@@ -31,9 +31,14 @@ function serve(flags = []) {
   });
 }
 
+// Every process this test starts, stopped at its end whatever happens.
+const started = [];
+process.on("exit", () => started.forEach((child) => child.kill()));
 const { child, base } = await serve();
+started.push(child);
 // A second service whose jobs must end within 300 ms: a long sweep there fails.
 const strict = await serve(["--job-deadline", "300ms"]);
+started.push(strict.child);
 // The answer area of a tab's panel, and a part of it.
 const area = (panel, part = "") => `#panel-${panel} .answer-area${part ? " ." + part : ""}`;
 const browser = await chromium.launch({
@@ -144,13 +149,13 @@ try {
   if (!progress.includes("200 / 200 (100 %)")) fail(`progress reads ${progress}`);
   const pointRows = await page.locator(`${area("sweep", "table")} tbody tr`).count();
   if (pointRows !== 200) fail(`the sweep's table has ${pointRows} rows, not its 200 points`);
-  const muHead = page.locator(`${area("sweep", "table")} th`, { hasText: "friction_coefficient" }).first();
+  const muHead = page.locator(`${area("sweep", "table")} th`, { hasText: /^friction_coefficient/ }).first();
   const muColumn = await muHead.evaluate((th) => th.cellIndex);
   const column = () => page.$$eval(`${area("sweep", "table")} tbody tr`, (rows, i) => rows.map((r) => Number(r.cells[i].textContent)), muColumn);
-  await muHead.click();
+  await muHead.getByRole("button").click();
   const ascending = await column();
   if (ascending.some((v, i) => i > 0 && v < ascending[i - 1])) fail(`sorted by μ the column reads ${ascending.slice(0, 5)}…`);
-  await muHead.click();
+  await muHead.getByRole("button").click();
   const descending = await column();
   if (descending[0] !== Math.max(...ascending) || (await muHead.getAttribute("aria-sort")) !== "descending") fail(`sorted again by μ the column starts ${descending[0]}`);
   await page.screenshot({ path: `${shots}/sweep.png`, fullPage: true });
@@ -246,7 +251,61 @@ try {
   if (await page.locator(`${area("figures", "status")}`).textContent()) fail("the Figures tab shows another tab's status");
   if (!(await page.locator(area("three-body", "picture")).isHidden())) fail("the three-body picture shows under Figures");
 
+  // A sweep of three-body systems: their own lists and base, the plot against the total load.
+  await page.getByRole("tab", { name: "Sweep" }).click();
+  await page.selectOption("#form-sweep select[name='kind']", "three_body");
+  if (!(await page.locator("#form-sweep input[name='vary.radius']").isHidden())) fail("a three-body sweep shows the rolling radii");
+  await page.fill("#form-sweep input[name='vary.total_load']", "0.5 mN, 1 mN");
+  await page.fill("input[name='vary.velocity']", "4 nm/s");
+  await page.getByRole("button", { name: "Run" }).click();
+  await page.waitForFunction((s) => document.querySelector(`${s} svg.plot`)?.dataset.x === "operating.total_load"
+    && document.querySelectorAll(`${s} circle.point`).length === 2, area("sweep", "picture"), { timeout: 60000 });
+  await page.selectOption("#form-sweep select[name='kind']", "rolling");
+
+  // Every input of a three-body system: asperities sent when given.
+  await page.getByRole("tab", { name: "Three-body system" }).click();
+  for (const [name, value] of [["asperities.density", "1e12 m^-2"], ["asperities.tip_radius", "1 um"], ["asperities.height_std", "20 nm"], ["asperities.hardness", "2 GPa"], ["upper_surface.elastic_modulus", "200 GPa"]]) {
+    await page.fill(`#form-three-body input[name='${name}']`, value);
+  }
+  await page.locator("#form-three-body").getByRole("button", { name: "Copy as job JSON" }).click();
+  await page.locator("#form-three-body").getByRole("button", { name: "Solve" }).click();
+  await page.waitForFunction((s) => document.querySelector(`${s} .status`).textContent.startsWith("Solved")
+    && [...document.querySelectorAll(`${s} .table tr`)].some((r) => r.textContent.startsWith("loads.asperities")), area("three-body"), { timeout: 30000 });
+  const asperityLoad = await page.locator(`${area("three-body", "table")} tr`, { hasText: "loads.asperities" }).first().textContent();
+  if (!/[1-9]/.test(asperityLoad)) fail(`the asperities carry no load: ${asperityLoad}`);
+
+  // Copy as Python: a script that posts the form's body as it is.
+  await page.getByRole("tab", { name: "Rolling contact" }).click();
+  await page.context().grantPermissions(["clipboard-read", "clipboard-write"], { origin: base });
+  await page.locator("#form-rolling").getByRole("button", { name: "Copy as Python" }).click();
+  const script = await page.evaluate(() => navigator.clipboard.readText());
+  const embedded = (script.match(/json\.loads\(r"""([\s\S]*?)"""\)/) || [])[1];
+  if (!embedded || JSON.parse(embedded).load !== "1 nN" || !script.includes(`requests.post(base + "/v1/rolling", json=body)`)) fail(`Copy as Python gives ${script}`);
+
+  // A fit from an uploaded CSV: the parameters with their intervals, the picture.
+  await page.getByRole("tab", { name: "Fit" }).click();
+  await page.setInputFiles("#form-fit input[type='file']", { name: "measured.csv", mimeType: "text/csv", buffer: Buffer.from("radius, load, velocity, value, uncertainty\n25 nm, 0.8 nN, 0 nm/s, 0.1173, 0.0015\n25 nm, 0.8 nN, 0.5 nm/s, 0.1139, 0.0015\n25 nm, 0.8 nN, 1 nm/s, 0.1063, 0.0015\n25 nm, 0.8 nN, 1.5 nm/s, 0.1058, 0.0015\n25 nm, 0.8 nN, 2 nm/s, 0.1036, 0.0015\n25 nm, 0.8 nN, 3 nm/s, 0.0973, 0.0015\n25 nm, 0.8 nN, 4 nm/s, 0.0896, 0.0015\n25 nm, 0.8 nN, 5 nm/s, 0.085, 0.0015\n25 nm, 0.8 nN, 6 nm/s, 0.0821, 0.0015\n25 nm, 0.8 nN, 8 nm/s, 0.0725, 0.0015\n25 nm, 0.8 nN, 10 nm/s, 0.0686, 0.0015\n25 nm, 0.8 nN, 12 nm/s, 0.0622, 0.0015\n25 nm, 0.8 nN, 15 nm/s, 0.0603, 0.0015\n25 nm, 0.8 nN, 20 nm/s, 0.0538, 0.0015\n25 nm, 0.8 nN, 30 nm/s, 0.0514, 0.0015\n25 nm, 1.2 nN, 0 nm/s, 0.0968, 0.0015\n25 nm, 1.2 nN, 0.5 nm/s, 0.0944, 0.0015\n25 nm, 1.2 nN, 1 nm/s, 0.0915, 0.0015\n25 nm, 1.2 nN, 1.5 nm/s, 0.0847, 0.0015\n25 nm, 1.2 nN, 2 nm/s, 0.0858, 0.0015\n25 nm, 1.2 nN, 3 nm/s, 0.0794, 0.0015\n25 nm, 1.2 nN, 4 nm/s, 0.074, 0.0015\n25 nm, 1.2 nN, 5 nm/s, 0.0725, 0.0015\n25 nm, 1.2 nN, 6 nm/s, 0.0698, 0.0015\n25 nm, 1.2 nN, 8 nm/s, 0.0663, 0.0015\n25 nm, 1.2 nN, 10 nm/s, 0.0578, 0.0015\n25 nm, 1.2 nN, 12 nm/s, 0.0567, 0.0015\n25 nm, 1.2 nN, 15 nm/s, 0.0452, 0.0015\n25 nm, 1.2 nN, 20 nm/s, 0.0461, 0.0015\n25 nm, 1.2 nN, 30 nm/s, 0.0426, 0.0015\n") });
+  await page.waitForFunction(() => document.querySelector("#form-fit textarea[name='series.csv']").value.includes("30 nm/s, 0.0426"));
+  await page.locator("#form-fit").getByRole("button", { name: "Fit" }).click();
+  await page.waitForFunction((s) => [...document.querySelectorAll(`${s} .table tr`)].some((r) => r.textContent.startsWith("parameters.elastic_modulus.value")), area("fit"), { timeout: 60000 });
+  const modulus = await page.locator(`${area("fit", "table")} tr`, { hasText: "parameters.elastic_modulus.value" }).first().textContent();
+  if (!/2\.53\d*\s*GPa/.test(modulus)) fail(`the fitted modulus reads ${modulus} (examples/fit.json: 2.53 GPa)`);
+  const interval = await page.locator(`${area("fit", "table")} tr`, { hasText: "parameters.elastic_modulus.interval_95" }).first().textContent();
+  if (!/2\.476 to 2\.59\s*GPa/.test(interval)) fail(`the modulus's 95 % interval reads ${interval}`);
+  await page.waitForSelector(`${area("fit", "picture")} svg`);
+  const fitNotes = await page.locator(`${area("fit", "picture")} svg .notes`).textContent();
+  if (!fitNotes.includes("E_L = 2.533 GPa") || !fitNotes.includes("bars: ± the uncertainty given")) fail(`the fit's picture notes read ${fitNotes}`);
+  await page.screenshot({ path: `${shots}/fit.png`, fullPage: true });
+  // A CSV row short of a value: refused before sending, the CSV marked.
+  await page.fill("#form-fit textarea[name='series.csv']", "velocity, value, uncertainty\n1 nm/s, 0.1");
+  await page.locator("#form-fit").getByRole("button", { name: "Fit" }).click();
+  await page.waitForSelector("#form-fit textarea[name='series.csv'][aria-invalid='true']");
+  const csvError = await page.locator(area("fit", "status")).textContent();
+  if (!csvError.includes("row 1 has 2 values")) fail(`a short CSV row reads ${csvError}`);
+  if (await page.locator(`${area("fit", "table")} tr`).count()) fail("the fit's table stays under the CSV's error");
+
   // Figure 6 from the gallery.
+  await page.getByRole("tab", { name: "Figures 3–9" }).click();
   await page.getByRole("button", { name: "Figure 6" }).click();
   await page.waitForFunction((s) => (document.querySelector(`${s} svg title`) || {}).textContent?.startsWith("Fig. 6"), area("figures", "picture"));
   const entries = await page.locator(`${area("figures", "picture")} svg .legend .entry`).count();
@@ -255,6 +314,7 @@ try {
 
   // The keyboard reaches the forms: Tab from the page start lands on a link or a control,
   // and the arrow keys move between the tabs.
+  await page.goto(`${base}/`);
   await page.keyboard.press("Tab");
   const focused = await page.evaluate(() => document.activeElement.tagName);
   if (!["A", "BUTTON", "INPUT"].includes(focused)) fail(`Tab focuses a ${focused}`);
@@ -267,6 +327,7 @@ try {
   // A job that cannot end within the server's deadline fails: the bar and the status say so.
   const second = await browser.newPage({ viewport: { width: 1366, height: 900 } });
   second.on("pageerror", (error) => errors.push(String(error)));
+  second.on("console", (message) => { if (message.type() === "error") errors.push(message.text()); });
   await second.goto(`${strict.base}/`);
   await second.getByRole("tab", { name: "Sweep" }).click();
   await second.fill("input[name='vary.load']", "1 nN, 2 nN, 3 nN");
@@ -288,9 +349,8 @@ try {
   // The negative load (422), the unknown job's events and its record (404 each).
   if (refusals.sort().join() !== "404,404,422") fail(`refused requests: ${refusals.join()}`);
   if (outside.length) fail(`requests left the server: ${outside.join(", ")}`);
-  if (!process.exitCode) console.log(`dashboard: rolling (both laws, compared, a Prony series), three-body (both laws), an error after a success, a 200-point sweep sorted, a refused point, a cancelled, a failed and an unknown job, Figure 6 and the tabs by keyboard work; screenshots in ${shots}`);
+  if (!process.exitCode) console.log(`dashboard: rolling (both laws, compared, a Prony series), three-body (both laws), an error after a success, a 200-point sweep sorted and explored (hover, zoom, log, heat map), a one-point and a three-body sweep, a refused point, a cancelled, a failed and an unknown job, every three-body input, copy as Python, a fit from an uploaded CSV and a bad CSV, Figure 6 and the tabs by keyboard work; screenshots in ${shots}`);
 } finally {
   await browser.close();
-  child.kill();
-  strict.child.kill();
+  started.forEach((child) => child.kill());
 }

@@ -5,7 +5,7 @@
 use serde_json::{json, Value};
 use thirdbody::job::figure::FigurePicture;
 use thirdbody::job::fit::FitPicture;
-use thirdbody::job::picture::{draw, Picture};
+use thirdbody::job::picture::{draw, shown, Picture};
 use thirdbody::job::rolling::RollingPicture;
 use thirdbody::job::sweep::SweepPicture;
 use thirdbody::job::three_body::ThreeBodyPicture;
@@ -207,8 +207,8 @@ fn a_fit_draws_each_series_measured_and_fitted_with_its_residuals() {
             "R = 25 nm, P = 1.2 nN, fitted"
         ]
     );
-    // Per series: its markers, its curve, one residual segment per point.
-    assert_eq!(series.len(), 2 * 2 + 30);
+    // Per series: its markers, its curve; per point its residual and its error bar.
+    assert_eq!(series.len(), 2 * 2 + 2 * 30);
     let chart = chart::<FitPicture>(&answer);
     let Layer::Line { points, .. } = &chart.layers[1] else {
         panic!("the fitted curve")
@@ -226,6 +226,24 @@ fn a_fit_draws_each_series_measured_and_fitted_with_its_residuals() {
     assert!(*dashed);
     assert_eq!(points[0].1, first["measured"].as_f64().unwrap());
     assert_eq!(points[1].1, first["fitted"].as_f64().unwrap());
+    // Its error bar: ± the uncertainty given, solid.
+    let Layer::Line { points, dashed, .. } = &chart.layers[3] else {
+        panic!("an error bar")
+    };
+    let (measured, uncertainty) = (
+        first["measured"].as_f64().unwrap(),
+        first["uncertainty"].as_f64().unwrap(),
+    );
+    assert!(!*dashed);
+    assert_eq!(points[0].1, measured - uncertainty);
+    assert_eq!(points[1].1, measured + uncertainty);
+    // The fitted values with their intervals, as the answer has them.
+    let modulus = &answer["parameters"]["elastic_modulus"];
+    let [lo, hi] = [0, 1].map(|i| modulus["interval_95"][i].as_f64().unwrap());
+    let value = format!("E_L = {}", shown(modulus["value"].as_f64().unwrap(), "Pa"));
+    let note = format!("95 %: {} to {}", shown(lo, "Pa"), shown(hi, "Pa"));
+    assert!(svg.contains(&format!(">{value}<")), "{value} in {svg}");
+    assert!(svg.contains(&note), "{note} in {svg}");
 }
 
 #[test]

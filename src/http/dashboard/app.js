@@ -7,17 +7,21 @@ const $ = (selector) => document.querySelector(selector);
 // ---- Forms to job inputs -------------------------------------------------------------
 
 /** A form's fields as the input object of its job: `a.b` names nest, lists split on commas,
- *  plain numbers become numbers, anything else is sent as typed (a value with its unit).
- *  A layer given as a Prony series drops the Kelvin times the series replaces. */
+ *  plain numbers become numbers, anything else is sent as typed (a value with its unit); an
+ *  empty or disabled field is left out (the server's default). A layer given as a Prony
+ *  series drops the Kelvin times the series replaces; a fit's CSV becomes its series, and a
+ *  parameter without a start is not fitted. */
 function inputOf(form) {
   const input = {};
   for (const field of form.querySelectorAll("input[name], select[name], textarea[name]")) {
     const text = field.value.trim();
-    if (text === "") continue;
+    if (text === "" || field.disabled) continue;
     const path = field.name.split(".");
     let value;
     if (path[0] === "vary") {
       value = text.split(",").map((t) => t.trim()).filter((t) => t !== "").map(typed);
+    } else if (field.dataset.csv !== undefined) {
+      value = pointsOf(text);
     } else {
       value = typed(text);
     }
@@ -26,11 +30,66 @@ function inputOf(form) {
     for (const key of path.slice(0, -1)) node = node[key] ??= {};
     node[path[path.length - 1]] = value;
   }
-  if (input.layer?.prony_csv !== undefined) {
-    delete input.layer.relaxation_time;
-    delete input.layer.retardation_time;
+  dropKelvinTimes(input);
+  if (form.dataset.kind === "fit") {
+    const { quantity, csv } = input.series || {};
+    input.series = seriesOf(quantity, csv || []);
+    for (const [name, bounds] of Object.entries(input.parameters || {})) {
+      if (bounds.start === undefined) delete input.parameters[name];
+    }
   }
   return input;
+}
+
+/** Every layer in `node` given as a Prony series loses the Kelvin times it replaces. */
+function dropKelvinTimes(node) {
+  if (!node || typeof node !== "object") return;
+  if (node.prony_csv !== undefined) {
+    delete node.relaxation_time;
+    delete node.retardation_time;
+  }
+  Object.values(node).forEach(dropKelvinTimes);
+}
+
+/** Measured points from CSV text: a header row naming the columns (radius, load, velocity,
+ *  total_load, value, uncertainty), then a point per row, values as typed. */
+function pointsOf(text) {
+  const lines = text.split(/\r?\n/).map((l) => l.trim()).filter((l) => l !== "" && !l.startsWith("#"));
+  const header = (lines.shift() || "").split(",").map((h) => h.trim().toLowerCase());
+  return lines.map((line, row) => {
+    const cells = line.split(",").map((c) => c.trim());
+    if (cells.length !== header.length) {
+      throw new InputError("series.csv", `row ${row + 1} has ${cells.length} values, the header ${header.length}`);
+    }
+    return Object.fromEntries(header.map((name, k) => [name, typed(cells[k])]));
+  });
+}
+
+/** Measured points as the fit's series: the condition (radius, load, velocity, total load)
+ *  that takes the most values is what each series runs along; the others, fixed within a
+ *  series, tell the series apart, so a curve is drawn through one condition's points. */
+function seriesOf(quantity, points) {
+  const conditions = ["radius", "load", "velocity", "total_load"].filter((c) => points.some((p) => p[c] !== undefined));
+  const spread = (c) => new Set(points.map((p) => p[c])).size;
+  const along = conditions.slice().sort((a, b) => spread(b) - spread(a))[0];
+  const fixed = conditions.filter((c) => c !== along);
+  const series = new Map();
+  for (const point of points) {
+    const key = JSON.stringify(fixed.map((c) => point[c]));
+    if (!series.has(key)) series.set(key, { quantity, ...Object.fromEntries(fixed.map((c) => [c, point[c]])), points: [] });
+    const own = { ...point };
+    for (const c of fixed) delete own[c];
+    series.get(key).points.push(own);
+  }
+  return series.size ? [...series.values()] : [{ quantity, points: [] }];
+}
+
+/** A form's field that cannot be read, said before anything is sent. */
+class InputError extends Error {
+  constructor(field, message) {
+    super(message);
+    this.problem = { title: "The input is not valid", errors: [{ field, value: "", allowed: message, message: `${field}: ${message}` }] };
+  }
 }
 
 function typed(text) {
@@ -43,6 +102,35 @@ function requestOf(form) {
   const kind = form.dataset.kind;
   const body = kind === "sweep" ? { kind: "sweep", input } : input;
   return { url: form.dataset.endpoint, body, job: { kind, input } };
+}
+
+/** Fills each `fieldset[data-fields=name]` from the template `#fields-name`: its fields named
+ *  under the fieldset's `data-prefix`, without those its `data-without` lists. One list of a
+ *  layer's fields serves every form that takes a layer. */
+function buildFieldsets() {
+  for (const set of document.querySelectorAll("fieldset[data-fields]")) {
+    const without = (set.dataset.without || "").split(" ").filter(Boolean);
+    set.append($(`#fields-${set.dataset.fields}`).content.cloneNode(true));
+    for (const label of set.querySelectorAll("label[data-field]")) {
+      if (without.includes(label.dataset.field)) label.remove();
+    }
+    for (const field of set.querySelectorAll("[name]")) field.name = set.dataset.prefix + field.name;
+  }
+}
+
+/** A form's `select[data-switch]` shows, and sends, only the parts marked `data-for` its value. */
+function switchParts(form) {
+  const select = form.querySelector("select[data-switch]");
+  if (!select) return;
+  const apply = () => {
+    for (const part of form.querySelectorAll("[data-for]")) {
+      const on = part.dataset.for === select.value;
+      part.hidden = !on;
+      for (const field of part.matches("[name]") ? [part] : part.querySelectorAll("[name]")) field.disabled = !on;
+    }
+  };
+  select.addEventListener("change", apply);
+  apply();
 }
 
 // ---- Showing answers -----------------------------------------------------------------
@@ -136,15 +224,19 @@ class Area {
       field.removeAttribute("aria-describedby");
     }
     errors.forEach((error, i) => {
-      const field = form.elements.namedItem(String(error.field).replace(/\[\d+\]/g, ""));
-      if (!(field instanceof HTMLElement)) return;
+      const name = String(error.field).replace(/\[\d+\]/g, "");
+      // A fit's points come from its CSV: their errors are the CSV's.
+      const named = (n) => [...form.querySelectorAll("[name]")].find((f) => f.name === n && !f.disabled);
+      const field = named(name) || (name.startsWith("series.points") ? named("series.csv") : undefined);
+      if (!field) return;
       const note = document.createElement("span");
       note.className = "field-error";
       note.id = `${form.id}-error-${i}`;
       note.textContent = `${JSON.stringify(error.value)}: expected ${error.allowed}`;
       field.setAttribute("aria-invalid", "true");
-      field.setAttribute("aria-describedby", note.id);
-      field.closest("label").append(note);
+      // A field with several errors is described by each.
+      field.setAttribute("aria-describedby", `${field.getAttribute("aria-describedby") || ""} ${note.id}`.trim());
+      (field.closest("label") || field.parentElement).append(note);
     });
   }
 }
@@ -175,7 +267,18 @@ async function readJson(response) {
   return { ok: false, body: { title, status: response.status, detail } };
 }
 
-/** Scalars of an answer (nested objects flattened, lists left out) with their units. */
+/** The units of an answer's fields (its `meta.units`), by path; with `prefix`, those under it
+ *  by their path below it (`points[].` gives each point's). */
+function unitsOf(answer, prefix = "") {
+  const units = {};
+  for (const [path, unit] of Object.entries((answer.meta && answer.meta.units) || {})) {
+    if (path.startsWith(prefix)) units[path.slice(prefix.length)] = unit;
+  }
+  return units;
+}
+
+/** Scalars of an answer with their units: nested objects flattened, a pair of numbers shown
+ *  as the range it is, other lists left out. */
 function rows(answer, units, prefix = "") {
   const out = [];
   for (const [key, value] of Object.entries(answer)) {
@@ -184,6 +287,11 @@ function rows(answer, units, prefix = "") {
     if (typeof value === "number") {
       const [shown, unit] = readable(value, units[path]);
       out.push([path, Number(shown.toPrecision(6)), unit]);
+    } else if (Array.isArray(value) && value.length === 2 && value.every((v) => typeof v === "number")) {
+      // A range (a fit's 95 % interval, its bounds): both ends in the unit of the larger.
+      // A list's unit is named by its path with `[]`.
+      const [size, unit] = scaleFor(Math.max(...value.map(Math.abs)), units[`${path}[]`]);
+      out.push([path, value.map((v) => Number((v / size).toPrecision(4))).join(" to "), unit]);
     } else if (value && typeof value === "object" && !Array.isArray(value)) {
       out.push(...rows(value, units, path + "."));
     }
@@ -210,7 +318,7 @@ function showTable(area, answer) {
   if (Array.isArray(answer.points)) return showPoints(area, answer);
   const table = freshTable(area, ["quantity", "value", "unit"]);
   const body = table.createTBody();
-  for (const [name, value, unit] of rows(answer, (answer.meta && answer.meta.units) || {})) {
+  for (const [name, value, unit] of rows(answer, unitsOf(answer))) {
     const row = body.insertRow();
     for (const cell of [name, value, unit]) row.insertCell().textContent = cell;
   }
@@ -222,11 +330,10 @@ const SHOWN_POINTS = 500;
 /** A sweep's points as a table, a column per scalar of its first point (units in the head),
  *  sorted by a column when its head is clicked (again: the other way). */
 function showPoints(area, answer) {
-  const units = {};
-  for (const [path, unit] of Object.entries((answer.meta && answer.meta.units) || {})) {
-    if (path.startsWith("points[].")) units[path.slice("points[].".length)] = unit;
-  }
-  const first = answer.points.find((p) => p && typeof p === "object") || {};
+  const units = unitsOf(answer, "points[].");
+  // Columns from a solved point: a refused or missing one has its inputs only.
+  const solved = (p) => p && typeof p === "object" && p.status !== "refused" && p.status !== "missing";
+  const first = answer.points.find(solved) || answer.points[0] || {};
   const columns = rows(first, units).map(([path]) => path).filter((path) => !path.startsWith("validity."));
   const statusColumn = typeof first.status === "string";
   // A column is shown in the unit of its largest value.
@@ -257,17 +364,16 @@ function showPoints(area, answer) {
   let sorted = { by: null, sign: 1 };
   [...table.tHead.rows[0].cells].forEach((th, i) => {
     const column = statusColumn ? (i === 0 ? "status" : columns[i - 1]) : columns[i];
-    th.tabIndex = 0;
-    th.setAttribute("aria-sort", "none");
-    const sort = () => {
+    // The head's text in a button: a sortable column is reached and sorted by keyboard too.
+    const button = Object.assign(document.createElement("button"), { type: "button", className: "sort", textContent: th.textContent });
+    th.replaceChildren(button);
+    button.addEventListener("click", () => {
       sorted = { by: column, sign: sorted.by === column ? -sorted.sign : 1 };
       const order = answer.points.slice().sort((a, b) => sorted.sign * compareValues(valueAt(a, column), valueAt(b, column)));
-      for (const other of table.tHead.rows[0].cells) other.setAttribute("aria-sort", "none");
+      for (const other of table.tHead.rows[0].cells) other.removeAttribute("aria-sort");
       th.setAttribute("aria-sort", sorted.sign > 0 ? "ascending" : "descending");
       draw(order);
-    };
-    th.addEventListener("click", sort);
-    th.addEventListener("keydown", (e) => { if (e.key === "Enter" || e.key === " ") { e.preventDefault(); sort(); } });
+    });
   });
   draw(answer.points);
 }
@@ -326,15 +432,16 @@ function showDownloads(area, fetchIn, name) {
     const button = document.createElement("button");
     button.type = "button";
     button.textContent = `Download ${label}`;
-    button.addEventListener("click", async () => {
-      const response = await fetchIn(accept);
-      if (!response.ok) return area.status(`Download ${label}: ${problemText((await readJson(response)).body)}`, "error");
-      const blob = await response.blob();
-      const link = document.createElement("a");
-      link.href = URL.createObjectURL(blob);
-      link.download = `${name}.${ext}`;
-      link.click();
-      URL.revokeObjectURL(link.href);
+    button.addEventListener("click", () => {
+      fetchIn(accept).then(async (response) => {
+        if (!response.ok) return area.status(`Download ${label}: ${problemText((await readJson(response)).body)}`, "error");
+        const link = document.createElement("a");
+        link.href = URL.createObjectURL(await response.blob());
+        link.download = `${name}.${ext}`;
+        link.click();
+        // Revoked once the download has begun: at once may abort it.
+        setTimeout(() => URL.revokeObjectURL(link.href), 10000);
+      }).catch((e) => area.status(`Download ${label}: ${e.message || e}`, "error"));
     });
     box.append(button);
   }
@@ -436,13 +543,12 @@ async function compare(form) {
   area.part("picture").replaceChildren(comparison(answers));
   const table = freshTable(area, ["quantity", "local law", "layer as a continuum"]);
   const rowsOf = table.createTBody();
-  // The two answers have the same quantities, in the same order.
-  const [local, continuum] = answers.map(([, a]) => rows(a, a.meta.units || {}));
-  continuum.forEach(([name, value, unit], i) => {
+  // Paired by name: a quantity one law has and the other lacks shows a dash.
+  const [local, continuum] = answers.map(([, a]) => new Map(rows(a, unitsOf(a)).map(([name, value, unit]) => [name, `${value} ${unit}`.trim()])));
+  for (const name of new Set([...local.keys(), ...continuum.keys()])) {
     const row = rowsOf.insertRow();
-    const [, theirs, theirUnit] = local[i];
-    for (const cell of [name, `${theirs} ${theirUnit}`, `${value} ${unit}`]) row.insertCell().textContent = cell;
-  });
+    for (const cell of [name, local.get(name) ?? "—", continuum.get(name) ?? "—"]) row.insertCell().textContent = cell;
+  }
   showWarnings(area, answers[0][1]);
   showWarnings(area, answers[1][1], true);
   area.status(`Both laws solved.${accuracy(answers[1][1])}`);
@@ -466,17 +572,27 @@ async function solve(form) {
 
 // ---- Jobs: progress from the event stream, cancel -------------------------------------
 
-/** The job the sweep tab follows (its event stream), if one runs. */
-let following = null;
+/** Stops following the job the sweep tab follows, if any: closes its stream, disables Cancel. */
+let stopFollowing = () => {};
 
 async function runJob(form) {
   const area = areaOf(form);
   const { url, body } = requestOf(form);
   const token = area.begin("Submitting…");
+  stopFollowing();
   showProgress({ status: "queued", progress: { done: 0, total: 0 } });
-  if (following) following.close();
-  const read = await readJson(await post(url, body));
-  if (!area.current(token)) return;
+  let read;
+  try {
+    read = await readJson(await post(url, body));
+  } catch (e) {
+    if (area.current(token)) showProgress(null);
+    throw e;
+  }
+  if (!area.current(token)) {
+    // Asked again meanwhile: this job has no one to show it to.
+    if (read.ok) fetch(`/v1/jobs/${read.body.id}/cancel`, { method: "POST" }).catch(() => {});
+    return;
+  }
   if (!read.ok) {
     showProgress(null);
     return area.problem(read.body);
@@ -505,40 +621,65 @@ function showProgress(view) {
   text.textContent = ended ? `${view.status} at ${count}` : count;
 }
 
+/** Runs the handler `work` of a request's event; what it throws reads as an error while the
+ *  request is the last one asked in `area`. */
+function handled(area, token, work) {
+  return (...args) => {
+    Promise.resolve()
+      .then(() => work(...args))
+      .catch((e) => {
+        if (area.current(token)) area.problem({ title: "The request failed", detail: e.message || String(e) });
+      });
+  };
+}
+
+/** Follows job `id` from its event stream; when the stream ends for good before the job does
+ *  (the job unknown, too many streams, a restart), from its record. */
 function follow(area, token, id) {
   const cancel = $("#cancel");
   cancel.disabled = false;
-  cancel.onclick = async () => {
+  cancel.onclick = handled(area, token, async () => {
     cancel.disabled = true;
     const read = await readJson(await fetch(`/v1/jobs/${id}/cancel`, { method: "POST", headers: { accept: "application/json" } }));
     if (!read.ok && area.current(token)) area.status(`Cancel: ${problemText(read.body)}`, "error");
-  };
+  });
   const events = new EventSource(`/v1/jobs/${id}/events`);
-  following = events;
   const stop = () => {
     events.close();
-    if (following === events) following = null;
     cancel.disabled = true;
   };
-  events.addEventListener("progress", (e) => {
+  stopFollowing = stop;
+  events.addEventListener("progress", handled(area, token, (e) => {
     if (!area.current(token)) return stop();
     const view = JSON.parse(e.data);
     showProgress(view);
     area.status(`Job ${view.status}…`, "busy");
-  });
-  // The stream closed for good (the job unknown, the server gone): what the job's URL says.
-  events.addEventListener("error", async () => {
-    if (events.readyState !== EventSource.CLOSED) return;
+  }));
+  events.addEventListener("error", handled(area, token, async () => {
+    if (events.readyState !== EventSource.CLOSED) {
+      if (area.current(token)) area.status("The connection to the server was lost: reconnecting…", "busy");
+      return;
+    }
     stop();
+    await poll(area, token, id);
+  }));
+  events.addEventListener("completion", handled(area, token, async (e) => {
+    stop();
+    if (area.current(token)) await finished(area, token, JSON.parse(e.data));
+  }));
+}
+
+/** Reads job `id`'s record every second until it ends (or another request is asked). */
+async function poll(area, token, id) {
+  while (area.current(token)) {
     const read = await readJson(await fetch(`/v1/jobs/${id}`, { headers: { accept: "application/json" } }));
     if (!area.current(token)) return;
     if (!read.ok) return area.problem(read.body);
-    finished(area, token, read.body);
-  });
-  events.addEventListener("completion", (e) => {
-    stop();
-    if (area.current(token)) finished(area, token, JSON.parse(e.data));
-  });
+    if (!["queued", "running"].includes(read.body.status)) return finished(area, token, read.body);
+    showProgress(read.body);
+    area.status(`Job ${read.body.status}…`, "busy");
+    await new Promise((resolve) => setTimeout(resolve, 1000));
+  }
 }
 
 /** A job's end: its answer, or what went wrong and the points it finished anyway. */
@@ -549,12 +690,12 @@ async function finished(area, token, view) {
     succeeded: ["Job succeeded.", ""],
     failed: [`Job failed: ${view.problem ? problemText(view.problem) : "no reason given"}.`, "error"],
     cancelled: [`Job cancelled after ${done} of ${total} points.`, "ended"],
-  }[view.status] || [`Job ${view.status}.`, ""];
-  area.status(ending[0], ending[1]);
+  }[view.status] || [`Job ${view.status}.`, "ended"];
   if (!view.result_url) {
     area.clear();
     return area.status(`${ending[0]} No point was finished.`, ending[1]);
   }
+  area.status(`${ending[0]} Reading its answer…`, "busy");
   const result = view.result_url;
   const read = await readJson(await fetch(result, { headers: { accept: "application/json" } }));
   if (!area.current(token)) return;
@@ -566,18 +707,51 @@ async function finished(area, token, view) {
 
 // ---- Copying a form as a command ----------------------------------------------------
 
+/** A form as a command: curl, the job as JSON (for `thirdbody solve`), or Python. */
 async function copy(form, what) {
   const area = areaOf(form);
   const { url, body, job } = requestOf(form);
-  const text = what === "job"
-    ? JSON.stringify(job, null, 2)
-    : `curl -s -X POST ${location.origin}${url} -H 'content-type: application/json' -d '${JSON.stringify(body)}'`;
+  const texts = {
+    job: ["the job as JSON", JSON.stringify(job, null, 2)],
+    curl: ["the curl command", `curl -s -X POST ${location.origin}${url} -H 'content-type: application/json' -d '${JSON.stringify(body)}'`],
+    python: ["the Python script", python(url, body)],
+  };
+  const [name, text] = texts[what];
   try {
     await navigator.clipboard.writeText(text);
-    area.status(`Copied ${what === "job" ? "the job as JSON" : "the curl command"}.`);
+    area.status(`Copied ${name}.`);
   } catch {
     area.status(text);
   }
+}
+
+/** A Python script (requests) that posts `body` to `url` and prints the answer; a job is
+ *  polled until it ends. The body is embedded as JSON, which Python reads as it is. */
+function python(url, body) {
+  const lines = [
+    "import json, time, requests",
+    "",
+    `base = "${location.origin}"`,
+    `body = json.loads(r"""${JSON.stringify(body, null, 2)}""")`,
+  ];
+  if (url === "/v1/jobs") {
+    lines.push(
+      `job = requests.post(base + "${url}", json=body).json()`,
+      'while job["status"] in ("queued", "running"):',
+      "    time.sleep(0.5)",
+      '    job = requests.get(f"{base}/v1/jobs/{job[\'id\']}").json()',
+      'print(job["status"])',
+      'answer = requests.get(base + job["result_url"]).json() if "result_url" in job else job',
+    );
+  } else {
+    lines.push(
+      `response = requests.post(base + "${url}", json=body)`,
+      "response.raise_for_status()",
+      "answer = response.json()",
+    );
+  }
+  lines.push("print(json.dumps({k: v for k, v in answer.items() if k != \"meta\"}, indent=2))");
+  return lines.join("\n") + "\n";
 }
 
 // ---- Figures, tabs, start-up ---------------------------------------------------------
@@ -624,12 +798,19 @@ function tabKeys(event) {
   selectTab(tabs[(to + tabs.length) % tabs.length], true);
 }
 
-/** Runs `work`; an exception (the server unreachable) reads as an error in `area`. */
+/** Runs `work`; a field that cannot be read, or an exception (the server unreachable),
+ *  reads as an error in `area`. */
 function guarded(area, work) {
-  work().catch((e) => area.status(`The request failed: ${e.message || e}`, "error"));
+  // The request `work` begins is the next one asked; one asked after it wins.
+  const before = area.asked;
+  work().catch((e) => {
+    if (area.asked > before + 1) return;
+    area.problem(e instanceof InputError ? e.problem : { title: "The request failed", detail: e.message || String(e) });
+  });
 }
 
 document.addEventListener("DOMContentLoaded", () => {
+  buildFieldsets();
   const template = $("#answer-area");
   for (const panel of document.querySelectorAll("[role=tabpanel]")) {
     const root = template.content.firstElementChild.cloneNode(true);
@@ -644,10 +825,17 @@ document.addEventListener("DOMContentLoaded", () => {
   for (const form of document.querySelectorAll("form")) {
     form.addEventListener("submit", (event) => {
       event.preventDefault();
-      guarded(areaOf(form), () => (form.dataset.kind === "sweep" ? runJob(form) : solve(form)));
+      guarded(areaOf(form), async () => (form.dataset.kind === "sweep" ? runJob(form) : solve(form)));
     });
     for (const button of form.querySelectorAll("[data-copy]")) {
-      button.addEventListener("click", () => copy(form, button.dataset.copy));
+      button.addEventListener("click", () => guarded(areaOf(form), () => copy(form, button.dataset.copy)));
+    }
+    switchParts(form);
+    // A CSV file read into the text it stands for.
+    for (const file of form.querySelectorAll("input[data-csv-file]")) {
+      file.addEventListener("change", async () => {
+        if (file.files.length) form.querySelector("textarea[data-csv]").value = await file.files[0].text();
+      });
     }
   }
   const rolling = $("#form-rolling");

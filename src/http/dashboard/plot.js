@@ -2,7 +2,7 @@
 // static SVG): any quantity against any varied input, one line per value of the others in a
 // sequential colour map, linear or log axes, hover to read a point with its units, drag to
 // zoom, and a heat map when two inputs vary. Plain JavaScript, no dependency; it uses
-// `scaleFor` and `readable` from app.js (loaded after it, before any plot is drawn).
+// `scaleFor`, `readable` and `unitsOf` from app.js (loaded after it, before any plot is drawn).
 "use strict";
 
 const PLOT = { width: 720, height: 420, left: 78, right: 20, top: 16, bottom: 52 };
@@ -85,10 +85,7 @@ function withUnit(value, unit) {
 class SweepPlot {
   constructor(box, answer) {
     this.points = answer.points.filter((p) => p && typeof p === "object");
-    this.units = {};
-    for (const [path, unit] of Object.entries((answer.meta && answer.meta.units) || {})) {
-      if (path.startsWith("points[].")) this.units[path.slice("points[].".length)] = unit;
-    }
+    this.units = unitsOf(answer, "points[].");
     const solved = this.points.find((p) => p.status !== "refused" && p.status !== "missing") || this.points[0] || {};
     const varied = Object.keys((answer.meta && answer.meta.input && answer.meta.input.vary) || {});
     const paths = numericPaths(solved);

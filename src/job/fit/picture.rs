@@ -1,12 +1,16 @@
-//! The picture of a fit: each series' measured points, the fitted curve through them, and
-//! each residual as a dashed segment from the point to the curve; all in one colour per
-//! series. Series of the other quantity than the first series' are left out, and a note
-//! says so.
+//! The picture of a fit: each series' measured points with their error bars (± the
+//! uncertainty given), the fitted curve through them, and each residual as a dashed segment
+//! from the point to the curve; all in one colour per series. The notes state each fitted
+//! value with its 95 % interval. Series of the other quantity than the first series' are
+//! left out, and a note says so.
+
+use std::collections::BTreeMap;
 
 use serde::Deserialize;
 
 use super::output::{Conditions, Curve, Residual};
 use crate::job::picture::{shown, symbol, Picture, PictureError};
+use crate::model::fit::FitParameter;
 use crate::render::svg::{Axis, Chart, Layer};
 
 /// What the picture shows of a fit.
@@ -14,8 +18,35 @@ use crate::render::svg::{Axis, Chart, Layer};
 pub struct FitPicture {
     curves: Vec<Curve>,
     residuals: Vec<Residual>,
+    parameters: BTreeMap<String, Fitted>,
     chi_squared: f64,
     dof: usize,
+}
+
+/// What the notes say of a fitted parameter.
+#[derive(Deserialize)]
+struct Fitted {
+    value: f64,
+    interval_95: Option<[f64; 2]>,
+}
+
+impl Fitted {
+    /// `E_L = 2.533 GPa` and `95 %: 2.476 GPa to 2.59 GPa` (two lines: the notes are narrow),
+    /// or why there is no interval.
+    fn note(&self, name: &str) -> [String; 2] {
+        let unit = FitParameter::ALL
+            .iter()
+            .find(|p| p.name() == name)
+            .map_or("", |p| p.parameter().unit());
+        let value = format!("{} = {}", symbol(name), shown(self.value, unit));
+        match self.interval_95 {
+            Some([lo, hi]) => [
+                value,
+                format!("95 %: {} to {}", shown(lo, unit), shown(hi, unit)),
+            ],
+            None => [value, "not determined alone".to_string()],
+        }
+    }
 }
 
 impl Picture for FitPicture {
@@ -71,6 +102,14 @@ impl Picture for FitPicture {
                     points: vec![(x, compared.measured), (x, compared.fitted)],
                     dashed: true,
                 });
+                if let Some(u) = compared.uncertainty {
+                    segments.push(Layer::Line {
+                        name: String::new(),
+                        group: group.clone(),
+                        points: vec![(x, compared.measured - u), (x, compared.measured + u)],
+                        dashed: false,
+                    });
+                }
             }
             all_x.extend(measured.iter().map(|p| p.0));
             // Markers first: they take the colour the series' lines then share.
@@ -94,10 +133,18 @@ impl Picture for FitPicture {
         if lo > 0.0 && hi / lo > 20.0 {
             x = x.log();
         }
-        let mut notes = vec![
-            format!("χ² = {} for {} dof", shown(self.chi_squared, ""), self.dof),
-            "dashed: residuals".to_string(),
-        ];
+        let mut notes: Vec<String> = self
+            .parameters
+            .iter()
+            .flat_map(|(name, fitted)| fitted.note(name))
+            .collect();
+        notes.push(format!(
+            "χ² = {} for {} dof",
+            shown(self.chi_squared, ""),
+            self.dof
+        ));
+        notes.push("bars: ± the uncertainty given".to_string());
+        notes.push("dashed: residuals".to_string());
         if left_out > 0 {
             notes.push(format!("{left_out} series of the other quantity not drawn"));
         }
