@@ -23,6 +23,47 @@ const PALETTE: [&str; 8] = [
     "#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2", "#17becf",
 ];
 
+/// viridis: the colours of more series than [`PALETTE`] has, in their order (a sweep's lines
+/// come in the order of the parameter that tells them apart), readable in grey and by
+/// colour-blind readers.
+const VIRIDIS: [[u8; 3]; 5] = [
+    [68, 1, 84],
+    [59, 82, 139],
+    [33, 145, 140],
+    [94, 201, 98],
+    [253, 231, 37],
+];
+
+/// The colours of a chart's series: the palette's while it has enough; beyond it, the lines
+/// run along [`VIRIDIS`] in their order and every other layer is dark grey.
+struct Colours {
+    lines: usize,
+    sequential: bool,
+}
+
+impl Colours {
+    /// The colour of the `i`th group of lines.
+    fn line(&self, i: usize) -> String {
+        if self.sequential {
+            ramp(
+                &VIRIDIS,
+                i as f64 / self.lines.saturating_sub(1).max(1) as f64,
+            )
+        } else {
+            PALETTE[i % PALETTE.len()].to_string()
+        }
+    }
+
+    /// The colour of the layer that is `i`th in the order of colours, not a line.
+    fn other(&self, i: usize) -> String {
+        if self.sequential {
+            "#444444".to_string()
+        } else {
+            PALETTE[i % PALETTE.len()].to_string()
+        }
+    }
+}
+
 /// An axis: the quantity it shows and its SI unit; its range follows the data.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Axis {
@@ -76,13 +117,16 @@ pub enum Layer {
         centre: (f64, f64),
         radius: f64,
     },
-    /// Values on a grid, `values[j][i]` at (`x[i]`, `y[j]`), with a colour bar.
+    /// Values on a grid, `values[j][i]` at (`x[i]`, `y[j]`), with a colour bar; drawn only
+    /// inside the polygon `clip` when it has points (a pressure map inside its contact,
+    /// whose edge cuts through the grid's cells).
     Heatmap {
         name: String,
         x: Vec<f64>,
         y: Vec<f64>,
         values: Vec<Vec<f64>>,
         unit: String,
+        clip: Vec<(f64, f64)>,
     },
 }
 
@@ -223,11 +267,16 @@ fn heat(t: f64) -> String {
         [244, 109, 67],
         [165, 0, 38],
     ];
-    let position = t.clamp(0.0, 1.0) * (STOPS.len() - 1) as f64;
-    let i = (position.floor() as usize).min(STOPS.len() - 2);
+    ramp(&STOPS, t)
+}
+
+/// The colour at `t` ∈ [0, 1] along `stops`, mixed linearly between the two it falls between.
+fn ramp(stops: &[[u8; 3]], t: f64) -> String {
+    let position = t.clamp(0.0, 1.0) * (stops.len() - 1) as f64;
+    let i = (position.floor() as usize).min(stops.len() - 2);
     let f = position - i as f64;
     let mix = |k: usize| {
-        let (a, b) = (f64::from(STOPS[i][k]), f64::from(STOPS[i + 1][k]));
+        let (a, b) = (f64::from(stops[i][k]), f64::from(stops[i + 1][k]));
         (a + f * (b - a)).round() as u8
     };
     format!("#{:02x}{:02x}{:02x}", mix(0), mix(1), mix(2))
@@ -295,14 +344,15 @@ impl Chart {
         let mut colour = 0;
         let mut groups: Vec<&str> = Vec::new();
         let mut notes = self.notes.clone();
+        let colours = self.colours();
         for layer in &self.layers {
-            let mut c = PALETTE[colour % PALETTE.len()];
+            let mut c = colours.other(colour);
             if let Layer::Line { group, .. } = layer {
                 match groups.iter().position(|g| g == group) {
-                    Some(i) => c = PALETTE[i % PALETTE.len()],
+                    Some(i) => c = colours.line(i),
                     None => {
                         groups.push(group);
-                        c = PALETTE[(groups.len() - 1) % PALETTE.len()];
+                        c = colours.line(groups.len() - 1);
                     }
                 }
             }
@@ -320,11 +370,19 @@ impl Chart {
                         escape(layer.name()),
                         path(points.iter().map(px), false)
                     );
+                    // A line of one point (a one-point sweep) has no length: its point shows.
+                    if let [only] = points.as_slice() {
+                        let (x, y) = px(only);
+                        let _ = write!(
+                            svg,
+                            r#"<circle class="lone" cx="{x:.1}" cy="{y:.1}" r="4" fill="{c}"/>"#
+                        );
+                    }
                     legend.push((layer.name(), c, if *dashed { "dashed" } else { "line" }));
                     colour = colour.max(groups.len());
                 }
                 Layer::Markers { points, hollow, .. } => {
-                    let fill = if *hollow { "#ffffff" } else { c };
+                    let fill = if *hollow { "#ffffff" } else { &c };
                     let _ = write!(
                         svg,
                         r#"<g class="series" data-name="{}">"#,
@@ -367,13 +425,16 @@ impl Chart {
                     y,
                     values,
                     unit,
+                    clip,
                 } => {
+                    let clip = path(clip.iter().map(px), true);
                     let drawn = self.write_heatmap(
                         &mut svg,
                         (&sx, &sy),
                         (x_factor, y_factor),
                         (x, y, values),
                         unit,
+                        &clip,
                     );
                     if drawn != (x.len(), y.len()) {
                         notes.push(format!("{name} drawn on {} × {} cells", drawn.0, drawn.1));
@@ -397,6 +458,26 @@ impl Chart {
         }
         svg.push_str("</g></svg>");
         svg
+    }
+
+    /// The chart's colours: one per group of lines and one per other layer but a heat map
+    /// (which has its own colour bar), sequential when the palette has too few.
+    fn colours(&self) -> Colours {
+        let mut groups: Vec<&str> = Vec::new();
+        let mut others = 0;
+        for layer in &self.layers {
+            match layer {
+                Layer::Line { group, .. } if !groups.contains(&group.as_str()) => {
+                    groups.push(group)
+                }
+                Layer::Line { .. } | Layer::Heatmap { .. } => {}
+                _ => others += 1,
+            }
+        }
+        Colours {
+            lines: groups.len(),
+            sequential: groups.len() + others > PALETTE.len(),
+        }
     }
 
     fn write_axes(&self, svg: &mut String, sx: &Scale, sy: &Scale, units: (&str, &str)) {
@@ -455,6 +536,7 @@ impl Chart {
         (x_factor, y_factor): (f64, f64),
         (x, y, values): (&[f64], &[f64], &[Vec<f64>]),
         unit: &str,
+        clip: &str,
     ) -> (usize, usize) {
         let finite = values.iter().flatten().copied().filter(|v| v.is_finite());
         let top_value = finite.fold(0.0, f64::max);
@@ -463,7 +545,14 @@ impl Chart {
         }
         let (factor, unit) = prefixed(unit, top_value);
         let (columns, rows, means) = coarsened((x, y, values), HEATMAP_CELLS);
-        svg.push_str(r#"<g class="heatmap">"#);
+        if clip.is_empty() {
+            svg.push_str(r#"<g class="heatmap">"#);
+        } else {
+            let _ = write!(
+                svg,
+                r#"<clipPath id="heatmap-clip"><path d="{clip}"/></clipPath><g class="heatmap" clip-path="url(#heatmap-clip)">"#
+            );
+        }
         for (&(y0, y1), row) in rows.iter().zip(&means) {
             for (&(x0, x1), &value) in columns.iter().zip(row) {
                 if value <= 0.0 {
@@ -603,7 +692,7 @@ fn path(points: impl Iterator<Item = (f64, f64)>, closed: bool) -> String {
 
 /// The legend, right of the plot: at most [`LEGEND_ROWS`] rows (the rest counted on the
 /// last). Returns the rows written.
-fn write_legend(svg: &mut String, entries: &[(&str, &str, &str)]) -> usize {
+fn write_legend(svg: &mut String, entries: &[(&str, String, &str)]) -> usize {
     let x = WIDTH - RIGHT + 20.0;
     let entries: Vec<_> = entries.iter().filter(|e| !e.0.is_empty()).collect();
     let _ = write!(svg, r#"<g class="legend">"#);

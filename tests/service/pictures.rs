@@ -109,8 +109,67 @@ fn a_rolling_contact_is_its_contact_region_at_its_size() {
 fn a_pressure_grid_is_a_heat_map_with_a_colour_bar() {
     let (_, svg) = solve(json!({"kind": "rolling", "input": {"options": {"pressure_grid": 20}}}));
     parts(&svg);
-    assert!(svg.contains(r#"<g class="heatmap">"#) && svg.contains(r#"<g class="colourbar">"#));
+    assert!(svg.contains(r#"<g class="colourbar">"#));
     assert!(svg.contains("pressure [MPa]"));
+    // Drawn inside the contact's outline only: no cell sticks out past its edge.
+    let doc = roxmltree::Document::parse(&svg).unwrap();
+    let heatmap = doc
+        .descendants()
+        .find(|n| n.attribute("class") == Some("heatmap"))
+        .unwrap();
+    assert_eq!(heatmap.attribute("clip-path"), Some("url(#heatmap-clip)"));
+    let clip = doc
+        .descendants()
+        .find(|n| n.attribute("id") == Some("heatmap-clip"))
+        .unwrap();
+    let outline = doc
+        .descendants()
+        .find(|n| n.attribute("data-name") == Some("contact, V = 4 nm/s"))
+        .unwrap();
+    let clip_path = clip.first_element_child().unwrap().attribute("d");
+    assert_eq!(clip_path, outline.attribute("d"));
+}
+
+#[test]
+fn a_one_point_sweep_draws_its_point() {
+    let (_, svg) = solve(json!({"kind": "sweep", "input": {"vary": {"load": ["1 nN"]}}}));
+    parts(&svg);
+    assert_eq!(svg.matches(r#"<circle class="lone""#).count(), 1, "{svg}");
+}
+
+#[test]
+fn more_lines_than_the_palette_has_run_along_a_sequential_map_in_their_order() {
+    let loads: Vec<String> = (1..=12)
+        .map(|i| format!("{} nN", f64::from(i) * 0.25))
+        .collect();
+    // Along the speed (the longer list), a line per load.
+    let speeds: Vec<String> = (0..14).map(|v| format!("{v} nm/s")).collect();
+    let (_, svg) = solve(json!({"kind": "sweep", "input": {"vary": {
+        "load": loads, "velocity": speeds}}}));
+    let (series, _) = parts(&svg);
+    assert_eq!(
+        series.len(),
+        12 + 1,
+        "a line per load, and the points at rest"
+    );
+    let stroke = |name: &str| {
+        let at = svg.find(&format!(r#"data-name="{name}""#)).unwrap();
+        let rest = &svg[at..];
+        let start = rest.find("stroke=\"").unwrap() + 8;
+        rest[start..start + 7].to_string()
+    };
+    // viridis from its dark end towards its light one, in the order of the loads: its green
+    // grows all along it.
+    assert_eq!(stroke("P = 250 pN"), "#440154");
+    let names = &series[..12];
+    let greens: Vec<u8> = names
+        .iter()
+        .map(|name| u8::from_str_radix(&stroke(name)[3..5], 16).unwrap())
+        .collect();
+    assert!(
+        greens.windows(2).all(|w| w[0] < w[1]),
+        "{names:?}: {greens:?}"
+    );
 }
 
 #[test]

@@ -25,6 +25,8 @@ impl Picture for RollingPicture {
         let rolling = job.rolling;
         let contact = &self.contact;
         let mut layers = Vec::new();
+        let mut outline: Vec<(f64, f64)> = self.boundary.iter().map(|p| (p.entry, p.y)).collect();
+        outline.extend(self.boundary.iter().rev().map(|p| (p.exit, p.y)));
         if let Some(grid) = self.pressure {
             layers.push(Layer::Heatmap {
                 name: "pressure".to_string(),
@@ -32,10 +34,10 @@ impl Picture for RollingPicture {
                 y: grid.y,
                 values: grid.values,
                 unit: "Pa".to_string(),
+                // The pressure is zero outside the contact: no cell past its edge.
+                clip: outline.clone(),
             });
         }
-        let mut outline: Vec<(f64, f64)> = self.boundary.iter().map(|p| (p.entry, p.y)).collect();
-        outline.extend(self.boundary.iter().rev().map(|p| (p.exit, p.y)));
         layers.push(Layer::Area {
             name: format!("contact, V = {}", shown(rolling.velocity, "m/s")),
             outline,
