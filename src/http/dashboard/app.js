@@ -764,17 +764,9 @@ async function figure(area, n) {
   if (!read.ok) return area.problem(read.body);
   const answer = read.body;
   area.status(`Figure ${n}: ${answer.title}`);
-  area.clear();
-  const table = freshTable(area, ["quantity", "value", "unit"]).createTBody();
-  for (const [name, value] of [["figure", answer.figure], ["series", answer.series.length]]) {
-    const row = table.insertRow();
-    for (const cell of [name, value, ""]) row.insertCell().textContent = cell;
-  }
-  const svg = await fetch(`${url}?format=svg`);
-  if (!area.current(token)) return;
-  if (!svg.ok) return area.problem((await readJson(svg)).body);
-  showPicture(area, await svg.text());
-  showDownloads(area, (accept) => fetch(url, { headers: { accept } }), `figure-${n}`);
+  // Its table says which figure and how many series; the series are in the downloads.
+  const summary = { figure: answer.figure, series: answer.series.length, meta: answer.meta };
+  await showAnswer(area, token, summary, () => fetch(`${url}?format=svg`), (accept) => fetch(url, { headers: { accept } }), `figure-${n}`);
 }
 
 /** Selects `tab` and shows its panel (and its own answer); `focus` moves the keyboard there. */
