@@ -34,8 +34,9 @@ const VIRIDIS: [[u8; 3]; 5] = [
     [253, 231, 37],
 ];
 
-/// The colours of a chart's series: the palette's while it has enough; beyond it, the lines
-/// run along [`VIRIDIS`] in their order and every other layer is dark grey.
+/// The colours of a chart's series: the palette's while it has one for each group of lines;
+/// beyond it, the lines run along [`VIRIDIS`] in their order, and every other layer takes
+/// its line's colour or, past the lines, dark grey.
 struct Colours {
     lines: usize,
     sequential: bool,
@@ -54,12 +55,13 @@ impl Colours {
         }
     }
 
-    /// The colour of the layer that is `i`th in the order of colours, not a line.
+    /// The colour of the layer that is `i`th in the order of colours, not a line: that of the
+    /// `i`th group of lines when there is one (a fit's measured points beside their curve).
     fn other(&self, i: usize) -> String {
-        if self.sequential {
+        if self.sequential && i >= self.lines {
             "#444444".to_string()
         } else {
-            PALETTE[i % PALETTE.len()].to_string()
+            self.line(i)
         }
     }
 }
@@ -427,7 +429,12 @@ impl Chart {
                     unit,
                     clip,
                 } => {
-                    let clip = path(clip.iter().map(px), true);
+                    // An outline of fewer than three points encloses nothing: no clip then.
+                    let clip = if clip.len() >= 3 {
+                        path(clip.iter().map(px), true)
+                    } else {
+                        String::new()
+                    };
                     let drawn = self.write_heatmap(
                         &mut svg,
                         (&sx, &sy),
@@ -447,7 +454,16 @@ impl Chart {
         let shown = write_legend(&mut svg, &legend);
         let mut y = TOP + 10.0 + 22.0 * shown as f64 + 10.0;
         svg.push_str(r#"<g class="notes">"#);
-        for note in &notes {
+        // As many as fit under the legend; the last line then says that more are in the answer.
+        let room = ((HEIGHT - 8.0 - y) / 18.0).floor().max(0.0) as usize + 1;
+        let cut = notes.len() > room;
+        let kept = if cut {
+            room.saturating_sub(1)
+        } else {
+            notes.len()
+        };
+        let more = cut.then(|| format!("… {} more in the answer", notes.len() - kept));
+        for note in notes[..kept].iter().chain(&more) {
             let _ = write!(
                 svg,
                 r#"<text x="{}" y="{y}" font-size="11">{}</text>"#,
@@ -460,23 +476,19 @@ impl Chart {
         svg
     }
 
-    /// The chart's colours: one per group of lines and one per other layer but a heat map
-    /// (which has its own colour bar), sequential when the palette has too few.
+    /// The chart's colours: sequential when its groups of lines outnumber the palette.
     fn colours(&self) -> Colours {
         let mut groups: Vec<&str> = Vec::new();
-        let mut others = 0;
         for layer in &self.layers {
-            match layer {
-                Layer::Line { group, .. } if !groups.contains(&group.as_str()) => {
-                    groups.push(group)
+            if let Layer::Line { group, .. } = layer {
+                if !groups.contains(&group.as_str()) {
+                    groups.push(group);
                 }
-                Layer::Line { .. } | Layer::Heatmap { .. } => {}
-                _ => others += 1,
             }
         }
         Colours {
             lines: groups.len(),
-            sequential: groups.len() + others > PALETTE.len(),
+            sequential: groups.len() > PALETTE.len(),
         }
     }
 
@@ -753,6 +765,112 @@ const LEGEND_ROWS: usize = 14;
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn notes_beyond_the_picture_s_height_are_counted_not_drawn_off_it() {
+        let chart = Chart {
+            title: "notes".to_string(),
+            x: Axis::new("x", "m"),
+            y: Axis::new("y", ""),
+            layers: vec![Layer::Line {
+                name: "line".to_string(),
+                group: "line".to_string(),
+                points: vec![(0.0, 0.0), (1.0, 1.0)],
+                dashed: false,
+            }],
+            equal_aspect: false,
+            notes: (0..40).map(|i| format!("note {i}")).collect(),
+        };
+        let svg = chart.to_svg();
+        let notes = &svg[svg.find(r#"<g class="notes">"#).unwrap()..];
+        let ys: Vec<f64> = notes
+            .split(r#" y=""#)
+            .skip(1)
+            .map(|rest| rest[..rest.find('"').unwrap()].parse().unwrap())
+            .collect();
+        assert!(ys.iter().all(|&y| y <= HEIGHT - 8.0), "{ys:?}");
+        let shown = ys.len() - 1;
+        assert!(notes.contains(&format!("… {} more in the answer", 40 - shown)));
+        assert!(notes.contains(&format!(">note {}<", shown - 1)));
+    }
+
+    #[test]
+    fn past_the_palette_markers_take_their_lines_colour_and_the_rest_grey() {
+        // Ten series as a fit draws them: each one's markers, then its curve; then one more
+        // layer of markers that no line pairs with.
+        let mut layers = Vec::new();
+        for i in 0..10 {
+            let name = format!("series {i}");
+            let points = vec![(0.0, f64::from(i)), (1.0, f64::from(i) + 0.5)];
+            layers.push(Layer::Markers {
+                name: format!("{name}, measured"),
+                points: points.clone(),
+                hollow: false,
+            });
+            layers.push(Layer::Line {
+                name: format!("{name}, fitted"),
+                group: name,
+                points,
+                dashed: false,
+            });
+        }
+        layers.push(Layer::Markers {
+            name: "at rest".to_string(),
+            points: vec![(0.5, 0.5)],
+            hollow: false,
+        });
+        let chart = Chart {
+            title: "many".to_string(),
+            x: Axis::new("x", ""),
+            y: Axis::new("y", ""),
+            layers,
+            equal_aspect: false,
+            notes: Vec::new(),
+        };
+        let svg = chart.to_svg();
+        let after = |name: &str, attribute: &str| {
+            let at = svg.find(&format!(r#"data-name="{name}""#)).unwrap();
+            let rest = &svg[at..];
+            let start = rest.find(&format!(r#"{attribute}=""#)).unwrap() + attribute.len() + 2;
+            rest[start..start + 7].to_string()
+        };
+        for i in 0..10 {
+            let line = after(&format!("series {i}, fitted"), "stroke");
+            assert_eq!(
+                after(&format!("series {i}, measured"), "fill"),
+                line,
+                "series {i}"
+            );
+        }
+        assert_eq!(after("series 0, fitted", "stroke"), "#440154");
+        assert_eq!(after("series 9, fitted", "stroke"), "#fde725");
+        assert_eq!(after("at rest", "fill"), "#444444");
+    }
+
+    #[test]
+    fn a_heatmap_clip_of_fewer_than_three_points_clips_nothing() {
+        let chart = |clip: Vec<(f64, f64)>| Chart {
+            title: "pressure".to_string(),
+            x: Axis::new("x", "m"),
+            y: Axis::new("y", "m"),
+            layers: vec![Layer::Heatmap {
+                name: "pressure".to_string(),
+                x: vec![0.0, 1.0],
+                y: vec![0.0, 1.0],
+                values: vec![vec![1.0, 2.0], vec![3.0, 4.0]],
+                unit: "Pa".to_string(),
+                clip,
+            }],
+            equal_aspect: true,
+            notes: Vec::new(),
+        };
+        for clip in [vec![], vec![(0.5, 0.5)], vec![(0.0, 0.0), (1.0, 1.0)]] {
+            let svg = chart(clip).to_svg();
+            assert!(svg.contains(r#"<g class="heatmap">"#) && !svg.contains("heatmap-clip"));
+        }
+        let svg = chart(vec![(0.0, 0.0), (1.0, 0.0), (0.5, 1.0)]).to_svg();
+        assert!(svg.contains(r#"clip-path="url(#heatmap-clip)""#));
+    }
 
     #[test]
     fn a_fine_heatmap_is_drawn_as_blocks_that_cover_it_and_keep_its_total() {

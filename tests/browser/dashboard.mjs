@@ -267,7 +267,6 @@ try {
   for (const [name, value] of [["asperities.density", "1e12 m^-2"], ["asperities.tip_radius", "1 um"], ["asperities.height_std", "20 nm"], ["asperities.hardness", "2 GPa"], ["upper_surface.elastic_modulus", "200 GPa"]]) {
     await page.fill(`#form-three-body input[name='${name}']`, value);
   }
-  await page.locator("#form-three-body").getByRole("button", { name: "Copy as job JSON" }).click();
   await page.locator("#form-three-body").getByRole("button", { name: "Solve" }).click();
   await page.waitForFunction((s) => document.querySelector(`${s} .status`).textContent.startsWith("Solved")
     && [...document.querySelectorAll(`${s} .table tr`)].some((r) => r.textContent.startsWith("loads.asperities")), area("three-body"), { timeout: 30000 });
@@ -309,6 +308,11 @@ try {
   await page.getByRole("button", { name: "Figure 6" }).click();
   await page.waitForFunction((s) => (document.querySelector(`${s} svg title`) || {}).textContent?.startsWith("Fig. 6"), area("figures", "picture"));
   const entries = await page.locator(`${area("figures", "picture")} svg .legend .entry`).count();
+  // Every tab's picture is in the page at once: no id twice (a clip path's url(#…) would
+  // find another picture's).
+  const ids = await page.$$eval("[id]", (nodes) => nodes.map((n) => n.id));
+  const twice = ids.filter((id, i) => ids.indexOf(id) !== i);
+  if (twice.length) fail(`ids found twice in the page: ${twice.join(", ")}`);
   if (entries !== 10) fail(`Figure 6 has ${entries} legend entries, not 10`);
   await page.screenshot({ path: `${shots}/figure-6.png`, fullPage: true });
 

@@ -52,7 +52,7 @@ function dropKelvinTimes(node) {
 }
 
 /** Measured points from CSV text: a header row naming the columns (radius, load, velocity,
- *  total_load, value, uncertainty), then a point per row, values as typed. */
+ *  value, uncertainty), then a point per row, values as typed. */
 function pointsOf(text) {
   const lines = text.split(/\r?\n/).map((l) => l.trim()).filter((l) => l !== "" && !l.startsWith("#"));
   const header = (lines.shift() || "").split(",").map((h) => h.trim().toLowerCase());
@@ -65,11 +65,11 @@ function pointsOf(text) {
   });
 }
 
-/** Measured points as the fit's series: the condition (radius, load, velocity, total load)
- *  that takes the most values is what each series runs along; the others, fixed within a
- *  series, tell the series apart, so a curve is drawn through one condition's points. */
+/** Measured points as the fit's series: the condition (radius, load, velocity) that takes
+ *  the most values is what each series runs along; the others, fixed within a series, tell
+ *  the series apart, so a curve is drawn through one condition's points. */
 function seriesOf(quantity, points) {
-  const conditions = ["radius", "load", "velocity", "total_load"].filter((c) => points.some((p) => p[c] !== undefined));
+  const conditions = ["radius", "load", "velocity"].filter((c) => points.some((p) => p[c] !== undefined));
   const spread = (c) => new Set(points.map((p) => p[c])).size;
   const along = conditions.slice().sort((a, b) => spread(b) - spread(a))[0];
   const fixed = conditions.filter((c) => c !== along);
@@ -88,7 +88,7 @@ function seriesOf(quantity, points) {
 class InputError extends Error {
   constructor(field, message) {
     super(message);
-    this.problem = { title: "The input is not valid", errors: [{ field, value: "", allowed: message, message: `${field}: ${message}` }] };
+    this.problem = { title: "The input is not valid", errors: [{ field, message: `${field}: ${message}` }] };
   }
 }
 
@@ -232,7 +232,7 @@ class Area {
       const note = document.createElement("span");
       note.className = "field-error";
       note.id = `${form.id}-error-${i}`;
-      note.textContent = `${JSON.stringify(error.value)}: expected ${error.allowed}`;
+      note.textContent = error.value === undefined ? error.message : `${JSON.stringify(error.value)}: expected ${error.allowed}`;
       field.setAttribute("aria-invalid", "true");
       // A field with several errors is described by each.
       field.setAttribute("aria-describedby", `${field.getAttribute("aria-describedby") || ""} ${note.id}`.trim());
@@ -332,8 +332,7 @@ const SHOWN_POINTS = 500;
 function showPoints(area, answer) {
   const units = unitsOf(answer, "points[].");
   // Columns from a solved point: a refused or missing one has its inputs only.
-  const solved = (p) => p && typeof p === "object" && p.status !== "refused" && p.status !== "missing";
-  const first = answer.points.find(solved) || answer.points[0] || {};
+  const first = answer.points.find(isSolved) || answer.points[0] || {};
   const columns = rows(first, units).map(([path]) => path).filter((path) => !path.startsWith("validity."));
   const statusColumn = typeof first.status === "string";
   // A column is shown in the unit of its largest value.
@@ -376,6 +375,11 @@ function showPoints(area, answer) {
     });
   });
   draw(answer.points);
+}
+
+/** Whether a sweep's point was solved: a refused or missing one has its inputs only. */
+function isSolved(point) {
+  return Boolean(point) && typeof point === "object" && point.status !== "refused" && point.status !== "missing";
 }
 
 /** The value at a dotted `path` of `object`. */
@@ -421,7 +425,29 @@ function showPicture(area, svgText) {
   const doc = new DOMParser().parseFromString(svgText, "image/svg+xml");
   const svg = doc.documentElement;
   svg.setAttribute("role", "img");
+  uniqueIds(svg);
   area.part("picture").replaceChildren(document.importNode(svg, true));
+}
+
+/** Pictures inlined so far: each one's ids get its number. */
+let picturesShown = 0;
+
+/** The ids of an SVG made its own, with the `url(#…)` that name them: every tab keeps a
+ *  picture in one page, and a clip path's id found first in another would clip this one. */
+function uniqueIds(svg) {
+  picturesShown += 1;
+  const renamed = new Map();
+  for (const node of svg.querySelectorAll("[id]")) {
+    renamed.set(node.id, `${node.id}-${picturesShown}`);
+    node.id = renamed.get(node.id);
+  }
+  for (const node of svg.querySelectorAll("*")) {
+    for (const attribute of ["clip-path", "fill", "stroke", "mask", "filter"]) {
+      const value = node.getAttribute(attribute);
+      const named = value && value.match(/^url\(#(.+)\)$/);
+      if (named && renamed.has(named[1])) node.setAttribute(attribute, `url(#${renamed.get(named[1])})`);
+    }
+  }
 }
 
 /** Download buttons: each fetches the answer in its form and saves it. */
@@ -457,8 +483,15 @@ async function showAnswer(area, token, answer, picture, downloads, name) {
     new SweepPlot(area.part("picture"), answer);
   } else {
     const svg = await picture();
+    const text = svg.ok ? await svg.text() : problemText((await readJson(svg)).body);
     if (!area.current(token)) return;
-    if (svg.ok) showPicture(area, await svg.text());
+    if (svg.ok) {
+      showPicture(area, text);
+    } else {
+      // The answer stands without its picture: why there is none is said in its place.
+      const note = Object.assign(document.createElement("p"), { className: "warning", textContent: `⚠ No picture: ${text}` });
+      area.part("picture").replaceChildren(note);
+    }
   }
   showDownloads(area, downloads, name);
 }
@@ -479,6 +512,7 @@ function accuracy(answer) {
 
 const SVG = "http://www.w3.org/2000/svg";
 
+/** An SVG element with its attributes and text (the plots of plot.js draw with it too). */
 function element(name, attributes, text) {
   const node = document.createElementNS(SVG, name);
   for (const [key, value] of Object.entries(attributes)) node.setAttribute(key, value);
@@ -660,7 +694,8 @@ function follow(area, token, id) {
       if (area.current(token)) area.status("The connection to the server was lost: reconnecting…", "busy");
       return;
     }
-    stop();
+    // Followed from its record from now on: Cancel stays until it ends.
+    events.close();
     await poll(area, token, id);
   }));
   events.addEventListener("completion", handled(area, token, async (e) => {
@@ -684,6 +719,7 @@ async function poll(area, token, id) {
 
 /** A job's end: its answer, or what went wrong and the points it finished anyway. */
 async function finished(area, token, view) {
+  $("#cancel").disabled = true;
   showProgress(view);
   const { done, total } = view.progress;
   const ending = {
@@ -825,9 +861,9 @@ document.addEventListener("DOMContentLoaded", () => {
     switchParts(form);
     // A CSV file read into the text it stands for.
     for (const file of form.querySelectorAll("input[data-csv-file]")) {
-      file.addEventListener("change", async () => {
+      file.addEventListener("change", () => guarded(areaOf(form), async () => {
         if (file.files.length) form.querySelector("textarea[data-csv]").value = await file.files[0].text();
-      });
+      }));
     }
   }
   const rolling = $("#form-rolling");

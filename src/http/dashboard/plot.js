@@ -2,13 +2,13 @@
 // static SVG): any quantity against any varied input, one line per value of the others in a
 // sequential colour map, linear or log axes, hover to read a point with its units, drag to
 // zoom, and a heat map when two inputs vary. Plain JavaScript, no dependency; it uses
-// `scaleFor`, `readable` and `unitsOf` from app.js (loaded after it, before any plot is drawn).
+// `scaleFor`, `readable`, `unitsOf`, `valueAt`, `isSolved`, `element` and `SVG` from app.js
+// (loaded before it).
 "use strict";
 
 const PLOT = { width: 720, height: 420, left: 78, right: 20, top: 16, bottom: 52 };
-const SVG_NS = "http://www.w3.org/2000/svg";
-/** Plots drawn so far: each clip path's id is its own. */
-let plotsDrawn = 0;
+/** Line plots drawn so far: each one's clip path has its own id. */
+let linePlotsDrawn = 0;
 
 /** viridis at 9 stops: ordered, readable in grey, safe for colour-blind readers. */
 const VIRIDIS = ["#440154", "#472d7b", "#3b528b", "#2c728e", "#21918c", "#28ae80", "#5ec962", "#addc30", "#fde725"];
@@ -22,13 +22,6 @@ function sequential(t) {
   return `rgb(${mix.join(",")})`;
 }
 
-function svgNode(name, attributes = {}, text) {
-  const node = document.createElementNS(SVG_NS, name);
-  for (const [key, value] of Object.entries(attributes)) node.setAttribute(key, value);
-  if (text !== undefined) node.textContent = text;
-  return node;
-}
-
 /** Scalar paths of `object` (`a.b`), numbers only. */
 function numericPaths(object, prefix = "") {
   const out = [];
@@ -37,10 +30,6 @@ function numericPaths(object, prefix = "") {
     else if (value && typeof value === "object" && !Array.isArray(value)) out.push(...numericPaths(value, `${prefix}${key}.`));
   }
   return out;
-}
-
-function at(object, path) {
-  return path.split(".").reduce((node, key) => (node == null ? undefined : node[key]), object);
 }
 
 /** About `count` round tick values across [lo, hi], or decades on a log axis. */
@@ -81,12 +70,20 @@ function withUnit(value, unit) {
   return `${Number(shown.toPrecision(4))}${name ? " " + name : ""}`;
 }
 
+/** The labels of the plot's axes, under it and up its left side, into `g`. */
+function axisLabels(g, xText, yText) {
+  const { width, height, left, right, top, bottom } = PLOT;
+  const middle = (top + height - bottom) / 2;
+  g.append(element("text", { class: "x-label", x: (left + width - right) / 2, y: height - 12, "text-anchor": "middle" }, xText));
+  g.append(element("text", { class: "y-label", x: 14, y: middle, "text-anchor": "middle", transform: `rotate(-90 14 ${middle})` }, yText));
+}
+
 /** A sweep answer's explorable plot, with its controls, in `box`. */
 class SweepPlot {
   constructor(box, answer) {
     this.points = answer.points.filter((p) => p && typeof p === "object");
     this.units = unitsOf(answer, "points[].");
-    const solved = this.points.find((p) => p.status !== "refused" && p.status !== "missing") || this.points[0] || {};
+    const solved = this.points.find(isSolved) || this.points[0] || {};
     const varied = Object.keys((answer.meta && answer.meta.input && answer.meta.input.vary) || {});
     const paths = numericPaths(solved);
     // The varied inputs as they sit in a point (`operating.total_load` for `total_load`).
@@ -94,7 +91,7 @@ class SweepPlot {
       .map((key) => paths.find((p) => p === key) || paths.find((p) => p.endsWith(`.${key}`)))
       .filter((p) => p !== undefined);
     this.quantities = paths.filter((p) => !this.inputs.includes(p) && !p.startsWith("validity."));
-    const spread = (path) => new Set(this.points.map((p) => at(p, path))).size;
+    const spread = (path) => new Set(this.points.map((p) => valueAt(p, path))).size;
     this.inputs.sort((a, b) => spread(b) - spread(a));
     this.moving = this.inputs.filter((path) => spread(path) > 1);
     this.state = {
@@ -106,7 +103,7 @@ class SweepPlot {
       zoom: null,
     };
     this.box = box;
-    box.replaceChildren(this.controls(), svgNode("svg", { class: "plot", viewBox: `0 0 ${PLOT.width} ${PLOT.height}`, width: PLOT.width, height: PLOT.height, role: "img" }), this.legendBox = document.createElement("div"));
+    box.replaceChildren(this.controls(), element("svg", { class: "plot", viewBox: `0 0 ${PLOT.width} ${PLOT.height}`, width: PLOT.width, height: PLOT.height, role: "img" }), this.legendBox = document.createElement("div"));
     this.legendBox.className = "plot-legend";
     this.svg = box.querySelector("svg.plot");
     this.draw();
@@ -161,6 +158,7 @@ class SweepPlot {
     this.svg.dataset.x = this.state.x;
     this.svg.dataset.y = this.state.y;
     this.svg.dataset.view = this.state.view;
+    this.svg.setAttribute("aria-label", `${this.state.y} against ${this.state.x}${this.state.view === "heat" ? " (heat map)" : ""}`);
     if (this.state.view === "heat" && this.moving.length === 2) this.drawHeat();
     else this.drawLines();
   }
@@ -169,7 +167,7 @@ class SweepPlot {
   usable(x, y) {
     const { logX, logY } = this.state;
     const kept = this.points.filter((p) => {
-      const [a, b] = [at(p, x), at(p, y)];
+      const [a, b] = [valueAt(p, x), valueAt(p, y)];
       return typeof a === "number" && typeof b === "number" && Number.isFinite(a) && Number.isFinite(b)
         && (!logX || a > 0) && (!logY || b > 0);
     });
@@ -178,8 +176,8 @@ class SweepPlot {
     return kept;
   }
 
-  /** Axes for the domain `[x0, x1] × [y0, y1]` in the readable units of their largest
-   *  values; returns the maps from values to the plot's pixels. */
+  /** Axes over the ranges `xs` × `ys` of the quantities at `xPath` and `yPath`, in the readable
+   *  units of their largest values; returns the maps from values to the plot's pixels. */
   axes(xs, ys, xPath, yPath) {
     const { logX, logY } = this.state;
     const { width, height, left, right, top, bottom } = PLOT;
@@ -189,20 +187,19 @@ class SweepPlot {
     };
     const px = map(xs[0], xs[1], logX, left, width - right);
     const py = map(ys[0], ys[1], logY, height - bottom, top);
-    const g = svgNode("g", { class: "axes", "font-size": 12, "font-family": "sans-serif" });
-    g.append(svgNode("rect", { x: left, y: top, width: width - left - right, height: height - top - bottom, fill: "#fff", stroke: "#444" }));
+    const g = element("g", { class: "axes", "font-size": 12, "font-family": "sans-serif" });
+    g.append(element("rect", { x: left, y: top, width: width - left - right, height: height - top - bottom, fill: "#fff", stroke: "#444" }));
     const [xSize, xUnit] = scaleFor(Math.max(Math.abs(xs[0]), Math.abs(xs[1])), this.units[xPath]);
     const [ySize, yUnit] = scaleFor(Math.max(Math.abs(ys[0]), Math.abs(ys[1])), this.units[yPath]);
     for (const v of ticks(xs[0], xs[1], logX)) {
-      g.append(svgNode("line", { x1: px(v), x2: px(v), y1: top, y2: height - bottom, stroke: "#eee" }));
-      g.append(svgNode("text", { x: px(v), y: height - bottom + 16, "text-anchor": "middle" }, String(Number((v / xSize).toPrecision(4)))));
+      g.append(element("line", { x1: px(v), x2: px(v), y1: top, y2: height - bottom, stroke: "#eee" }));
+      g.append(element("text", { x: px(v), y: height - bottom + 16, "text-anchor": "middle" }, String(Number((v / xSize).toPrecision(4)))));
     }
     for (const v of ticks(ys[0], ys[1], logY)) {
-      g.append(svgNode("line", { x1: left, x2: width - right, y1: py(v), y2: py(v), stroke: "#eee" }));
-      g.append(svgNode("text", { x: left - 6, y: py(v) + 4, "text-anchor": "end" }, String(Number((v / ySize).toPrecision(4)))));
+      g.append(element("line", { x1: left, x2: width - right, y1: py(v), y2: py(v), stroke: "#eee" }));
+      g.append(element("text", { x: left - 6, y: py(v) + 4, "text-anchor": "end" }, String(Number((v / ySize).toPrecision(4)))));
     }
-    g.append(svgNode("text", { class: "x-label", x: (left + width - right) / 2, y: height - 12, "text-anchor": "middle" }, `${xPath}${xUnit ? ` [${xUnit}]` : ""}${logX ? " (log)" : ""}`));
-    g.append(svgNode("text", { class: "y-label", x: 14, y: (top + height - bottom) / 2, "text-anchor": "middle", transform: `rotate(-90 14 ${(top + height - bottom) / 2})` }, `${yPath}${yUnit ? ` [${yUnit}]` : ""}${logY ? " (log)" : ""}`));
+    axisLabels(g, `${xPath}${xUnit ? ` [${xUnit}]` : ""}${logX ? " (log)" : ""}`, `${yPath}${yUnit ? ` [${yUnit}]` : ""}${logY ? " (log)" : ""}`);
     this.svg.append(g);
     return { px, py };
   }
@@ -212,11 +209,11 @@ class SweepPlot {
     const { x, y, logX, logY, zoom } = this.state;
     const kept = this.usable(x, y);
     if (!kept.length) return;
-    const xs = zoom ? zoom.x : extent(kept.map((p) => at(p, x)), logX);
-    const ys = zoom ? zoom.y : extent(kept.map((p) => at(p, y)), logY);
+    const xs = zoom ? zoom.x : extent(kept.map((p) => valueAt(p, x)), logX);
+    const ys = zoom ? zoom.y : extent(kept.map((p) => valueAt(p, y)), logY);
     const { px, py } = this.axes(xs, ys, x, y);
     const others = this.moving.filter((path) => path !== x);
-    const keyOf = (p) => others.map((path) => at(p, path));
+    const keyOf = (p) => others.map((path) => valueAt(p, path));
     const groups = new Map();
     for (const p of kept) {
       const key = JSON.stringify(keyOf(p));
@@ -228,24 +225,24 @@ class SweepPlot {
       for (let i = 0; i < u.length; i++) if (u[i] !== v[i]) return u[i] - v[i];
       return 0;
     });
-    plotsDrawn += 1;
-    const clip = svgNode("clipPath", { id: `plot-clip-${plotsDrawn}` });
-    clip.append(svgNode("rect", { x: PLOT.left, y: PLOT.top, width: PLOT.width - PLOT.left - PLOT.right, height: PLOT.height - PLOT.top - PLOT.bottom }));
+    linePlotsDrawn += 1;
+    const clip = element("clipPath", { id: `plot-clip-${linePlotsDrawn}` });
+    clip.append(element("rect", { x: PLOT.left, y: PLOT.top, width: PLOT.width - PLOT.left - PLOT.right, height: PLOT.height - PLOT.top - PLOT.bottom }));
     this.svg.append(clip);
-    const layer = svgNode("g", { "clip-path": `url(#plot-clip-${plotsDrawn})` });
+    const layer = element("g", { "clip-path": `url(#plot-clip-${linePlotsDrawn})` });
     this.svg.append(layer);
     this.drawn = [];
     order.forEach((key, i) => {
       const colour = sequential(order.length === 1 ? 0.35 : i / (order.length - 1));
-      const series = groups.get(key).slice().sort((a, b) => at(a, x) - at(b, x));
-      const label = others.map((path) => `${path} = ${withUnit(at(series[0], path), this.units[path])}`).join(", ") || y;
+      const series = groups.get(key).slice().sort((a, b) => valueAt(a, x) - valueAt(b, x));
+      const label = others.map((path) => `${path} = ${withUnit(valueAt(series[0], path), this.units[path])}`).join(", ") || y;
       if (series.length > 1) {
-        const d = series.map((p, k) => `${k ? "L" : "M"}${px(at(p, x)).toFixed(1)},${py(at(p, y)).toFixed(1)}`).join("");
-        layer.append(svgNode("path", { class: "series", d, fill: "none", stroke: colour, "stroke-width": 2, "data-name": label }));
+        const d = series.map((p, k) => `${k ? "L" : "M"}${px(valueAt(p, x)).toFixed(1)},${py(valueAt(p, y)).toFixed(1)}`).join("");
+        layer.append(element("path", { class: "series", d, fill: "none", stroke: colour, "stroke-width": 2, "data-name": label }));
       }
       for (const p of series) {
-        const [cx, cy] = [px(at(p, x)), py(at(p, y))];
-        layer.append(svgNode("circle", { class: "point", cx, cy, r: series.length > 1 ? 2.5 : 5, fill: colour }));
+        const [cx, cy] = [px(valueAt(p, x)), py(valueAt(p, y))];
+        layer.append(element("circle", { class: "point", cx, cy, r: series.length > 1 ? 2.5 : 5, fill: colour }));
         this.drawn.push({ cx, cy, p, label });
       }
       this.legendEntry(colour, label);
@@ -285,35 +282,34 @@ class SweepPlot {
   drawHeat() {
     const { x, y } = this.state;
     const other = this.moving.find((path) => path !== x);
-    const kept = this.usable(x, y).filter((p) => typeof at(p, other) === "number");
+    const kept = this.usable(x, y).filter((p) => typeof valueAt(p, other) === "number");
     if (!kept.length) return;
-    const columns = [...new Set(kept.map((p) => at(p, x)))].sort((a, b) => a - b);
-    const rows = [...new Set(kept.map((p) => at(p, other)))].sort((a, b) => a - b);
-    const values = kept.map((p) => at(p, y));
+    const columns = [...new Set(kept.map((p) => valueAt(p, x)))].sort((a, b) => a - b);
+    const rows = [...new Set(kept.map((p) => valueAt(p, other)))].sort((a, b) => a - b);
+    const values = kept.map((p) => valueAt(p, y));
     const [lo, hi] = [Math.min(...values), Math.max(...values)];
     const { width, height, left, right, top, bottom } = PLOT;
     const cw = (width - left - right) / columns.length;
     const ch = (height - top - bottom) / rows.length;
-    const g = svgNode("g", { class: "heat", "font-size": 12, "font-family": "sans-serif" });
+    const g = element("g", { class: "heat", "font-size": 12, "font-family": "sans-serif" });
     this.drawn = [];
     for (const p of kept) {
-      const [i, j] = [columns.indexOf(at(p, x)), rows.indexOf(at(p, other))];
-      const fill = sequential(hi > lo ? (at(p, y) - lo) / (hi - lo) : 0.5);
-      const cell = svgNode("rect", { class: "cell", x: left + i * cw, y: height - bottom - (j + 1) * ch, width: cw, height: ch, fill });
+      const [i, j] = [columns.indexOf(valueAt(p, x)), rows.indexOf(valueAt(p, other))];
+      const fill = sequential(hi > lo ? (valueAt(p, y) - lo) / (hi - lo) : 0.5);
+      const cell = element("rect", { class: "cell", x: left + i * cw, y: height - bottom - (j + 1) * ch, width: cw, height: ch, fill });
       g.append(cell);
       this.drawn.push({ cx: left + (i + 0.5) * cw, cy: height - bottom - (j + 0.5) * ch, p, label: "" });
     }
     const every = (n) => Math.max(1, Math.ceil(n / 8));
     columns.forEach((v, i) => {
       if (i % every(columns.length)) return;
-      g.append(svgNode("text", { x: left + (i + 0.5) * cw, y: height - bottom + 16, "text-anchor": "middle" }, withUnit(v, this.units[x])));
+      g.append(element("text", { x: left + (i + 0.5) * cw, y: height - bottom + 16, "text-anchor": "middle" }, withUnit(v, this.units[x])));
     });
     rows.forEach((v, j) => {
       if (j % every(rows.length)) return;
-      g.append(svgNode("text", { x: left - 6, y: height - bottom - (j + 0.5) * ch + 4, "text-anchor": "end" }, withUnit(v, this.units[other])));
+      g.append(element("text", { x: left - 6, y: height - bottom - (j + 0.5) * ch + 4, "text-anchor": "end" }, withUnit(v, this.units[other])));
     });
-    g.append(svgNode("text", { class: "x-label", x: (left + width - right) / 2, y: height - 12, "text-anchor": "middle" }, x));
-    g.append(svgNode("text", { class: "y-label", x: 14, y: (top + height - bottom) / 2, "text-anchor": "middle", transform: `rotate(-90 14 ${(top + height - bottom) / 2})` }, other));
+    axisLabels(g, x, other);
     this.svg.append(g);
     this.legendBox.append(this.colourBar(withUnit(lo, this.units[y]), withUnit(hi, this.units[y]), y));
     this.interact(null, null, null, null);
@@ -322,10 +318,10 @@ class SweepPlot {
   /** Hover reads the nearest point; a drag on the lines zooms to its rectangle; a double
    *  click resets. */
   interact(xs, ys, px, py) {
-    const tip = svgNode("g", { class: "tip", visibility: "hidden", "pointer-events": "none", "font-size": 12, "font-family": "sans-serif" });
-    const box = svgNode("rect", { fill: "#fff", stroke: "#333", rx: 3, opacity: 0.95 });
+    const tip = element("g", { class: "tip", visibility: "hidden", "pointer-events": "none", "font-size": 12, "font-family": "sans-serif" });
+    const box = element("rect", { fill: "#fff", stroke: "#333", rx: 3, opacity: 0.95 });
     tip.append(box);
-    const band = svgNode("rect", { class: "zoom-band", fill: "rgba(31,95,168,0.15)", stroke: "#1f5fa8", visibility: "hidden" });
+    const band = element("rect", { class: "zoom-band", fill: "rgba(31,95,168,0.15)", stroke: "#1f5fa8", visibility: "hidden" });
     this.svg.append(band, tip);
     const local = (event) => {
       const r = this.svg.getBoundingClientRect();
@@ -338,9 +334,9 @@ class SweepPlot {
         if (dist < 24 && (!best || dist < best.dist)) best = { ...d, dist };
       }
       if (!best) return tip.setAttribute("visibility", "hidden");
-      const lines = [...this.moving, this.state.y].map((path) => `${path} = ${withUnit(at(best.p, path), this.units[path])}`);
+      const lines = [...this.moving, this.state.y].map((path) => `${path} = ${withUnit(valueAt(best.p, path), this.units[path])}`);
       for (const old of tip.querySelectorAll("text")) old.remove();
-      lines.forEach((line, k) => tip.append(svgNode("text", { x: 8, y: 16 + 15 * k }, line)));
+      lines.forEach((line, k) => tip.append(element("text", { x: 8, y: 16 + 15 * k }, line)));
       const w = 8 + 7 * Math.max(...lines.map((l) => l.length));
       const h = 8 + 15 * lines.length;
       box.setAttribute("width", w);
