@@ -118,6 +118,25 @@ function buildFieldsets() {
   }
 }
 
+/** Fills each `[data-bounds=name]` row with the start, least and most of the fitted
+ *  parameter `name`, prefilled from its `data-start`, `data-min` and `data-max` (none: the
+ *  parameter is not fitted until a start is given). */
+function buildBounds() {
+  for (const row of document.querySelectorAll("[data-bounds]")) {
+    const label = row.textContent.trim();
+    row.setAttribute("role", "group");
+    row.setAttribute("aria-label", label);
+    for (const [key, word] of [["start", "start"], ["min", "least"], ["max", "most"]]) {
+      const input = document.createElement("input");
+      input.name = `parameters.${row.dataset.bounds}.${key}`;
+      input.setAttribute("aria-label", `${label}: ${word}`);
+      if (row.dataset[key] !== undefined) input.value = row.dataset[key];
+      else input.placeholder = key === "start" ? "not fitted" : word;
+      row.append(input);
+    }
+  }
+}
+
 /** A form's `select[data-switch]` shows, and sends, only the parts marked `data-for` its value. */
 function switchParts(form) {
   const select = form.querySelector("select[data-switch]");
@@ -655,6 +674,11 @@ function showProgress(view) {
   text.textContent = ended ? `${view.status} at ${count}` : count;
 }
 
+/** A request that threw (the server unreachable, a reply cut short) as a problem. */
+function failure(e) {
+  return { title: "The request failed", detail: e.message || String(e) };
+}
+
 /** Runs the handler `work` of a request's event; what it throws reads as an error while the
  *  request is the last one asked in `area`. */
 function handled(area, token, work) {
@@ -662,7 +686,7 @@ function handled(area, token, work) {
     Promise.resolve()
       .then(() => work(...args))
       .catch((e) => {
-        if (area.current(token)) area.problem({ title: "The request failed", detail: e.message || String(e) });
+        if (area.current(token)) area.problem(failure(e));
       });
   };
 }
@@ -833,12 +857,13 @@ function guarded(area, work) {
   const before = area.asked;
   work().catch((e) => {
     if (area.asked > before + 1) return;
-    area.problem(e instanceof InputError ? e.problem : { title: "The request failed", detail: e.message || String(e) });
+    area.problem(e instanceof InputError ? e.problem : failure(e));
   });
 }
 
 document.addEventListener("DOMContentLoaded", () => {
   buildFieldsets();
+  buildBounds();
   const template = $("#answer-area");
   for (const panel of document.querySelectorAll("[role=tabpanel]")) {
     const root = template.content.firstElementChild.cloneNode(true);

@@ -274,6 +274,7 @@ class SweepPlot {
     bar.className = "colour-bar";
     const ramp = document.createElement("span");
     ramp.className = "ramp";
+    ramp.style.background = `linear-gradient(to right, ${VIRIDIS.join(", ")})`;
     bar.append(Object.assign(document.createElement("div"), { textContent: title }), document.createTextNode(low), ramp, document.createTextNode(high));
     return bar;
   }
