@@ -19,14 +19,20 @@ RUN cargo build --release --locked --bin thirdbody
 
 # Run stage: the binary alone, as an unprivileged user.
 FROM debian:bookworm-slim
-RUN useradd --system --uid 10001 --no-create-home thirdbody
+# The database of saved analyses lives in a volume (a single service keeps its history
+# there across restarts; a fleet keeps it in Redis and leaves the volume empty).
+RUN useradd --system --uid 10001 --no-create-home thirdbody \
+    && mkdir -p /var/lib/thirdbody && chown thirdbody /var/lib/thirdbody
+VOLUME /var/lib/thirdbody
 COPY --from=build /src/target/release/thirdbody /usr/local/bin/thirdbody
 USER thirdbody
 # Every setting is a flag with an environment variable (`thirdbody serve --help`); these are
-# the ones a container needs: listen on all interfaces, JSON logs for the log collector, and
-# a shutdown bound below the orchestrator's grace period (deploy/base/deployment.yaml: 40 s).
+# the ones a container needs: listen on all interfaces, JSON logs for the log collector, the
+# database in the volume, and a shutdown bound below the orchestrator's grace period
+# (deploy/base/deployment.yaml: 40 s).
 ENV THIRDBODY_BIND=0.0.0.0:8080 \
     THIRDBODY_LOG_FORMAT=json \
+    THIRDBODY_DATABASE=/var/lib/thirdbody/thirdbody.db \
     THIRDBODY_SHUTDOWN_TIMEOUT=25s \
     THIRDBODY_DRAIN_DELAY=2s
 EXPOSE 8080

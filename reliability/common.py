@@ -6,8 +6,10 @@ the same measurement runs against any build (RELIABILITY.md compares before and 
 import http.client
 import json
 import os
+import shutil
 import socket
 import subprocess
+import tempfile
 import time
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -32,6 +34,11 @@ class Server:
     def __init__(self, *flags, preexec=None):
         self.port = free_port()
         self.log = open(os.devnull, "w")
+        # Its database of saved analyses in a directory of its own (servers run side by side,
+        # and a database file is one process's), for builds that keep one.
+        self.data = tempfile.mkdtemp(prefix="thirdbody-reliability-")
+        if "--database" not in flags and supports("--database"):
+            flags = (*flags, "--database", os.path.join(self.data, "thirdbody.db"))
         self.proc = subprocess.Popen(
             [BIN, "serve", "--bind", f"127.0.0.1:{self.port}", *flags],
             stdout=self.log,
@@ -56,6 +63,7 @@ class Server:
             self.proc.kill()
         self.proc.wait()
         self.log.close()
+        shutil.rmtree(self.data, ignore_errors=True)
 
     def rss_mib(self):
         """Resident memory of the server process (MiB)."""

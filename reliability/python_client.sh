@@ -9,7 +9,7 @@ command -v openapi-python-client >/dev/null \
 cargo build --release --locked --quiet --bin thirdbody
 work=$(mktemp -d)
 port=$(python3 -c 'import socket; s=socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])')
-target/release/thirdbody serve --bind "127.0.0.1:$port" --log-format text >"$work/log" 2>&1 &
+target/release/thirdbody serve --bind "127.0.0.1:$port" --log-format text --database "$work/thirdbody.db" >"$work/log" 2>&1 &
 server=$!
 trap 'kill $server 2>/dev/null; wait $server 2>/dev/null || true; rm -rf "$work"' EXIT
 (cd "$work" && openapi-python-client generate --path "$OLDPWD/openapi/openapi.json" \

@@ -9,7 +9,7 @@ command -v st >/dev/null || python3 -m pip install --quiet 'schemathesis>=4.3,<5
 cargo build --release --locked --quiet --bin thirdbody
 port=$(python3 -c 'import socket; s=socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])')
 log=$(mktemp)
-target/release/thirdbody serve --bind "127.0.0.1:$port" --log-format text >"$log" 2>&1 &
+target/release/thirdbody serve --bind "127.0.0.1:$port" --log-format text --database :memory: >"$log" 2>&1 &
 server=$!
 trap 'kill $server 2>/dev/null; wait $server 2>/dev/null || true; rm -f "$log"' EXIT
 for _ in $(seq 50); do

@@ -307,13 +307,14 @@ fn serve(args: ServeArgs) -> ExitCode {
     let served = runtime.block_on(async {
         let signals = Signals::new();
         let (bind, timeout) = (config.bind, config.shutdown_timeout);
+        // The service first (its database may be another process's): then the port.
+        let state = AppState::new(config)?;
         let listener = tokio::net::TcpListener::bind(bind)
             .await
             .map_err(|e| format!("cannot listen on {bind}: {e}"))?;
         // The address bound (the port the system chose, for `--bind 127.0.0.1:0`).
         let address = listener.local_addr().unwrap_or(bind);
         tracing::info!(%address, "listening; dashboard at /, API docs at /docs");
-        let state = AppState::new(config)?;
         let shutdown = shut_down_on(signals, state.engine().clone(), timeout);
         http::run(listener, state, shutdown)
             .await

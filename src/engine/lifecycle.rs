@@ -20,7 +20,7 @@ use super::ids::{self, JobIds, Unknown};
 use super::metrics::{self as names, Metrics};
 use super::solver::Solver;
 use super::spill::JobResult;
-use super::store::{JobRecord, JobState, JobStatus, JobStore};
+use super::store::{JobRecord, JobState, JobStatus, JobStore, Listing, Owner, Page};
 use super::{EngineConfig, EngineError};
 use crate::job::{Control, JobError, Keyed, Work};
 
@@ -170,12 +170,17 @@ impl Lifecycle {
 
     /// Queues `keyed` to run in the background; returns its record. Refused when the queue
     /// is full, the service is draining, or there is no room to keep the job's result.
-    pub(super) async fn submit(self: &Arc<Self>, keyed: Keyed) -> Result<JobRecord, EngineError> {
+    pub(super) async fn submit(
+        self: &Arc<Self>,
+        keyed: Keyed,
+        owner: Option<Owner>,
+    ) -> Result<JobRecord, EngineError> {
         self.store_reachable()?;
         let (kind, work) = (keyed.job().kind(), keyed.job().work());
+        let queued = |id| JobRecord::queued(id, kind, work, keyed.key()).owned_by(owner.clone());
         // A job whose answer is cached is answered at once: it takes no place in the queue.
         if let Some(solved) = self.solver.cached(keyed.key()).await {
-            let mut record = JobRecord::queued(self.ids.next(), kind, work);
+            let mut record = queued(self.ids.next());
             let done = match work {
                 Work::Known(total) => total,
                 Work::Unknown => 0,
@@ -192,7 +197,8 @@ impl Lifecycle {
             return Ok(record);
         }
         if let Some(shared) = &self.fleet {
-            return self.enqueue(shared, keyed).await;
+            let record = queued(self.ids.next());
+            return self.enqueue(shared, keyed, record).await;
         }
         let max = self.config.max_queued_jobs;
         if self
@@ -215,7 +221,7 @@ impl Lifecycle {
                 return Err(EngineError::Backlogged(backlogged));
             }
         };
-        let record = JobRecord::queued(self.ids.next(), kind, work);
+        let record = queued(self.ids.next());
         let id = record.id;
         let result_bytes = keyed.job().result_bytes();
         if let Err(refusal) = self.jobs.insert(record.clone(), result_bytes).await {
@@ -257,7 +263,12 @@ impl Lifecycle {
 
     /// Puts `job` on the fleet's work stream (in parts, if it splits into more than a part's
     /// points); refused when the stream holds more than 64 entries per queued job allowed.
-    async fn enqueue(&self, shared: &Shared, keyed: Keyed) -> Result<JobRecord, EngineError> {
+    async fn enqueue(
+        &self,
+        shared: &Shared,
+        keyed: Keyed,
+        record: JobRecord,
+    ) -> Result<JobRecord, EngineError> {
         let unavailable = |e: super::fleet::Failure| EngineError::Unavailable(e.why);
         let job = keyed.job();
         let (backlog, rate) = shared
@@ -268,7 +279,6 @@ impl Lifecycle {
             return Err(EngineError::Overloaded);
         }
         let parts = placement::plan(job.points(), rate, shared.fleet.config.part_points);
-        let record = JobRecord::queued(self.ids.next(), job.kind(), job.work());
         let deadline = std::time::SystemTime::now() + self.config.job_deadline;
         shared
             .store
@@ -308,10 +318,38 @@ impl Lifecycle {
         Some(record)
     }
 
+    /// The jobs of `listing`'s owner, newest first, filtered and paged; a job this process
+    /// runs has its progress counted up to now.
+    pub(super) async fn list(&self, listing: &Listing) -> Result<Page, EngineError> {
+        self.store_reachable()?;
+        let mut page = self
+            .jobs
+            .list(listing)
+            .await
+            .map_err(EngineError::Unavailable)?;
+        let live = self.live();
+        for record in &mut page.jobs {
+            if let Some(job) = live.get(&record.id) {
+                record.done = job.control.done();
+            }
+        }
+        Ok(page)
+    }
+
+    /// The newest job that succeeded on the input whose hash is `input_hash`.
+    pub(super) async fn with_input(&self, input_hash: &str) -> Option<JobRecord> {
+        self.jobs.with_input(input_hash).await
+    }
+
     /// What can be told of a job `id` that the job store does not know.
     pub(super) async fn unknown(&self, id: Uuid) -> Unknown {
         if !ids::is_ours(id) {
             return Unknown::NeverIssued;
+        }
+        if self.fleet.is_none() && self.jobs.durable() {
+            // Every job accepted is in the database from its acceptance until deleted or
+            // expired, whichever run accepted it.
+            return Unknown::Gone;
         }
         match &self.fleet {
             Some(shared) => match shared.fleet.epoch().await {
@@ -365,6 +403,10 @@ impl Lifecycle {
     /// [`Lifecycle::jobs_collected`] for their clients to read them.
     pub(super) fn begin_drain(&self) {
         self.draining.cancel();
+        if self.jobs.durable() {
+            // Their answers outlive the process: a client reads them after the restart.
+            return;
+        }
         let unfinished: Vec<Uuid> = self.live().keys().copied().collect();
         let uncollected: Vec<Uuid> = self.uncollected().ids.iter().copied().collect();
         self.owed()
@@ -403,8 +445,11 @@ impl Lifecycle {
 
     /// Jobs finished that no client has read yet: those a drain waits for clients to read
     /// (once it has begun, the jobs it owes that are finished; before, every one unread).
+    /// None when the store outlives the process: their clients read them after a restart.
     pub(super) fn unread_jobs(&self) -> usize {
-        if self.is_draining() {
+        if self.jobs.durable() {
+            0
+        } else if self.is_draining() {
             let live: HashSet<Uuid> = self.live().keys().copied().collect();
             self.owed().iter().filter(|id| !live.contains(id)).count()
         } else {

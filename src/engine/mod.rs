@@ -7,6 +7,7 @@
 //! ([`Solver`]) and the life of asynchronous jobs (`lifecycle`); the fleet's workers
 //! ([`fleet::Worker`]) solve through the same [`Solver`].
 
+pub mod archive;
 mod background;
 mod backlog;
 mod bounded;
@@ -18,6 +19,7 @@ pub mod fleet;
 pub mod heavy;
 mod ids;
 mod lifecycle;
+mod local;
 mod memo;
 pub mod metrics;
 pub mod pool;

@@ -12,15 +12,17 @@ use std::time::{Duration, Instant};
 use tokio::sync::watch;
 use uuid::Uuid;
 
+use super::archive::Archive;
 use super::backlog::Backlogged;
 use super::budget::Budget;
 use super::cache::{MemoryCache, ResultCache, Solved};
 use super::fleet::Shared;
 use super::lifecycle::Lifecycle;
+use super::local::LocalJobStore;
 use super::metrics::{self as names, Metrics};
 use super::solver::{CacheStatus, Solver};
 use super::spill::SpillDir;
-use super::store::{JobRecord, JobStatus, JobStore, MemoryJobStore, Refusal};
+use super::store::{JobRecord, JobStatus, JobStore, Listing, MemoryJobStore, Owner, Page, Refusal};
 use crate::job::{JobError, Keyed};
 
 /// The limits of an engine.
@@ -41,8 +43,13 @@ pub struct EngineConfig {
     pub max_jobs: usize,
     /// How long an answer stays cached.
     pub cache_ttl: Duration,
-    /// How long a finished asynchronous job is kept.
+    /// How long a finished asynchronous job's record and result stay in memory for its
+    /// client to collect.
     pub job_retention: Duration,
+    /// The database of saved analyses: a file, or [`super::archive::IN_MEMORY`].
+    pub database: String,
+    /// How long finished jobs are kept in the history (the database, or the fleet's Redis).
+    pub history_retention: Duration,
     /// Where results too large for the memory budget are kept (a directory of this
     /// process's is made there), and how many bytes of them at most; `None` or 0 bytes: in
     /// memory only.
@@ -60,22 +67,28 @@ pub struct Storage {
 }
 
 impl Storage {
-    /// In this process's memory (and its spill directory), within `config`'s bounds: the
-    /// default. Fails if the spill directory cannot be made.
-    pub fn in_process(config: &EngineConfig) -> std::io::Result<Storage> {
+    /// In this process's memory (and its spill directory), within `config`'s bounds, and
+    /// its database of saved analyses: the default. Fails if the spill directory cannot be
+    /// made or the database opened.
+    pub fn in_process(config: &EngineConfig) -> Result<Storage, String> {
         let budget = Budget::split(config.memory_budget);
         let spill = match &config.spill {
-            Some((parent, bytes)) if *bytes > 0 => Some(SpillDir::create(parent, *bytes)?),
+            Some((parent, bytes)) if *bytes > 0 => Some(
+                SpillDir::create(parent, *bytes)
+                    .map_err(|e| format!("--spill-dir {}: {e}", parent.display()))?,
+            ),
             _ => None,
         };
+        let memory = MemoryJobStore::new(
+            config.job_retention,
+            config.max_jobs,
+            budget.job_results,
+            spill,
+        );
+        let archive = Archive::open(&config.database, config.history_retention)?;
         Ok(Storage {
             cache: Arc::new(MemoryCache::for_engine(config)),
-            jobs: Arc::new(MemoryJobStore::new(
-                config.job_retention,
-                config.max_jobs,
-                budget.job_results,
-                spill,
-            )),
+            jobs: Arc::new(LocalJobStore::new(memory, archive)),
             fleet: None,
         })
     }
@@ -127,7 +140,7 @@ pub struct Engine {
 
 impl Engine {
     /// An engine that keeps everything in this process.
-    pub fn new(config: EngineConfig, metrics: Metrics) -> std::io::Result<Arc<Engine>> {
+    pub fn new(config: EngineConfig, metrics: Metrics) -> Result<Arc<Engine>, String> {
         let storage = Storage::in_process(&config)?;
         Ok(Engine::with_storage(config, metrics, storage))
     }
@@ -203,9 +216,13 @@ impl Engine {
     /// Queues `keyed` to run in the background; returns its record. Refused when the
     /// queue is full, the service is draining, or there is no room to keep the job's
     /// result.
-    pub async fn submit(&self, keyed: Keyed) -> Result<JobRecord, EngineError> {
+    pub async fn submit(
+        &self,
+        keyed: Keyed,
+        owner: Option<Owner>,
+    ) -> Result<JobRecord, EngineError> {
         self.admit()?;
-        let record = self.jobs.submit(keyed).await;
+        let record = self.jobs.submit(keyed, owner).await;
         record.map_err(|e| self.refused(e))
     }
 
@@ -231,6 +248,21 @@ impl Engine {
     /// its progress counted up to now.
     pub async fn job(&self, id: Uuid) -> Option<JobRecord> {
         self.jobs.job(id).await
+    }
+
+    /// The jobs of `listing`'s owner, newest first, filtered and paged.
+    pub async fn list(&self, listing: &Listing) -> Result<Page, EngineError> {
+        self.jobs.list(listing).await
+    }
+
+    /// The newest job that succeeded on the input whose hash is `input_hash`.
+    pub async fn with_input(&self, input_hash: &str) -> Option<JobRecord> {
+        self.jobs.with_input(input_hash).await
+    }
+
+    /// The cached answer whose key (input hash) is `key`, if any.
+    pub async fn cached(&self, key: &str) -> Option<Arc<Solved>> {
+        self.solver.cached(key).await
     }
 
     /// What can be told of a job `id` that the job store does not know.

@@ -313,6 +313,8 @@ mod tests {
             cache_ttl: Duration::from_secs(60),
             job_retention: Duration::from_secs(60),
             spill: None,
+            database: crate::engine::archive::IN_MEMORY.to_string(),
+            history_retention: Duration::from_secs(3600),
         };
         let cache = Arc::new(MemoryCache::for_engine(&config));
         let solver = Solver::new(&config, Metrics::noop(), cache);

@@ -12,8 +12,9 @@ use std::sync::Arc;
 use bytes::Bytes;
 use uuid::Uuid;
 
+use async_trait::async_trait;
+
 use super::cache::Solved;
-use super::fleet::StoredResult;
 use crate::job::registry::KindName;
 use crate::render::Format;
 
@@ -101,7 +102,59 @@ impl Drop for Spilled {
     }
 }
 
-/// Where a job's result is: in memory, spilled to disk, or in the fleet's Redis.
+/// Where a result kept outside this process's memory is: the fleet's Redis, or the database
+/// of saved analyses.
+#[async_trait]
+pub trait ResultPlace: Send + Sync {
+    /// The answer as JSON (`json`) or CSV (`csv`).
+    async fn body(&self, field: &str) -> io::Result<Bytes>;
+}
+
+/// A finished job's result kept outside this process's memory: status reads never carry it;
+/// a client asking for it gets the one form it asks for.
+#[derive(Clone)]
+pub struct StoredResult {
+    /// The job's cache key.
+    pub key: String,
+    /// The job's kind (which draws its picture).
+    pub kind: KindName,
+    /// Whether the answer is whole (see [`Solved::complete`]).
+    pub complete: bool,
+    place: Arc<dyn ResultPlace>,
+}
+
+impl StoredResult {
+    pub fn new(
+        key: String,
+        kind: KindName,
+        complete: bool,
+        place: Arc<dyn ResultPlace>,
+    ) -> StoredResult {
+        StoredResult {
+            key,
+            kind,
+            complete,
+            place,
+        }
+    }
+
+    /// The answer as JSON (`json`) or CSV (`csv`).
+    pub async fn body(&self, field: &str) -> io::Result<Bytes> {
+        self.place.body(field).await
+    }
+}
+
+impl std::fmt::Debug for StoredResult {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("StoredResult")
+            .field("key", &self.key)
+            .field("complete", &self.complete)
+            .finish()
+    }
+}
+
+/// Where a job's result is: in memory, spilled to disk, or stored (in the fleet's Redis or
+/// the database of saved analyses).
 #[derive(Clone, Debug)]
 pub enum JobResult {
     Ready(Arc<Solved>),

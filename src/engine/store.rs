@@ -5,7 +5,7 @@
 
 use std::collections::{HashMap, VecDeque};
 use std::sync::{Arc, Mutex, MutexGuard};
-use std::time::{Duration, Instant};
+use std::time::{Duration, SystemTime};
 
 use async_trait::async_trait;
 use serde::Serialize;
@@ -31,6 +31,15 @@ pub enum JobStatus {
 }
 
 impl JobStatus {
+    pub const ALL: [JobStatus; 6] = [
+        JobStatus::Queued,
+        JobStatus::Running,
+        JobStatus::Succeeded,
+        JobStatus::Failed,
+        JobStatus::Cancelled,
+        JobStatus::Interrupted,
+    ];
+
     pub fn as_str(self) -> &'static str {
         match self {
             JobStatus::Queued => "queued",
@@ -141,26 +150,124 @@ pub struct JobRecord {
     /// Work done when the record was last written (a running job's own count is live in
     /// the process that runs it).
     pub done: usize,
+    /// The hash of the job's canonical input (its cache key): equal inputs, equal answers.
+    pub input_hash: String,
+    /// Who submitted it, if they said ([`Owner`]): the jobs listed to them.
+    pub owner: Option<Owner>,
+    /// When it was accepted (wall clock: it is shown, and compared across processes).
+    pub submitted_at: SystemTime,
     /// When it finished, once it has.
-    pub finished_at: Option<Instant>,
+    pub finished_at: Option<SystemTime>,
 }
 
 impl JobRecord {
-    /// A job just accepted, whose id is `id`.
-    pub fn queued(id: Uuid, kind: KindName, work: Work) -> JobRecord {
+    /// A job just accepted, whose id is `id`, on the input whose hash is `input_hash`.
+    pub fn queued(id: Uuid, kind: KindName, work: Work, input_hash: &str) -> JobRecord {
         JobRecord {
             id,
             kind,
             work,
             state: JobState::Queued,
             done: 0,
+            input_hash: input_hash.to_string(),
+            owner: None,
+            submitted_at: SystemTime::now(),
             finished_at: None,
         }
     }
 
-    fn expired(&self, retention: Duration, now: Instant) -> bool {
-        self.finished_at
-            .is_some_and(|t| now.duration_since(t) >= retention)
+    /// The same record, owned by `owner`.
+    pub fn owned_by(self, owner: Option<Owner>) -> JobRecord {
+        JobRecord { owner, ..self }
+    }
+
+    fn expired(&self, retention: Duration, now: SystemTime) -> bool {
+        self.finished_at.is_some_and(|t| age(t, now) >= retention)
+    }
+
+    /// Whether the record passes `listing`'s filters (its owner aside).
+    pub fn listed_in(&self, listing: &Listing) -> bool {
+        listing.kind.is_none_or(|kind| kind == self.kind)
+            && listing
+                .status
+                .is_none_or(|status| status == self.state.status())
+    }
+}
+
+/// `time` in milliseconds since the Unix epoch: how times are stored and shared.
+pub fn unix_millis(time: SystemTime) -> u64 {
+    let since = time
+        .duration_since(std::time::UNIX_EPOCH)
+        .unwrap_or_default();
+    u64::try_from(since.as_millis()).unwrap_or(u64::MAX)
+}
+
+/// The time `unix_ms` milliseconds after the Unix epoch.
+pub fn from_unix_millis(unix_ms: u64) -> SystemTime {
+    std::time::UNIX_EPOCH + Duration::from_millis(unix_ms)
+}
+
+/// How long before `now` the time `then` was (none if it is not before).
+pub fn age(then: SystemTime, now: SystemTime) -> Duration {
+    now.duration_since(then).unwrap_or_default()
+}
+
+/// Who submitted a job: the SHA-256 of a token only its holder knows (the dashboard keeps a
+/// random one in the browser's storage), so that the list of a holder's jobs is shown to
+/// that holder alone, and the stored form cannot be replayed to list them.
+#[derive(Clone, Debug, PartialEq, Eq, Hash)]
+pub struct Owner(String);
+
+impl Owner {
+    /// The owner holding `token` (checked by the caller).
+    pub fn of_token(token: &str) -> Owner {
+        use sha2::{Digest, Sha256};
+        let digest = Sha256::digest(token.as_bytes());
+        Owner(digest.iter().map(|b| format!("{b:02x}")).collect())
+    }
+
+    /// An owner as stored (the hash).
+    pub fn stored(hash: String) -> Owner {
+        Owner(hash)
+    }
+
+    /// The stored form: 64 hexadecimal digits.
+    pub fn as_str(&self) -> &str {
+        &self.0
+    }
+}
+
+/// Which of an owner's jobs to list: newest first, filtered, a page of them.
+#[derive(Clone, Debug)]
+pub struct Listing {
+    pub owner: Owner,
+    pub kind: Option<KindName>,
+    pub status: Option<JobStatus>,
+    /// Jobs skipped (the pages before).
+    pub offset: usize,
+    /// Jobs on the page at most.
+    pub limit: usize,
+}
+
+/// A page of an owner's jobs.
+#[derive(Clone, Debug, Default)]
+pub struct Page {
+    pub jobs: Vec<JobRecord>,
+    /// The owner's jobs that pass the filters, on every page.
+    pub total: usize,
+}
+
+impl Page {
+    /// The page `listing` asks for, out of `matching` (every job passing its filters,
+    /// newest first).
+    pub fn of(matching: Vec<JobRecord>, listing: &Listing) -> Page {
+        let total = matching.len();
+        let jobs = matching
+            .into_iter()
+            .skip(listing.offset)
+            .take(listing.limit)
+            .collect();
+        Page { jobs, total }
     }
 }
 
@@ -199,12 +306,21 @@ pub trait JobStore: Send + Sync {
     async fn remove(&self, id: Uuid);
     /// Forgets the jobs past their retention; returns how many.
     async fn purge_expired(&self) -> usize;
+    /// The jobs of `listing`'s owner, newest first, filtered and paged; an error says why
+    /// the store cannot be read.
+    async fn list(&self, listing: &Listing) -> Result<Page, String>;
+    /// The newest job that succeeded on the input whose hash is `input_hash`.
+    async fn with_input(&self, input_hash: &str) -> Option<JobRecord>;
 
     /// Whether every process of the fleet shares the store (so any of them answers for any
     /// job, and a job unknown to it is unknown to all).
     fn shared(&self) -> bool {
         false
     }
+
+    /// Whether the store outlives the process (a database file, Redis): a job of an earlier
+    /// run that it does not know was deleted or expired, not lost with that run.
+    fn durable(&self) -> bool;
 }
 
 /// Where a job's result will be kept.
@@ -268,7 +384,7 @@ impl Records {
     }
 
     /// Forgets the jobs past their retention.
-    fn purge(&mut self, retention: Duration, now: Instant) -> usize {
+    fn purge(&mut self, retention: Duration, now: SystemTime) -> usize {
         let expired: Vec<Uuid> = self
             .jobs
             .values()
@@ -285,11 +401,11 @@ impl Records {
 
     /// How long until the oldest finished job expires (and makes room), at most
     /// `retention`.
-    fn next_expiry(&self, retention: Duration, now: Instant) -> Duration {
+    fn next_expiry(&self, retention: Duration, now: SystemTime) -> Duration {
         self.finished
             .iter()
             .filter_map(|id| self.jobs.get(id)?.finished_at)
-            .map(|t| retention.saturating_sub(now.duration_since(t)))
+            .map(|t| retention.saturating_sub(age(t, now)))
             .min()
             .unwrap_or(retention)
     }
@@ -347,7 +463,7 @@ impl MemoryJobStore {
                 megabytes(self.spill_limit()),
                 megabytes(bytes),
             ),
-            retry_after: records.next_expiry(self.retention, Instant::now()),
+            retry_after: records.next_expiry(self.retention, SystemTime::now()),
         })
     }
 
@@ -387,10 +503,11 @@ fn megabytes(n: u64) -> String {
     format!("{:.1} MB", n as f64 / 1e6)
 }
 
-#[async_trait]
-impl JobStore for MemoryJobStore {
-    async fn insert(&self, record: JobRecord, result_bytes: u64) -> Result<(), Refusal> {
-        let now = Instant::now();
+/// The in-memory half of [`super::local::LocalJobStore`]: the [`JobStore`] calls that it
+/// answers alone.
+impl MemoryJobStore {
+    pub async fn insert(&self, record: JobRecord, result_bytes: u64) -> Result<(), Refusal> {
+        let now = SystemTime::now();
         let mut records = self.records();
         records.purge(self.retention, now);
         if records.jobs.len() >= self.max_jobs {
@@ -416,17 +533,17 @@ impl JobStore for MemoryJobStore {
         Ok(())
     }
 
-    async fn get(&self, id: Uuid) -> Option<JobRecord> {
+    pub async fn get(&self, id: Uuid) -> Option<JobRecord> {
         let mut records = self.records();
         let record = records.jobs.get(&id)?;
-        if record.expired(self.retention, Instant::now()) {
+        if record.expired(self.retention, SystemTime::now()) {
             records.forget(&id);
             return None;
         }
         Some(record.clone())
     }
 
-    async fn update(&self, id: Uuid, state: JobState, done: usize) {
+    pub async fn update(&self, id: Uuid, state: JobState, done: usize) {
         let finishing = state.status().is_finished();
         // The room made for the result, taken once: by the update that finishes the job.
         let reservation = if finishing {
@@ -457,7 +574,7 @@ impl JobStore for MemoryJobStore {
         };
         let finished = finishing && record.finished_at.is_none();
         if finished {
-            record.finished_at = Some(Instant::now());
+            record.finished_at = Some(SystemTime::now());
         }
         record.state = state;
         record.done = done;
@@ -466,12 +583,12 @@ impl JobStore for MemoryJobStore {
         }
     }
 
-    async fn remove(&self, id: Uuid) {
+    pub async fn remove(&self, id: Uuid) {
         self.records().forget(&id);
     }
 
-    async fn purge_expired(&self) -> usize {
-        self.records().purge(self.retention, Instant::now())
+    pub async fn purge_expired(&self) -> usize {
+        self.records().purge(self.retention, SystemTime::now())
     }
 }
 
@@ -521,6 +638,7 @@ mod tests {
             Uuid::new_v4(),
             KindName::of::<crate::job::RollingJob>(),
             Work::Known(1),
+            "k",
         )
     }
 

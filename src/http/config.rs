@@ -64,9 +64,22 @@ pub struct ServeArgs {
     #[arg(long, env = "THIRDBODY_CACHE_TTL", default_value = "1h", value_parser = duration)]
     pub cache_ttl: Duration,
 
-    /// How long a finished asynchronous job is kept for its client to collect.
+    /// How long a finished asynchronous job's result stays in memory for its client to
+    /// collect; after that it is read from the database (--database).
     #[arg(long, env = "THIRDBODY_JOB_RETENTION", default_value = "15m", value_parser = duration)]
     pub job_retention: Duration,
+
+    /// The database of saved analyses: every job and its result, listed at GET /v1/jobs and
+    /// kept across restarts (an SQLite file, made if missing, one process per file;
+    /// `:memory:` keeps them only while the process runs). Unused in a fleet, whose
+    /// history is in Redis.
+    #[arg(long, env = "THIRDBODY_DATABASE", default_value = "thirdbody.db")]
+    pub database: String,
+
+    /// How long finished jobs and their results are kept in the history (the database, or
+    /// Redis in a fleet), e.g. 30days, 12h.
+    #[arg(long, env = "THIRDBODY_HISTORY_RETENTION", default_value = "30days", value_parser = duration)]
+    pub history_retention: Duration,
 
     /// Where the results of finished jobs that do not fit in the memory budget are kept: a
     /// directory of this process's is made there, and removed when it stops. Default: the
@@ -332,6 +345,7 @@ impl ServeArgs {
             ("--job-deadline", self.job_deadline, false),
             ("--cache-ttl", self.cache_ttl, false),
             ("--job-retention", self.job_retention, false),
+            ("--history-retention", self.history_retention, false),
             ("--shutdown-timeout", self.shutdown_timeout, false),
             ("--drain-delay", self.drain_delay, true),
         ] {
@@ -389,6 +403,8 @@ impl ServeArgs {
                 max_jobs: self.max_jobs,
                 cache_ttl: self.cache_ttl,
                 job_retention: self.job_retention,
+                database: self.database,
+                history_retention: self.history_retention,
                 spill,
             },
             limits: Limits {

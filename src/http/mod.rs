@@ -66,17 +66,12 @@ struct Inner {
 
 impl AppState {
     /// A service with its own engine, its answers and jobs in its own memory (and spill
-    /// directory) or its fleet's Redis, and its own metrics registry; or why it cannot start.
+    /// directory and database) or its fleet's Redis, and its own metrics registry; or why it
+    /// cannot start.
     pub fn new(config: Config) -> Result<Self, String> {
         let storage = match &config.fleet {
             Some(fleet) => crate::engine::fleet::storage(&config.engine, fleet.clone())?,
-            None => Storage::in_process(&config.engine).map_err(|e| {
-                let dir = config.engine.spill.as_ref().map(|(dir, _)| dir.display());
-                format!(
-                    "cannot make the results' spill directory in {}: {e}",
-                    dir.map_or_else(String::new, |d| d.to_string())
-                )
-            })?,
+            None => Storage::in_process(&config.engine)?,
         };
         Ok(AppState::with_storage(config, storage))
     }

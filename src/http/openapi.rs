@@ -69,7 +69,9 @@ fn document_validators(spec: &mut Spec) {
             if let Some(RefOr::T(ok)) = responses.get_mut("200") {
                 let etag = "The cache key of the answer, quoted; suffixed `.csv` for CSV";
                 ok.headers.insert("etag".to_string(), header(etag));
-                if operation.operation_id.as_deref() != Some("get_job_result") {
+                // A result read back was solved before: it has no cache status.
+                let read_back = ["get_job_result", "get_result_by_input"];
+                if !read_back.contains(&operation.operation_id.as_deref().unwrap_or_default()) {
                     let cache = "`hit` (from the cache) or `miss` (solved for this request)";
                     ok.headers.insert("x-cache".to_string(), header(cache));
                 }

@@ -11,6 +11,7 @@ use utoipa::openapi::{ContentBuilder, Ref, RefOr, Response};
 use utoipa::IntoResponses;
 
 use super::error::PROBLEM_JSON;
+use crate::job::registry::AnyOutput;
 
 /// A response whose body is a [`Problem`].
 fn problem(description: &str, retry_after: bool) -> RefOr<Response> {
@@ -51,6 +52,13 @@ const INVALID_INPUT: &str = "invalid-input: fields of the wrong shape or out of 
     named in `errors` with its value and the allowed range";
 
 problems!(
+    /// Errors of a request's query or headers.
+    InvalidQuery {
+        (422, INVALID_INPUT, false),
+    }
+);
+
+problems!(
     /// Errors of a request body.
     BadBody {
         (400, "malformed-json: the body is not JSON", false),
@@ -61,6 +69,31 @@ problems!(
             it, with its numbers)"), false),
     }
 );
+
+/// The 200 of an answer read back (a job's result, an input's answer): its JSON, its CSV or
+/// its picture.
+pub enum ReadBack {}
+
+impl IntoResponses for ReadBack {
+    fn responses() -> BTreeMap<String, RefOr<Response>> {
+        let text = || {
+            ContentBuilder::new()
+                .schema(Some(ObjectBuilder::new().schema_type(Type::String)))
+                .build()
+        };
+        // Inline: one of the kinds' outputs, each a component of its kind's endpoint.
+        let json = ContentBuilder::new()
+            .schema(Some(<AnyOutput as utoipa::PartialSchema>::schema()))
+            .build();
+        let response = ResponseBuilder::new()
+            .description("The answer, or its picture")
+            .content("application/json", json)
+            .content("text/csv", text())
+            .content("image/svg+xml", text())
+            .build();
+        BTreeMap::from([("200".to_string(), response.into())])
+    }
+}
 
 /// The 422 of `POST /v1/checks`: checks that failed, or a checks document that is not valid.
 /// Listed after [`BadBody`] in the route's responses, whose 422 it replaces (a later entry

@@ -22,9 +22,19 @@ pub struct TestApp {
     pub server: JoinHandle<std::io::Result<()>>,
 }
 
-/// The validated settings of `thirdbody serve` with these flags.
+/// The validated settings of `thirdbody serve` with these flags; the database of saved
+/// analyses in memory unless the flags name one (tests run side by side, and a file is
+/// one process's).
 pub fn config(flags: &[&str]) -> Config {
-    let args = std::iter::once("serve").chain(flags.iter().copied());
+    let memory = ["--database", ":memory:"];
+    let database = if flags.contains(&"--database") {
+        &[][..]
+    } else {
+        &memory[..]
+    };
+    let args = std::iter::once("serve")
+        .chain(database.iter().copied())
+        .chain(flags.iter().copied());
     ServeArgs::try_parse_from(args)
         .expect("valid flags")
         .validate()

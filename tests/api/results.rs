@@ -22,8 +22,8 @@ async fn the_largest_sweep_the_defaults_allow_is_kept_whole_compact_and_compress
     let job = app
         .wait_for_job(&location, |j| j["status"] == "succeeded")
         .await;
-    // The view is small: it links to the answer.
-    assert!(job.to_string().len() < 300, "{job}");
+    // The view is small (its id, hash and times): it links to the answer.
+    assert!(job.to_string().len() < 400, "{job}");
     let response = app.get(job["result_url"].as_str().unwrap()).await;
     assert_eq!(response.status(), 200);
     let etag = response.headers()["etag"].to_str().unwrap().to_string();

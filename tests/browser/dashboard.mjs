@@ -2,7 +2,8 @@
 // playwright-core against `thirdbody serve` on a port the system chooses. Fails on a console
 // error or on any request that leaves the server. Screenshots go to target/browser/.
 import { spawn } from "node:child_process";
-import { mkdirSync } from "node:fs";
+import { mkdirSync, mkdtempSync, rmSync } from "node:fs";
+import { tmpdir } from "node:os";
 import { chromium } from "playwright-core";
 
 const root = new URL("../../", import.meta.url).pathname;
@@ -15,9 +16,9 @@ function fail(message) {
   process.exitCode = 1;
 }
 
-/** Starts the service on 127.0.0.1:0 (with `flags`) and resolves with its base URL (from its log). */
-function serve(flags = []) {
-  const child = spawn(bin, ["serve", "--bind", "127.0.0.1:0", "--log-format", "json", ...flags], {
+/** Starts the service on `bind` (with `flags`) and resolves with its base URL (from its log). */
+function serve(flags = [], bind = "127.0.0.1:0") {
+  const child = spawn(bin, ["serve", "--bind", bind, "--log-format", "json", ...flags], {
     stdio: ["ignore", "ignore", "pipe"],
   });
   return new Promise((resolve, reject) => {
@@ -31,13 +32,27 @@ function serve(flags = []) {
   });
 }
 
+/** Stops `child` as an operator would (SIGTERM, the drain) and resolves when it has exited. */
+function stop(child) {
+  return new Promise((resolve) => {
+    child.on("exit", resolve);
+    child.kill("SIGTERM");
+  });
+}
+
 // Every process this test starts, stopped at its end whatever happens.
 const started = [];
-process.on("exit", () => started.forEach((child) => child.kill()));
-const { child, base } = await serve();
+const data = mkdtempSync(`${tmpdir()}/thirdbody-dashboard-`);
+process.on("exit", () => {
+  started.forEach((child) => child.kill());
+  rmSync(data, { recursive: true, force: true });
+});
+// The database of saved analyses in a file, as `thirdbody serve` keeps it by default.
+const database = ["--database", `${data}/analyses.db`];
+const { child, base } = await serve(database);
 started.push(child);
 // A second service whose jobs must end within 300 ms: a long sweep there fails.
-const strict = await serve(["--job-deadline", "300ms"]);
+const strict = await serve(["--job-deadline", "300ms", "--database", ":memory:"]);
 started.push(strict.child);
 // The answer area of a tab's panel, and a part of it.
 const area = (panel, part = "") => `#panel-${panel} .answer-area${part ? " ." + part : ""}`;
@@ -322,11 +337,60 @@ try {
   await page.keyboard.press("Tab");
   const focused = await page.evaluate(() => document.activeElement.tagName);
   if (!["A", "BUTTON", "INPUT"].includes(focused)) fail(`Tab focuses a ${focused}`);
-  await page.getByRole("tab", { name: "Figures 3–9" }).focus();
+  await page.getByRole("tab", { name: "History" }).focus();
   await page.keyboard.press("ArrowRight");
   const wrapped = await page.evaluate(() => [document.activeElement.id, document.activeElement.getAttribute("aria-selected")]);
   if (wrapped[0] !== "tab-rolling" || wrapped[1] !== "true") fail(`ArrowRight from the last tab reaches ${wrapped}`);
   if (await page.locator("#panel-rolling").isHidden()) fail("the rolling panel stays hidden when its tab is selected by key");
+
+  // The history: every sweep and fit run above, newest first, filtered by kind.
+  await page.getByRole("tab", { name: "History" }).click();
+  await page.waitForFunction(() => document.querySelectorAll("#history-jobs tbody tr").length > 5);
+  const listedRows = () => page.$$eval("#history-jobs tbody tr", (rows) => rows.map((r) => ({
+    id: r.dataset.id, kind: r.cells[1].textContent, status: r.cells[2].textContent, points: r.cells[3].textContent })));
+  const listed = await listedRows();
+  if (listed[0].kind !== "fit" || listed[0].status !== "succeeded") fail(`the newest job listed is ${JSON.stringify(listed[0])}, not the fit`);
+  const cancelledRow = listed.find((r) => r.kind === "sweep" && r.status.startsWith("cancelled"));
+  const bigSweep = listed.find((r) => r.kind === "sweep" && r.points === "200 / 200");
+  if (!cancelledRow || !bigSweep) fail(`the cancelled sweep or the 200-point one is not listed: ${JSON.stringify(listed)}`);
+  const shown = await page.locator("#history-count").textContent();
+  if (shown !== `${listed.length} of ${listed.length} jobs shown.`) fail(`the history's count reads ${shown}`);
+  await page.selectOption("#history-kind", "fit");
+  await page.waitForFunction(() => {
+    const rows = [...document.querySelectorAll("#history-jobs tbody tr")];
+    return rows.length && rows.every((r) => r.cells[1].textContent === "fit");
+  });
+  await page.selectOption("#history-kind", "");
+  await page.waitForFunction((n) => document.querySelectorAll("#history-jobs tbody tr").length === n, listed.length);
+
+  // Across a restart (the same database and port, so the same origin and its token): the
+  // fit's link opens it, the history lists the same jobs, their answers download.
+  const address = new URL(base).host;
+  await stop(child);
+  const restarted = await serve(database, address);
+  started.push(restarted.child);
+  await page.goto("about:blank");
+  await page.goto(`${base}/#job=${listed[0].id}`);
+  await page.waitForFunction((s) => [...document.querySelectorAll(`${s} .table tr`)].some((r) => r.textContent.startsWith("parameters.elastic_modulus.value")), area("history"), { timeout: 30000 });
+  const reopened = await page.locator(`${area("history", "table")} tr`, { hasText: "parameters.elastic_modulus.value" }).first().textContent();
+  if (!/2\.53\d*\s*GPa/.test(reopened)) fail(`the reopened fit's modulus reads ${reopened}`);
+  if (await page.locator("#panel-history").isHidden()) fail("a job's link does not show the history");
+  await page.waitForFunction((n) => document.querySelectorAll("#history-jobs tbody tr").length === n, listed.length);
+  const relisted = await listedRows();
+  if (relisted.map((r) => r.id).join() !== listed.map((r) => r.id).join()) fail("the history after the restart is not the one before");
+  const csvLink = await page.locator(`#history-jobs tbody tr[data-id='${bigSweep.id}'] a`, { hasText: "CSV" }).getAttribute("href");
+  const csv = await page.request.get(`${base}${csvLink}`);
+  const csvLines = (await csv.text()).trim().split("\n");
+  if (csv.status() !== 200 || !csvLines[0].startsWith("radius [m]") || csvLines.length !== 201) fail(`the 200-point sweep's CSV after the restart: ${csv.status()}, ${csvLines.length} lines`);
+  await page.locator(`#history-jobs tbody tr[data-id='${bigSweep.id}']`).getByRole("button", { name: "Open" }).click();
+  await page.waitForSelector(`${area("history", "picture")} svg.plot`);
+  if (!(await page.evaluate(() => location.hash)).endsWith(bigSweep.id)) fail("opening a job does not put its link in the address");
+  await page.screenshot({ path: `${shots}/history.png`, fullPage: true });
+  // Deleted (after a confirmation): gone from the list, and from the service.
+  page.once("dialog", (dialog) => dialog.accept());
+  await page.locator(`#history-jobs tbody tr[data-id='${cancelledRow.id}']`).getByRole("button", { name: "Delete" }).click();
+  await page.waitForFunction((n) => document.querySelectorAll("#history-jobs tbody tr").length === n, listed.length - 1);
+  if ((await page.request.get(`${base}/v1/jobs/${cancelledRow.id}`)).status() !== 404) fail("a deleted job is still served");
 
   // A job that cannot end within the server's deadline fails: the bar and the status say so.
   const second = await browser.newPage({ viewport: { width: 1366, height: 900 } });
@@ -353,7 +417,7 @@ try {
   // The negative load (422), the unknown job's events and its record (404 each).
   if (refusals.sort().join() !== "404,404,422") fail(`refused requests: ${refusals.join()}`);
   if (outside.length) fail(`requests left the server: ${outside.join(", ")}`);
-  if (!process.exitCode) console.log(`dashboard: rolling (both laws, compared, a Prony series), three-body (both laws), an error after a success, a 200-point sweep sorted and explored (hover, zoom, log, heat map), a one-point and a three-body sweep, a refused point, a cancelled, a failed and an unknown job, every three-body input, copy as Python, a fit from an uploaded CSV and a bad CSV, Figure 6 and the tabs by keyboard work; screenshots in ${shots}`);
+  if (!process.exitCode) console.log(`dashboard: rolling (both laws, compared, a Prony series), three-body (both laws), an error after a success, a 200-point sweep sorted and explored (hover, zoom, log, heat map), a one-point and a three-body sweep, a refused point, a cancelled, a failed and an unknown job, every three-body input, copy as Python, a fit from an uploaded CSV and a bad CSV, Figure 6, the history across a restart (listed, filtered, reopened by link, downloaded, deleted) and the tabs by keyboard work; screenshots in ${shots}`);
 } finally {
   await browser.close();
   started.forEach((child) => child.kill());

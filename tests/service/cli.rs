@@ -226,6 +226,20 @@ fn the_container_configuration_starts_a_service_that_drains_on_sigterm() {
     assert!(text.contains("ENTRYPOINT [\"thirdbody\"]") && text.contains("CMD [\"serve\"]"));
     let bind = &env.iter().find(|(k, _)| k == "THIRDBODY_BIND").unwrap().1;
     assert!(text.contains(&format!("EXPOSE {}", bind.rsplit(':').next().unwrap())));
+    // The database of saved analyses is in the image's volume, which its user may write.
+    let database = &env
+        .iter()
+        .find(|(k, _)| k == "THIRDBODY_DATABASE")
+        .unwrap()
+        .1;
+    assert!(database.starts_with("/var/lib/thirdbody/"), "{database}");
+    assert!(
+        text.contains("VOLUME /var/lib/thirdbody")
+            && text.contains("chown thirdbody /var/lib/thirdbody")
+    );
+    // Here, in a directory of the test's (made by the service, as the volume would be).
+    let volume = std::env::temp_dir().join(format!("thirdbody-volume-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&volume);
 
     // The same settings, listening on a free loopback port instead of 0.0.0.0:8080.
     let port = std::net::TcpListener::bind("127.0.0.1:0")
@@ -238,6 +252,7 @@ fn the_container_configuration_starts_a_service_that_drains_on_sigterm() {
         .envs(env.iter().map(|(k, v)| (k.as_str(), v.as_str())))
         .env("THIRDBODY_BIND", format!("127.0.0.1:{port}"))
         .env("THIRDBODY_DRAIN_DELAY", "0s")
+        .env("THIRDBODY_DATABASE", volume.join("thirdbody.db"))
         .stdout(Stdio::null())
         .stderr(Stdio::piped())
         .spawn()
@@ -289,6 +304,11 @@ fn the_container_configuration_starts_a_service_that_drains_on_sigterm() {
             .any(|l| l.starts_with('{') && l.contains("listening")),
         "{logs}"
     );
+    assert!(
+        volume.join("thirdbody.db").is_file(),
+        "no database in the volume"
+    );
+    let _ = std::fs::remove_dir_all(&volume);
 }
 
 /// POSTs the JSON `body` to `path`; the answer's status line and body.
@@ -323,6 +343,8 @@ fn ctrl_c_says_what_the_drain_waits_for_and_a_second_exits_at_once() {
         let mut child = Command::new(env!("CARGO_BIN_EXE_thirdbody"))
             .args(["serve", "--bind", &format!("127.0.0.1:{port}")])
             .args(["--log-format", format, "--shutdown-timeout", "30s"])
+            // Without a database file: its results would outlive the process.
+            .args(["--database", ":memory:"])
             .env("THIRDBODY_DRAIN_DELAY", "0s")
             .env("RUST_LOG", "info")
             .stdout(Stdio::null())

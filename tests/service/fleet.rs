@@ -506,6 +506,8 @@ async fn a_worker_on_its_own_takes_a_job_from_the_stream_and_stores_its_answer()
         cache_ttl: minute,
         job_retention: minute,
         spill: None,
+        database: thirdbody::engine::archive::IN_MEMORY.to_string(),
+        history_retention: Duration::from_secs(3600),
     };
     let fleet = Arc::new(
         Fleet::open(FleetConfig {
@@ -529,7 +531,7 @@ async fn a_worker_on_its_own_takes_a_job_from_the_stream_and_stores_its_answer()
     .unwrap()
     .keyed();
     let job = keyed.job();
-    let record = JobRecord::queued(uuid::Uuid::new_v4(), job.kind(), job.work());
+    let record = JobRecord::queued(uuid::Uuid::new_v4(), job.kind(), job.work(), keyed.key());
     let deadline = std::time::SystemTime::now() + minute;
     store
         .enqueue(&record, &job.to_wire(), keyed.key(), deadline, &[])

@@ -255,7 +255,7 @@ async fn a_slow_redis_sends_synchronous_solves_to_the_process_and_readyz_says_wh
 }
 
 /// A sweep on the layer as a continuum: 240 points of ~25 ms, in parts of 20 points.
-fn long_sweep() -> Value {
+pub(crate) fn long_sweep() -> Value {
     let speeds: Vec<String> = (0..60)
         .map(|i| format!("{} nm/s", 0.1 + 0.1 * f64::from(i)))
         .collect();

@@ -8,6 +8,7 @@ mod fit;
 mod fit_continuum;
 mod fleet;
 mod fleet_faults;
+mod history;
 mod honest_answers;
 mod jobs;
 mod kinds;

@@ -20,7 +20,7 @@ use std::time::Duration;
 
 pub use cache::TieredCache;
 pub use link::{Failure, Health, Link};
-pub use store::{RedisJobStore, StoredResult};
+pub use store::RedisJobStore;
 pub use worker::{Shared, Worker};
 
 use super::cache::MemoryCache;
@@ -65,6 +65,16 @@ mod keys {
     /// their total under `total`), which bound the cache's share of the server.
     pub const ANSWERS_BY_AGE: &str = "thirdbody:answers:by-age";
     pub const ANSWER_SIZES: &str = "thirdbody:answers:sizes";
+
+    /// The jobs of an owner (its hash), scored by their submission (Unix ms).
+    pub fn owner(owner: &str) -> String {
+        format!("thirdbody:owner:{owner}")
+    }
+
+    /// The newest job that succeeded on the input whose hash is `input_hash`.
+    pub fn input(input_hash: &str) -> String {
+        format!("thirdbody:input:{input_hash}")
+    }
 
     /// The fleet-wide claim on solving `key`.
     pub fn solving(key: &str) -> String {
@@ -174,9 +184,10 @@ impl Fleet {
 pub fn storage(config: &EngineConfig, fleet: FleetConfig) -> Result<Storage, String> {
     let fleet = Arc::new(Fleet::open(fleet)?);
     let l1 = MemoryCache::for_engine(config);
+    // A fleet's finished jobs are its history: kept in Redis for the history's retention.
     let store = Arc::new(RedisJobStore::new(
         fleet.clone(),
-        config.job_retention,
+        config.history_retention,
         config.job_deadline,
     ));
     Ok(Storage {

@@ -6,7 +6,7 @@
 
 use std::collections::HashMap;
 use std::ops::Range;
-use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
+use std::time::{Duration, Instant, SystemTime};
 
 use async_trait::async_trait;
 use bytes::Bytes;
@@ -15,8 +15,11 @@ use uuid::Uuid;
 
 use super::cache::millis;
 use super::{keys, Failure, Fleet};
-use crate::engine::spill::JobResult;
-use crate::engine::store::{JobRecord, JobState, JobStatus, JobStore, Refusal};
+use crate::engine::spill::{JobResult, ResultPlace, StoredResult};
+pub(super) use crate::engine::store::unix_millis;
+use crate::engine::store::{
+    from_unix_millis, JobRecord, JobState, JobStatus, JobStore, Listing, Owner, Page, Refusal,
+};
 use crate::job::parts::RenderedPart;
 use crate::job::registry::KindName;
 use crate::job::{JobError, Work};
@@ -27,9 +30,11 @@ use std::sync::Arc;
 /// through the script's arguments), drops the parts and starts the retention of every key of
 /// the job; a state refused drops the staged result.
 ///
-/// KEYS: record, result, parts, deliveries, staged result. ARGV: status, done, error,
-/// retention (ms), now (Unix ms), whether a staged result is whole (`whole`/`partial`), and
-/// its cache key.
+/// A job that succeeded becomes its input's newest answer (for the input's stable link).
+///
+/// KEYS: record, result, parts, deliveries, staged result, the input's pointer. ARGV:
+/// status, done, error, retention (ms), now (Unix ms), whether a staged result is whole
+/// (`whole`/`partial`), its cache key, and the job's id.
 const UPDATE: &str = r#"
 local current = redis.call('HGET', KEYS[1], 'status')
 if current ~= 'queued' and current ~= 'running' then
@@ -47,6 +52,9 @@ if ARGV[1] ~= 'queued' and ARGV[1] ~= 'running' then
   redis.call('HSET', KEYS[1], 'finished_at', ARGV[5])
   redis.call('DEL', KEYS[3])
   for i = 1, 4 do redis.call('PEXPIRE', KEYS[i], ARGV[4]) end
+  if ARGV[1] == 'succeeded' and ARGV[7] ~= '' then
+    redis.call('SET', KEYS[6], ARGV[8], 'PX', ARGV[4])
+  end
 end
 return 1
 "#;
@@ -84,6 +92,15 @@ if tonumber(redis.call('HGET', KEYS[1], 'parts_done')) < parts then
 end
 return 1
 "#;
+
+/// Deletes an input's pointer to a job (ARGV: its id) unless it points to another since.
+const FORGET_POINTER: &str = r#"
+if redis.call('GET', KEYS[1]) == ARGV[1] then redis.call('DEL', KEYS[1]) end
+return 0
+"#;
+
+/// The most jobs of one owner listed: the newest.
+const LISTED: isize = 10_000;
 
 /// A script run inside a transaction: `EVAL` with its text, so that it needs no loading.
 pub(super) fn eval(script: &str, keys: &[&str], args: &[&[u8]]) -> Cmd {
@@ -145,21 +162,18 @@ impl RedisJobStore {
         let mut pipe = redis::pipe();
         // Borrowed where they can be: the job's text may be long (a fit's data).
         let deadline = unix_millis(deadline);
-        let (work, deadline_text) = (work_text(record.work), deadline.to_string());
+        let deadline_text = deadline.to_string();
         let count = parts.len().max(1).to_string();
-        let fields: [(&str, &str); 9] = [
-            ("kind", record.kind.name()),
-            ("work", &work),
+        let fields: [(&str, &str); 5] = [
             ("status", JobStatus::Queued.as_str()),
-            ("done", "0"),
             ("job", wire),
             ("key", key),
             ("deadline", &deadline_text),
             ("parts", &count),
-            ("parts_done", "0"),
         ];
-        pipe.atomic()
-            .hset_multiple(&job.record, &fields)
+        pipe.atomic();
+        self.record_fields(&mut pipe, record);
+        pipe.hset_multiple(&job.record, &fields)
             .ignore()
             .cmd("PEXPIREAT")
             .arg(&job.record)
@@ -183,6 +197,32 @@ impl RedisJobStore {
             pipe.xadd(keys::STREAM, "*", &entry).ignore();
         }
         self.fleet.jobs.pipe::<()>(&pipe).await
+    }
+
+    /// Adds to `pipe` the fields every new record has (kind, work, progress, owner, time of
+    /// submission), and its place in its owner's list, which lives as long as its newest
+    /// job may.
+    fn record_fields(&self, pipe: &mut redis::Pipeline, record: &JobRecord) {
+        let key = keys::job(record.id).record;
+        let submitted = unix_millis(record.submitted_at);
+        let (work, submitted_text) = (work_text(record.work), submitted.to_string());
+        let owner = record.owner.as_ref().map_or("", Owner::as_str);
+        let fields: [(&str, &str); 6] = [
+            ("kind", record.kind.name()),
+            ("work", &work),
+            ("done", "0"),
+            ("parts_done", "0"),
+            ("owner", owner),
+            ("submitted", &submitted_text),
+        ];
+        pipe.hset_multiple(&key, &fields).ignore();
+        if let Some(owner) = &record.owner {
+            let list = keys::owner(owner.as_str());
+            pipe.zadd(&list, record.id.to_string(), submitted)
+                .ignore()
+                .pexpire(&list, millis(self.lifetime) as i64)
+                .ignore();
+        }
     }
 
     /// The status of job `id`; `None` if it is gone (deleted or expired). A running part's
@@ -349,8 +389,10 @@ impl RedisJobStore {
         let done = done.map(|n| n.to_string()).unwrap_or_default();
         let retention = millis(self.retention).to_string();
         let now = unix_millis(SystemTime::now()).to_string();
+        let input = super::keys::input(key);
+        let id = id.to_string();
         let mut all = keys.all().to_vec();
-        all.push(&keys.staged);
+        all.extend([keys.staged.as_str(), &input]);
         pipe.add_command(eval(
             UPDATE,
             &all,
@@ -362,29 +404,57 @@ impl RedisJobStore {
                 now.as_bytes(),
                 whole.as_bytes(),
                 key.as_bytes(),
+                id.as_bytes(),
             ],
         ));
         let (moved,): (i64,) = self.fleet.jobs.pipe(&pipe).await?;
         Ok(moved == 1)
     }
 
+    /// The fields a status needs: not the job's text, which may be long (a fit's data).
+    const FIELDS: [&'static str; 11] = [
+        "kind",
+        "work",
+        "status",
+        "done",
+        "key",
+        "result",
+        "error",
+        "finished_at",
+        "owner",
+        "submitted",
+        "deadline",
+    ];
+
     /// The record of job `id`, without its result (which stays in Redis until a client
     /// reads it: see [`StoredResult`]); `None` if unknown or expired.
     pub async fn record(&self, id: Uuid) -> Result<Option<JobRecord>, Failure> {
-        // The fields a status needs: not the job's text, which may be long (a fit's data).
-        const FIELDS: [&str; 8] = [
-            "kind",
-            "work",
-            "status",
-            "done",
-            "key",
-            "result",
-            "error",
-            "finished_at",
-        ];
-        let cmd = Cmd::hmget(keys::job(id).record, &FIELDS[..]);
+        let cmd = Cmd::hmget(keys::job(id).record, &Self::FIELDS[..]);
         let values: Vec<Option<Vec<u8>>> = self.fleet.jobs.query(&cmd).await?;
-        let fields: HashMap<&str, Vec<u8>> = FIELDS
+        self.parse(id, values).await
+    }
+
+    /// The records of jobs `ids` (`None` for those gone), read in one round trip.
+    async fn records(&self, ids: &[Uuid]) -> Result<Vec<Option<JobRecord>>, Failure> {
+        let mut pipe = redis::pipe();
+        for id in ids {
+            pipe.hmget(keys::job(*id).record, &Self::FIELDS[..]);
+        }
+        let all: Vec<Vec<Option<Vec<u8>>>> = self.fleet.jobs.pipe(&pipe).await?;
+        let mut records = Vec::with_capacity(ids.len());
+        for (id, values) in ids.iter().zip(all) {
+            records.push(self.parse(*id, values).await?);
+        }
+        Ok(records)
+    }
+
+    /// The record of job `id` from the values of [`Self::FIELDS`].
+    async fn parse(
+        &self,
+        id: Uuid,
+        values: Vec<Option<Vec<u8>>>,
+    ) -> Result<Option<JobRecord>, Failure> {
+        let fields: HashMap<&str, Vec<u8>> = Self::FIELDS
             .into_iter()
             .zip(values)
             .filter_map(|(name, value)| Some((name, value?)))
@@ -408,13 +478,15 @@ impl RedisJobStore {
         };
         // A result of a cancelled or failed job is what it finished before it stopped.
         let result = || match form.as_str() {
-            form @ ("whole" | "partial") => Some(JobResult::Stored(Arc::new(StoredResult {
-                fleet: self.fleet.clone(),
-                id,
-                key: text("key"),
+            form @ ("whole" | "partial") => Some(JobResult::Stored(Arc::new(StoredResult::new(
+                text("key"),
                 kind,
-                complete: form == "whole",
-            }))),
+                form == "whole",
+                Arc::new(InRedis {
+                    fleet: self.fleet.clone(),
+                    id,
+                }),
+            )))),
             _ => None,
         };
         let state = match parse_status(&text("status")) {
@@ -436,14 +508,22 @@ impl RedisJobStore {
                 )),
             },
         };
-        let finished_at = text("finished_at").parse().ok().map(instant_of);
+        let time = |name: &str| text(name).parse().ok().map(from_unix_millis);
+        let owner = Some(text("owner")).filter(|o| !o.is_empty());
         Ok(Some(JobRecord {
             id,
             kind,
             work,
             state,
             done: text("done").parse().unwrap_or(0),
-            finished_at,
+            input_hash: text("key"),
+            owner: owner.map(Owner::stored),
+            // A record of the version before submissions were timed: its deadline, which
+            // orders it among the others all the same.
+            submitted_at: time("submitted")
+                .or_else(|| time("deadline"))
+                .unwrap_or(std::time::UNIX_EPOCH),
+            finished_at: time("finished_at"),
         }))
     }
 
@@ -466,33 +546,15 @@ impl RedisJobStore {
     }
 }
 
-/// A finished job's result, left in Redis: status reads never carry it; a client asking for
-/// it gets the one form it asks for.
-#[derive(Clone)]
-pub struct StoredResult {
+/// A finished job's result, left in Redis.
+struct InRedis {
     fleet: Arc<Fleet>,
     id: Uuid,
-    /// The job's cache key.
-    pub key: String,
-    /// The job's kind (which draws its picture).
-    pub kind: KindName,
-    /// Whether the answer is whole (see [`crate::engine::cache::Solved::complete`]).
-    pub complete: bool,
 }
 
-impl std::fmt::Debug for StoredResult {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("StoredResult")
-            .field("id", &self.id)
-            .field("key", &self.key)
-            .field("complete", &self.complete)
-            .finish()
-    }
-}
-
-impl StoredResult {
-    /// The answer as JSON (`json`) or CSV (`csv`).
-    pub async fn body(&self, field: &str) -> std::io::Result<Bytes> {
+#[async_trait]
+impl ResultPlace for InRedis {
+    async fn body(&self, field: &str) -> std::io::Result<Bytes> {
         let cmd = Cmd::hget(keys::job(self.id).result, field);
         let body: Option<Vec<u8>> = self
             .fleet
@@ -512,17 +574,15 @@ impl JobStore for RedisJobStore {
     /// is made here.
     async fn insert(&self, record: JobRecord, _result_bytes: u64) -> Result<(), Refusal> {
         let fields = [
-            ("kind", record.kind.name().to_string()),
-            ("work", work_text(record.work)),
-            ("status", record.state.status().as_str().to_string()),
-            ("done", record.done.to_string()),
-            ("parts", "1".to_string()),
-            ("parts_done", "0".to_string()),
+            ("status", record.state.status().as_str()),
+            ("key", &record.input_hash),
+            ("parts", "1"),
         ];
         let key = keys::job(record.id).record;
         let mut pipe = redis::pipe();
-        pipe.atomic()
-            .hset_multiple(&key, &fields)
+        pipe.atomic();
+        self.record_fields(&mut pipe, &record);
+        pipe.hset_multiple(&key, &fields)
             .ignore()
             .pexpire(&key, millis(self.lifetime) as i64)
             .ignore();
@@ -542,9 +602,35 @@ impl JobStore for RedisJobStore {
         }
     }
 
+    /// Forgets the job's keys, its place in its owner's list, and its input's pointer to it.
     async fn remove(&self, id: Uuid) {
-        let cmd = Cmd::del(&keys::job(id).all()[..]);
-        let _ = self.fleet.jobs.query::<i64>(&cmd).await;
+        let job = keys::job(id);
+        let (owner, input): (Option<String>, Option<String>) = match self
+            .fleet
+            .jobs
+            .query(&Cmd::hmget(&job.record, &["owner", "key"][..]))
+            .await
+        {
+            Ok(fields) => fields,
+            Err(e) => {
+                tracing::warn!(error = %e, %id, "a job was not deleted");
+                return;
+            }
+        };
+        let id_text = id.to_string();
+        let mut pipe = redis::pipe();
+        pipe.atomic().del(&job.all()[..]).ignore();
+        if let Some(owner) = owner.filter(|o| !o.is_empty()) {
+            pipe.zrem(keys::owner(&owner), &id_text).ignore();
+        }
+        if let Some(input) = input {
+            let pointer = keys::input(&input);
+            pipe.add_command(eval(FORGET_POINTER, &[&pointer], &[id_text.as_bytes()]))
+                .ignore();
+        }
+        if let Err(e) = self.fleet.jobs.pipe::<()>(&pipe).await {
+            tracing::warn!(error = %e, %id, "a job was not deleted");
+        }
     }
 
     /// Redis forgets expired jobs by itself.
@@ -552,7 +638,47 @@ impl JobStore for RedisJobStore {
         0
     }
 
+    /// Reads every job in the owner's list (the newest [`LISTED`]), so that the filters and
+    /// the total are exact; jobs expired since are dropped from the list.
+    async fn list(&self, listing: &Listing) -> Result<Page, String> {
+        let list = keys::owner(listing.owner.as_str());
+        let ids: Vec<String> = self
+            .fleet
+            .jobs
+            .query(&Cmd::zrevrange(&list, 0, LISTED - 1))
+            .await
+            .map_err(|e| e.why)?;
+        let ids: Vec<Uuid> = ids.iter().filter_map(|id| id.parse().ok()).collect();
+        let records = self.records(&ids).await.map_err(|e| e.why)?;
+        let gone: Vec<String> = ids
+            .iter()
+            .zip(&records)
+            .filter(|(_, record)| record.is_none())
+            .map(|(id, _)| id.to_string())
+            .collect();
+        if !gone.is_empty() {
+            let _ = self.fleet.jobs.query::<i64>(&Cmd::zrem(&list, gone)).await;
+        }
+        let matching = records
+            .into_iter()
+            .flatten()
+            .filter(|record| record.listed_in(listing))
+            .collect();
+        Ok(Page::of(matching, listing))
+    }
+
+    async fn with_input(&self, input_hash: &str) -> Option<JobRecord> {
+        let cmd = Cmd::get(keys::input(input_hash));
+        let id: Option<String> = self.fleet.jobs.query(&cmd).await.ok()?;
+        let record = self.record(id?.parse().ok()?).await.ok()??;
+        matches!(record.state, JobState::Succeeded(_)).then_some(record)
+    }
+
     fn shared(&self) -> bool {
+        true
+    }
+
+    fn durable(&self) -> bool {
         true
     }
 }
@@ -565,21 +691,10 @@ fn work_text(work: Work) -> String {
 }
 
 fn parse_status(text: &str) -> JobStatus {
-    [
-        JobStatus::Queued,
-        JobStatus::Running,
-        JobStatus::Succeeded,
-        JobStatus::Failed,
-        JobStatus::Cancelled,
-        JobStatus::Interrupted,
-    ]
-    .into_iter()
-    .find(|s| s.as_str() == text)
-    .unwrap_or(JobStatus::Failed)
-}
-
-pub(super) fn unix_millis(time: SystemTime) -> u64 {
-    millis(time.duration_since(UNIX_EPOCH).unwrap_or_default())
+    JobStatus::ALL
+        .into_iter()
+        .find(|s| s.as_str() == text)
+        .unwrap_or(JobStatus::Failed)
 }
 
 /// The instant of this process at the Unix time `unix_ms` (clocks of the fleet's machines

@@ -96,12 +96,18 @@ function typed(text) {
   return /^[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$/.test(text) ? Number(text) : text;
 }
 
-/** The request a form makes: where, and the body. Sweeps go through /v1/jobs. */
+/** The request a form makes: where, and the body. Sweeps and fits go through /v1/jobs, so
+ *  that they are kept in the history. */
 function requestOf(form) {
   const input = inputOf(form);
   const kind = form.dataset.kind;
-  const body = kind === "sweep" ? { kind: "sweep", input } : input;
-  return { url: form.dataset.endpoint, body, job: { kind, input } };
+  const job = { kind, input };
+  return { url: form.dataset.endpoint, body: isJob(form) ? job : input, job };
+}
+
+/** Whether `form` submits a job (rather than asking for the answer at once). */
+function isJob(form) {
+  return form.dataset.endpoint === "/v1/jobs";
 }
 
 /** Fills each `fieldset[data-fields=name]` from the template `#fields-name`: its fields named
@@ -608,7 +614,21 @@ async function compare(form) {
 }
 
 async function post(url, body, accept = "application/json") {
-  return fetch(url, { method: "POST", headers: { "content-type": "application/json", accept }, body: JSON.stringify(body) });
+  const headers = { "content-type": "application/json", accept };
+  if (url === "/v1/jobs") headers["thirdbody-owner"] = ownerToken();
+  return fetch(url, { method: "POST", headers, body: JSON.stringify(body) });
+}
+
+/** This browser's token as the owner of its jobs (the service lists a token's jobs to its
+ *  holder only): made once, kept in local storage. 128 random bits, in hexadecimal. */
+function ownerToken() {
+  let token = localStorage.getItem("thirdbody-owner");
+  if (!token) {
+    const bytes = crypto.getRandomValues(new Uint8Array(16));
+    token = [...bytes].map((b) => b.toString(16).padStart(2, "0")).join("");
+    localStorage.setItem("thirdbody-owner", token);
+  }
+  return token;
 }
 
 async function solve(form) {
@@ -625,20 +645,23 @@ async function solve(form) {
 
 // ---- Jobs: progress from the event stream, cancel -------------------------------------
 
-/** Stops following the job the sweep tab follows, if any: closes its stream, disables Cancel. */
-let stopFollowing = () => {};
+/** The form of the tab panel of `area` (none for a panel without one, the history's). */
+function formOf(area) {
+  return area.root.closest("[role=tabpanel]").querySelector("form");
+}
 
 async function runJob(form) {
   const area = areaOf(form);
   const { url, body } = requestOf(form);
   const token = area.begin("Submitting…");
-  stopFollowing();
-  showProgress({ status: "queued", progress: { done: 0, total: 0 } });
+  // The job this tab followed, if any, is no longer followed: its stream closed.
+  if (form.stopFollowing) form.stopFollowing();
+  showProgress(area, { status: "queued", progress: { done: 0, total: 0 } });
   let read;
   try {
     read = await readJson(await post(url, body));
   } catch (e) {
-    if (area.current(token)) showProgress(null);
+    if (area.current(token)) showProgress(area, null);
     throw e;
   }
   if (!area.current(token)) {
@@ -647,18 +670,21 @@ async function runJob(form) {
     return;
   }
   if (!read.ok) {
-    showProgress(null);
+    showProgress(area, null);
     return area.problem(read.body);
   }
   area.clear();
   follow(area, token, read.body.id);
 }
 
-/** The progress bar and its text for a job's `view`: how far, and how it ended when it did
- *  not succeed (a failed or cancelled job's bar says so, in its colour). `null` empties it. */
-function showProgress(view) {
-  const bar = $("#progress");
-  const text = $("#progress-text");
+/** The progress bar and its text in `area`'s form for a job's `view`: how far, and how it
+ *  ended when it did not succeed (a failed or cancelled job's bar says so, in its colour).
+ *  `null` empties it. A panel without a bar shows the progress in its status only. */
+function showProgress(area, view) {
+  const form = formOf(area);
+  const bar = form && form.querySelector("progress");
+  if (!bar) return;
+  const text = form.querySelector(".progress-text");
   if (!view) {
     bar.value = 0;
     bar.className = "";
@@ -666,9 +692,12 @@ function showProgress(view) {
     return;
   }
   const { done, total } = view.progress;
+  const running = ["queued", "running"].includes(view.status);
   bar.max = Math.max(total, 1);
-  bar.value = done;
-  const count = total ? `${done} / ${total} (${Math.round((100 * done) / total)} %)` : `${done}`;
+  // A job that cannot tell its work in advance (a fit) runs with an indeterminate bar.
+  if (total || !running) bar.value = total ? done : bar.max;
+  else bar.removeAttribute("value");
+  const count = total ? `${done} / ${total} (${Math.round((100 * done) / total)} %)` : `${done} points evaluated`;
   const ended = view.status === "failed" || view.status === "cancelled";
   bar.className = ended ? view.status : "";
   text.textContent = ended ? `${view.status} at ${count}` : count;
@@ -694,7 +723,8 @@ function handled(area, token, work) {
 /** Follows job `id` from its event stream; when the stream ends for good before the job does
  *  (the job unknown, too many streams, a restart), from its record. */
 function follow(area, token, id) {
-  const cancel = $("#cancel");
+  const form = formOf(area);
+  const cancel = (form && form.querySelector(".cancel")) || document.createElement("button");
   cancel.disabled = false;
   cancel.onclick = handled(area, token, async () => {
     cancel.disabled = true;
@@ -706,11 +736,11 @@ function follow(area, token, id) {
     events.close();
     cancel.disabled = true;
   };
-  stopFollowing = stop;
+  if (form) form.stopFollowing = stop;
   events.addEventListener("progress", handled(area, token, (e) => {
     if (!area.current(token)) return stop();
     const view = JSON.parse(e.data);
-    showProgress(view);
+    showProgress(area, view);
     area.status(`Job ${view.status}…`, "busy");
   }));
   events.addEventListener("error", handled(area, token, async () => {
@@ -735,7 +765,7 @@ async function poll(area, token, id) {
     if (!area.current(token)) return;
     if (!read.ok) return area.problem(read.body);
     if (!["queued", "running"].includes(read.body.status)) return finished(area, token, read.body);
-    showProgress(read.body);
+    showProgress(area, read.body);
     area.status(`Job ${read.body.status}…`, "busy");
     await new Promise((resolve) => setTimeout(resolve, 1000));
   }
@@ -743,8 +773,9 @@ async function poll(area, token, id) {
 
 /** A job's end: its answer, or what went wrong and the points it finished anyway. */
 async function finished(area, token, view) {
-  $("#cancel").disabled = true;
-  showProgress(view);
+  const form = formOf(area);
+  if (form && form.querySelector(".cancel")) form.querySelector(".cancel").disabled = true;
+  showProgress(area, view);
   const { done, total } = view.progress;
   const ending = {
     succeeded: ["Job succeeded.", ""],
@@ -773,7 +804,7 @@ async function copy(form, what) {
   const { url, body, job } = requestOf(form);
   const texts = {
     job: ["the job as JSON", JSON.stringify(job, null, 2)],
-    curl: ["the curl command", `curl -s -X POST ${location.origin}${url} -H 'content-type: application/json' -d '${JSON.stringify(body)}'`],
+    curl: ["the curl command", `curl -s -X POST ${location.origin}${url} -H 'content-type: application/json'${url === "/v1/jobs" ? ` -H 'thirdbody-owner: ${ownerToken()}'` : ""} -d '${JSON.stringify(body)}'`],
     python: ["the Python script", python(url, body)],
   };
   const [name, text] = texts[what];
@@ -796,7 +827,8 @@ function python(url, body) {
   ];
   if (url === "/v1/jobs") {
     lines.push(
-      `job = requests.post(base + "${url}", json=body).json()`,
+      `owner = {"thirdbody-owner": "${ownerToken()}"}  # lists the job in this browser's history`,
+      `job = requests.post(base + "${url}", json=body, headers=owner).json()`,
       'while job["status"] in ("queued", "running"):',
       "    time.sleep(0.5)",
       '    job = requests.get(f"{base}/v1/jobs/{job[\'id\']}").json()',
@@ -814,6 +846,108 @@ function python(url, body) {
   return lines.join("\n") + "\n";
 }
 
+// ---- History: this browser's jobs, kept by the service --------------------------------
+
+/** The history's listing: the URL of its next page, while there is one. */
+const listing = { next: null };
+
+/** The first page of the history as the filters ask. */
+function historyUrl() {
+  const params = new URLSearchParams({ limit: "20" });
+  for (const [name, id] of [["kind", "#history-kind"], ["status", "#history-status"]]) {
+    if ($(id).value) params.set(name, $(id).value);
+  }
+  return `/v1/jobs?${params}`;
+}
+
+/** Lists this browser's jobs: the first page, or (`more`) the next one below those shown. */
+async function loadHistory(more = false) {
+  const area = $("#panel-history").area;
+  const url = more ? listing.next : historyUrl();
+  if (!url) return;
+  const headers = { accept: "application/json", "thirdbody-owner": ownerToken() };
+  const read = await readJson(await fetch(url, { headers }));
+  if (!read.ok) return area.problem(read.body);
+  const rows = $("#history-jobs tbody");
+  if (!more) rows.replaceChildren();
+  for (const view of read.body.jobs) rows.append(historyRow(view));
+  listing.next = read.body.next || null;
+  $("#history-more").hidden = !listing.next;
+  $("#history-count").textContent = read.body.total
+    ? `${rows.rows.length} of ${read.body.total} jobs shown.`
+    : "No jobs here yet: the sweeps and fits run in this browser are listed.";
+}
+
+/** A job's row: when, what, how far and how it ended; open, download or delete it. */
+function historyRow(view) {
+  const row = document.createElement("tr");
+  row.dataset.id = view.id;
+  const when = (t) => (t ? new Date(t).toLocaleString() : "—");
+  const { done, total } = view.progress;
+  const cells = [when(view.submitted_at), view.kind, view.status + (view.partial ? " (partial)" : ""), total ? `${done} / ${total}` : "—", when(view.finished_at)];
+  for (const text of cells) row.insertCell().textContent = text;
+  // A cell holds its buttons in a box of its own: a cell laid out as flex leaves the table.
+  const actions = row.insertCell().appendChild(Object.assign(document.createElement("div"), { className: "actions" }));
+  const open = Object.assign(document.createElement("button"), { type: "button", textContent: "Open" });
+  open.addEventListener("click", () => guarded($("#panel-history").area, () => openJob(view.id)));
+  actions.append(open);
+  if (view.result_url) {
+    for (const format of ["json", "csv", "svg"]) {
+      const link = Object.assign(document.createElement("a"), { href: `${view.result_url}?format=${format}`, textContent: format.toUpperCase() });
+      link.download = `${view.kind}-${view.id}.${format}`;
+      actions.append(link);
+    }
+  }
+  const remove = Object.assign(document.createElement("button"), { type: "button", textContent: "Delete" });
+  remove.addEventListener("click", () => guarded($("#panel-history").area, () => deleteJob(view, row)));
+  actions.append(remove);
+  return row;
+}
+
+/** Opens job `id` in the history's answer area, its link in the address bar; a job not
+ *  finished is followed to its end. */
+async function openJob(id) {
+  const area = $("#panel-history").area;
+  const token = area.begin("Opening the job…");
+  history.replaceState(null, "", `#job=${id}`);
+  const read = await readJson(await fetch(`/v1/jobs/${id}`, { headers: { accept: "application/json" } }));
+  if (!area.current(token)) return;
+  if (!read.ok) return area.problem(read.body);
+  if (["queued", "running"].includes(read.body.status)) return follow(area, token, id);
+  await finished(area, token, read.body);
+}
+
+/** Opens the answer to the input whose hash is `hash` (its stable link). */
+async function openInput(hash) {
+  const area = $("#panel-history").area;
+  const token = area.begin("Opening the answer…");
+  const url = `/v1/results/${hash}`;
+  const read = await readJson(await fetch(url, { headers: { accept: "application/json" } }));
+  if (!area.current(token)) return;
+  if (!read.ok) return area.problem(read.body);
+  area.status(`The answer to input ${hash.slice(0, 12)}…`);
+  await showAnswer(area, token, read.body, () => fetch(`${url}?format=svg`), (accept) => fetch(url, { headers: { accept } }), `answer-${hash.slice(0, 12)}`);
+}
+
+/** Deletes the job of `view` (after asking), and its row. */
+async function deleteJob(view, row) {
+  if (!confirm(`Delete the ${view.kind} job of ${new Date(view.submitted_at).toLocaleString()} and its answer?`)) return;
+  const area = $("#panel-history").area;
+  const read = await readJson(await fetch(`/v1/jobs/${view.id}`, { method: "DELETE", headers: { accept: "application/json" } }));
+  if (!read.ok) return area.problem(read.body);
+  row.remove();
+  area.status(`Deleted the ${view.kind} job of ${new Date(view.submitted_at).toLocaleString()}.`);
+  await loadHistory();
+}
+
+/** A link to a job (`#job=id`) or an input's answer (`#input=hash`) opens it in the history. */
+function openLinked() {
+  const [, what, value] = location.hash.match(/^#(job|input)=([\w-]+)$/) || [];
+  if (!what) return;
+  selectTab($("#tab-history"));
+  guarded($("#panel-history").area, () => (what === "job" ? openJob(value) : openInput(value)));
+}
+
 // ---- Figures, tabs, start-up ---------------------------------------------------------
 
 async function figure(area, n) {
@@ -829,7 +963,8 @@ async function figure(area, n) {
   await showAnswer(area, token, summary, () => fetch(`${url}?format=svg`), (accept) => fetch(url, { headers: { accept } }), `figure-${n}`);
 }
 
-/** Selects `tab` and shows its panel (and its own answer); `focus` moves the keyboard there. */
+/** Selects `tab` and shows its panel (and its own answer); `focus` moves the keyboard there.
+ *  The history is listed afresh each time it is shown. */
 function selectTab(tab, focus = false) {
   for (const other of document.querySelectorAll("[role=tab]")) {
     const selected = other === tab;
@@ -838,6 +973,7 @@ function selectTab(tab, focus = false) {
     document.getElementById(other.getAttribute("aria-controls")).hidden = !selected;
   }
   if (focus) tab.focus();
+  if (tab.id === "tab-history") guarded($("#panel-history").area, () => loadHistory());
 }
 
 /** The tabs as the ARIA pattern has them: arrows, Home and End move between them. */
@@ -878,7 +1014,7 @@ document.addEventListener("DOMContentLoaded", () => {
   for (const form of document.querySelectorAll("form")) {
     form.addEventListener("submit", (event) => {
       event.preventDefault();
-      guarded(areaOf(form), async () => (form.dataset.kind === "sweep" ? runJob(form) : solve(form)));
+      guarded(areaOf(form), async () => (isJob(form) ? runJob(form) : solve(form)));
     });
     for (const button of form.querySelectorAll("[data-copy]")) {
       button.addEventListener("click", () => guarded(areaOf(form), () => copy(form, button.dataset.copy)));
@@ -901,4 +1037,10 @@ document.addEventListener("DOMContentLoaded", () => {
     button.addEventListener("click", () => guarded(areaOf(buttons), () => figure(areaOf(buttons), n)));
     buttons.append(button);
   }
+  const historyArea = $("#panel-history").area;
+  for (const id of ["#history-kind", "#history-status"]) $(id).addEventListener("change", () => guarded(historyArea, () => loadHistory()));
+  $("#history-refresh").addEventListener("click", () => guarded(historyArea, () => loadHistory()));
+  $("#history-more").addEventListener("click", () => guarded(historyArea, () => loadHistory(true)));
+  openLinked();
+  window.addEventListener("hashchange", openLinked);
 });

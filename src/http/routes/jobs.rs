@@ -16,6 +16,7 @@ use tokio::sync::watch;
 use utoipa::{IntoParams, ToSchema};
 use uuid::Uuid;
 
+use super::history::OwnerHeader;
 use super::{Answering, FormatQuery};
 use crate::engine::store::{JobRecord, JobState, JobStatus};
 use crate::engine::{Engine, Unknown};
@@ -23,11 +24,11 @@ use crate::http::accept::{Accept, AcceptsJson};
 use crate::http::body::JsonBody;
 use crate::http::error::{ApiError, Problem};
 use crate::http::responses::{
-    BadBody, Busy, Gone, JobFailure, NotAcceptable, NotFound, NotModified, TooManyStreams,
-    Unfinished,
+    BadBody, Busy, Gone, JobFailure, NotAcceptable, NotFound, NotModified, ReadBack,
+    TooManyStreams, Unfinished,
 };
 use crate::http::AppState;
-use crate::job::registry::{AnyOutput, Envelope, KindName};
+use crate::job::registry::{Envelope, KindName};
 use crate::job::{Job, JobError, Work};
 
 /// How often a progress stream looks at a running job's count of solves.
@@ -63,11 +64,20 @@ pub struct JobView {
     /// Why it failed, once `failed`.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub problem: Option<Problem>,
+    /// The hash of the job's canonical input: its answer's stable link is
+    /// `/v1/results/{input_hash}`.
+    pub input_hash: String,
+    /// When the job was accepted (RFC 3339, UTC).
+    pub submitted_at: String,
+    /// When it finished, once it has (RFC 3339, UTC).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub finished_at: Option<String>,
 }
 
 impl JobView {
     /// The job as recorded.
-    fn of(record: &JobRecord) -> JobView {
+    pub fn of(record: &JobRecord) -> JobView {
+        let time = |t| humantime::format_rfc3339_millis(t).to_string();
         let result = record.state.result();
         JobView {
             id: record.id,
@@ -86,6 +96,9 @@ impl JobView {
                 JobState::Failed { error, .. } => Some(ApiError::from(error.clone()).problem()),
                 _ => None,
             },
+            input_hash: record.input_hash.clone(),
+            submitted_at: time(record.submitted_at),
+            finished_at: record.finished_at.map(time),
         }
     }
 }
@@ -150,12 +163,16 @@ fn seconds_since(unix_ms: u64) -> u64 {
 ///
 /// The body is a job envelope, as `thirdbody solve` takes: `{"kind": "sweep", "input":
 /// {...}}`. The answer is `202` with the job's URL in `Location`; poll it, or follow
-/// `/v1/jobs/{id}/events`. A job already in the cache is `succeeded` at once.
+/// `/v1/jobs/{id}/events`. A job already in the cache is `succeeded` at once. The job and
+/// its answer are kept for the history's retention, across restarts.
 #[utoipa::path(
     post,
     path = "/v1/jobs",
     operation_id = "submit_job",
     tag = "jobs",
+    params(("thirdbody-owner" = Option<String>, Header, pattern = r"^[A-Za-z0-9._~-]{16,128}$",
+        description = "A token of 16 to 128 \
+        characters the client keeps: the job is then listed to its holder by `GET /v1/jobs`")),
     request_body(content = Envelope, content_type = "application/json"),
     responses(
         (status = 202, description = "Accepted: queued, running, or already succeeded",
@@ -168,6 +185,7 @@ fn seconds_since(unix_ms: u64) -> u64 {
 pub async fn submit(
     State(state): State<AppState>,
     _: AcceptsJson,
+    OwnerHeader(owner): OwnerHeader,
     body: JsonBody,
 ) -> Result<Response, ApiError> {
     let limits = state.config().limits;
@@ -176,7 +194,7 @@ pub async fn submit(
             Ok(Job::from_value(envelope, &limits)?.keyed())
         })
         .await?;
-    let record = state.engine().submit(keyed).await?;
+    let record = state.engine().submit(keyed, owner).await?;
     let location = format!("/v1/jobs/{}", record.id);
     let view = JobView::of(&record);
     let headers = [
@@ -257,10 +275,13 @@ pub async fn delete(
     tag = "jobs",
     params(JobId, FormatQuery),
     responses(
-        (status = 200, description = "The job's answer, or its picture", content(
-            (AnyOutput = "application/json"), (String = "text/csv"),
-            (String = "image/svg+xml"))),
-        NotModified, NotFound, Gone, NotAcceptable, Unfinished, JobFailure,
+        ReadBack,
+        NotModified,
+        NotFound,
+        Gone,
+        NotAcceptable,
+        Unfinished,
+        JobFailure
     )
 )]
 pub async fn result(

@@ -6,6 +6,7 @@
 pub mod checks;
 pub mod figures;
 pub mod fits;
+pub mod history;
 pub mod jobs;
 pub mod ops;
 pub mod rolling;
@@ -59,11 +60,12 @@ pub fn router() -> OpenApiRouter<AppState> {
         .routes(routes!(sweeps::solve))
         .routes(routes!(fits::solve))
         .routes(routes!(checks::run))
-        .routes(routes!(jobs::submit))
+        .routes(routes!(jobs::submit, history::list))
         .routes(routes!(jobs::status, jobs::delete))
         .routes(routes!(jobs::cancel))
         .routes(routes!(jobs::events))
         .routes(routes!(jobs::result))
+        .routes(routes!(history::by_input))
         .routes(routes!(figures::figure))
         .routes(routes!(ops::healthz))
         .routes(routes!(ops::readyz))

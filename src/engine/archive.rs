@@ -1,0 +1,384 @@
+//! Saved analyses: every job this process accepts, recorded in an embedded SQLite database
+//! (a file by default) from its acceptance, with its result once it finishes, and kept for
+//! the history's retention, across restarts. Its owner's list of jobs, a job's stable link
+//! and an input's newest answer are read from here once the job has left memory.
+//!
+//! One process per file: the database is locked for the process's life (SQLite's exclusive
+//! locking mode), so that a second `serve` on the same file fails at start-up rather than
+//! marking the first one's running jobs interrupted. A fleet keeps its history in Redis.
+//!
+//! The calls block (SQLite is synchronous): [`super::local::LocalJobStore`] makes them off
+//! the async threads.
+
+use std::path::Path;
+use std::sync::{Arc, Mutex, MutexGuard};
+use std::time::{Duration, SystemTime};
+
+use async_trait::async_trait;
+use bytes::Bytes;
+use rusqlite::{params, Connection, OptionalExtension, Row};
+use uuid::Uuid;
+
+use super::spill::{JobResult, ResultPlace, StoredResult};
+use super::store::{
+    from_unix_millis, unix_millis, JobRecord, JobState, JobStatus, Listing, Owner, Page,
+};
+use crate::job::registry::KindName;
+use crate::job::{JobError, Work};
+
+/// The database path that keeps nothing past the process (SQLite's own name for it).
+pub const IN_MEMORY: &str = ":memory:";
+
+/// The tables: jobs (small rows, listed) and their results (large, read one at a time).
+const SCHEMA: &str = "
+CREATE TABLE IF NOT EXISTS jobs (
+    id TEXT PRIMARY KEY,
+    owner TEXT,
+    kind TEXT NOT NULL,
+    status TEXT NOT NULL,
+    done INTEGER NOT NULL,
+    total INTEGER,
+    input_hash TEXT NOT NULL,
+    submitted INTEGER NOT NULL,
+    finished INTEGER,
+    error TEXT,
+    result TEXT
+);
+CREATE INDEX IF NOT EXISTS jobs_by_owner ON jobs (owner, submitted DESC);
+CREATE INDEX IF NOT EXISTS jobs_by_input ON jobs (input_hash, finished DESC);
+CREATE INDEX IF NOT EXISTS jobs_by_end ON jobs (finished);
+CREATE TABLE IF NOT EXISTS results (
+    id TEXT PRIMARY KEY,
+    json BLOB NOT NULL,
+    csv BLOB NOT NULL
+);
+";
+
+/// The columns a record is read from, in [`Archive::record`]'s order.
+const COLUMNS: &str =
+    "id, owner, kind, status, done, total, input_hash, submitted, finished, error, result";
+
+/// The database of saved analyses.
+pub struct Archive {
+    db: Mutex<Connection>,
+    retention: Duration,
+    durable: bool,
+}
+
+impl Archive {
+    /// Opens (or creates) the database at `path` (a file, or [`IN_MEMORY`]), keeping finished
+    /// jobs for `retention`. Jobs an earlier run left unfinished are marked interrupted:
+    /// that run stopped before they ended.
+    pub fn open(path: &str, retention: Duration) -> Result<Arc<Archive>, String> {
+        let failed = |e: rusqlite::Error| {
+            let hint = match e.sqlite_error_code() {
+                Some(rusqlite::ErrorCode::DatabaseBusy | rusqlite::ErrorCode::DatabaseLocked) => {
+                    ": another thirdbody process has it open (give each process its own \
+                     --database; a fleet keeps its history in Redis)"
+                }
+                _ => "",
+            };
+            format!("--database {path}: {e}{hint}")
+        };
+        let durable = path != IN_MEMORY;
+        if durable {
+            if let Some(dir) = Path::new(path)
+                .parent()
+                .filter(|d| !d.as_os_str().is_empty())
+            {
+                std::fs::create_dir_all(dir).map_err(|e| format!("--database {path}: {e}"))?;
+            }
+        }
+        let db = Connection::open(path).map_err(failed)?;
+        db.execute_batch(
+            "PRAGMA locking_mode = EXCLUSIVE;
+             PRAGMA journal_mode = WAL;
+             PRAGMA synchronous = NORMAL;",
+        )
+        .map_err(failed)?;
+        db.execute_batch(SCHEMA).map_err(failed)?;
+        let now = millis(SystemTime::now());
+        let interrupted = db
+            .execute(
+                "UPDATE jobs SET status = 'interrupted', finished = ?1 WHERE finished IS NULL",
+                [now],
+            )
+            .map_err(failed)?;
+        if interrupted > 0 {
+            tracing::warn!(
+                jobs = interrupted,
+                "jobs left unfinished by the last run are marked interrupted"
+            );
+        }
+        let archive = Arc::new(Archive {
+            db: Mutex::new(db),
+            retention,
+            durable,
+        });
+        archive.purge().map_err(failed)?;
+        Ok(archive)
+    }
+
+    fn db(&self) -> MutexGuard<'_, Connection> {
+        self.db.lock().unwrap_or_else(|p| p.into_inner())
+    }
+
+    /// Whether the database is a file (it outlives the process).
+    pub fn durable(&self) -> bool {
+        self.durable
+    }
+
+    /// The earliest end (Unix ms) of a job still within its retention.
+    fn cutoff(&self) -> i64 {
+        let retention = i64::try_from(self.retention.as_millis()).unwrap_or(i64::MAX);
+        millis(SystemTime::now()).saturating_sub(retention)
+    }
+
+    /// Writes `record` as it is now, with its result's JSON and CSV (`bodies`) once it has
+    /// one.
+    pub fn save(&self, record: &JobRecord, bodies: Option<(Bytes, Bytes)>) -> rusqlite::Result<()> {
+        let mut db = self.db();
+        let tx = db.transaction()?;
+        let state = &record.state;
+        let error = match state {
+            JobState::Failed { error, .. } => serde_json::to_string(error).ok(),
+            _ => None,
+        };
+        let result = state
+            .result()
+            .map(|r| if r.complete() { "whole" } else { "partial" });
+        let total = match record.work {
+            Work::Known(n) => Some(n as i64),
+            Work::Unknown => None,
+        };
+        tx.execute(
+            "INSERT OR REPLACE INTO jobs (id, owner, kind, status, done, total, input_hash, \
+             submitted, finished, error, result) VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, \
+             ?10, ?11)",
+            params![
+                record.id.to_string(),
+                record.owner.as_ref().map(Owner::as_str),
+                record.kind.name(),
+                state.status().as_str(),
+                record.done as i64,
+                total,
+                record.input_hash,
+                millis(record.submitted_at),
+                record.finished_at.map(millis),
+                error,
+                result,
+            ],
+        )?;
+        if let Some((json, csv)) = bodies {
+            tx.execute(
+                "INSERT OR REPLACE INTO results (id, json, csv) VALUES (?1, ?2, ?3)",
+                params![record.id.to_string(), &json[..], &csv[..]],
+            )?;
+        }
+        tx.commit()
+    }
+
+    /// Moves the job `id` to `status` (a job started), unless it has finished.
+    pub fn set_status(&self, id: Uuid, status: JobStatus) -> rusqlite::Result<()> {
+        self.db().execute(
+            "UPDATE jobs SET status = ?2 WHERE id = ?1 AND finished IS NULL",
+            params![id.to_string(), status.as_str()],
+        )?;
+        Ok(())
+    }
+
+    /// The job `id`, unless unknown or past its retention.
+    pub fn get(self: &Arc<Self>, id: Uuid) -> rusqlite::Result<Option<JobRecord>> {
+        let sql = format!(
+            "SELECT {COLUMNS} FROM jobs WHERE id = ?1 AND (finished IS NULL OR finished > ?2)"
+        );
+        let db = self.db();
+        let row = db
+            .query_row(&sql, params![id.to_string(), self.cutoff()], |row| {
+                self.record(row)
+            })
+            .optional()?;
+        Ok(row.flatten())
+    }
+
+    /// The jobs of `listing`'s owner within their retention, newest first, filtered and
+    /// paged.
+    pub fn list(self: &Arc<Self>, listing: &Listing) -> rusqlite::Result<Page> {
+        let filter = "owner = ?1 AND (?2 IS NULL OR kind = ?2) AND (?3 IS NULL OR status = ?3) \
+                      AND (finished IS NULL OR finished > ?4)";
+        let db = self.db();
+        let (owner, kind, status, cutoff) = (
+            listing.owner.as_str(),
+            listing.kind.map(|k| k.name()),
+            listing.status.map(JobStatus::as_str),
+            self.cutoff(),
+        );
+        let total: i64 = db.query_row(
+            &format!("SELECT COUNT(*) FROM jobs WHERE {filter}"),
+            params![owner, kind, status, cutoff],
+            |row| row.get(0),
+        )?;
+        let sql = format!(
+            "SELECT {COLUMNS} FROM jobs WHERE {filter} ORDER BY submitted DESC, id DESC \
+             LIMIT ?5 OFFSET ?6"
+        );
+        let mut statement = db.prepare(&sql)?;
+        let rows = statement.query_map(
+            params![
+                owner,
+                kind,
+                status,
+                cutoff,
+                listing.limit as i64,
+                listing.offset as i64
+            ],
+            |row| self.record(row),
+        )?;
+        let mut jobs = Vec::new();
+        for row in rows {
+            jobs.extend(row?);
+        }
+        Ok(Page {
+            jobs,
+            total: total as usize,
+        })
+    }
+
+    /// The newest job within its retention that succeeded on the input whose hash is
+    /// `input_hash`.
+    pub fn with_input(self: &Arc<Self>, input_hash: &str) -> rusqlite::Result<Option<JobRecord>> {
+        let sql = format!(
+            "SELECT {COLUMNS} FROM jobs WHERE input_hash = ?1 AND status = 'succeeded' \
+             AND finished > ?2 ORDER BY finished DESC LIMIT 1"
+        );
+        let db = self.db();
+        let row = db
+            .query_row(&sql, params![input_hash, self.cutoff()], |row| {
+                self.record(row)
+            })
+            .optional()?;
+        Ok(row.flatten())
+    }
+
+    /// Forgets the job `id` and its result.
+    pub fn remove(&self, id: Uuid) -> rusqlite::Result<()> {
+        let mut db = self.db();
+        let tx = db.transaction()?;
+        tx.execute("DELETE FROM results WHERE id = ?1", [id.to_string()])?;
+        tx.execute("DELETE FROM jobs WHERE id = ?1", [id.to_string()])?;
+        tx.commit()
+    }
+
+    /// Forgets the jobs past their retention; returns how many.
+    pub fn purge(&self) -> rusqlite::Result<usize> {
+        let cutoff = self.cutoff();
+        let mut db = self.db();
+        let tx = db.transaction()?;
+        tx.execute(
+            "DELETE FROM results WHERE id IN (SELECT id FROM jobs WHERE finished <= ?1)",
+            [cutoff],
+        )?;
+        let purged = tx.execute("DELETE FROM jobs WHERE finished <= ?1", [cutoff])?;
+        tx.commit()?;
+        Ok(purged)
+    }
+
+    /// The result of job `id` as JSON (`json`) or CSV (`csv`).
+    fn body(&self, id: Uuid, field: &str) -> rusqlite::Result<Option<Vec<u8>>> {
+        let column = if field == "csv" { "csv" } else { "json" };
+        self.db()
+            .query_row(
+                &format!("SELECT {column} FROM results WHERE id = ?1"),
+                [id.to_string()],
+                |row| row.get(0),
+            )
+            .optional()
+    }
+
+    /// The record of a row of `COLUMNS`; `None` for a row this version cannot read (a kind
+    /// it does not know).
+    fn record(self: &Arc<Self>, row: &Row<'_>) -> rusqlite::Result<Option<JobRecord>> {
+        let text = |i: usize| row.get::<_, String>(i);
+        let Ok(id) = Uuid::parse_str(&text(0)?) else {
+            return Ok(None);
+        };
+        let Ok(kind) = KindName::find(&text(2)?) else {
+            return Ok(None);
+        };
+        let input_hash = text(6)?;
+        let result = row.get::<_, Option<String>>(10)?.map(|form| {
+            let saved = Arc::new(Saved {
+                archive: self.clone(),
+                id,
+            });
+            let stored = StoredResult::new(input_hash.clone(), kind, form == "whole", saved);
+            JobResult::Stored(Arc::new(stored))
+        });
+        let error = || -> JobError {
+            row.get::<_, Option<String>>(9)
+                .ok()
+                .flatten()
+                .and_then(|e| serde_json::from_str(&e).ok())
+                .unwrap_or_else(|| JobError::Internal("the job's error is unreadable".into()))
+        };
+        let state = match text(3)?.as_str() {
+            "queued" => JobState::Queued,
+            "running" => JobState::Running,
+            "succeeded" => match result {
+                Some(result) => JobState::Succeeded(result),
+                None => JobState::failed(JobError::Internal(
+                    "the job's result was not saved".to_string(),
+                )),
+            },
+            "cancelled" => JobState::Cancelled { partial: result },
+            "interrupted" => JobState::Interrupted,
+            _ => JobState::Failed {
+                error: error(),
+                partial: result,
+            },
+        };
+        Ok(Some(JobRecord {
+            id,
+            kind,
+            work: row
+                .get::<_, Option<i64>>(5)?
+                .map_or(Work::Unknown, |n| Work::Known(n as usize)),
+            state,
+            done: row.get::<_, i64>(4)? as usize,
+            input_hash,
+            owner: row.get::<_, Option<String>>(1)?.map(Owner::stored),
+            submitted_at: time(row.get(7)?),
+            finished_at: row.get::<_, Option<i64>>(8)?.map(time),
+        }))
+    }
+}
+
+/// `time` as stored: Unix ms (SQLite's integers are signed).
+fn millis(time: SystemTime) -> i64 {
+    i64::try_from(unix_millis(time)).unwrap_or(i64::MAX)
+}
+
+/// The time stored as `unix_ms`.
+fn time(unix_ms: i64) -> SystemTime {
+    from_unix_millis(u64::try_from(unix_ms).unwrap_or(0))
+}
+
+/// A result in the database.
+struct Saved {
+    archive: Arc<Archive>,
+    id: Uuid,
+}
+
+#[async_trait]
+impl ResultPlace for Saved {
+    async fn body(&self, field: &str) -> std::io::Result<Bytes> {
+        let (archive, id, field) = (self.archive.clone(), self.id, field.to_string());
+        let body = super::heavy::run(move || archive.body(id, &field))
+            .await
+            .map_err(std::io::Error::other)?
+            .map_err(std::io::Error::other)?;
+        body.map(Bytes::from).ok_or_else(|| {
+            std::io::Error::other("the job's result was deleted, or expired, meanwhile")
+        })
+    }
+}

@@ -1,0 +1,249 @@
+//! The history: an owner's jobs listed (`GET /v1/jobs`), and an input's answer at a stable
+//! link (`GET /v1/results/{input_hash}`). Jobs and their results are kept for the history's
+//! retention, across restarts (in the database of saved analyses, or a fleet's Redis).
+//!
+//! Until API keys exist, an owner is whoever holds the token sent in `Thirdbody-Owner` with
+//! the submissions: the dashboard keeps a random one in the browser's storage, so that a
+//! browser lists its own jobs and nobody else's.
+
+use axum::extract::{FromRequestParts, Path, State};
+use axum::http::request::Parts;
+use axum::response::Response;
+use axum::Json;
+use serde::{Deserialize, Serialize};
+use serde_json::Value;
+use utoipa::{IntoParams, ToSchema};
+
+use super::jobs::JobView;
+use super::{Answering, FormatQuery};
+use crate::engine::store::{JobStatus, Listing, Owner};
+use crate::http::accept::AcceptsJson;
+use crate::http::error::ApiError;
+use crate::http::responses::{Busy, InvalidQuery, NotAcceptable, NotFound, NotModified, ReadBack};
+use crate::http::AppState;
+use crate::job::registry::KindName;
+use crate::job::{FieldError, JobError};
+
+/// The header naming who submits and lists jobs.
+pub const OWNER_HEADER: &str = "thirdbody-owner";
+
+/// Jobs on a page unless `limit` says, and at most.
+const PAGE: usize = 20;
+const MAX_PAGE: usize = 100;
+
+/// The owner named by the request's `Thirdbody-Owner` header, if any: a token of 16 to 128
+/// characters that the client keeps (stored only as its hash).
+pub struct OwnerHeader(pub Option<Owner>);
+
+impl<S: Send + Sync> FromRequestParts<S> for OwnerHeader {
+    type Rejection = ApiError;
+
+    async fn from_request_parts(parts: &mut Parts, _: &S) -> Result<Self, ApiError> {
+        let Some(value) = parts.headers.get(OWNER_HEADER) else {
+            return Ok(OwnerHeader(None));
+        };
+        let token = String::from_utf8_lossy(value.as_bytes());
+        let allowed = |b: u8| b.is_ascii_alphanumeric() || b"-_.~".contains(&b);
+        if (16..=128).contains(&token.len()) && token.bytes().all(allowed) {
+            return Ok(OwnerHeader(Some(Owner::of_token(&token))));
+        }
+        Err(invalid(
+            &format!("header {OWNER_HEADER}"),
+            Value::String(token.into_owned()),
+            "16 to 128 characters of A-Z, a-z, 0-9, '-', '_', '.' and '~' (a random token \
+             the client keeps, e.g. a UUID)",
+        ))
+    }
+}
+
+/// A 422 `invalid-input` problem naming `field`, its `value` and what is `allowed`.
+fn invalid(field: &str, value: Value, allowed: &str) -> ApiError {
+    let shown = match &value {
+        Value::Null => "missing".to_string(),
+        other => other.to_string(),
+    };
+    JobError::Invalid(vec![FieldError {
+        field: field.to_string(),
+        message: format!("{field} = {shown}: allowed {allowed}"),
+        value,
+        allowed: allowed.to_string(),
+    }])
+    .into()
+}
+
+/// `GET /v1/jobs`'s query: filters and the page.
+#[derive(Deserialize, IntoParams)]
+#[into_params(parameter_in = Query)]
+pub struct ListQuery {
+    /// Only jobs of this kind.
+    #[param(value_type = Option<KindName>)]
+    kind: Option<String>,
+    /// Only jobs in this status.
+    #[param(value_type = Option<JobStatus>)]
+    status: Option<String>,
+    /// Jobs on the page: 1 to 100 (default 20).
+    #[param(value_type = Option<usize>, minimum = 1, maximum = 100)]
+    limit: Option<String>,
+    /// Jobs skipped: those of the pages before (default 0).
+    #[param(value_type = Option<usize>)]
+    offset: Option<String>,
+}
+
+impl ListQuery {
+    /// The listing asked for `owner`; a value out of range is a 422 naming it.
+    fn listing(&self, owner: Owner) -> Result<Listing, ApiError> {
+        let number = |name: &str, text: &Option<String>, default: usize, most: usize| {
+            let Some(text) = text else {
+                return Ok(default);
+            };
+            let least = usize::from(name == "limit");
+            match text.parse::<usize>() {
+                Ok(n) if (least..=most).contains(&n) => Ok(n),
+                _ => Err(invalid(
+                    name,
+                    Value::String(text.clone()),
+                    &format!("a whole number from {least} to {most}"),
+                )),
+            }
+        };
+        let kind = match &self.kind {
+            None => None,
+            Some(name) => Some(KindName::find(name).map_err(|_| {
+                invalid(
+                    "kind",
+                    Value::String(name.clone()),
+                    &crate::job::registry::NAMES.join(", "),
+                )
+            })?),
+        };
+        let status = match &self.status {
+            None => None,
+            Some(name) => Some(
+                JobStatus::ALL
+                    .into_iter()
+                    .find(|s| s.as_str() == name)
+                    .ok_or_else(|| {
+                        let names: Vec<&str> = JobStatus::ALL.map(JobStatus::as_str).to_vec();
+                        invalid("status", Value::String(name.clone()), &names.join(", "))
+                    })?,
+            ),
+        };
+        Ok(Listing {
+            owner,
+            kind,
+            status,
+            limit: number("limit", &self.limit, PAGE, MAX_PAGE)?,
+            offset: number("offset", &self.offset, 0, usize::MAX / 2)?,
+        })
+    }
+
+    /// The URL of the page after `listing`'s.
+    fn next(&self, listing: &Listing) -> String {
+        let mut url = format!(
+            "/v1/jobs?limit={}&offset={}",
+            listing.limit,
+            listing.offset + listing.limit
+        );
+        if let Some(kind) = listing.kind {
+            url.push_str(&format!("&kind={}", kind.name()));
+        }
+        if let Some(status) = listing.status {
+            url.push_str(&format!("&status={}", status.as_str()));
+        }
+        url
+    }
+}
+
+/// A page of an owner's jobs.
+#[derive(Serialize, ToSchema)]
+pub struct JobList {
+    /// The page's jobs, newest first (each as `GET /v1/jobs/{id}` shows it).
+    pub jobs: Vec<JobView>,
+    /// The owner's jobs that pass the filters, on every page.
+    pub total: usize,
+    /// The next page's URL, while there is one.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub next: Option<String>,
+}
+
+/// List your jobs.
+///
+/// The jobs submitted with the same `Thirdbody-Owner` token as this request, newest first,
+/// within the history's retention (across restarts): queued and running ones, and finished
+/// ones with their results. The dashboard keeps its token in the browser's storage. Without
+/// the header the answer is 422: nobody lists jobs that are not theirs.
+#[utoipa::path(
+    get,
+    path = "/v1/jobs",
+    operation_id = "list_jobs",
+    tag = "jobs",
+    params(ListQuery, ("thirdbody-owner" = String, Header, pattern = r"^[A-Za-z0-9._~-]{16,128}$",
+        description = "The token sent with the jobs' submissions (16 to 128 characters)")),
+    responses((status = 200, description = "A page of the owner's jobs", body = JobList),
+        InvalidQuery, NotAcceptable, Busy)
+)]
+pub async fn list(
+    State(state): State<AppState>,
+    _: AcceptsJson,
+    OwnerHeader(owner): OwnerHeader,
+    axum::extract::Query(query): axum::extract::Query<ListQuery>,
+) -> Result<Json<JobList>, ApiError> {
+    let Some(owner) = owner else {
+        return Err(invalid(
+            &format!("header {OWNER_HEADER}"),
+            Value::Null,
+            "the token sent with the jobs' submissions (16 to 128 characters): jobs are \
+             listed to their owner only",
+        ));
+    };
+    let listing = query.listing(owner)?;
+    let page = state.engine().list(&listing).await?;
+    let next = (listing.offset + page.jobs.len() < page.total).then(|| query.next(&listing));
+    Ok(Json(JobList {
+        jobs: page.jobs.iter().map(JobView::of).collect(),
+        total: page.total,
+        next,
+    }))
+}
+
+/// The input named in the path by its hash.
+#[derive(Deserialize, IntoParams)]
+#[into_params(parameter_in = Path)]
+pub struct InputHash {
+    /// The hash of a job's canonical input: `meta.input_hash` of its answer, `input_hash`
+    /// of its job.
+    input_hash: String,
+}
+
+/// An input's answer, at a stable link.
+///
+/// Answers are content-addressed: equal inputs (in canonical form) have equal answers. This
+/// is the answer to the input whose hash is `input_hash`, as cached, or as the newest job
+/// on it that succeeded within the history's retention left it; in the form the client
+/// accepts (or `?format=`), as `GET /v1/jobs/{id}/result` gives it.
+#[utoipa::path(
+    get,
+    path = "/v1/results/{input_hash}",
+    operation_id = "get_result_by_input",
+    tag = "jobs",
+    params(InputHash, FormatQuery),
+    responses(ReadBack, NotModified, NotFound, NotAcceptable)
+)]
+pub async fn by_input(
+    State(state): State<AppState>,
+    answering: Answering,
+    Path(InputHash { input_hash }): Path<InputHash>,
+) -> Result<Response, ApiError> {
+    let engine = state.engine();
+    if let Some(solved) = engine.cached(&input_hash).await {
+        return answering.respond(&solved, None);
+    }
+    let record = engine.with_input(&input_hash).await;
+    match record.as_ref().and_then(|r| r.state.result()) {
+        Some(result) => answering.respond_result(result).await,
+        None => Err(ApiError::not_found(format!(
+            "no answer to the input {input_hash}: it is not cached, and no job on it \
+             succeeded within the history's retention"
+        ))),
+    }
+}
