@@ -134,45 +134,71 @@ impl Archive {
         millis(SystemTime::now()).saturating_sub(retention)
     }
 
-    /// Writes `record` as it is now, with its result's JSON and CSV (`bodies`) once it has
-    /// one.
-    pub fn save(&self, record: &JobRecord, bodies: Option<(Bytes, Bytes)>) -> rusqlite::Result<()> {
-        let mut db = self.db();
-        let tx = db.transaction()?;
-        let state = &record.state;
-        let error = match state {
-            JobState::Failed { error, .. } => serde_json::to_string(error).ok(),
-            _ => None,
-        };
-        let result = state
-            .result()
-            .map(|r| if r.complete() { "whole" } else { "partial" });
+    /// Records the job `record`, just accepted (a row written once: its end is
+    /// [`Archive::finish`]'s).
+    pub fn insert(&self, record: &JobRecord) -> rusqlite::Result<()> {
         let total = match record.work {
             Work::Known(n) => Some(n as i64),
             Work::Unknown => None,
         };
-        tx.execute(
-            "INSERT OR REPLACE INTO jobs (id, owner, kind, status, done, total, input_hash, \
-             submitted, finished, error, result) VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, \
-             ?10, ?11)",
+        self.db().execute(
+            "INSERT OR IGNORE INTO jobs (id, owner, kind, status, done, total, input_hash, \
+             submitted) VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8)",
             params![
                 record.id.to_string(),
                 record.owner.as_ref().map(Owner::as_str),
                 record.kind.name(),
-                state.status().as_str(),
+                record.state.status().as_str(),
                 record.done as i64,
                 total,
                 record.input_hash,
                 millis(record.submitted_at),
-                record.finished_at.map(millis),
+            ],
+        )?;
+        Ok(())
+    }
+
+    /// Ends the job `id` in `state` with `done` units done at `finished`, with its result's
+    /// JSON and CSV (`bodies`) if it has one that could be read; a job deleted meanwhile (no
+    /// row) or already ended stays as it is.
+    pub fn finish(
+        &self,
+        id: Uuid,
+        state: &JobState,
+        done: usize,
+        finished: SystemTime,
+        bodies: Option<(Bytes, Bytes)>,
+    ) -> rusqlite::Result<()> {
+        let mut db = self.db();
+        let tx = db.transaction()?;
+        let error = match state {
+            JobState::Failed { error, .. } => serde_json::to_string(error).ok(),
+            _ => None,
+        };
+        // A result is named only when its bodies are written with it.
+        let result = state.result().filter(|_| bodies.is_some()).map(|r| {
+            if r.complete() {
+                "whole"
+            } else {
+                "partial"
+            }
+        });
+        let ended = tx.execute(
+            "UPDATE jobs SET status = ?2, done = ?3, finished = ?4, error = ?5, result = ?6 \
+             WHERE id = ?1 AND finished IS NULL",
+            params![
+                id.to_string(),
+                state.status().as_str(),
+                done as i64,
+                millis(finished),
                 error,
                 result,
             ],
         )?;
-        if let Some((json, csv)) = bodies {
+        if let (1, Some((json, csv))) = (ended, bodies) {
             tx.execute(
                 "INSERT OR REPLACE INTO results (id, json, csv) VALUES (?1, ?2, ?3)",
-                params![record.id.to_string(), &json[..], &csv[..]],
+                params![id.to_string(), &json[..], &csv[..]],
             )?;
         }
         tx.commit()
@@ -218,8 +244,10 @@ impl Archive {
             params![owner, kind, status, cutoff],
             |row| row.get(0),
         )?;
+        // Jobs accepted in the same millisecond are in the order they were accepted (the
+        // row id grows with each insert; ids are random past their millisecond).
         let sql = format!(
-            "SELECT {COLUMNS} FROM jobs WHERE {filter} ORDER BY submitted DESC, id DESC \
+            "SELECT {COLUMNS} FROM jobs WHERE {filter} ORDER BY submitted DESC, rowid DESC \
              LIMIT ?5 OFFSET ?6"
         );
         let mut statement = db.prepare(&sql)?;

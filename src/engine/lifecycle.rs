@@ -337,8 +337,15 @@ impl Lifecycle {
     }
 
     /// The newest job that succeeded on the input whose hash is `input_hash`.
-    pub(super) async fn with_input(&self, input_hash: &str) -> Option<JobRecord> {
-        self.jobs.with_input(input_hash).await
+    pub(super) async fn with_input(
+        &self,
+        input_hash: &str,
+    ) -> Result<Option<JobRecord>, EngineError> {
+        self.store_reachable()?;
+        self.jobs
+            .with_input(input_hash)
+            .await
+            .map_err(EngineError::Unavailable)
     }
 
     /// What can be told of a job `id` that the job store does not know.

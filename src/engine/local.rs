@@ -11,6 +11,9 @@ use uuid::Uuid;
 use super::archive::Archive;
 use super::store::{JobRecord, JobState, JobStore, Listing, MemoryJobStore, Page, Refusal};
 
+/// Why a read of the database failed, for the client (the log says more).
+const UNREADABLE: &str = "the database of saved analyses cannot be read now (the log says why)";
+
 /// A process's jobs: in memory, and in its database.
 pub struct LocalJobStore {
     memory: MemoryJobStore,
@@ -40,33 +43,13 @@ impl LocalJobStore {
             )
             .ok()
     }
-
-    /// Saves job `id` as memory holds it now, with its result if it has one.
-    async fn save(&self, id: Uuid) {
-        let Some(record) = self.memory.get(id).await else {
-            return;
-        };
-        let bodies = match record.state.result() {
-            Some(result) => match result.bodies().await {
-                Ok(bodies) => Some(bodies),
-                Err(e) => {
-                    tracing::error!(error = %e, %id, "a job's result could not be read to save it");
-                    None
-                }
-            },
-            None => None,
-        };
-        self.db("save a job", move |db| db.save(&record, bodies))
-            .await;
-    }
 }
 
 #[async_trait]
 impl JobStore for LocalJobStore {
     async fn insert(&self, record: JobRecord, result_bytes: u64) -> Result<(), Refusal> {
-        let id = record.id;
-        self.memory.insert(record, result_bytes).await?;
-        self.save(id).await;
+        self.memory.insert(record.clone(), result_bytes).await?;
+        self.db("save a job", move |db| db.insert(&record)).await;
         Ok(())
     }
 
@@ -77,15 +60,30 @@ impl JobStore for LocalJobStore {
         }
     }
 
+    /// The end is saved from the state as given (as memory kept it), not read back from
+    /// memory, which may have forgotten the job meanwhile.
     async fn update(&self, id: Uuid, state: JobState, done: usize) {
         let status = state.status();
-        self.memory.update(id, state, done).await;
-        if status.is_finished() {
-            self.save(id).await;
-        } else {
+        let (kept, finished) = self.memory.update(id, state, done).await;
+        let Some(finished) = finished else {
             self.db("record a job's start", move |db| db.set_status(id, status))
                 .await;
-        }
+            return;
+        };
+        let bodies = match kept.result() {
+            Some(result) => match result.bodies().await {
+                Ok(bodies) => Some(bodies),
+                Err(e) => {
+                    tracing::error!(error = %e, %id, "a job's result could not be read to save it");
+                    None
+                }
+            },
+            None => None,
+        };
+        self.db("save a job's end", move |db| {
+            db.finish(id, &kept, done, finished, bodies)
+        })
+        .await;
     }
 
     async fn remove(&self, id: Uuid) {
@@ -102,14 +100,14 @@ impl JobStore for LocalJobStore {
         let query = listing.clone();
         self.db("list jobs", move |db| db.list(&query))
             .await
-            .ok_or_else(|| "the database of saved analyses cannot be read (see the log)".into())
+            .ok_or_else(|| UNREADABLE.to_string())
     }
 
-    async fn with_input(&self, input_hash: &str) -> Option<JobRecord> {
+    async fn with_input(&self, input_hash: &str) -> Result<Option<JobRecord>, String> {
         let hash = input_hash.to_string();
         self.db("find an input's answer", move |db| db.with_input(&hash))
             .await
-            .flatten()
+            .ok_or_else(|| UNREADABLE.to_string())
     }
 
     fn durable(&self) -> bool {

@@ -256,7 +256,7 @@ impl Engine {
     }
 
     /// The newest job that succeeded on the input whose hash is `input_hash`.
-    pub async fn with_input(&self, input_hash: &str) -> Option<JobRecord> {
+    pub async fn with_input(&self, input_hash: &str) -> Result<Option<JobRecord>, EngineError> {
         self.jobs.with_input(input_hash).await
     }
 

@@ -172,12 +172,15 @@ impl JobResult {
         }
     }
 
-    /// The answer's JSON and CSV.
+    /// The answer's JSON and CSV (a CSV rendered now is rendered off the async threads: a
+    /// large sweep's takes tens of milliseconds).
     pub async fn bodies(&self) -> io::Result<(Bytes, Bytes)> {
         match self {
             JobResult::Ready(solved) => {
-                let csv = solved
-                    .body(Format::Csv)
+                let rendering = solved.clone();
+                let csv = super::heavy::run(move || rendering.body(Format::Csv))
+                    .await
+                    .map_err(io::Error::other)?
                     .map_err(|e| io::Error::other(e.to_string()))?;
                 Ok((solved.json().clone(), csv))
             }

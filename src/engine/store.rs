@@ -31,6 +31,7 @@ pub enum JobStatus {
 }
 
 impl JobStatus {
+    /// Every status, in the order of a job's life (for parsing and for errors naming them).
     pub const ALL: [JobStatus; 6] = [
         JobStatus::Queued,
         JobStatus::Running,
@@ -309,8 +310,9 @@ pub trait JobStore: Send + Sync {
     /// The jobs of `listing`'s owner, newest first, filtered and paged; an error says why
     /// the store cannot be read.
     async fn list(&self, listing: &Listing) -> Result<Page, String>;
-    /// The newest job that succeeded on the input whose hash is `input_hash`.
-    async fn with_input(&self, input_hash: &str) -> Option<JobRecord>;
+    /// The newest job that succeeded on the input whose hash is `input_hash`; an error says
+    /// why the store cannot be read.
+    async fn with_input(&self, input_hash: &str) -> Result<Option<JobRecord>, String>;
 
     /// Whether every process of the fleet shares the store (so any of them answers for any
     /// job, and a job unknown to it is unknown to all).
@@ -543,7 +545,14 @@ impl MemoryJobStore {
         Some(record.clone())
     }
 
-    pub async fn update(&self, id: Uuid, state: JobState, done: usize) {
+    /// Moves job `id` to `state`; returns the state as kept (a result spilled to disk is
+    /// the file's) and, once finished, when it finished (now, if memory forgot the job).
+    pub async fn update(
+        &self,
+        id: Uuid,
+        state: JobState,
+        done: usize,
+    ) -> (JobState, Option<SystemTime>) {
         let finishing = state.status().is_finished();
         // The room made for the result, taken once: by the update that finishes the job.
         let reservation = if finishing {
@@ -570,17 +579,19 @@ impl MemoryJobStore {
             }
         }
         let Some(record) = records.jobs.get_mut(&id) else {
-            return;
+            return (state, finishing.then(SystemTime::now));
         };
         let finished = finishing && record.finished_at.is_none();
         if finished {
             record.finished_at = Some(SystemTime::now());
         }
-        record.state = state;
+        record.state = state.clone();
         record.done = done;
+        let finished_at = record.finished_at;
         if finished {
             records.finished.push_back(id);
         }
+        (state, finished_at)
     }
 
     pub async fn remove(&self, id: Uuid) {

@@ -358,6 +358,15 @@ impl ServeArgs {
                 ));
             }
         }
+        // (A fleet keeps no job in a process's memory: its history is its only retention.)
+        if self.fleet.redis_url.is_none() && self.history_retention < self.job_retention {
+            return fail(format!(
+                "--history-retention {} must be at least --job-retention {}: a finished job \
+                 is kept in memory for the one and in the history for the other",
+                humantime::format_duration(self.history_retention),
+                humantime::format_duration(self.job_retention)
+            ));
+        }
         if self.solve_deadline >= self.request_timeout {
             return fail(format!(
                 "--solve-deadline {} must be shorter than --request-timeout {}, so that a \

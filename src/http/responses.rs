@@ -52,8 +52,24 @@ const INVALID_INPUT: &str = "invalid-input: fields of the wrong shape or out of 
     named in `errors` with its value and the allowed range";
 
 problems!(
+    /// The history's store failing a read (a fleet's Redis unreachable, the database).
+    HistoryUnreadable {
+        (500, "internal: a stored result cannot be read back", false),
+        (503, "about:blank: the history cannot be read now (the detail says why)", false),
+    }
+);
+
+problems!(
+    /// A job with an owner, asked to change by a request that does not name it.
+    NotTheOwner {
+        (403, "about:blank: the job was submitted with an owner's token \
+            (thirdbody-owner), and only a request with the same token may cancel or delete it", false),
+    }
+);
+
+problems!(
     /// Errors of a request's query or headers.
-    InvalidQuery {
+    InvalidParameters {
         (422, INVALID_INPUT, false),
     }
 );

@@ -282,7 +282,13 @@ try {
   for (const [name, value] of [["asperities.density", "1e12 m^-2"], ["asperities.tip_radius", "1 um"], ["asperities.height_std", "20 nm"], ["asperities.hardness", "2 GPa"], ["upper_surface.elastic_modulus", "200 GPa"]]) {
     await page.fill(`#form-three-body input[name='${name}']`, value);
   }
+  // Its discretisation too.
+  await page.fill("#form-three-body input[name='options.diameter_nodes']", "24");
+  await page.selectOption("#form-three-body select[name='options.quadrature']", "midpoint");
+  const sent = page.waitForRequest((r) => r.url().endsWith("/v1/three-body") && r.method() === "POST");
   await page.locator("#form-three-body").getByRole("button", { name: "Solve" }).click();
+  const options = JSON.parse((await sent).postData()).options;
+  if (options?.diameter_nodes !== 24 || options?.quadrature !== "midpoint") fail(`the three-body options sent: ${JSON.stringify(options)}`);
   await page.waitForFunction((s) => document.querySelector(`${s} .status`).textContent.startsWith("Solved")
     && [...document.querySelectorAll(`${s} .table tr`)].some((r) => r.textContent.startsWith("loads.asperities")), area("three-body"), { timeout: 30000 });
   const asperityLoad = await page.locator(`${area("three-body", "table")} tr`, { hasText: "loads.asperities" }).first().textContent();
@@ -386,6 +392,16 @@ try {
   await page.waitForSelector(`${area("history", "picture")} svg.plot`);
   if (!(await page.evaluate(() => location.hash)).endsWith(bigSweep.id)) fail("opening a job does not put its link in the address");
   await page.screenshot({ path: `${shots}/history.png`, fullPage: true });
+  // The token is given on asking, and never inside a copied command.
+  await page.click("#history-token");
+  await page.waitForFunction(() => document.querySelector("#panel-history .status").textContent.startsWith("Copied this browser's token"));
+  const token = await page.evaluate(() => localStorage.getItem("thirdbody-owner"));
+  if (!/^[0-9a-f]{32}$/.test(token) || (await page.evaluate(() => navigator.clipboard.readText())) !== token) fail(`the copied token is not this browser's: ${token}`);
+  await page.getByRole("tab", { name: "Sweep" }).click();
+  await page.locator("#form-sweep").getByRole("button", { name: "Copy as curl" }).click();
+  const curl = await page.evaluate(() => navigator.clipboard.readText());
+  if (curl.includes(token) || !curl.includes('"thirdbody-owner: $THIRDBODY_OWNER"')) fail(`the copied curl command: ${curl}`);
+  await page.getByRole("tab", { name: "History" }).click();
   // Deleted (after a confirmation): gone from the list, and from the service.
   page.once("dialog", (dialog) => dialog.accept());
   await page.locator(`#history-jobs tbody tr[data-id='${cancelledRow.id}']`).getByRole("button", { name: "Delete" }).click();

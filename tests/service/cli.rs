@@ -186,6 +186,21 @@ fn serve_refuses_a_bad_setting_at_start_up_with_status_2() {
     assert!(stderr.contains("--pool-size 0"), "{stderr}");
     let output = thirdbody(&["serve", "--bind", "nowhere"], None);
     assert_eq!(output.status.code(), Some(2));
+    // A history shorter than the time a result stays in memory would contradict it.
+    let flags = [
+        "serve",
+        "--history-retention",
+        "1m",
+        "--job-retention",
+        "15m",
+    ];
+    let output = thirdbody(&flags, None);
+    assert_eq!(output.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(
+        stderr.contains("--history-retention 1m must be at least --job-retention 15m"),
+        "{stderr}"
+    );
 }
 
 /// `ENV` settings of the Dockerfile's run stage, as (name, value) pairs.

@@ -215,6 +215,11 @@ async fn saved_analyses_outlive_a_restart_of_the_embedded_database() {
         ("/v1/jobs?kind=fits", Some(OWNER), "kind"),
         ("/v1/jobs?status=done", Some(OWNER), "status"),
         ("/v1/jobs?limit=101", Some(OWNER), "limit"),
+        (
+            "/v1/jobs?status=failed&status=failed",
+            Some(OWNER),
+            "status",
+        ),
     ] {
         let (status, problem) = list(&http, &base, path, owner).await;
         assert_eq!(
@@ -224,6 +229,27 @@ async fn saved_analyses_outlive_a_restart_of_the_embedded_database() {
         );
         assert_eq!(problem["errors"][0]["field"], field, "{problem}");
     }
+    // A token refused is not echoed (it may be a secret mistyped).
+    let (_, problem) = list(&http, &base, "/v1/jobs", Some("short")).await;
+    assert_eq!(problem["errors"][0]["value"], "(5 characters)", "{problem}");
+    assert!(!problem.to_string().contains("short"), "{problem}");
+
+    // An owned job is cancelled or deleted by its owner only (its link may be shared).
+    let rolled_url = format!("{base}/v1/jobs/{rolled_id}");
+    for owner in [None, Some(OTHER)] {
+        for request in [
+            http.delete(&rolled_url),
+            http.post(format!("{rolled_url}/cancel")),
+        ] {
+            let request = match owner {
+                Some(owner) => request.header("thirdbody-owner", owner),
+                None => request,
+            };
+            let response = request.send().await.unwrap();
+            assert_eq!(response.status(), StatusCode::FORBIDDEN);
+        }
+    }
+    assert_eq!(get_json(&http, rolled_url).await["status"], "succeeded");
 
     // The input's stable link answers from the database (the cache went with the process).
     let hash = before[0].0["input_hash"].as_str().unwrap();
@@ -238,9 +264,10 @@ async fn saved_analyses_outlive_a_restart_of_the_embedded_database() {
         StatusCode::NOT_FOUND
     );
 
-    // Deleted: gone from the list, its URL and its input's link.
+    // Deleted by its owner: gone from the list, its URL and its input's link.
     let deleted = http
         .delete(format!("{base}/v1/jobs/{swept_id}"))
+        .header("thirdbody-owner", OWNER)
         .send()
         .await
         .unwrap();
@@ -356,6 +383,7 @@ async fn a_fleets_history_outlives_its_processes_and_expires_in_redis() {
         dropped_id
     );
     http.delete(format!("{base}/v1/jobs/{dropped_id}"))
+        .header("thirdbody-owner", OWNER)
         .send()
         .await
         .unwrap();

@@ -50,6 +50,8 @@ if ARGV[1] ~= 'queued' and ARGV[1] ~= 'running' then
     redis.call('HSET', KEYS[1], 'result', ARGV[6], 'key', ARGV[7])
   end
   redis.call('HSET', KEYS[1], 'finished_at', ARGV[5])
+  -- The job's text (a fit's data may be long) is for its workers only: not kept for days.
+  redis.call('HDEL', KEYS[1], 'job')
   redis.call('DEL', KEYS[3])
   for i = 1, 4 do redis.call('PEXPIRE', KEYS[i], ARGV[4]) end
   if ARGV[1] == 'succeeded' and ARGV[7] ~= '' then
@@ -217,8 +219,22 @@ impl RedisJobStore {
         ];
         pipe.hset_multiple(&key, &fields).ignore();
         if let Some(owner) = &record.owner {
+            // Scored in µs (exact in a double until the year 2255), so that jobs submitted in
+            // the same millisecond keep their order; ids are random past their millisecond.
+            // Jobs submitted longer ago than a job may be kept are gone: their places too.
             let list = keys::owner(owner.as_str());
-            pipe.zadd(&list, record.id.to_string(), submitted)
+            let micros = |t: std::time::Duration| u64::try_from(t.as_micros()).unwrap_or(u64::MAX);
+            let since_epoch = record
+                .submitted_at
+                .duration_since(std::time::UNIX_EPOCH)
+                .unwrap_or_default();
+            let (score, oldest) = (
+                micros(since_epoch),
+                micros(since_epoch.saturating_sub(self.lifetime)),
+            );
+            pipe.zadd(&list, record.id.to_string(), score)
+                .ignore()
+                .zrembyscore(&list, "-inf", format!("({oldest}"))
                 .ignore()
                 .pexpire(&list, millis(self.lifetime) as i64)
                 .ignore();
@@ -434,8 +450,12 @@ impl RedisJobStore {
         self.parse(id, values).await
     }
 
-    /// The records of jobs `ids` (`None` for those gone), read in one round trip.
-    async fn records(&self, ids: &[Uuid]) -> Result<Vec<Option<JobRecord>>, Failure> {
+    /// The records of jobs `ids` (`None` for those gone, an error for one this version
+    /// cannot read), read in one round trip.
+    async fn records(
+        &self,
+        ids: &[Uuid],
+    ) -> Result<Vec<Result<Option<JobRecord>, Failure>>, Failure> {
         let mut pipe = redis::pipe();
         for id in ids {
             pipe.hmget(keys::job(*id).record, &Self::FIELDS[..]);
@@ -443,7 +463,7 @@ impl RedisJobStore {
         let all: Vec<Vec<Option<Vec<u8>>>> = self.fleet.jobs.pipe(&pipe).await?;
         let mut records = Vec::with_capacity(ids.len());
         for (id, values) in ids.iter().zip(all) {
-            records.push(self.parse(*id, values).await?);
+            records.push(self.parse(*id, values).await);
         }
         Ok(records)
     }
@@ -653,25 +673,35 @@ impl JobStore for RedisJobStore {
         let gone: Vec<String> = ids
             .iter()
             .zip(&records)
-            .filter(|(_, record)| record.is_none())
+            .filter(|(_, record)| matches!(record, Ok(None)))
             .map(|(id, _)| id.to_string())
             .collect();
         if !gone.is_empty() {
             let _ = self.fleet.jobs.query::<i64>(&Cmd::zrem(&list, gone)).await;
         }
-        let matching = records
-            .into_iter()
-            .flatten()
+        // A record this version cannot read (another version's kind) is left out, not fatal.
+        let matching = ids
+            .iter()
+            .zip(records)
+            .filter_map(|(id, record)| {
+                record
+                    .inspect_err(|e| tracing::warn!(error = %e, %id, "a listed job is unreadable"))
+                    .ok()
+                    .flatten()
+            })
             .filter(|record| record.listed_in(listing))
             .collect();
         Ok(Page::of(matching, listing))
     }
 
-    async fn with_input(&self, input_hash: &str) -> Option<JobRecord> {
+    async fn with_input(&self, input_hash: &str) -> Result<Option<JobRecord>, String> {
         let cmd = Cmd::get(keys::input(input_hash));
-        let id: Option<String> = self.fleet.jobs.query(&cmd).await.ok()?;
-        let record = self.record(id?.parse().ok()?).await.ok()??;
-        matches!(record.state, JobState::Succeeded(_)).then_some(record)
+        let id: Option<String> = self.fleet.jobs.query(&cmd).await.map_err(|e| e.why)?;
+        let Some(id) = id.and_then(|id| id.parse().ok()) else {
+            return Ok(None);
+        };
+        let record = self.record(id).await.map_err(|e| e.why)?;
+        Ok(record.filter(|r| matches!(r.state, JobState::Succeeded(_))))
     }
 
     fn shared(&self) -> bool {

@@ -615,8 +615,13 @@ async function compare(form) {
 
 async function post(url, body, accept = "application/json") {
   const headers = { "content-type": "application/json", accept };
-  if (url === "/v1/jobs") headers["thirdbody-owner"] = ownerToken();
-  return fetch(url, { method: "POST", headers, body: JSON.stringify(body) });
+  return fetch(url, { method: "POST", headers: url === "/v1/jobs" ? owned(headers) : headers, body: JSON.stringify(body) });
+}
+
+/** `headers` with this browser's token as the owner: its jobs are listed to it, and only it
+ *  cancels or deletes them. */
+function owned(headers = {}) {
+  return { ...headers, "thirdbody-owner": ownerToken() };
 }
 
 /** This browser's token as the owner of its jobs (the service lists a token's jobs to its
@@ -666,7 +671,7 @@ async function runJob(form) {
   }
   if (!area.current(token)) {
     // Asked again meanwhile: this job has no one to show it to.
-    if (read.ok) fetch(`/v1/jobs/${read.body.id}/cancel`, { method: "POST" }).catch(() => {});
+    if (read.ok) fetch(`/v1/jobs/${read.body.id}/cancel`, { method: "POST", headers: owned() }).catch(() => {});
     return;
   }
   if (!read.ok) {
@@ -728,7 +733,7 @@ function follow(area, token, id) {
   cancel.disabled = false;
   cancel.onclick = handled(area, token, async () => {
     cancel.disabled = true;
-    const read = await readJson(await fetch(`/v1/jobs/${id}/cancel`, { method: "POST", headers: { accept: "application/json" } }));
+    const read = await readJson(await fetch(`/v1/jobs/${id}/cancel`, { method: "POST", headers: owned({ accept: "application/json" }) }));
     if (!read.ok && area.current(token)) area.status(`Cancel: ${problemText(read.body)}`, "error");
   });
   const events = new EventSource(`/v1/jobs/${id}/events`);
@@ -780,7 +785,7 @@ async function finished(area, token, view) {
   const ending = {
     succeeded: ["Job succeeded.", ""],
     failed: [`Job failed: ${view.problem ? problemText(view.problem) : "no reason given"}.`, "error"],
-    cancelled: [`Job cancelled after ${done} of ${total} points.`, "ended"],
+    cancelled: [total ? `Job cancelled after ${done} of ${total} points.` : "Job cancelled.", "ended"],
   }[view.status] || [`Job ${view.status}.`, "ended"];
   if (!view.result_url) {
     area.clear();
@@ -792,7 +797,7 @@ async function finished(area, token, view) {
   if (!area.current(token)) return;
   if (!read.ok) return area.problem({ ...read.body, title: `${ending[0]} Its answer cannot be read (${read.body.title})` });
   const partial = view.partial ? " The answer below is partial: the points it finished." : "";
-  area.status(ending[0] + partial, ending[1]);
+  area.status(ending[0] + partial + accuracy(read.body), ending[1]);
   await showAnswer(area, token, read.body, () => fetch(`${result}?format=svg`), (accept) => fetch(result, { headers: { accept } }), `job-${view.id}`);
 }
 
@@ -804,7 +809,7 @@ async function copy(form, what) {
   const { url, body, job } = requestOf(form);
   const texts = {
     job: ["the job as JSON", JSON.stringify(job, null, 2)],
-    curl: ["the curl command", `curl -s -X POST ${location.origin}${url} -H 'content-type: application/json'${url === "/v1/jobs" ? ` -H 'thirdbody-owner: ${ownerToken()}'` : ""} -d '${JSON.stringify(body)}'`],
+    curl: ["the curl command", `curl -s -X POST ${location.origin}${url} -H 'content-type: application/json'${url === "/v1/jobs" ? ` -H "thirdbody-owner: $THIRDBODY_OWNER"` : ""} -d '${JSON.stringify(body)}'`],
     python: ["the Python script", python(url, body)],
   };
   const [name, text] = texts[what];
@@ -820,14 +825,15 @@ async function copy(form, what) {
  *  polled until it ends. The body is embedded as JSON, which Python reads as it is. */
 function python(url, body) {
   const lines = [
-    "import json, time, requests",
+    "import json, os, time, requests",
     "",
     `base = "${location.origin}"`,
     `body = json.loads(r"""${JSON.stringify(body, null, 2)}""")`,
   ];
   if (url === "/v1/jobs") {
     lines.push(
-      `owner = {"thirdbody-owner": "${ownerToken()}"}  # lists the job in this browser's history`,
+      "# With THIRDBODY_OWNER set to this browser's token (History: copy it), the job is in its history.",
+      'owner = {"thirdbody-owner": os.environ["THIRDBODY_OWNER"]} if "THIRDBODY_OWNER" in os.environ else {}',
       `job = requests.post(base + "${url}", json=body, headers=owner).json()`,
       'while job["status"] in ("queued", "running"):',
       "    time.sleep(0.5)",
@@ -848,8 +854,9 @@ function python(url, body) {
 
 // ---- History: this browser's jobs, kept by the service --------------------------------
 
-/** The history's listing: the URL of its next page, while there is one. */
-const listing = { next: null };
+/** The history's listing: the URL of its next page, while there is one, and the count of
+ *  listings asked (the last one asked is the one shown). */
+const listing = { next: null, asked: 0 };
 
 /** The first page of the history as the filters ask. */
 function historyUrl() {
@@ -865,8 +872,10 @@ async function loadHistory(more = false) {
   const area = $("#panel-history").area;
   const url = more ? listing.next : historyUrl();
   if (!url) return;
-  const headers = { accept: "application/json", "thirdbody-owner": ownerToken() };
-  const read = await readJson(await fetch(url, { headers }));
+  const asked = ++listing.asked;
+  const read = await readJson(await fetch(url, { headers: owned({ accept: "application/json" }) }));
+  // A later listing (another filter, a refresh) wins over this one.
+  if (asked !== listing.asked) return;
   if (!read.ok) return area.problem(read.body);
   const rows = $("#history-jobs tbody");
   if (!more) rows.replaceChildren();
@@ -933,7 +942,7 @@ async function openInput(hash) {
 async function deleteJob(view, row) {
   if (!confirm(`Delete the ${view.kind} job of ${new Date(view.submitted_at).toLocaleString()} and its answer?`)) return;
   const area = $("#panel-history").area;
-  const read = await readJson(await fetch(`/v1/jobs/${view.id}`, { method: "DELETE", headers: { accept: "application/json" } }));
+  const read = await readJson(await fetch(`/v1/jobs/${view.id}`, { method: "DELETE", headers: owned({ accept: "application/json" }) }));
   if (!read.ok) return area.problem(read.body);
   row.remove();
   area.status(`Deleted the ${view.kind} job of ${new Date(view.submitted_at).toLocaleString()}.`);
@@ -1041,6 +1050,10 @@ document.addEventListener("DOMContentLoaded", () => {
   for (const id of ["#history-kind", "#history-status"]) $(id).addEventListener("change", () => guarded(historyArea, () => loadHistory()));
   $("#history-refresh").addEventListener("click", () => guarded(historyArea, () => loadHistory()));
   $("#history-more").addEventListener("click", () => guarded(historyArea, () => loadHistory(true)));
+  $("#history-token").addEventListener("click", () => guarded(historyArea, async () => {
+    await navigator.clipboard.writeText(ownerToken());
+    historyArea.status("Copied this browser's token: set THIRDBODY_OWNER to it, and the jobs of copied commands are listed here. Keep it to yourself: it lists your jobs.");
+  }));
   openLinked();
   window.addEventListener("hashchange", openLinked);
 });

@@ -6,8 +6,9 @@
 //! the submissions: the dashboard keeps a random one in the browser's storage, so that a
 //! browser lists its own jobs and nobody else's.
 
-use axum::extract::{FromRequestParts, Path, State};
+use axum::extract::{FromRequestParts, Path, RawQuery, State};
 use axum::http::request::Parts;
+use axum::http::StatusCode;
 use axum::response::Response;
 use axum::Json;
 use serde::{Deserialize, Serialize};
@@ -17,9 +18,12 @@ use utoipa::{IntoParams, ToSchema};
 use super::jobs::JobView;
 use super::{Answering, FormatQuery};
 use crate::engine::store::{JobStatus, Listing, Owner};
+use crate::engine::EngineError;
 use crate::http::accept::AcceptsJson;
 use crate::http::error::ApiError;
-use crate::http::responses::{Busy, InvalidQuery, NotAcceptable, NotFound, NotModified, ReadBack};
+use crate::http::responses::{
+    HistoryUnreadable, InvalidParameters, NotAcceptable, NotFound, NotModified, ReadBack,
+};
 use crate::http::AppState;
 use crate::job::registry::KindName;
 use crate::job::{FieldError, JobError};
@@ -47,12 +51,24 @@ impl<S: Send + Sync> FromRequestParts<S> for OwnerHeader {
         if (16..=128).contains(&token.len()) && token.bytes().all(allowed) {
             return Ok(OwnerHeader(Some(Owner::of_token(&token))));
         }
+        // Not echoed: it may be a secret mistyped.
         Err(invalid(
             &format!("header {OWNER_HEADER}"),
-            Value::String(token.into_owned()),
+            Value::String(format!("({} characters)", token.chars().count())),
             "16 to 128 characters of A-Z, a-z, 0-9, '-', '_', '.' and '~' (a random token \
              the client keeps, e.g. a UUID)",
         ))
+    }
+}
+
+/// The history's store failing a read: 503, saying why (not a submission's refusal).
+fn unreadable(error: EngineError) -> ApiError {
+    match error {
+        EngineError::Unavailable(why) => ApiError::from_status(
+            StatusCode::SERVICE_UNAVAILABLE,
+            format!("the history cannot be read now: {why}"),
+        ),
+        other => other.into(),
     }
 }
 
@@ -71,8 +87,9 @@ fn invalid(field: &str, value: Value, allowed: &str) -> ApiError {
     .into()
 }
 
-/// `GET /v1/jobs`'s query: filters and the page.
-#[derive(Deserialize, IntoParams)]
+/// `GET /v1/jobs`'s query: filters and the page. Read by hand, so that every bad query
+/// (a parameter given twice too) is a 422 naming the parameter.
+#[derive(Default, IntoParams)]
 #[into_params(parameter_in = Query)]
 pub struct ListQuery {
     /// Only jobs of this kind.
@@ -90,6 +107,33 @@ pub struct ListQuery {
 }
 
 impl ListQuery {
+    /// The parameters of the query string `query` (others are ignored).
+    fn parse(query: Option<&str>) -> Result<ListQuery, ApiError> {
+        let mut read = ListQuery::default();
+        for pair in query
+            .unwrap_or_default()
+            .split('&')
+            .filter(|p| !p.is_empty())
+        {
+            let (name, value) = pair.split_once('=').unwrap_or((pair, ""));
+            let slot = match name {
+                "kind" => &mut read.kind,
+                "status" => &mut read.status,
+                "limit" => &mut read.limit,
+                "offset" => &mut read.offset,
+                _ => continue,
+            };
+            if slot.replace(value.to_string()).is_some() {
+                return Err(invalid(
+                    name,
+                    Value::String(value.to_string()),
+                    "one value: the parameter is given twice",
+                ));
+            }
+        }
+        Ok(read)
+    }
+
     /// The listing asked for `owner`; a value out of range is a 422 naming it.
     fn listing(&self, owner: Owner) -> Result<Listing, ApiError> {
         let number = |name: &str, text: &Option<String>, default: usize, most: usize| {
@@ -180,14 +224,15 @@ pub struct JobList {
     params(ListQuery, ("thirdbody-owner" = String, Header, pattern = r"^[A-Za-z0-9._~-]{16,128}$",
         description = "The token sent with the jobs' submissions (16 to 128 characters)")),
     responses((status = 200, description = "A page of the owner's jobs", body = JobList),
-        InvalidQuery, NotAcceptable, Busy)
+        InvalidParameters, NotAcceptable, HistoryUnreadable)
 )]
 pub async fn list(
     State(state): State<AppState>,
     _: AcceptsJson,
     OwnerHeader(owner): OwnerHeader,
-    axum::extract::Query(query): axum::extract::Query<ListQuery>,
+    RawQuery(query): RawQuery,
 ) -> Result<Json<JobList>, ApiError> {
+    let query = ListQuery::parse(query.as_deref())?;
     let Some(owner) = owner else {
         return Err(invalid(
             &format!("header {OWNER_HEADER}"),
@@ -197,7 +242,7 @@ pub async fn list(
         ));
     };
     let listing = query.listing(owner)?;
-    let page = state.engine().list(&listing).await?;
+    let page = state.engine().list(&listing).await.map_err(unreadable)?;
     let next = (listing.offset + page.jobs.len() < page.total).then(|| query.next(&listing));
     Ok(Json(JobList {
         jobs: page.jobs.iter().map(JobView::of).collect(),
@@ -227,7 +272,7 @@ pub struct InputHash {
     operation_id = "get_result_by_input",
     tag = "jobs",
     params(InputHash, FormatQuery),
-    responses(ReadBack, NotModified, NotFound, NotAcceptable)
+    responses(ReadBack, NotModified, NotFound, NotAcceptable, HistoryUnreadable)
 )]
 pub async fn by_input(
     State(state): State<AppState>,
@@ -238,7 +283,7 @@ pub async fn by_input(
     if let Some(solved) = engine.cached(&input_hash).await {
         return answering.respond(&solved, None);
     }
-    let record = engine.with_input(&input_hash).await;
+    let record = engine.with_input(&input_hash).await.map_err(unreadable)?;
     match record.as_ref().and_then(|r| r.state.result()) {
         Some(result) => answering.respond_result(result).await,
         None => Err(ApiError::not_found(format!(

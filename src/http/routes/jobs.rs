@@ -16,16 +16,16 @@ use tokio::sync::watch;
 use utoipa::{IntoParams, ToSchema};
 use uuid::Uuid;
 
-use super::history::OwnerHeader;
+use super::history::{OwnerHeader, OWNER_HEADER};
 use super::{Answering, FormatQuery};
-use crate::engine::store::{JobRecord, JobState, JobStatus};
+use crate::engine::store::{JobRecord, JobState, JobStatus, Owner};
 use crate::engine::{Engine, Unknown};
 use crate::http::accept::{Accept, AcceptsJson};
 use crate::http::body::JsonBody;
 use crate::http::error::{ApiError, Problem};
 use crate::http::responses::{
-    BadBody, Busy, Gone, JobFailure, NotAcceptable, NotFound, NotModified, ReadBack,
-    TooManyStreams, Unfinished,
+    BadBody, Busy, Gone, InvalidParameters, JobFailure, NotAcceptable, NotFound, NotModified,
+    NotTheOwner, ReadBack, TooManyStreams, Unfinished,
 };
 use crate::http::AppState;
 use crate::job::registry::{Envelope, KindName};
@@ -68,9 +68,11 @@ pub struct JobView {
     /// `/v1/results/{input_hash}`.
     pub input_hash: String,
     /// When the job was accepted (RFC 3339, UTC).
+    #[schema(format = DateTime)]
     pub submitted_at: String,
     /// When it finished, once it has (RFC 3339, UTC).
     #[serde(skip_serializing_if = "Option::is_none")]
+    #[schema(format = DateTime)]
     pub finished_at: Option<String>,
 }
 
@@ -170,9 +172,7 @@ fn seconds_since(unix_ms: u64) -> u64 {
     path = "/v1/jobs",
     operation_id = "submit_job",
     tag = "jobs",
-    params(("thirdbody-owner" = Option<String>, Header, pattern = r"^[A-Za-z0-9._~-]{16,128}$",
-        description = "A token of 16 to 128 \
-        characters the client keeps: the job is then listed to its holder by `GET /v1/jobs`")),
+    params(OwnerParam),
     request_body(content = Envelope, content_type = "application/json"),
     responses(
         (status = 202, description = "Accepted: queued, running, or already succeeded",
@@ -221,45 +221,78 @@ pub async fn status(_: AcceptsJson, FoundJob(record): FoundJob) -> Json<JobView>
 ///
 /// A queued job is cancelled at once, a running one at the solver's next check (between two
 /// rolling solves); the answer is the job once it stopped. The job stays, `cancelled`, for
-/// its retention time. A finished job is left as it is.
+/// its retention time. A finished job is left as it is. A job submitted with an owner's
+/// token is cancelled only by a request with the same token (its link may be shared).
 #[utoipa::path(
     post,
     path = "/v1/jobs/{id}/cancel",
     operation_id = "cancel_job",
     tag = "jobs",
-    params(JobId),
+    params(JobId, OwnerParam),
     responses((status = 200, description = "The job after the cancel", body = JobView),
-        NotFound, Gone, NotAcceptable)
+        NotTheOwner, InvalidParameters, NotFound, Gone, NotAcceptable)
 )]
 pub async fn cancel(
     State(state): State<AppState>,
     _: AcceptsJson,
+    OwnerHeader(owner): OwnerHeader,
     FoundJob(record): FoundJob,
-) -> Json<JobView> {
+) -> Result<Json<JobView>, ApiError> {
+    owned_by(&record, owner)?;
     let record = state.engine().cancel(record.id).await.unwrap_or(record);
-    Json(JobView::of(&record))
+    Ok(Json(JobView::of(&record)))
+}
+
+/// Refuses a change to `record` unless the request names its owner (a job without one is
+/// anyone's who holds its id).
+fn owned_by(record: &JobRecord, owner: Option<Owner>) -> Result<(), ApiError> {
+    match &record.owner {
+        Some(theirs) if owner.as_ref() != Some(theirs) => Err(ApiError::from_status(
+            StatusCode::FORBIDDEN,
+            format!(
+                "job {} was submitted with an owner's token: only a request with the same \
+                 {OWNER_HEADER} header may cancel or delete it",
+                record.id
+            ),
+        )),
+        _ => Ok(()),
+    }
+}
+
+/// The owner's token, for a job submitted with one.
+#[derive(IntoParams)]
+#[into_params(parameter_in = Header)]
+pub struct OwnerParam {
+    /// A token of 16 to 128 characters the client keeps: a job submitted with it is listed
+    /// to its holder (`GET /v1/jobs`), and only a request with it cancels or deletes the job.
+    #[param(rename = "thirdbody-owner", pattern = r"^[A-Za-z0-9._~-]{16,128}$")]
+    #[allow(dead_code)]
+    owner: Option<String>,
 }
 
 /// Delete a job.
 ///
 /// Cancels it if it has not finished (as `POST /v1/jobs/{id}/cancel` does), then forgets
-/// it: the answer is the job as it ended, and its URL answers 404 from then on.
+/// it: the answer is the job as it ended, and its URL answers 404 from then on. A job
+/// submitted with an owner's token is deleted only by a request with the same token.
 #[utoipa::path(
     delete,
     path = "/v1/jobs/{id}",
     operation_id = "delete_job",
     tag = "jobs",
-    params(JobId),
+    params(JobId, OwnerParam),
     responses((status = 200, description = "The job as it ended, now forgotten", body = JobView),
-        NotFound, Gone, NotAcceptable)
+        NotTheOwner, InvalidParameters, NotFound, Gone, NotAcceptable)
 )]
 pub async fn delete(
     State(state): State<AppState>,
     _: AcceptsJson,
+    OwnerHeader(owner): OwnerHeader,
     FoundJob(record): FoundJob,
-) -> Json<JobView> {
+) -> Result<Json<JobView>, ApiError> {
+    owned_by(&record, owner)?;
     let record = state.engine().delete(record.id).await.unwrap_or(record);
-    Json(JobView::of(&record))
+    Ok(Json(JobView::of(&record)))
 }
 
 /// A finished job's answer.
