@@ -32,8 +32,9 @@ function inputOf(form) {
   }
   dropKelvinTimes(input);
   if (form.dataset.kind === "fit") {
-    const { quantity, csv } = input.series || {};
-    input.series = seriesOf(quantity, csv || []);
+    // `on` chooses what was measured; a system of the defaults alone is `{}`, still a system.
+    const { quantity, csv, on, system } = input.series || {};
+    input.series = seriesOf(quantity, csv || [], on === "system" ? system || {} : undefined);
     for (const [name, bounds] of Object.entries(input.parameters || {})) {
       if (bounds.start === undefined) delete input.parameters[name];
     }
@@ -65,23 +66,24 @@ function pointsOf(text) {
   });
 }
 
-/** Measured points as the fit's series: the condition (radius, load, velocity) that takes
- *  the most values is what each series runs along; the others, fixed within a series, tell
- *  the series apart, so a curve is drawn through one condition's points. */
-function seriesOf(quantity, points) {
-  const conditions = ["radius", "load", "velocity"].filter((c) => points.some((p) => p[c] !== undefined));
+/** Measured points as the fit's series: the condition (radius, load, velocity, or a system's
+ *  total_load) that takes the most values is what each series runs along; the others, fixed
+ *  within a series, tell the series apart, so a curve is drawn through one condition's
+ *  points. Measured on a three-body `system`, every series is of that system. */
+function seriesOf(quantity, points, system) {
+  const conditions = ["radius", "load", "velocity", "total_load"].filter((c) => points.some((p) => p[c] !== undefined));
   const spread = (c) => new Set(points.map((p) => p[c])).size;
   const along = conditions.slice().sort((a, b) => spread(b) - spread(a))[0];
   const fixed = conditions.filter((c) => c !== along);
   const series = new Map();
   for (const point of points) {
     const key = JSON.stringify(fixed.map((c) => point[c]));
-    if (!series.has(key)) series.set(key, { quantity, ...Object.fromEntries(fixed.map((c) => [c, point[c]])), points: [] });
+    if (!series.has(key)) series.set(key, { quantity, system, ...Object.fromEntries(fixed.map((c) => [c, point[c]])), points: [] });
     const own = { ...point };
     for (const c of fixed) delete own[c];
     series.get(key).points.push(own);
   }
-  return series.size ? [...series.values()] : [{ quantity, points: [] }];
+  return series.size ? [...series.values()] : [{ quantity, system, points: [] }];
 }
 
 /** A form's field that cannot be read, said before anything is sent. */
