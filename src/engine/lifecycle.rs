@@ -410,10 +410,6 @@ impl Lifecycle {
     /// [`Lifecycle::jobs_collected`] for their clients to read them.
     pub(super) fn begin_drain(&self) {
         self.draining.cancel();
-        if self.jobs.durable() {
-            // Their answers outlive the process: a client reads them after the restart.
-            return;
-        }
         let unfinished: Vec<Uuid> = self.live().keys().copied().collect();
         let uncollected: Vec<Uuid> = self.uncollected().ids.iter().copied().collect();
         self.owed()
@@ -452,11 +448,8 @@ impl Lifecycle {
 
     /// Jobs finished that no client has read yet: those a drain waits for clients to read
     /// (once it has begun, the jobs it owes that are finished; before, every one unread).
-    /// None when the store outlives the process: their clients read them after a restart.
     pub(super) fn unread_jobs(&self) -> usize {
-        if self.jobs.durable() {
-            0
-        } else if self.is_draining() {
+        if self.is_draining() {
             let live: HashSet<Uuid> = self.live().keys().copied().collect();
             self.owed().iter().filter(|id| !live.contains(id)).count()
         } else {
