@@ -176,13 +176,10 @@ impl Archive {
             _ => None,
         };
         // A result is named only when its bodies are written with it.
-        let result = state.result().filter(|_| bodies.is_some()).map(|r| {
-            if r.complete() {
-                "whole"
-            } else {
-                "partial"
-            }
-        });
+        let result = state
+            .result()
+            .filter(|_| bodies.is_some())
+            .map(JobResult::form);
         let ended = tx.execute(
             "UPDATE jobs SET status = ?2, done = ?3, finished = ?4, error = ?5, result = ?6 \
              WHERE id = ?1 AND finished IS NULL",
@@ -349,22 +346,8 @@ impl Archive {
                 .and_then(|e| serde_json::from_str(&e).ok())
                 .unwrap_or_else(|| JobError::Internal("the job's error is unreadable".into()))
         };
-        let state = match text(3)?.as_str() {
-            "queued" => JobState::Queued,
-            "running" => JobState::Running,
-            "succeeded" => match result {
-                Some(result) => JobState::Succeeded(result),
-                None => JobState::failed(JobError::Internal(
-                    "the job's result was not saved".to_string(),
-                )),
-            },
-            "cancelled" => JobState::Cancelled { partial: result },
-            "interrupted" => JobState::Interrupted,
-            _ => JobState::Failed {
-                error: error(),
-                partial: result,
-            },
-        };
+        let status = JobStatus::parse(&text(3)?).unwrap_or(JobStatus::Failed);
+        let state = JobState::restored(status, result, error);
         Ok(Some(JobRecord {
             id,
             kind,

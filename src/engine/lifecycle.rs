@@ -353,17 +353,14 @@ impl Lifecycle {
         if !ids::is_ours(id) {
             return Unknown::NeverIssued;
         }
-        if self.fleet.is_none() && self.jobs.durable() {
-            // Every job accepted is in the database from its acceptance until deleted or
-            // expired, whichever run accepted it.
-            return Unknown::Gone;
-        }
         match &self.fleet {
             Some(shared) => match shared.fleet.epoch().await {
                 Some(since) if ids::issued_at(id) < since => Unknown::LostWithStore { since },
                 _ => Unknown::Gone,
             },
-            None if self.ids.issued_here(id) => Unknown::Gone,
+            // Every job accepted is in a durable store (the database) from its acceptance
+            // until deleted or expired, whichever run accepted it.
+            None if self.jobs.durable() || self.ids.issued_here(id) => Unknown::Gone,
             None => Unknown::EarlierRun,
         }
     }

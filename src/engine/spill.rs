@@ -172,6 +172,15 @@ impl JobResult {
         }
     }
 
+    /// How stores name the result's completeness: `whole` or `partial`.
+    pub fn form(&self) -> &'static str {
+        if self.complete() {
+            "whole"
+        } else {
+            "partial"
+        }
+    }
+
     /// The answer's JSON and CSV (a CSV rendered now is rendered off the async threads: a
     /// large sweep's takes tens of milliseconds).
     pub async fn bodies(&self) -> io::Result<(Bytes, Bytes)> {

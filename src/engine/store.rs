@@ -41,6 +41,11 @@ impl JobStatus {
         JobStatus::Interrupted,
     ];
 
+    /// The status named `text` (as [`JobStatus::as_str`] writes it).
+    pub fn parse(text: &str) -> Option<JobStatus> {
+        JobStatus::ALL.into_iter().find(|s| s.as_str() == text)
+    }
+
     pub fn as_str(self) -> &'static str {
         match self {
             JobStatus::Queued => "queued",
@@ -103,6 +108,31 @@ impl JobState {
             JobState::Failed { .. } => JobStatus::Failed,
             JobState::Cancelled { .. } => JobStatus::Cancelled,
             JobState::Interrupted => JobStatus::Interrupted,
+        }
+    }
+
+    /// The state of a job read back from a store as its `status`, its `result` if one was
+    /// stored, and its `error` (read only for a failed job).
+    pub fn restored(
+        status: JobStatus,
+        result: Option<JobResult>,
+        error: impl FnOnce() -> JobError,
+    ) -> JobState {
+        match status {
+            JobStatus::Queued => JobState::Queued,
+            JobStatus::Running => JobState::Running,
+            JobStatus::Cancelled => JobState::Cancelled { partial: result },
+            JobStatus::Interrupted => JobState::Interrupted,
+            JobStatus::Failed => JobState::Failed {
+                error: error(),
+                partial: result,
+            },
+            JobStatus::Succeeded => match result {
+                Some(result) => JobState::Succeeded(result),
+                None => JobState::failed(JobError::Internal(
+                    "the job's result was lost from the job store".to_string(),
+                )),
+            },
         }
     }
 

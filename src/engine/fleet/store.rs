@@ -395,11 +395,7 @@ impl RedisJobStore {
                 .map_err(|e| Failure::new(format!("cannot render the result: {e}")))?;
             let fields: [(&str, &[u8]); 2] = [("json", &json), ("csv", &csv)];
             pipe.hset_multiple(&keys.staged, &fields).ignore();
-            whole = if result.complete() {
-                "whole"
-            } else {
-                "partial"
-            };
+            whole = result.form();
         }
         let status = state.status().as_str();
         let done = done.map(|n| n.to_string()).unwrap_or_default();
@@ -509,25 +505,12 @@ impl RedisJobStore {
             )))),
             _ => None,
         };
-        let state = match parse_status(&text("status")) {
-            JobStatus::Queued => JobState::Queued,
-            JobStatus::Running => JobState::Running,
-            JobStatus::Cancelled => JobState::Cancelled { partial: result() },
-            JobStatus::Interrupted => JobState::Interrupted,
-            JobStatus::Failed => JobState::Failed {
-                error: serde_json::from_slice(fields.get("error").map_or(&[][..], Vec::as_slice))
-                    .unwrap_or_else(|e| {
-                        JobError::Internal(format!("the job's error is unreadable: {e}"))
-                    }),
-                partial: result(),
-            },
-            JobStatus::Succeeded => match result() {
-                Some(result) => JobState::Succeeded(result),
-                None => JobState::failed(JobError::Internal(
-                    "the job's result was lost from the job store".to_string(),
-                )),
-            },
-        };
+        let state = JobState::restored(parse_status(&text("status")), result(), || {
+            serde_json::from_slice(fields.get("error").map_or(&[][..], Vec::as_slice))
+                .unwrap_or_else(|e| {
+                    JobError::Internal(format!("the job's error is unreadable: {e}"))
+                })
+        });
         let time = |name: &str| text(name).parse().ok().map(from_unix_millis);
         let owner = Some(text("owner")).filter(|o| !o.is_empty());
         Ok(Some(JobRecord {
@@ -720,11 +703,9 @@ fn work_text(work: Work) -> String {
     }
 }
 
+/// The status stored as `text`; failed for one this version does not know.
 fn parse_status(text: &str) -> JobStatus {
-    JobStatus::ALL
-        .into_iter()
-        .find(|s| s.as_str() == text)
-        .unwrap_or(JobStatus::Failed)
+    JobStatus::parse(text).unwrap_or(JobStatus::Failed)
 }
 
 /// The instant of this process at the Unix time `unix_ms` (clocks of the fleet's machines

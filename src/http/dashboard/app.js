@@ -910,7 +910,7 @@ function historyRow(view) {
     }
   }
   const remove = Object.assign(document.createElement("button"), { type: "button", textContent: "Delete" });
-  remove.addEventListener("click", () => guarded($("#panel-history").area, () => deleteJob(view, row)));
+  remove.addEventListener("click", () => guarded($("#panel-history").area, () => deleteJob(view)));
   actions.append(remove);
   return row;
 }
@@ -940,14 +940,14 @@ async function openInput(hash) {
   await showAnswer(area, token, read.body, () => fetch(`${url}?format=svg`), (accept) => fetch(url, { headers: { accept } }), `answer-${hash.slice(0, 12)}`);
 }
 
-/** Deletes the job of `view` (after asking), and its row. */
-async function deleteJob(view, row) {
-  if (!confirm(`Delete the ${view.kind} job of ${new Date(view.submitted_at).toLocaleString()} and its answer?`)) return;
+/** Deletes the job of `view` (after asking); the history is listed again without it. */
+async function deleteJob(view) {
+  const job = `the ${view.kind} job of ${new Date(view.submitted_at).toLocaleString()}`;
+  if (!confirm(`Delete ${job} and its answer?`)) return;
   const area = $("#panel-history").area;
   const read = await readJson(await fetch(`/v1/jobs/${view.id}`, { method: "DELETE", headers: owned({ accept: "application/json" }) }));
   if (!read.ok) return area.problem(read.body);
-  row.remove();
-  area.status(`Deleted the ${view.kind} job of ${new Date(view.submitted_at).toLocaleString()}.`);
+  area.status(`Deleted ${job}.`);
   await loadHistory();
 }
 

@@ -162,15 +162,10 @@ impl ListQuery {
         };
         let status = match &self.status {
             None => None,
-            Some(name) => Some(
-                JobStatus::ALL
-                    .into_iter()
-                    .find(|s| s.as_str() == name)
-                    .ok_or_else(|| {
-                        let names: Vec<&str> = JobStatus::ALL.map(JobStatus::as_str).to_vec();
-                        invalid("status", Value::String(name.clone()), &names.join(", "))
-                    })?,
-            ),
+            Some(name) => Some(JobStatus::parse(name).ok_or_else(|| {
+                let names: Vec<&str> = JobStatus::ALL.map(JobStatus::as_str).to_vec();
+                invalid("status", Value::String(name.clone()), &names.join(", "))
+            })?),
         };
         Ok(Listing {
             owner,
@@ -180,22 +175,22 @@ impl ListQuery {
             offset: number("offset", &self.offset, 0, usize::MAX / 2)?,
         })
     }
+}
 
-    /// The URL of the page after `listing`'s.
-    fn next(&self, listing: &Listing) -> String {
-        let mut url = format!(
-            "/v1/jobs?limit={}&offset={}",
-            listing.limit,
-            listing.offset + listing.limit
-        );
-        if let Some(kind) = listing.kind {
-            url.push_str(&format!("&kind={}", kind.name()));
-        }
-        if let Some(status) = listing.status {
-            url.push_str(&format!("&status={}", status.as_str()));
-        }
-        url
+/// The URL of the page after `listing`'s.
+fn next_page(listing: &Listing) -> String {
+    let mut url = format!(
+        "/v1/jobs?limit={}&offset={}",
+        listing.limit,
+        listing.offset + listing.limit
+    );
+    if let Some(kind) = listing.kind {
+        url.push_str(&format!("&kind={}", kind.name()));
     }
+    if let Some(status) = listing.status {
+        url.push_str(&format!("&status={}", status.as_str()));
+    }
+    url
 }
 
 /// A page of an owner's jobs.
@@ -243,7 +238,7 @@ pub async fn list(
     };
     let listing = query.listing(owner)?;
     let page = state.engine().list(&listing).await.map_err(unreadable)?;
-    let next = (listing.offset + page.jobs.len() < page.total).then(|| query.next(&listing));
+    let next = (listing.offset + page.jobs.len() < page.total).then(|| next_page(&listing));
     Ok(Json(JobList {
         jobs: page.jobs.iter().map(JobView::of).collect(),
         total: page.total,
