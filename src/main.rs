@@ -63,6 +63,20 @@ enum Command {
     Worker(Box<ServeArgs>),
     /// Print the OpenAPI description of the HTTP API.
     Openapi,
+    /// Make an API key: prints the key on the first line (give it to its holder: it is kept
+    /// nowhere) and, on the second, its entry for the keys file of `serve --api-keys`.
+    NewKey {
+        /// The key's tenant: jobs submitted with it belong to this name (keys of one name
+        /// share them: add a new key under the old name to rotate it).
+        #[arg(long)]
+        name: String,
+        /// What it may do: a comma-separated list of submit, read, metrics and admin.
+        #[arg(long, default_value = "submit,read")]
+        scopes: String,
+        /// When it stops being accepted (RFC 3339, e.g. 2027-06-30T00:00:00Z); never if absent.
+        #[arg(long)]
+        expires: Option<String>,
+    },
     /// Exit 0 if the service on THIRDBODY_BIND answers /healthz (a container's health check:
     /// the image has no curl).
     Healthcheck {
@@ -144,6 +158,11 @@ fn main() -> ExitCode {
         Command::Serve(args) => return serve(*args),
         Command::Worker(args) => return worker(*args),
         Command::Openapi => return print(&http::openapi::spec_json()),
+        Command::NewKey {
+            name,
+            scopes,
+            expires,
+        } => return new_key(&name, &scopes, expires.as_deref()),
         Command::Healthcheck { bind } => return healthcheck(bind),
     };
     let result = job.and_then(|job| {
@@ -243,6 +262,17 @@ fn healthcheck(mut bind: std::net::SocketAddr) -> ExitCode {
         Err(e) => {
             eprintln!("thirdbody healthcheck: {bind}: {e}");
             ExitCode::FAILURE
+        }
+    }
+}
+
+/// `thirdbody new-key`: a key and its entry, or why not (exit 2).
+fn new_key(name: &str, scopes: &str, expires: Option<&str>) -> ExitCode {
+    match http::access::keys::issue(name, scopes, expires) {
+        Ok((key, entry)) => print(&format!("{key}\n{entry}\n")),
+        Err(e) => {
+            eprintln!("thirdbody new-key: {e}");
+            ExitCode::from(INVALID_JOB)
         }
     }
 }

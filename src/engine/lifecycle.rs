@@ -291,9 +291,14 @@ impl Lifecycle {
     /// `Unavailable` while the fleet's job store cannot be reached.
     pub(super) fn store_reachable(&self) -> Result<(), EngineError> {
         match &self.fleet {
-            Some(shared) if !shared.fleet.jobs.is_up() => Err(EngineError::Unavailable(
-                "Redis (jobs) cannot be reached: no answer at the last try".to_string(),
-            )),
+            Some(shared) if !shared.fleet.jobs.is_up() => {
+                let jobs = &shared.fleet.jobs;
+                let why = match jobs.health() {
+                    Health::Denied => Health::Denied.reason(jobs.role).unwrap_or_default(),
+                    _ => "Redis (jobs) cannot be reached: no answer at the last try".to_string(),
+                };
+                Err(EngineError::Unavailable(why))
+            }
             _ => Ok(()),
         }
     }

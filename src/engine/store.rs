@@ -243,11 +243,16 @@ pub fn age(then: SystemTime, now: SystemTime) -> Duration {
     now.duration_since(then).unwrap_or_default()
 }
 
-/// Who submitted a job: the SHA-256 of a token only its holder knows (the dashboard keeps a
-/// random one in the browser's storage), so that the list of a holder's jobs is shown to
-/// that holder alone, and the stored form cannot be replayed to list them.
+/// Who submitted a job: an API key's tenant (`key:` and its name), or, without a key, the
+/// SHA-256 of a token only its holder knows (the dashboard keeps a random one in the
+/// browser's storage), so that the list of a holder's jobs is shown to that holder alone,
+/// and the stored form cannot be replayed to list them. A token's hash is hexadecimal, so
+/// it is never taken for a tenant.
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]
 pub struct Owner(String);
+
+/// The prefix of a tenant's stored form.
+const TENANT: &str = "key:";
 
 impl Owner {
     /// The owner holding `token` (checked by the caller).
@@ -257,12 +262,22 @@ impl Owner {
         Owner(digest.iter().map(|b| format!("{b:02x}")).collect())
     }
 
-    /// An owner as stored (the hash).
+    /// The tenant of the API keys named `name`.
+    pub fn of_tenant(name: &str) -> Owner {
+        Owner(format!("{TENANT}{name}"))
+    }
+
+    /// Whether the owner is an API key's tenant (whose jobs only its keys read).
+    pub fn is_tenant(&self) -> bool {
+        self.0.starts_with(TENANT)
+    }
+
+    /// An owner as stored.
     pub fn stored(hash: String) -> Owner {
         Owner(hash)
     }
 
-    /// The stored form: 64 hexadecimal digits.
+    /// The stored form: 64 hexadecimal digits, or `key:` and a tenant's name.
     pub fn as_str(&self) -> &str {
         &self.0
     }

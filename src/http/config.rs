@@ -5,11 +5,13 @@
 use std::fmt;
 use std::net::SocketAddr;
 use std::path::PathBuf;
+use std::sync::Arc;
 use std::time::Duration;
 
 use axum::http::HeaderValue;
 use clap::{Parser, ValueEnum};
 
+use super::access::{Access, Keys, Scopes, Source};
 use super::server::{BodyPace, ConnectionLimits};
 use crate::engine::fleet::FleetConfig;
 use crate::engine::EngineConfig;
@@ -135,6 +137,23 @@ pub struct ServeArgs {
     )]
     pub cors_origins: Vec<String>,
 
+    /// API keys: a JSON file of hashed keys, each with a name, scopes and an optional
+    /// expiry, read again within a second when it changes (or the JSON itself, e.g. in an
+    /// environment variable: then changed by a restart). See README, "API keys". Absent:
+    /// no key is accepted, and every caller is anonymous.
+    #[arg(long, env = "THIRDBODY_API_KEYS")]
+    pub api_keys: Option<String>,
+
+    /// What a caller without an API key may do: a comma-separated list of submit, read and
+    /// metrics, or `none` (then everything but the dashboard's files and the probes needs a
+    /// key).
+    #[arg(
+        long,
+        env = "THIRDBODY_ANONYMOUS",
+        default_value = "submit,read,metrics"
+    )]
+    pub anonymous: String,
+
     /// Log format.
     #[arg(long, env = "THIRDBODY_LOG_FORMAT", value_enum, default_value_t = LogFormat::Json)]
     pub log_format: LogFormat,
@@ -200,6 +219,7 @@ impl FleetArgs {
             .unwrap_or_else(|| cache_url.clone());
         for (flag, url) in [("--redis-url", &cache_url), ("--redis-jobs-url", &jobs_url)] {
             if let Err(e) = redis::Client::open(url.as_str()) {
+                let url = crate::engine::fleet::link::redacted(url);
                 return Err(ConfigError(format!("{flag} {url}: {e}")));
             }
         }
@@ -258,6 +278,8 @@ pub struct Config {
     pub body_limit: usize,
     pub request_timeout: Duration,
     pub cors_origins: CorsOrigins,
+    /// The API keys and what anonymous callers may do.
+    pub access: Arc<Access>,
     pub log_format: LogFormat,
     pub drain_delay: Duration,
     pub shutdown_timeout: Duration,
@@ -389,6 +411,7 @@ impl ServeArgs {
                 Some((dir, bytes))
             }
         };
+        let access = access(self.api_keys.as_deref(), &self.anonymous)?;
         Ok(Config {
             bind: self.bind,
             fleet: self.fleet.validate()?,
@@ -422,11 +445,32 @@ impl ServeArgs {
             body_limit: self.body_limit,
             request_timeout: self.request_timeout,
             cors_origins: cors_origins(&self.cors_origins)?,
+            access: Arc::new(access),
             log_format: self.log_format,
             drain_delay: self.drain_delay,
             shutdown_timeout: self.shutdown_timeout,
         })
     }
+}
+
+/// The keys of `--api-keys` (read now: a file that cannot be used fails the start) and
+/// the scopes of `--anonymous`.
+fn access(api_keys: Option<&str>, anonymous: &str) -> Result<Access, ConfigError> {
+    let anonymous =
+        Scopes::parse(anonymous).map_err(|e| ConfigError(format!("--anonymous: {e}")))?;
+    if anonymous.is_admin() {
+        return Err(ConfigError(
+            "--anonymous admin: an admin needs a key (allowed submit, read, metrics, or none)"
+                .to_string(),
+        ));
+    }
+    if anonymous == Scopes::NONE && api_keys.is_none() {
+        return Err(ConfigError(
+            "--anonymous none without --api-keys: nobody could use the service".to_string(),
+        ));
+    }
+    let keys = Keys::load(api_keys.map(Source::of)).map_err(ConfigError)?;
+    Ok(Access::new(keys, anonymous))
 }
 
 /// Origins are `scheme://host[:port]` exactly as browsers send them, or `*` alone.
@@ -495,6 +539,17 @@ mod tests {
             (&["--cors-origin", "dashboard.example"], "dashboard.example"),
             (&["--cors-origin", "https://a.example/path"], "no path"),
             (&["--log-format", "xml"], "xml"),
+            (
+                &["--anonymous", "read,write"],
+                "--anonymous: unknown scope \"write\"",
+            ),
+            (&["--anonymous", "admin"], "an admin needs a key"),
+            (&["--anonymous", "none"], "nobody could use the service"),
+            (
+                &["--api-keys", "/nonexistent/keys.json"],
+                "--api-keys /nonexistent/keys.json",
+            ),
+            (&["--api-keys", "{\"keys\": 3}"], "--api-keys: invalid type"),
             (
                 &["--max-connections", "18446744073709551615"],
                 "--max-connections 18446744073709551615: allowed 1 to 1048576",

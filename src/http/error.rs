@@ -33,7 +33,10 @@ pub struct Problem {
     /// extension members),
     /// `unsupported-media-type` (415),
     /// `not-acceptable` (406: the `Accept` header names no form the resource offers),
-    /// `payload-too-large` (413), `not-found` (404), `interrupted` (410: the service stopped
+    /// `payload-too-large` (413), `unauthorized` (401: no API key where one is needed, or a
+    /// key not accepted: unknown, expired), `forbidden` (403: the caller's key lacks the
+    /// scope, or the job is another's to change; a refused cross-origin preflight),
+    /// `not-found` (404), `interrupted` (410: the service stopped
     /// before the job finished), `not-ready` (409: the job has no result yet), `cancelled`
     /// (409), `overloaded` (429), `too-many-streams` (429: every event stream the service
     /// follows at once is open; poll the job instead),
@@ -72,6 +75,8 @@ enum Kind {
     UnsupportedMediaType,
     NotAcceptable,
     PayloadTooLarge,
+    Unauthorized,
+    Forbidden,
     NotFound,
     Interrupted,
     NotReady,
@@ -102,6 +107,8 @@ impl Kind {
             Kind::UnsupportedMediaType => StatusCode::UNSUPPORTED_MEDIA_TYPE,
             Kind::NotAcceptable => StatusCode::NOT_ACCEPTABLE,
             Kind::PayloadTooLarge => StatusCode::PAYLOAD_TOO_LARGE,
+            Kind::Unauthorized => StatusCode::UNAUTHORIZED,
+            Kind::Forbidden => StatusCode::FORBIDDEN,
             Kind::NotFound => StatusCode::NOT_FOUND,
             Kind::Interrupted => StatusCode::GONE,
             Kind::Cancelled | Kind::NotReady => StatusCode::CONFLICT,
@@ -126,6 +133,11 @@ impl Kind {
             Kind::UnsupportedMediaType => ("unsupported-media-type", "Send application/json"),
             Kind::NotAcceptable => ("not-acceptable", "No acceptable form of the answer"),
             Kind::PayloadTooLarge => ("payload-too-large", "The body is too large"),
+            Kind::Unauthorized => (
+                "unauthorized",
+                "An API key is needed, or the one sent is not accepted",
+            ),
+            Kind::Forbidden => ("forbidden", "The caller may not do this"),
             Kind::NotFound => ("not-found", "Not found"),
             Kind::Interrupted => ("interrupted", "The service stopped before the job finished"),
             Kind::NotReady => ("not-ready", "The job has no result yet"),
@@ -209,6 +221,16 @@ impl ApiError {
 
     pub fn not_found(detail: impl Into<String>) -> Self {
         ApiError::new(Kind::NotFound, detail)
+    }
+
+    /// No API key where one is needed, or one that is not accepted.
+    pub fn unauthorized(detail: impl Into<String>) -> Self {
+        ApiError::new(Kind::Unauthorized, detail)
+    }
+
+    /// A caller known, and not allowed to do this.
+    pub fn forbidden(detail: impl Into<String>) -> Self {
+        ApiError::new(Kind::Forbidden, detail)
     }
 
     pub fn not_acceptable(detail: impl Into<String>) -> Self {
@@ -298,6 +320,12 @@ impl ApiError {
             response
                 .headers_mut()
                 .insert(header::RETRY_AFTER, HeaderValue::from(seconds));
+        }
+        if self.kind == Kind::Unauthorized {
+            response.headers_mut().insert(
+                header::WWW_AUTHENTICATE,
+                HeaderValue::from_static("Bearer realm=\"thirdbody\""),
+            );
         }
         response.extensions_mut().insert(Answered);
         response

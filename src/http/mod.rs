@@ -6,6 +6,7 @@
 //! signal, then drains. Tests and the binary start the service the same way.
 
 mod accept;
+pub mod access;
 mod body;
 pub mod config;
 mod dashboard;
@@ -47,6 +48,8 @@ use crate::engine::{Engine, Storage};
 const X_REQUEST_ID: HeaderName = HeaderName::from_static("x-request-id");
 /// How often metrics histograms are drained and expired jobs forgotten.
 const HOUSEKEEPING_INTERVAL: Duration = Duration::from_secs(5);
+/// How often the API keys' file is read again (a revoked key stops working within this).
+const KEYS_INTERVAL: Duration = Duration::from_secs(1);
 
 /// What every handler shares: the settings, the engine and the metrics.
 #[derive(Clone)]
@@ -138,6 +141,7 @@ pub fn app(state: AppState) -> Router {
         .merge(dashboard::router())
         .route_layer(middleware::from_fn(observe::tag_route))
         .fallback(not_found)
+        .layer(middleware::from_fn_with_state(state.clone(), access::admit))
         .layer(DefaultBodyLimit::max(config.body_limit))
         .layer(middleware::from_fn_with_state(
             state.clone(),
@@ -155,6 +159,10 @@ pub fn app(state: AppState) -> Router {
         .layer(CompressionLayer::new().quality(CompressionLevel::Fastest))
         .layer(middleware::map_response(weaken_compressed_etag))
         .layer(option_layer(cors(&config.cors_origins)))
+        .layer(middleware::from_fn_with_state(
+            state.clone(),
+            access::refuse_foreign_preflight,
+        ))
         .layer(middleware::from_fn_with_state(
             state.clone(),
             observe::record_request,
@@ -213,6 +221,9 @@ fn cors(origins: &CorsOrigins) -> Option<CorsLayer> {
                 header::CONTENT_TYPE,
                 header::ACCEPT,
                 header::IF_NONE_MATCH,
+                header::AUTHORIZATION,
+                HeaderName::from_static(access::API_KEY_HEADER),
+                HeaderName::from_static(routes::history::OWNER_HEADER),
                 X_REQUEST_ID,
             ])
             .expose_headers(
@@ -220,6 +231,7 @@ fn cors(origins: &CorsOrigins) -> Option<CorsLayer> {
                     header::LOCATION,
                     header::ETAG,
                     header::RETRY_AFTER,
+                    header::WWW_AUTHENTICATE,
                     routes::X_CACHE,
                     X_REQUEST_ID,
                 ]
@@ -256,6 +268,7 @@ pub async fn run(
     state.engine().start_workers(workers, true);
     let stop_accepting = CancellationToken::new();
     let housekeeping = tokio::spawn(housekeeping(state.clone()));
+    let keys = tokio::spawn(reread_keys(state.clone()));
     let deadline = Arc::new(std::sync::Mutex::new(None::<tokio::time::Instant>));
     let remaining = {
         let deadline = deadline.clone();
@@ -276,6 +289,7 @@ pub async fn run(
     tokio::select! {
         result = &mut server => {
             housekeeping.abort();
+            keys.abort();
             return result?;
         }
         () = shutdown => {}
@@ -306,6 +320,7 @@ pub async fn run(
     stop_accepting.cancel();
     let served = server.await;
     housekeeping.abort();
+    keys.abort();
     served?
 }
 
@@ -317,5 +332,19 @@ async fn housekeeping(state: AppState) {
         tick.tick().await;
         state.inner.prometheus.run_upkeep();
         state.engine().purge_expired_jobs().await;
+    }
+}
+
+/// Reads the API keys' file again every [`KEYS_INTERVAL`]: keys are added, rotated and
+/// revoked without a restart. (A blocking read of a small file, off the async threads.)
+async fn reread_keys(state: AppState) {
+    if !state.config().access.keys.configured() {
+        return;
+    }
+    let mut tick = tokio::time::interval(KEYS_INTERVAL);
+    loop {
+        tick.tick().await;
+        let access = state.config().access.clone();
+        let _ = tokio::task::spawn_blocking(move || access.keys.reload()).await;
     }
 }

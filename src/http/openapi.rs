@@ -42,6 +42,7 @@ pub fn router_and_spec() -> (Router<AppState>, Spec) {
         .split_for_parts();
     document_validators(&mut spec);
     document_units(&mut spec);
+    document_access(&mut spec);
     (router, spec)
 }
 
@@ -83,6 +84,58 @@ fn document_validators(spec: &mut Spec) {
                 ]) {
                     ok.headers
                         .insert(name.as_str().to_string(), header(description));
+                }
+            }
+        }
+    }
+}
+
+/// The API keys, documented once for all operations (`access::admit` guards them all in
+/// one place): an API key in `x-api-key` or as a bearer token, or none (anonymous callers
+/// may do what the service's `--anonymous` allows); and the 401 and 403 answers of every
+/// operation but the probes.
+fn document_access(spec: &mut Spec) {
+    use utoipa::openapi::security::{
+        ApiKey, ApiKeyValue, Http, HttpAuthScheme, SecurityRequirement, SecurityScheme,
+    };
+    use utoipa::IntoResponses;
+    let components = spec.components.get_or_insert_with(Default::default);
+    components.add_security_scheme(
+        "api_key",
+        SecurityScheme::ApiKey(ApiKey::Header(ApiKeyValue::with_description(
+            super::access::API_KEY_HEADER,
+            "An API key (see the README's \"API keys\")",
+        ))),
+    );
+    components.add_security_scheme(
+        "bearer",
+        SecurityScheme::Http(Http::new(HttpAuthScheme::Bearer)),
+    );
+    spec.security = Some(vec![
+        SecurityRequirement::default(),
+        SecurityRequirement::new("api_key", Vec::<String>::new()),
+        SecurityRequirement::new("bearer", Vec::<String>::new()),
+    ]);
+    let refused = super::responses::Refused::responses();
+    for item in spec.paths.paths.values_mut() {
+        for operation in [&mut item.get, &mut item.post, &mut item.delete]
+            .into_iter()
+            .flatten()
+        {
+            let probe = ["healthz", "readyz"];
+            if probe.contains(&operation.operation_id.as_deref().unwrap_or_default()) {
+                continue;
+            }
+            let responses = &mut operation.responses.responses;
+            for (status, answer) in &refused {
+                match (responses.get_mut(status), answer) {
+                    (Some(RefOr::T(own)), RefOr::T(theirs)) => {
+                        own.description = format!("{}; or {}", own.description, theirs.description);
+                    }
+                    (Some(_), _) => {}
+                    (None, _) => {
+                        responses.insert(status.clone(), answer.clone());
+                    }
                 }
             }
         }

@@ -62,8 +62,25 @@ problems!(
 problems!(
     /// A job with an owner, asked to change by a request that does not name it.
     NotTheOwner {
-        (403, "about:blank: the job was submitted with an owner's token \
-            (thirdbody-owner), and only a request with the same token may cancel or delete it", false),
+        (403, "forbidden: the job has an owner (an API key's tenant, or a thirdbody-owner \
+            token), and only its owner or an admin key may cancel or delete it", false),
+    }
+);
+
+problems!(
+    /// Another tenant's jobs asked for by a key that is not an admin's.
+    NotAnAdmin {
+        (403, "forbidden: only an admin's API key lists another tenant's jobs", false),
+    }
+);
+
+problems!(
+    /// The answers of the access rules, which every operation but the probes may give.
+    Refused {
+        (401, "unauthorized: this needs an API key (anonymous callers may not do it here), \
+            or the key sent is not accepted (unknown, expired); with WWW-Authenticate", false),
+        (403, "forbidden: the API key sent lacks the scope this needs (submit, read, \
+            metrics, or admin)", false),
     }
 );
 

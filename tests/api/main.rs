@@ -1,6 +1,7 @@
 //! The HTTP service end to end: real HTTP against servers on port 0 (one per test, each with
 //! its own engine, cache and metrics), plus in-process router tests with `oneshot`.
 
+mod access;
 mod checks;
 mod continuum;
 mod errors;

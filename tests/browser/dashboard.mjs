@@ -2,6 +2,7 @@
 // playwright-core against `thirdbody serve` on a port the system chooses. Fails on a console
 // error or on any request that leaves the server. Screenshots go to target/browser/.
 import { spawn } from "node:child_process";
+import { createHash } from "node:crypto";
 import { mkdirSync, mkdtempSync, rmSync } from "node:fs";
 import { tmpdir } from "node:os";
 import { chromium } from "playwright-core";
@@ -54,6 +55,11 @@ started.push(child);
 // A second service whose jobs must end within 300 ms: a long sweep there fails.
 const strict = await serve(["--job-deadline", "300ms", "--database", ":memory:"]);
 started.push(strict.child);
+// A third that asks every caller for an API key (its keys given inline, hashed).
+const apiKey = "tb_key-of-the-browser-test-0001";
+const keys = { keys: [{ name: "lab", sha256: createHash("sha256").update(apiKey).digest("hex"), scopes: ["submit", "read"] }] };
+const keyed = await serve(["--anonymous", "none", "--api-keys", JSON.stringify(keys), "--database", ":memory:"]);
+started.push(keyed.child);
 // The answer area of a tab's panel, and a part of it.
 const area = (panel, part = "") => `#panel-${panel} .answer-area${part ? " ." + part : ""}`;
 const browser = await chromium.launch({
@@ -300,7 +306,7 @@ try {
   await page.locator("#form-rolling").getByRole("button", { name: "Copy as Python" }).click();
   const script = await page.evaluate(() => navigator.clipboard.readText());
   const embedded = (script.match(/json\.loads\(r"""([\s\S]*?)"""\)/) || [])[1];
-  if (!embedded || JSON.parse(embedded).load !== "1 nN" || !script.includes(`requests.post(base + "/v1/rolling", json=body)`)) fail(`Copy as Python gives ${script}`);
+  if (!embedded || JSON.parse(embedded).load !== "1 nN" || !script.includes(`requests.post(base + "/v1/rolling", json=body, headers=key)`)) fail(`Copy as Python gives ${script}`);
 
   // A fit from an uploaded CSV: the parameters with their intervals, the picture.
   await page.getByRole("tab", { name: "Fit" }).click();
@@ -448,11 +454,54 @@ try {
   if (!failedBar.startsWith("failed at") || (await second.locator("#progress").getAttribute("class")) !== "failed") fail(`the failed sweep's bar reads ${failedBar}`);
   await second.screenshot({ path: `${shots}/sweep-failed.png`, fullPage: true });
 
+  // A service that asks for a key: refused and told where to enter it; with it, a solve,
+  // a sweep listed in the history and its CSV downloaded with the key.
+  const third = await browser.newPage({ viewport: { width: 1366, height: 900 } });
+  const unauthorized = [];
+  third.on("pageerror", (error) => errors.push(String(error)));
+  third.on("console", (message) => {
+    if (message.type() !== "error") return;
+    (message.text().includes("status of 401") ? unauthorized : errors).push(`${message.text()} (${message.location().url})`);
+  });
+  await third.context().grantPermissions(["clipboard-read", "clipboard-write"], { origin: keyed.base });
+  await third.goto(`${keyed.base}/`);
+  await third.locator("#form-rolling").getByRole("button", { name: "Solve" }).click();
+  await third.waitForSelector(`${area("rolling", "status")}.error`);
+  const asked = await third.locator(area("rolling", "status")).textContent();
+  if (!asked.includes("Enter an API key with “API key” at the top of the page")) fail(`without a key the dashboard says ${asked}`);
+  await third.getByRole("button", { name: "API key" }).click();
+  await third.fill("#api-key", apiKey);
+  await third.getByRole("button", { name: "Use this key" }).click();
+  await third.waitForFunction(() => document.querySelector("#api-key-status").textContent.startsWith("Key accepted"));
+  if ((await third.locator("#api-key-button").textContent()) !== "API key (in use)") fail("the key button does not say a key is in use");
+  await third.locator("#form-rolling").getByRole("button", { name: "Solve" }).click();
+  await third.waitForSelector(`${area("rolling", "picture")} svg .series`);
+  const keyedMu = await third.locator(`${area("rolling", "table")} tr`, { hasText: "friction_coefficient" }).first().textContent();
+  if (!/0\.0947/.test(keyedMu)) fail(`with the key, μ reads ${keyedMu}`);
+  await third.getByRole("tab", { name: "Sweep" }).click();
+  await third.fill("input[name='vary.load']", "1 nN, 2 nN, 3 nN");
+  await third.getByRole("button", { name: "Run" }).click();
+  await third.waitForSelector(`${area("sweep", "picture")} svg .series`, { timeout: 60000 });
+  await third.locator("#form-sweep").getByRole("button", { name: "Copy as curl" }).click();
+  const keyedCurl = await third.evaluate(() => navigator.clipboard.readText());
+  if (keyedCurl.includes(apiKey) || !keyedCurl.includes('"x-api-key: $THIRDBODY_API_KEY"')) fail(`the copied curl command with a key: ${keyedCurl}`);
+  await third.getByRole("tab", { name: "History" }).click();
+  await third.waitForSelector("#history-jobs tbody tr a");
+  const [download] = await Promise.all([
+    third.waitForEvent("download"),
+    third.locator("#history-jobs tbody tr").first().locator("a", { hasText: "CSV" }).click(),
+  ]);
+  const { readFileSync } = await import("node:fs");
+  const keyedCsv = readFileSync(await download.path(), "utf8").trim().split("\n");
+  if (!keyedCsv[0].startsWith("radius [m]") || keyedCsv.length < 4) fail(`the CSV downloaded with the key: ${keyedCsv.slice(0, 2)}`);
+  await third.screenshot({ path: `${shots}/api-key.png`, fullPage: true });
+  if (unauthorized.length !== 1) fail(`requests refused for want of a key: ${unauthorized.join(" | ")} (1 expected: the solve before the key)`);
+
   if (errors.length) fail(`console errors: ${errors.join(" | ")}`);
   // The negative load (422), the unknown job's events and its record (404 each).
   if (refusals.sort().join() !== "404,404,422") fail(`refused requests: ${refusals.join()}`);
   if (outside.length) fail(`requests left the server: ${outside.join(", ")}`);
-  if (!process.exitCode) console.log(`dashboard: rolling (both laws, compared, a Prony series), three-body (both laws), an error after a success, a 200-point sweep sorted and explored (hover, zoom, log, heat map), a one-point and a three-body sweep, a refused point, a cancelled, a failed and an unknown job, every three-body input, copy as Python, a fit from an uploaded CSV and a bad CSV, a fit measured on a three-body system, Figure 6, the history across a restart (listed, filtered, reopened by link, downloaded, deleted) and the tabs by keyboard work; screenshots in ${shots}`);
+  if (!process.exitCode) console.log(`dashboard: rolling (both laws, compared, a Prony series), three-body (both laws), an error after a success, a 200-point sweep sorted and explored (hover, zoom, log, heat map), a one-point and a three-body sweep, a refused point, a cancelled, a failed and an unknown job, every three-body input, copy as Python, a fit from an uploaded CSV and a bad CSV, a fit measured on a three-body system, Figure 6, the history across a restart (listed, filtered, reopened by link, downloaded, deleted), a service that asks for an API key, and the tabs by keyboard work; screenshots in ${shots}`);
 } finally {
   await browser.close();
   started.forEach((child) => child.kill());

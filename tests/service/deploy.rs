@@ -1,8 +1,11 @@
-//! The deployment files, checked offline (no cluster, no Docker engine here): every file the
-//! kustomization names parses, and the invariants between them hold: probes on the
-//! service's own endpoints, a preStop drain within the grace period, resources, the Redis
-//! URL pointing at the Redis Service, the autoscaler and the disruption budget on the
-//! Deployment; the compose file runs two replicas, a worker, Redis and Prometheus scraping
+//! The deployment files, checked offline (no cluster, no Docker engine here; `.ci/run` also
+//! validates every resource against Kubernetes' schemas): every file the kustomization
+//! names parses, and the invariants between them hold: probes on the service's own
+//! endpoints, a preStop drain within the grace period, resources, the image set by the
+//! kustomization, the Redis URLs pointing at the Redis Services with the password of the
+//! Secret each Redis asks for, the job store on a claim, Redis reachable from the API's pods
+//! alone, the autoscaler and the disruption budget on the Deployment; the compose file
+//! builds with the commit and runs two replicas, a worker, Redis and Prometheus scraping
 //! both replicas.
 
 use std::path::Path;
@@ -69,53 +72,84 @@ fn the_kustomize_base_wires_probes_drain_redis_autoscaler_and_budget() {
     let grace = pod["terminationGracePeriodSeconds"].as_u64().unwrap();
     assert!(grace > sleep + 25, "grace {grace} s");
 
-    // The configuration reaches the pods and names the Redis Service.
+    // The configuration reaches the pods; the image is the kustomization's to set.
     let config = &kustomization["configMapGenerator"][0];
     assert_eq!(
         container["envFrom"][0]["configMapRef"]["name"],
         config["name"]
     );
-    let literals: Vec<&str> = config["literals"]
-        .as_sequence()
-        .unwrap()
-        .iter()
-        .map(|l| l.as_str().unwrap())
-        .collect();
+    assert_eq!(container["image"], "thirdbody");
+    let image = &kustomization["images"][0];
+    assert_eq!(image["name"], "thirdbody");
+    assert!(
+        image["newName"].as_str().unwrap().contains('/'),
+        "a registry"
+    );
+    assert!(image["newTag"].is_string());
+
+    // Each Redis asks for the password of one Secret, which the API's URLs carry.
+    let secret = |env: &Value, name: &str| -> String {
+        let var = env
+            .as_sequence()
+            .unwrap()
+            .iter()
+            .find(|v| v["name"] == name)
+            .unwrap_or_else(|| panic!("{name} is set"));
+        let from = &var["valueFrom"]["secretKeyRef"];
+        format!(
+            "{}/{}",
+            from["name"].as_str().unwrap(),
+            from["key"].as_str().unwrap()
+        )
+    };
+    let password = secret(&container["env"], "REDIS_PASSWORD");
+    let url_of = |variable: &str| -> String {
+        container["env"]
+            .as_sequence()
+            .unwrap()
+            .iter()
+            .find(|v| v["name"] == variable)
+            .and_then(|v| v["value"].as_str())
+            .unwrap_or_else(|| panic!("{variable} is configured"))
+            .to_string()
+    };
     // Two Redis roles, each its own Service and server: the cache may evict, the jobs
-    // never are evicted and are persisted.
-    for (variable, name, policy, persisted) in [
+    // never are evicted and are persisted on a claim.
+    for (variable, name, kind, policy, persisted) in [
         (
             "THIRDBODY_REDIS_URL",
             "thirdbody-redis-cache",
+            "Deployment",
             "allkeys-lru",
             "no",
         ),
         (
             "THIRDBODY_REDIS_JOBS_URL",
             "thirdbody-redis-jobs",
+            "StatefulSet",
             "noeviction",
             "yes",
         ),
     ] {
-        let url = literals
-            .iter()
-            .find_map(|l| l.strip_prefix(&format!("{variable}=")))
-            .unwrap_or_else(|| panic!("{variable} is configured"));
         let service = docs
             .iter()
             .find(|d| d["kind"] == "Service" && d["metadata"]["name"] == name)
             .unwrap_or_else(|| panic!("no Service {name}"));
         let port = service["spec"]["ports"][0]["port"].as_u64().unwrap();
-        assert_eq!(url, format!("redis://{name}:{port}"));
-        let redis = deployments
+        assert_eq!(
+            url_of(variable),
+            format!("redis://:$(REDIS_PASSWORD)@{name}:{port}")
+        );
+        let redis = docs
             .iter()
-            .find(|d| d["metadata"]["name"] == name)
-            .unwrap_or_else(|| panic!("no Deployment {name}"));
+            .find(|d| d["kind"] == kind && d["metadata"]["name"] == name)
+            .unwrap_or_else(|| panic!("no {kind} {name}"));
         assert_eq!(
             service["spec"]["selector"],
             redis["spec"]["selector"]["matchLabels"]
         );
-        let args = strings(&redis["spec"]["template"]["spec"]["containers"][0]["args"]);
+        let server = &redis["spec"]["template"]["spec"]["containers"][0];
+        let args = strings(&server["args"]);
         assert!(
             args.windows(2).any(|w| w == ["--maxmemory-policy", policy]),
             "{name}"
@@ -124,6 +158,39 @@ fn the_kustomize_base_wires_probes_drain_redis_autoscaler_and_budget() {
             args.windows(2).any(|w| w == ["--appendonly", persisted]),
             "{name}"
         );
+        assert!(
+            args.windows(2)
+                .any(|w| w == ["--requirepass", "$(REDIS_PASSWORD)"]),
+            "{name} asks for a password"
+        );
+        for variable in ["REDIS_PASSWORD", "REDISCLI_AUTH"] {
+            assert_eq!(
+                secret(&server["env"], variable),
+                password,
+                "{name} {variable}"
+            );
+        }
+        if persisted == "yes" {
+            let mount = &server["volumeMounts"][0];
+            assert_eq!(mount["mountPath"], "/data");
+            let claim = &redis["spec"]["volumeClaimTemplates"][0];
+            assert_eq!(
+                claim["metadata"]["name"], mount["name"],
+                "{name}: /data on a claim"
+            );
+        }
+        // Only the API's pods reach it.
+        let policy = find(&docs, "NetworkPolicy");
+        let selected = policy["spec"]["podSelector"]["matchExpressions"][0]["values"]
+            .as_sequence()
+            .unwrap();
+        assert!(selected.iter().any(|v| v == name), "{name} is guarded");
+        let from = &policy["spec"]["ingress"][0];
+        assert_eq!(
+            from["from"][0]["podSelector"]["matchLabels"],
+            app["spec"]["selector"]["matchLabels"]
+        );
+        assert_eq!(from["ports"][0]["port"].as_u64(), Some(port));
     }
 
     // The autoscaler and the budget act on the API's Deployment.
@@ -151,6 +218,14 @@ fn compose_runs_two_replicas_a_worker_two_redis_roles_and_prometheus_scraping_bo
     let services = compose["services"].as_mapping().unwrap();
     let get = |name: &str| &services[&Value::from(name)];
     let anchor = &compose["x-thirdbody"];
+    // The image names the commit it was built from (the Dockerfile's build argument).
+    let commit = "THIRDBODY_GIT_COMMIT";
+    assert_eq!(
+        anchor["build"]["args"][commit],
+        format!("${{{commit}:-unknown}}").as_str()
+    );
+    let dockerfile = std::fs::read_to_string("Dockerfile").unwrap();
+    assert!(dockerfile.contains(&format!("ARG {commit}")));
     // The cache may evict; the jobs never are evicted, and are persisted.
     for (variable, name, policy, persisted) in [
         ("THIRDBODY_REDIS_URL", "redis-cache", "allkeys-lru", "no"),

@@ -89,8 +89,15 @@ pub(crate) fn start(
     flags: &[&str],
 ) -> (Process, Arc<Mutex<Vec<String>>>) {
     let mut cmd = Command::new(env!("CARGO_BIN_EXE_thirdbody"));
+    let url = format!("redis://127.0.0.1:{redis}");
+    let default_url = ["--redis-url", url.as_str()];
     cmd.arg(command)
-        .args(["--redis-url", &format!("redis://127.0.0.1:{redis}")])
+        // Unless the test names it (with a password, say).
+        .args(if flags.contains(&"--redis-url") {
+            &[][..]
+        } else {
+            &default_url[..]
+        })
         .args(["--claim-idle", "2s", "--log-format", "text"])
         // Unless the test sizes them: parts of 100 points until the fleet measures a cost.
         .args(if flags.contains(&"--part-points") {

@@ -2,6 +2,7 @@
 //! the fleet's processes on a real Redis, and the deployment files. One test binary, a
 //! module per concern (the HTTP service end to end is the `api` binary).
 
+mod access;
 mod cli;
 mod deploy;
 mod fit;

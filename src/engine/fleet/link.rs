@@ -33,6 +33,8 @@ pub enum Health {
     /// Reachable, but refusing writes at its memory limit.
     Full,
     Down,
+    /// Reachable, and refusing this process's credentials (AUTH).
+    Denied,
 }
 
 impl Health {
@@ -42,6 +44,7 @@ impl Health {
             Health::Slow(_) => "slow",
             Health::Full => "full",
             Health::Down => "down",
+            Health::Denied => "denied",
         }
     }
 
@@ -58,6 +61,10 @@ impl Health {
                 "Redis ({role}) is full: it refuses writes at its memory limit (maxmemory)"
             )),
             Health::Down => Some(format!("Redis ({role}) cannot be reached")),
+            Health::Denied => Some(format!(
+                "Redis ({role}) refuses this process's credentials (AUTH): check the password \
+                 in its URL (--redis-url, --redis-jobs-url)"
+            )),
         }
     }
 }
@@ -98,6 +105,8 @@ pub struct Link {
     url: String,
     connection: ConnectionManager,
     up: AtomicBool,
+    /// Whether the last failure was a refusal of the credentials.
+    denied: AtomicBool,
     /// The last ping's round trip, in µs.
     round_trip: AtomicU64,
     /// When a write was last refused for want of memory (ms since `opened`; 0: never).
@@ -109,19 +118,21 @@ pub struct Link {
 impl Link {
     /// A link to the server at `url`; connects at the first call (the server may start later).
     pub fn open(role: &'static str, url: &str) -> Result<Link, String> {
-        let client = redis::Client::open(url).map_err(|e| format!("{role} URL {url}: {e}"))?;
+        let shown = redacted(url);
+        let client = redis::Client::open(url).map_err(|e| format!("{role} URL {shown}: {e}"))?;
         let config = ConnectionManagerConfig::new()
             .set_connection_timeout(Some(CALL_TIMEOUT))
             .set_response_timeout(Some(CALL_TIMEOUT))
             .set_number_of_retries(1)
             .set_max_delay(Duration::from_millis(200));
         let connection = ConnectionManager::new_lazy_with_config(client, config)
-            .map_err(|e| format!("{role} URL {url}: {e}"))?;
+            .map_err(|e| format!("{role} URL {shown}: {e}"))?;
         Ok(Link {
             role,
             url: url.to_string(),
             connection,
             up: AtomicBool::new(true),
+            denied: AtomicBool::new(false),
             round_trip: AtomicU64::new(0),
             full_at: AtomicU64::new(0),
             opened: Instant::now(),
@@ -150,7 +161,9 @@ impl Link {
     pub fn health(&self) -> Health {
         let full_at = self.full_at.load(Ordering::Relaxed);
         let round_trip = Duration::from_micros(self.round_trip.load(Ordering::Relaxed));
-        if !self.is_up() {
+        if !self.is_up() && self.denied.load(Ordering::Relaxed) {
+            Health::Denied
+        } else if !self.is_up() {
             Health::Down
         } else if full_at > 0 && self.since_opened() < full_at + FULL_FOR.as_millis() as u64 {
             Health::Full
@@ -190,6 +203,7 @@ impl Link {
     ) -> Result<T, Failure> {
         match result {
             Ok(Ok(value)) => {
+                self.denied.store(false, Ordering::Relaxed);
                 self.set_up(true);
                 Ok(value)
             }
@@ -199,7 +213,10 @@ impl Link {
                     || e.is_connection_dropped()
                     || e.is_connection_refusal()
                     || e.is_unrecoverable_error();
-                if lost {
+                let denied = e.kind() == redis::ErrorKind::AuthenticationFailed
+                    || matches!(e.code(), Some("NOAUTH" | "WRONGPASS"));
+                self.denied.store(denied, Ordering::Relaxed);
+                if lost || denied {
                     self.set_up(false);
                 }
                 let code = e.code().map(str::to_string);
@@ -216,6 +233,8 @@ impl Link {
                         );
                     }
                     Health::Full.reason(role).unwrap_or_default()
+                } else if denied {
+                    Health::Denied.reason(role).unwrap_or_default()
                 } else if lost {
                     format!("Redis ({role}) cannot be reached: {e}")
                 } else {
@@ -310,6 +329,60 @@ impl Link {
                     tracing::info!(role = self.role, "Redis takes writes again");
                 }
             }
+        }
+    }
+}
+
+/// `url` with its password (AUTH, from a Secret) replaced by `***`, for messages and logs:
+/// everything between `://` and the last `@` but the user name (a password may hold `/`,
+/// `?` or `@`), and the value of a `pass` or `password` parameter (`redis+unix://`).
+pub fn redacted(url: &str) -> String {
+    let Some((scheme, rest)) = url.split_once("://") else {
+        return url.to_string();
+    };
+    let mut shown = match rest.rsplit_once('@') {
+        Some((userinfo, host)) => {
+            let user = userinfo.split_once(':').map_or("", |(user, _)| user);
+            format!("{scheme}://{user}:***@{host}")
+        }
+        None => url.to_string(),
+    };
+    if let Some((base, query)) = shown.split_once('?') {
+        let parameters: Vec<String> = query
+            .split('&')
+            .map(|pair| match pair.split_once('=') {
+                Some((name @ ("pass" | "password"), _)) => format!("{name}=***"),
+                _ => pair.to_string(),
+            })
+            .collect();
+        shown = format!("{base}?{}", parameters.join("&"));
+    }
+    shown
+}
+
+#[cfg(test)]
+mod redaction {
+    use super::redacted;
+
+    #[test]
+    fn a_password_never_shows() {
+        for (url, shown) in [
+            ("redis://:s3cret@redis:6379/0", "redis://:***@redis:6379/0"),
+            (
+                "rediss://app:s3cret@redis.example:6380",
+                "rediss://app:***@redis.example:6380",
+            ),
+            ("redis://127.0.0.1:6379", "redis://127.0.0.1:6379"),
+            (
+                "redis://:ab/cd?e@f@redis:6379/0",
+                "redis://:***@redis:6379/0",
+            ),
+            (
+                "redis+unix:///run/redis.sock?db=1&pass=s3cret",
+                "redis+unix:///run/redis.sock?db=1&pass=***",
+            ),
+        ] {
+            assert_eq!(redacted(url), shown);
         }
     }
 }

@@ -10,7 +10,7 @@
 //! jobs (no eviction, persisted), so that a full cache never loses an accepted job.
 
 mod cache;
-mod link;
+pub mod link;
 pub mod placement;
 mod store;
 pub mod worker;

@@ -288,6 +288,10 @@ async function readJson(response) {
     body = await response.json().catch(() => null);
   }
   if (response.ok && body) return { ok: true, body };
+  if (response.status === 401 && body && body.title) {
+    const where = apiKey() ? "Change the API key (top of the page)." : "Enter an API key with “API key” at the top of the page.";
+    return { ok: false, body: { ...body, detail: `${body.detail}. ${where}` } };
+  }
   if (!response.ok && body && body.title) return { ok: false, body };
   const title = response.ok ? "Unreadable answer" : `${response.status} ${response.statusText || "Error"}`;
   const detail = response.ok ? "the server's answer is not JSON" : "the server gave no description of the problem";
@@ -615,9 +619,62 @@ async function compare(form) {
   area.status(`Both laws solved.${accuracy(answers[1][1])}`);
 }
 
+/** `fetch` of the service, with the API key this browser was given, if any (a service may
+ *  ask for one: `--anonymous`), in `x-api-key`. */
+function api(url, init = {}) {
+  const key = apiKey();
+  if (!key) return fetch(url, init);
+  const headers = new Headers(init.headers || {});
+  headers.set("x-api-key", key);
+  return fetch(url, { ...init, headers });
+}
+
+/** The API key entered in this browser (kept in its storage), or "". */
+function apiKey() {
+  return localStorage.getItem("thirdbody-api-key") || "";
+}
+
+/** The header's key control: a key entered is checked (a listing of its jobs), kept, and
+ *  sent with every call from then on; forgotten, calls go without. */
+function setUpApiKey() {
+  const button = $("#api-key-button");
+  const form = $("#api-key-form");
+  const said = $("#api-key-status");
+  const shown = () => {
+    button.textContent = apiKey() ? "API key (in use)" : "API key";
+  };
+  shown();
+  button.addEventListener("click", () => {
+    form.hidden = !form.hidden;
+    button.setAttribute("aria-expanded", String(!form.hidden));
+    if (!form.hidden) $("#api-key").focus();
+  });
+  form.addEventListener("submit", async (event) => {
+    event.preventDefault();
+    const key = $("#api-key").value.trim();
+    if (!key) return;
+    localStorage.setItem("thirdbody-api-key", key);
+    $("#api-key").value = "";
+    shown();
+    const response = await api("/v1/jobs?limit=1", { headers: { accept: "application/json" } });
+    // A key refused is not kept: every call would be refused with it.
+    if (response.status === 401) localStorage.removeItem("thirdbody-api-key");
+    shown();
+    const read = await readJson(response);
+    said.textContent = read.ok
+      ? `Key accepted: ${read.body.total} job${read.body.total === 1 ? "" : "s"} of its tenant in the history.`
+      : `This key may not read jobs here: ${read.body.detail}`;
+  });
+  $("#api-key-forget").addEventListener("click", () => {
+    localStorage.removeItem("thirdbody-api-key");
+    shown();
+    said.textContent = "The key is forgotten: calls go without one.";
+  });
+}
+
 async function post(url, body, accept = "application/json") {
   const headers = { "content-type": "application/json", accept };
-  return fetch(url, { method: "POST", headers: url === "/v1/jobs" ? owned(headers) : headers, body: JSON.stringify(body) });
+  return api(url, { method: "POST", headers: url === "/v1/jobs" ? owned(headers) : headers, body: JSON.stringify(body) });
 }
 
 /** `headers` with this browser's token as the owner: its jobs are listed to it, and only it
@@ -673,7 +730,7 @@ async function runJob(form) {
   }
   if (!area.current(token)) {
     // Asked again meanwhile: this job has no one to show it to.
-    if (read.ok) fetch(`/v1/jobs/${read.body.id}/cancel`, { method: "POST", headers: owned() }).catch(() => {});
+    if (read.ok) api(`/v1/jobs/${read.body.id}/cancel`, { method: "POST", headers: owned() }).catch(() => {});
     return;
   }
   if (!read.ok) {
@@ -727,6 +784,54 @@ function handled(area, token, work) {
   };
 }
 
+/** An event stream read with this browser's API key, which an EventSource cannot send: the
+ *  stream read through `fetch`, its events dispatched as an EventSource's are. It does not
+ *  reconnect: a stream that ends or fails before it is closed says so with an `error` event,
+ *  closed, as an EventSource that gave up does (the job is then followed from its record). */
+class KeyedEventSource extends EventTarget {
+  constructor(url) {
+    super();
+    this.readyState = EventSource.CONNECTING;
+    this.aborter = new AbortController();
+    this.read(url)
+      .catch(() => {})
+      .finally(() => {
+        if (this.readyState === EventSource.CLOSED) return;
+        this.readyState = EventSource.CLOSED;
+        this.dispatchEvent(new Event("error"));
+      });
+  }
+
+  async read(url) {
+    const response = await api(url, { headers: { accept: "text/event-stream" }, signal: this.aborter.signal });
+    if (!response.ok || !response.body) return;
+    this.readyState = EventSource.OPEN;
+    const reader = response.body.pipeThrough(new TextDecoderStream()).getReader();
+    let buffer = "";
+    for (;;) {
+      const { value, done } = await reader.read();
+      if (done) return;
+      buffer += value.replace(/\r\n?/g, "\n");
+      for (let end = buffer.indexOf("\n\n"); end >= 0; end = buffer.indexOf("\n\n")) {
+        const block = buffer.slice(0, end);
+        buffer = buffer.slice(end + 2);
+        let name = "message";
+        const data = [];
+        for (const line of block.split("\n")) {
+          if (line.startsWith("event:")) name = line.slice(6).trim();
+          else if (line.startsWith("data:")) data.push(line.slice(5).replace(/^ /, ""));
+        }
+        if (data.length && this.readyState !== EventSource.CLOSED) this.dispatchEvent(new MessageEvent(name, { data: data.join("\n") }));
+      }
+    }
+  }
+
+  close() {
+    this.readyState = EventSource.CLOSED;
+    this.aborter.abort();
+  }
+}
+
 /** Follows job `id` from its event stream; when the stream ends for good before the job does
  *  (the job unknown, too many streams, a restart), from its record. */
 function follow(area, token, id) {
@@ -735,10 +840,11 @@ function follow(area, token, id) {
   cancel.disabled = false;
   cancel.onclick = handled(area, token, async () => {
     cancel.disabled = true;
-    const read = await readJson(await fetch(`/v1/jobs/${id}/cancel`, { method: "POST", headers: owned({ accept: "application/json" }) }));
+    const read = await readJson(await api(`/v1/jobs/${id}/cancel`, { method: "POST", headers: owned({ accept: "application/json" }) }));
     if (!read.ok && area.current(token)) area.status(`Cancel: ${problemText(read.body)}`, "error");
   });
-  const events = new EventSource(`/v1/jobs/${id}/events`);
+  const url = `/v1/jobs/${id}/events`;
+  const events = apiKey() ? new KeyedEventSource(url) : new EventSource(url);
   const stop = () => {
     events.close();
     cancel.disabled = true;
@@ -768,7 +874,7 @@ function follow(area, token, id) {
 /** Reads job `id`'s record every second until it ends (or another request is asked). */
 async function poll(area, token, id) {
   while (area.current(token)) {
-    const read = await readJson(await fetch(`/v1/jobs/${id}`, { headers: { accept: "application/json" } }));
+    const read = await readJson(await api(`/v1/jobs/${id}`, { headers: { accept: "application/json" } }));
     if (!area.current(token)) return;
     if (!read.ok) return area.problem(read.body);
     if (!["queued", "running"].includes(read.body.status)) return finished(area, token, read.body);
@@ -795,12 +901,12 @@ async function finished(area, token, view) {
   }
   area.status(`${ending[0]} Reading its answer…`, "busy");
   const result = view.result_url;
-  const read = await readJson(await fetch(result, { headers: { accept: "application/json" } }));
+  const read = await readJson(await api(result, { headers: { accept: "application/json" } }));
   if (!area.current(token)) return;
   if (!read.ok) return area.problem({ ...read.body, title: `${ending[0]} Its answer cannot be read (${read.body.title})` });
   const partial = view.partial ? " The answer below is partial: the points it finished." : "";
   area.status(ending[0] + partial + accuracy(read.body), ending[1]);
-  await showAnswer(area, token, read.body, () => fetch(`${result}?format=svg`), (accept) => fetch(result, { headers: { accept } }), `job-${view.id}`);
+  await showAnswer(area, token, read.body, () => api(`${result}?format=svg`), (accept) => api(result, { headers: { accept } }), `job-${view.id}`);
 }
 
 // ---- Copying a form as a command ----------------------------------------------------
@@ -811,7 +917,7 @@ async function copy(form, what) {
   const { url, body, job } = requestOf(form);
   const texts = {
     job: ["the job as JSON", JSON.stringify(job, null, 2)],
-    curl: ["the curl command", `curl -s -X POST ${location.origin}${url} -H 'content-type: application/json'${url === "/v1/jobs" ? ` -H "thirdbody-owner: $THIRDBODY_OWNER"` : ""} -d '${JSON.stringify(body)}'`],
+    curl: ["the curl command", `curl -s -X POST ${location.origin}${url} -H 'content-type: application/json'${apiKey() ? ` -H "x-api-key: $THIRDBODY_API_KEY"` : url === "/v1/jobs" ? ` -H "thirdbody-owner: $THIRDBODY_OWNER"` : ""} -d '${JSON.stringify(body)}'`],
     python: ["the Python script", python(url, body)],
   };
   const [name, text] = texts[what];
@@ -831,21 +937,23 @@ function python(url, body) {
     "",
     `base = "${location.origin}"`,
     `body = json.loads(r"""${JSON.stringify(body, null, 2)}""")`,
+    "# THIRDBODY_API_KEY: a key, for a service that asks for one.",
+    'key = {"x-api-key": os.environ["THIRDBODY_API_KEY"]} if "THIRDBODY_API_KEY" in os.environ else {}',
   ];
   if (url === "/v1/jobs") {
     lines.push(
-      "# With THIRDBODY_OWNER set to this browser's token (History: copy it), the job is in its history.",
+      "# Without a key, THIRDBODY_OWNER set to this browser's token (History: copy it) puts the job in its history.",
       'owner = {"thirdbody-owner": os.environ["THIRDBODY_OWNER"]} if "THIRDBODY_OWNER" in os.environ else {}',
-      `job = requests.post(base + "${url}", json=body, headers=owner).json()`,
+      `job = requests.post(base + "${url}", json=body, headers={**key, **owner}).json()`,
       'while job["status"] in ("queued", "running"):',
       "    time.sleep(0.5)",
-      '    job = requests.get(f"{base}/v1/jobs/{job[\'id\']}").json()',
+      '    job = requests.get(f"{base}/v1/jobs/{job[\'id\']}", headers=key).json()',
       'print(job["status"])',
-      'answer = requests.get(base + job["result_url"]).json() if "result_url" in job else job',
+      'answer = requests.get(base + job["result_url"], headers=key).json() if "result_url" in job else job',
     );
   } else {
     lines.push(
-      `response = requests.post(base + "${url}", json=body)`,
+      `response = requests.post(base + "${url}", json=body, headers=key)`,
       "response.raise_for_status()",
       "answer = response.json()",
     );
@@ -875,7 +983,7 @@ async function loadHistory(more = false) {
   const url = more ? listing.next : historyUrl();
   if (!url) return;
   const asked = ++listing.asked;
-  const read = await readJson(await fetch(url, { headers: owned({ accept: "application/json" }) }));
+  const read = await readJson(await api(url, { headers: owned({ accept: "application/json" }) }));
   // A later listing (another filter, a refresh) wins over this one.
   if (asked !== listing.asked) return;
   if (!read.ok) return area.problem(read.body);
@@ -906,6 +1014,18 @@ function historyRow(view) {
     for (const format of ["json", "csv", "svg"]) {
       const link = Object.assign(document.createElement("a"), { href: `${view.result_url}?format=${format}`, textContent: format.toUpperCase() });
       link.download = `${view.kind}-${view.id}.${format}`;
+      // A link sends no header: with a key, the file is fetched with it, then saved.
+      link.addEventListener("click", (event) => {
+        if (!apiKey()) return;
+        event.preventDefault();
+        guarded($("#panel-history").area, async () => {
+          const response = await api(link.href);
+          if (!response.ok) return $("#panel-history").area.problem((await readJson(response)).body);
+          const saved = Object.assign(document.createElement("a"), { href: URL.createObjectURL(await response.blob()), download: link.download });
+          saved.click();
+          setTimeout(() => URL.revokeObjectURL(saved.href), 10000);
+        });
+      });
       actions.append(link);
     }
   }
@@ -921,7 +1041,7 @@ async function openJob(id) {
   const area = $("#panel-history").area;
   const token = area.begin("Opening the job…");
   history.replaceState(null, "", `#job=${id}`);
-  const read = await readJson(await fetch(`/v1/jobs/${id}`, { headers: { accept: "application/json" } }));
+  const read = await readJson(await api(`/v1/jobs/${id}`, { headers: { accept: "application/json" } }));
   if (!area.current(token)) return;
   if (!read.ok) return area.problem(read.body);
   if (["queued", "running"].includes(read.body.status)) return follow(area, token, id);
@@ -933,11 +1053,11 @@ async function openInput(hash) {
   const area = $("#panel-history").area;
   const token = area.begin("Opening the answer…");
   const url = `/v1/results/${hash}`;
-  const read = await readJson(await fetch(url, { headers: { accept: "application/json" } }));
+  const read = await readJson(await api(url, { headers: { accept: "application/json" } }));
   if (!area.current(token)) return;
   if (!read.ok) return area.problem(read.body);
   area.status(`The answer to input ${hash.slice(0, 12)}…`);
-  await showAnswer(area, token, read.body, () => fetch(`${url}?format=svg`), (accept) => fetch(url, { headers: { accept } }), `answer-${hash.slice(0, 12)}`);
+  await showAnswer(area, token, read.body, () => api(`${url}?format=svg`), (accept) => api(url, { headers: { accept } }), `answer-${hash.slice(0, 12)}`);
 }
 
 /** Deletes the job of `view` (after asking); the history is listed again without it. */
@@ -945,7 +1065,7 @@ async function deleteJob(view) {
   const job = `the ${view.kind} job of ${new Date(view.submitted_at).toLocaleString()}`;
   if (!confirm(`Delete ${job} and its answer?`)) return;
   const area = $("#panel-history").area;
-  const read = await readJson(await fetch(`/v1/jobs/${view.id}`, { method: "DELETE", headers: owned({ accept: "application/json" }) }));
+  const read = await readJson(await api(`/v1/jobs/${view.id}`, { method: "DELETE", headers: owned({ accept: "application/json" }) }));
   if (!read.ok) return area.problem(read.body);
   area.status(`Deleted ${job}.`);
   await loadHistory();
@@ -964,14 +1084,14 @@ function openLinked() {
 async function figure(area, n) {
   const token = area.begin(`Figure ${n}…`);
   const url = `/v1/figures/${n}`;
-  const read = await readJson(await fetch(url, { headers: { accept: "application/json" } }));
+  const read = await readJson(await api(url, { headers: { accept: "application/json" } }));
   if (!area.current(token)) return;
   if (!read.ok) return area.problem(read.body);
   const answer = read.body;
   area.status(`Figure ${n}: ${answer.title}`);
   // Its table says which figure and how many series; the series are in the downloads.
   const summary = { figure: answer.figure, series: answer.series.length, meta: answer.meta };
-  await showAnswer(area, token, summary, () => fetch(`${url}?format=svg`), (accept) => fetch(url, { headers: { accept } }), `figure-${n}`);
+  await showAnswer(area, token, summary, () => api(`${url}?format=svg`), (accept) => api(url, { headers: { accept } }), `figure-${n}`);
 }
 
 /** Selects `tab` and shows its panel (and its own answer); `focus` moves the keyboard there.
@@ -1022,7 +1142,7 @@ document.addEventListener("DOMContentLoaded", () => {
     tab.addEventListener("keydown", tabKeys);
   }
   selectTab(document.querySelector("[role=tab][aria-selected=true]"));
-  for (const form of document.querySelectorAll("form")) {
+  for (const form of document.querySelectorAll("main form")) {
     form.addEventListener("submit", (event) => {
       event.preventDefault();
       guarded(areaOf(form), async () => (isJob(form) ? runJob(form) : solve(form)));
@@ -1056,6 +1176,7 @@ document.addEventListener("DOMContentLoaded", () => {
     await navigator.clipboard.writeText(ownerToken());
     historyArea.status("Copied this browser's token: set THIRDBODY_OWNER to it, and the jobs of copied commands are listed here. Keep it to yourself: it lists your jobs.");
   }));
+  setUpApiKey();
   openLinked();
   window.addEventListener("hashchange", openLinked);
 });

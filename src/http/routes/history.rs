@@ -2,9 +2,10 @@
 //! link (`GET /v1/results/{input_hash}`). Jobs and their results are kept for the history's
 //! retention, across restarts (in the database of saved analyses, or a fleet's Redis).
 //!
-//! Until API keys exist, an owner is whoever holds the token sent in `Thirdbody-Owner` with
-//! the submissions: the dashboard keeps a random one in the browser's storage, so that a
-//! browser lists its own jobs and nobody else's.
+//! An owner is the tenant of the API key a job was submitted with; without a key, whoever
+//! holds the token sent in `Thirdbody-Owner` with the submissions: the dashboard keeps a
+//! random one in the browser's storage, so that a browser lists its own jobs and nobody
+//! else's. An admin key lists any tenant's jobs (`?tenant=`).
 
 use axum::extract::{FromRequestParts, Path, RawQuery, State};
 use axum::http::request::Parts;
@@ -20,9 +21,12 @@ use super::{Answering, FormatQuery};
 use crate::engine::store::{JobStatus, Listing, Owner};
 use crate::engine::EngineError;
 use crate::http::accept::AcceptsJson;
+use crate::http::access::keys::is_tenant_name;
+use crate::http::access::Caller;
 use crate::http::error::ApiError;
 use crate::http::responses::{
-    HistoryUnreadable, InvalidParameters, NotAcceptable, NotFound, NotModified, ReadBack,
+    HistoryUnreadable, InvalidParameters, NotAcceptable, NotAnAdmin, NotFound, NotModified,
+    ReadBack,
 };
 use crate::http::AppState;
 use crate::job::registry::KindName;
@@ -104,6 +108,8 @@ pub struct ListQuery {
     /// Jobs skipped: those of the pages before (default 0).
     #[param(value_type = Option<usize>)]
     offset: Option<String>,
+    /// The jobs of the API keys of this name instead of the caller's (an admin key only).
+    tenant: Option<String>,
 }
 
 impl ListQuery {
@@ -121,6 +127,7 @@ impl ListQuery {
                 "status" => &mut read.status,
                 "limit" => &mut read.limit,
                 "offset" => &mut read.offset,
+                "tenant" => &mut read.tenant,
                 _ => continue,
             };
             if slot.replace(value.to_string()).is_some() {
@@ -132,6 +139,35 @@ impl ListQuery {
             }
         }
         Ok(read)
+    }
+
+    /// Whose jobs `caller` (with the owner's token `token`) asks to list: its own, or, for
+    /// an admin, the tenant's it names.
+    fn owner(&self, caller: &Caller, token: Option<Owner>) -> Result<Owner, ApiError> {
+        match &self.tenant {
+            Some(name) if !is_tenant_name(name) => Err(invalid(
+                "tenant",
+                Value::String(name.clone()),
+                "the name of API keys: 1 to 64 characters of A-Z, a-z, 0-9, '-', '_' and '.'",
+            )),
+            Some(name) if caller.is_admin() || caller.tenant() == Some(name.as_str()) => {
+                Ok(Owner::of_tenant(name))
+            }
+            Some(name) => Err(ApiError::forbidden(format!(
+                "tenant={name}: only an admin's API key lists another tenant's jobs ({} is \
+                 not one)",
+                caller.describe()
+            ))),
+            None => caller.owner(token).ok_or_else(|| {
+                invalid(
+                    &format!("header {OWNER_HEADER}"),
+                    Value::Null,
+                    "an API key (x-api-key or Authorization: Bearer), or the token sent with \
+                     the jobs' submissions (16 to 128 characters): jobs are listed to their \
+                     owner only",
+                )
+            }),
+        }
     }
 
     /// The listing asked for `owner`; a value out of range is a 422 naming it.
@@ -177,13 +213,16 @@ impl ListQuery {
     }
 }
 
-/// The URL of the page after `listing`'s.
-fn next_page(listing: &Listing) -> String {
+/// The URL of the page after `listing`'s (of the tenant's jobs `tenant` names, if it does).
+fn next_page(listing: &Listing, tenant: Option<&str>) -> String {
     let mut url = format!(
         "/v1/jobs?limit={}&offset={}",
         listing.limit,
         listing.offset + listing.limit
     );
+    if let Some(tenant) = tenant {
+        url.push_str(&format!("&tenant={tenant}"));
+    }
     if let Some(kind) = listing.kind {
         url.push_str(&format!("&kind={}", kind.name()));
     }
@@ -207,10 +246,12 @@ pub struct JobList {
 
 /// List your jobs.
 ///
-/// The jobs submitted with the same `Thirdbody-Owner` token as this request, newest first,
-/// within the history's retention (across restarts): queued and running ones, and finished
-/// ones with their results. The dashboard keeps its token in the browser's storage. Without
-/// the header the answer is 422: nobody lists jobs that are not theirs.
+/// The jobs submitted with an API key of the same name as this request's (its tenant's),
+/// or, without a key, with the same `Thirdbody-Owner` token, newest first, within the
+/// history's retention (across restarts): queued and running ones, and finished ones with
+/// their results. The dashboard keeps its token in the browser's storage. Without either
+/// the answer is 422: nobody lists jobs that are not theirs. An admin key lists a tenant's
+/// jobs with `?tenant=`.
 #[utoipa::path(
     get,
     path = "/v1/jobs",
@@ -219,26 +260,20 @@ pub struct JobList {
     params(ListQuery, ("thirdbody-owner" = String, Header, pattern = r"^[A-Za-z0-9._~-]{16,128}$",
         description = "The token sent with the jobs' submissions (16 to 128 characters)")),
     responses((status = 200, description = "A page of the owner's jobs", body = JobList),
-        InvalidParameters, NotAcceptable, HistoryUnreadable)
+        InvalidParameters, NotAnAdmin, NotAcceptable, HistoryUnreadable)
 )]
 pub async fn list(
     State(state): State<AppState>,
     _: AcceptsJson,
-    OwnerHeader(owner): OwnerHeader,
+    caller: Caller,
+    OwnerHeader(token): OwnerHeader,
     RawQuery(query): RawQuery,
 ) -> Result<Json<JobList>, ApiError> {
     let query = ListQuery::parse(query.as_deref())?;
-    let Some(owner) = owner else {
-        return Err(invalid(
-            &format!("header {OWNER_HEADER}"),
-            Value::Null,
-            "the token sent with the jobs' submissions (16 to 128 characters): jobs are \
-             listed to their owner only",
-        ));
-    };
-    let listing = query.listing(owner)?;
+    let listing = query.listing(query.owner(&caller, token)?)?;
     let page = state.engine().list(&listing).await.map_err(unreadable)?;
-    let next = (listing.offset + page.jobs.len() < page.total).then(|| next_page(&listing));
+    let next = (listing.offset + page.jobs.len() < page.total)
+        .then(|| next_page(&listing, query.tenant.as_deref()));
     Ok(Json(JobList {
         jobs: page.jobs.iter().map(JobView::of).collect(),
         total: page.total,
@@ -260,7 +295,9 @@ pub struct InputHash {
 /// Answers are content-addressed: equal inputs (in canonical form) have equal answers. This
 /// is the answer to the input whose hash is `input_hash`, as cached, or as the newest job
 /// on it that succeeded within the history's retention left it; in the form the client
-/// accepts (or `?format=`), as `GET /v1/jobs/{id}/result` gives it.
+/// accepts (or `?format=`), as `GET /v1/jobs/{id}/result` gives it. A job's answer is
+/// given to a caller who may read the job (an API key's tenant's jobs, to its keys); a
+/// cached answer to anyone, as a solve of the same input would.
 #[utoipa::path(
     get,
     path = "/v1/results/{input_hash}",
@@ -271,6 +308,7 @@ pub struct InputHash {
 )]
 pub async fn by_input(
     State(state): State<AppState>,
+    caller: Caller,
     answering: Answering,
     Path(InputHash { input_hash }): Path<InputHash>,
 ) -> Result<Response, ApiError> {
@@ -278,7 +316,11 @@ pub async fn by_input(
     if let Some(solved) = engine.cached(&input_hash).await {
         return answering.respond(&solved, None);
     }
-    let record = engine.with_input(&input_hash).await.map_err(unreadable)?;
+    let record = engine
+        .with_input(&input_hash)
+        .await
+        .map_err(unreadable)?
+        .filter(|record| caller.may_read(record.owner.as_ref()));
     match record.as_ref().and_then(|r| r.state.result()) {
         Some(result) => answering.respond_result(result).await,
         None => Err(ApiError::not_found(format!(

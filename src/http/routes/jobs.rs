@@ -21,6 +21,7 @@ use super::{Answering, FormatQuery};
 use crate::engine::store::{JobRecord, JobState, JobStatus, Owner};
 use crate::engine::{Engine, Unknown};
 use crate::http::accept::{Accept, AcceptsJson};
+use crate::http::access::Caller;
 use crate::http::body::JsonBody;
 use crate::http::error::{ApiError, Problem};
 use crate::http::responses::{
@@ -125,15 +126,16 @@ impl FromRequestParts<AppState> for FoundJob {
             .map_err(|_| ApiError::not_found("no such job: its id is a UUID"))?;
         let engine = state.engine();
         if let Some(record) = engine.job(id).await {
+            let caller = Caller::of(parts);
+            if !caller.may_read(record.owner.as_ref()) {
+                return Err(never_issued(id, state));
+            }
             return Ok(FoundJob(record));
         }
         // Unknown here may be unknown only while the fleet's store is away.
         engine.store_reachable()?;
         Err(match engine.unknown(id).await {
-            Unknown::NeverIssued => ApiError::not_found(format!(
-                "no job {id}: no run of this service issued this id (check it against the \
-                 Location of the job's submission)"
-            )),
+            Unknown::NeverIssued => never_issued(id, state),
             Unknown::Gone => ApiError::not_found(format!(
                 "no job {id}: it was deleted, or it expired (it finished more than the \
                  retention time ago)"
@@ -151,6 +153,20 @@ impl FromRequestParts<AppState> for FoundJob {
             )),
         })
     }
+}
+
+/// An id no run issued, or, with API keys, a job another tenant's: told alike, so that a
+/// tenant's jobs are not another's to know of.
+fn never_issued(id: Uuid, state: &AppState) -> ApiError {
+    let whose = if state.config().access.keys.configured() {
+        " to a caller whose jobs this one may read"
+    } else {
+        ""
+    };
+    ApiError::not_found(format!(
+        "no job {id}: no run of this service issued this id{whose} (check it against the \
+         Location of the job's submission)"
+    ))
 }
 
 /// Whole seconds from the Unix time `unix_ms` to now.
@@ -185,9 +201,11 @@ fn seconds_since(unix_ms: u64) -> u64 {
 pub async fn submit(
     State(state): State<AppState>,
     _: AcceptsJson,
-    OwnerHeader(owner): OwnerHeader,
+    caller: Caller,
+    OwnerHeader(token): OwnerHeader,
     body: JsonBody,
 ) -> Result<Response, ApiError> {
+    let owner = caller.owner(token);
     let limits = state.config().limits;
     let keyed = body
         .read(&state, move |envelope| {
@@ -235,28 +253,27 @@ pub async fn status(_: AcceptsJson, FoundJob(record): FoundJob) -> Json<JobView>
 pub async fn cancel(
     State(state): State<AppState>,
     _: AcceptsJson,
-    OwnerHeader(owner): OwnerHeader,
+    caller: Caller,
+    OwnerHeader(token): OwnerHeader,
     FoundJob(record): FoundJob,
 ) -> Result<Json<JobView>, ApiError> {
-    owned_by(&record, owner)?;
+    changeable(&record, &caller, token)?;
     let record = state.engine().cancel(record.id).await.unwrap_or(record);
     Ok(Json(JobView::of(&record)))
 }
 
-/// Refuses a change to `record` unless the request names its owner (a job without one is
-/// anyone's who holds its id).
-fn owned_by(record: &JobRecord, owner: Option<Owner>) -> Result<(), ApiError> {
-    match &record.owner {
-        Some(theirs) if owner.as_ref() != Some(theirs) => Err(ApiError::from_status(
-            StatusCode::FORBIDDEN,
-            format!(
-                "job {} was submitted with an owner's token: only a request with the same \
-                 {OWNER_HEADER} header may cancel or delete it",
-                record.id
-            ),
-        )),
-        _ => Ok(()),
+/// Refuses a change to `record` unless the request comes from its owner (the same API
+/// key's tenant, or the same owner's token) or an admin; a job without an owner is anyone's
+/// who holds its id.
+fn changeable(record: &JobRecord, caller: &Caller, token: Option<Owner>) -> Result<(), ApiError> {
+    if caller.may_change(record.owner.as_ref(), token) {
+        return Ok(());
     }
+    Err(ApiError::forbidden(format!(
+        "job {} was submitted with an owner's token: only a request with the same \
+         {OWNER_HEADER} header (or an admin's API key) may cancel or delete it",
+        record.id
+    )))
 }
 
 /// The owner's token, for a job submitted with one.
@@ -287,10 +304,11 @@ pub struct OwnerParam {
 pub async fn delete(
     State(state): State<AppState>,
     _: AcceptsJson,
-    OwnerHeader(owner): OwnerHeader,
+    caller: Caller,
+    OwnerHeader(token): OwnerHeader,
     FoundJob(record): FoundJob,
 ) -> Result<Json<JobView>, ApiError> {
-    owned_by(&record, owner)?;
+    changeable(&record, &caller, token)?;
     let record = state.engine().delete(record.id).await.unwrap_or(record);
     Ok(Json(JobView::of(&record)))
 }

@@ -18,13 +18,16 @@ use crate::http::AppState;
 #[derive(Serialize, ToSchema)]
 pub struct Health {
     /// `ok` (alive), `ready` (taking work), or `degraded` (taking work, but a Redis of the
-    /// fleet is down, slow or full: synchronous solves answer from this process alone, and
-    /// job submissions are refused with 503 while the job store cannot take them).
+    /// fleet is down, slow, full or refusing its credentials: synchronous solves answer from
+    /// this process alone, and job submissions are refused with 503 while the job store
+    /// cannot take them; or the API keys' file cannot be used).
     pub status: &'static str,
-    /// In a fleet: each Redis role (`cache`, `jobs`) with `up`, `slow`, `full` or `down`.
+    /// In a fleet: each Redis role (`cache`, `jobs`) with `up`, `slow`, `full`, `down` or
+    /// `denied` (its credentials refused).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub redis: Option<BTreeMap<&'static str, &'static str>>,
-    /// Why the service is degraded, in a sentence per Redis role not `up`.
+    /// Why the service is degraded, in a sentence per Redis role not `up` (and one for the
+    /// API keys' file, if it cannot be used).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub reasons: Vec<String>,
 }
@@ -74,6 +77,7 @@ pub async fn readyz(
         .iter()
         .flatten()
         .filter_map(|(role, health)| health.reason(role))
+        .chain(state.config().access.keys.problem())
         .collect();
     Ok(Json(Health {
         status: if reasons.is_empty() {

@@ -1,0 +1,409 @@
+//! Access rules over HTTP: anonymous callers and API keys, scopes, expiry, tenants (another
+//! tenant's job is not found), admins, and the cross-origin preflight this service does not
+//! allow. Keys are given inline (`--api-keys {...}`); their file, re-read without a restart,
+//! is tested on the binary (`tests/service/access.rs`).
+
+use reqwest::{Method, Response, StatusCode};
+use serde_json::{json, Value};
+use thirdbody::http::access::keys::hash_hex;
+
+use crate::helpers::{spawn_app, TestApp};
+
+const LAB_A: &str = "key-of-lab-a-0000000000000001";
+const LAB_A_ROTATED: &str = "key-of-lab-a-0000000000000002";
+const LAB_B: &str = "key-of-lab-b-0000000000000003";
+const READER: &str = "key-of-a-reader-0000000000004";
+const ADMIN: &str = "key-of-the-admin-000000000005";
+const EXPIRED: &str = "key-that-expired-000000000006";
+
+/// The keys of these tests, as `--api-keys` takes them inline.
+fn keys() -> String {
+    let entry = |key: &str, name: &str, scopes: &[&str], expires: Option<&str>| {
+        let mut entry = json!({"name": name, "sha256": hash_hex(key), "scopes": scopes});
+        if let Some(at) = expires {
+            entry["expires"] = at.into();
+        }
+        entry
+    };
+    json!({"keys": [
+        entry(LAB_A, "lab-a", &["submit", "read"], None),
+        entry(LAB_A_ROTATED, "lab-a", &["submit", "read"], Some("2999-01-01T00:00:00Z")),
+        entry(LAB_B, "lab-b", &["submit", "read"], None),
+        entry(READER, "reader", &["read"], None),
+        entry(ADMIN, "ops", &["admin"], None),
+        entry(EXPIRED, "old", &["submit", "read"], Some("2020-01-01T00:00:00Z")),
+    ]})
+    .to_string()
+}
+
+async fn service(anonymous: &str) -> TestApp {
+    spawn_app(&["--api-keys", &keys(), "--anonymous", anonymous]).await
+}
+
+fn with_key(key: &str) -> (&'static str, String) {
+    ("x-api-key", key.to_string())
+}
+
+async fn send(
+    app: &TestApp,
+    method: Method,
+    path: &str,
+    key: Option<&str>,
+    body: Option<&Value>,
+) -> Response {
+    let header = key.map(with_key);
+    let headers: Vec<(&str, &str)> = header.iter().map(|(n, v)| (*n, v.as_str())).collect();
+    app.send(method, path, &headers, body).await
+}
+
+/// The problem of a refused request, checked to be a problem of `status` and `kind`.
+async fn refused(response: Response, status: StatusCode, kind: &str) -> String {
+    assert_eq!(response.status(), status);
+    let www = response.headers().get("www-authenticate").cloned();
+    assert_eq!(www.is_some(), status == StatusCode::UNAUTHORIZED, "{www:?}");
+    let problem: Value = response.json().await.unwrap();
+    assert_eq!(
+        problem["type"],
+        format!("tag:thirdbody,2026:problems/{kind}"),
+        "{problem}"
+    );
+    problem["detail"].as_str().unwrap().to_string()
+}
+
+/// The job id in `path` (`/v1/jobs/{id}...`).
+fn id_of(path: &str) -> &str {
+    &path["/v1/jobs/".len().."/v1/jobs/".len() + 36]
+}
+
+/// `path` with its job id replaced by one no run issued.
+fn uuid_like(path: &str) -> String {
+    path.replace(id_of(path), "01a21b77-0000-7000-8000-000000000000")
+}
+
+/// The default rolling contact, solved now with `key`.
+async fn solve_with(app: &TestApp, key: &str) -> Response {
+    send(
+        app,
+        Method::POST,
+        "/v1/rolling",
+        Some(key),
+        Some(&json!({})),
+    )
+    .await
+}
+
+fn rolling_job(radius: &str) -> Value {
+    json!({"kind": "rolling", "input": {"radius": radius}})
+}
+
+/// Submits `job` with `key`; returns the job's path.
+async fn submit(app: &TestApp, key: Option<&str>, job: &Value) -> String {
+    let response = send(app, Method::POST, "/v1/jobs", key, Some(job)).await;
+    assert_eq!(response.status(), StatusCode::ACCEPTED);
+    response.headers()["location"].to_str().unwrap().to_string()
+}
+
+#[tokio::test]
+async fn without_keys_configured_everyone_is_anonymous_and_a_key_is_refused() {
+    let app = spawn_app(&[]).await;
+    assert_eq!(
+        app.post("/v1/rolling", &json!({})).await.status(),
+        StatusCode::OK
+    );
+    assert_eq!(app.get("/metrics").await.status(), StatusCode::OK);
+    let sent = solve_with(&app, LAB_A).await;
+    let detail = refused(sent, StatusCode::UNAUTHORIZED, "unauthorized").await;
+    assert!(detail.contains("started without --api-keys"), "{detail}");
+}
+
+#[tokio::test]
+async fn scopes_decide_what_a_caller_may_do() {
+    let app = service("read").await;
+    // Anonymous: may read (docs, figures), not submit nor read metrics.
+    assert_eq!(app.get("/openapi.json").await.status(), StatusCode::OK);
+    let detail = refused(
+        app.post("/v1/rolling", &json!({})).await,
+        StatusCode::UNAUTHORIZED,
+        "unauthorized",
+    )
+    .await;
+    assert!(
+        detail.contains("submit scope") && detail.contains("anonymous: read"),
+        "{detail}"
+    );
+    refused(
+        app.get("/metrics").await,
+        StatusCode::UNAUTHORIZED,
+        "unauthorized",
+    )
+    .await;
+    // The probes and the dashboard need nothing.
+    for path in ["/healthz", "/readyz", "/"] {
+        assert_eq!(app.get(path).await.status(), StatusCode::OK, "{path}");
+    }
+    // A key with submit: as x-api-key or as a bearer token.
+    assert_eq!(solve_with(&app, LAB_A).await.status(), StatusCode::OK);
+    let bearer = app
+        .send(
+            Method::POST,
+            "/v1/rolling",
+            &[("authorization", &format!("Bearer {LAB_B}"))],
+            Some(&json!({})),
+        )
+        .await;
+    assert_eq!(bearer.status(), StatusCode::OK);
+    // A reader's key may not submit: 403 naming its scopes.
+    let sent = solve_with(&app, READER).await;
+    let detail = refused(sent, StatusCode::FORBIDDEN, "forbidden").await;
+    assert!(
+        detail.contains("\"reader\" has the scopes read, not submit"),
+        "{detail}"
+    );
+    // Only metrics (or admin) reads /metrics.
+    let metrics = send(&app, Method::GET, "/metrics", Some(LAB_A), None).await;
+    refused(metrics, StatusCode::FORBIDDEN, "forbidden").await;
+    assert_eq!(
+        send(&app, Method::GET, "/metrics", Some(ADMIN), None)
+            .await
+            .status(),
+        StatusCode::OK
+    );
+    // Keys not accepted: unknown, expired, two different, not a bearer.
+    let unknown = send(
+        &app,
+        Method::GET,
+        "/openapi.json",
+        Some("nobody-s-key-000000"),
+        None,
+    )
+    .await;
+    assert!(refused(unknown, StatusCode::UNAUTHORIZED, "unauthorized")
+        .await
+        .contains("not known"));
+    let expired = send(&app, Method::GET, "/openapi.json", Some(EXPIRED), None).await;
+    let detail = refused(expired, StatusCode::UNAUTHORIZED, "unauthorized").await;
+    assert!(
+        detail.contains("\"old\" expired at 2020-01-01T00:00:00Z"),
+        "{detail}"
+    );
+    let two = app
+        .send(
+            Method::GET,
+            "/openapi.json",
+            &[
+                ("x-api-key", LAB_A),
+                ("authorization", &format!("Bearer {LAB_B}")),
+            ],
+            None,
+        )
+        .await;
+    assert!(refused(two, StatusCode::UNAUTHORIZED, "unauthorized")
+        .await
+        .contains("two different keys"));
+    // Another scheme (a proxy's Basic credentials) is not a key: the caller is anonymous.
+    let basic = [("authorization", "Basic YTpi")];
+    let read = app.send(Method::GET, "/openapi.json", &basic, None).await;
+    assert_eq!(read.status(), StatusCode::OK);
+    let body = json!({});
+    let submitted = app
+        .send(Method::POST, "/v1/rolling", &basic, Some(&body))
+        .await;
+    let detail = refused(submitted, StatusCode::UNAUTHORIZED, "unauthorized").await;
+    assert!(detail.contains("callers without an API key"), "{detail}");
+}
+
+#[tokio::test]
+async fn anonymous_access_can_be_turned_off() {
+    let app = service("none").await;
+    for path in ["/openapi.json", "/v1/figures/3", "/metrics"] {
+        refused(
+            app.get(path).await,
+            StatusCode::UNAUTHORIZED,
+            "unauthorized",
+        )
+        .await;
+    }
+    assert_eq!(app.get("/healthz").await.status(), StatusCode::OK);
+    let figure = send(&app, Method::GET, "/v1/figures/3", Some(READER), None).await;
+    assert_eq!(figure.status(), StatusCode::OK);
+}
+
+#[tokio::test]
+async fn a_tenants_jobs_are_its_keys_and_the_admins_alone() {
+    let app = service("submit,read").await;
+    let ours = submit(&app, Some(LAB_A), &rolling_job("30 nm")).await;
+    let theirs = submit(&app, Some(LAB_B), &rolling_job("31 nm")).await;
+    let anonymous = submit(&app, None, &rolling_job("32 nm")).await;
+    app.wait_for_job(&anonymous, |j| j["status"] == "succeeded")
+        .await;
+
+    // Another tenant, and anonymous callers, do not find lab-a's job; a rotated key of
+    // the same name, and the admin, do.
+    for path in [
+        ours.clone(),
+        format!("{ours}/result"),
+        format!("{ours}/events"),
+    ] {
+        for key in [Some(LAB_B), None] {
+            let response = send(&app, Method::GET, &path, key, None).await;
+            let detail = refused(response, StatusCode::NOT_FOUND, "not-found").await;
+            // As for an id never issued: nothing says the job exists.
+            let never = uuid_like(&path);
+            let unknown = send(&app, Method::GET, &never, key, None).await;
+            let told = refused(unknown, StatusCode::NOT_FOUND, "not-found").await;
+            assert_eq!(
+                detail.replace(id_of(&path), "ID"),
+                told.replace(id_of(&never), "ID")
+            );
+        }
+    }
+    for key in [LAB_A, LAB_A_ROTATED, ADMIN] {
+        let response = send(&app, Method::GET, &ours, Some(key), None).await;
+        assert_eq!(response.status(), StatusCode::OK, "{key}");
+    }
+    // Nor cancel or delete it.
+    let delete = send(&app, Method::DELETE, &ours, Some(LAB_B), None).await;
+    assert_eq!(delete.status(), StatusCode::NOT_FOUND);
+    // An anonymous job is read by anyone holding its id, as before keys.
+    assert_eq!(
+        send(&app, Method::GET, &anonymous, Some(LAB_B), None)
+            .await
+            .status(),
+        StatusCode::OK
+    );
+
+    let done = within_done(&app, &ours, LAB_A).await;
+    let hash = done["input_hash"].as_str().unwrap();
+
+    // Listing: each key its tenant's jobs; the admin any tenant's.
+    let listed = |key: &'static str, query: &'static str| {
+        let app = &app;
+        async move {
+            let response = send(
+                app,
+                Method::GET,
+                &format!("/v1/jobs{query}"),
+                Some(key),
+                None,
+            )
+            .await;
+            let status = response.status();
+            (status, response.json::<Value>().await.unwrap())
+        }
+    };
+    let ids = |page: &Value| -> Vec<String> {
+        page["jobs"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|j| format!("/v1/jobs/{}", j["id"].as_str().unwrap()))
+            .collect()
+    };
+    let (_, page) = listed(LAB_A_ROTATED, "").await;
+    assert_eq!(ids(&page), [ours.as_str()]);
+    let (_, page) = listed(LAB_B, "").await;
+    assert_eq!(ids(&page), [theirs.as_str()]);
+    let (_, page) = listed(ADMIN, "?tenant=lab-a").await;
+    assert_eq!(ids(&page), [ours.as_str()]);
+    let (status, problem) = listed(LAB_B, "?tenant=lab-a").await;
+    assert_eq!(status, StatusCode::FORBIDDEN, "{problem}");
+    assert!(
+        problem["detail"]
+            .as_str()
+            .unwrap()
+            .contains("only an admin"),
+        "{problem}"
+    );
+
+    // The admin cancels and deletes another tenant's job.
+    let deleted = send(&app, Method::DELETE, &theirs, Some(ADMIN), None).await;
+    assert_eq!(deleted.status(), StatusCode::OK);
+    let gone = send(&app, Method::GET, &theirs, Some(LAB_B), None).await;
+    assert_eq!(gone.status(), StatusCode::NOT_FOUND);
+    // The input's link answers from the cache (a solve of that input would too).
+    let by_input = send(
+        &app,
+        Method::GET,
+        &format!("/v1/results/{hash}"),
+        Some(LAB_B),
+        None,
+    )
+    .await;
+    assert_eq!(by_input.status(), StatusCode::OK);
+}
+
+#[tokio::test]
+async fn a_tenants_answer_by_its_input_needs_its_key_once_out_of_the_cache() {
+    // A cache too small to keep the answer: the link reads the job's saved answer.
+    let app = spawn_app(&["--api-keys", &keys(), "--cache-ttl", "1ms"]).await;
+    let ours = submit(&app, Some(LAB_A), &rolling_job("33 nm")).await;
+    let job = within_done(&app, &ours, LAB_A).await;
+    let link = format!("/v1/results/{}", job["input_hash"].as_str().unwrap());
+    tokio::time::sleep(std::time::Duration::from_millis(20)).await;
+    assert_eq!(
+        send(&app, Method::GET, &link, Some(LAB_A), None)
+            .await
+            .status(),
+        StatusCode::OK
+    );
+    assert_eq!(
+        send(&app, Method::GET, &link, Some(LAB_B), None)
+            .await
+            .status(),
+        StatusCode::NOT_FOUND
+    );
+}
+
+async fn within_done(app: &TestApp, path: &str, key: &str) -> Value {
+    crate::helpers::within(async {
+        loop {
+            let job: Value = send(app, Method::GET, path, Some(key), None)
+                .await
+                .json()
+                .await
+                .unwrap();
+            if job["status"] == "succeeded" {
+                return job;
+            }
+            tokio::time::sleep(std::time::Duration::from_millis(10)).await;
+        }
+    })
+    .await
+}
+
+#[tokio::test]
+async fn a_cross_origin_preflight_not_allowed_names_the_flag() {
+    let preflight = |app: &TestApp, origin: &'static str| {
+        app.client
+            .request(Method::OPTIONS, app.url("/v1/rolling"))
+            .header("origin", origin)
+            .header("access-control-request-method", "POST")
+            .header("access-control-request-headers", "content-type, x-api-key")
+            .send()
+    };
+    let closed = spawn_app(&[]).await;
+    let response = preflight(&closed, "https://lab.example").await.unwrap();
+    let detail = refused(response, StatusCode::FORBIDDEN, "forbidden").await;
+    assert!(
+        detail.contains("--cors-origin https://lab.example"),
+        "{detail}"
+    );
+
+    let open = spawn_app(&["--cors-origin", "https://lab.example"]).await;
+    let allowed = preflight(&open, "https://lab.example").await.unwrap();
+    assert_eq!(allowed.status(), StatusCode::OK);
+    let headers = allowed.headers()["access-control-allow-headers"]
+        .to_str()
+        .unwrap()
+        .to_lowercase();
+    assert!(
+        headers.contains("x-api-key") && headers.contains("thirdbody-owner"),
+        "{headers}"
+    );
+    let other = preflight(&open, "https://elsewhere.example").await.unwrap();
+    let detail = refused(other, StatusCode::FORBIDDEN, "forbidden").await;
+    assert!(
+        detail.contains("allows https://lab.example. Add https://elsewhere.example"),
+        "{detail}"
+    );
+}

@@ -1,0 +1,293 @@
+//! API keys on the binary: keys made by `thirdbody new-key`, their file read again without a
+//! restart (a key added, rotated, revoked), and tenants in a fleet whose Redis asks for a
+//! password (AUTH): a job belongs to its key's tenant in every process of the fleet.
+
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+use reqwest::{Client, StatusCode};
+use serde_json::{json, Value};
+
+use crate::fleet::{answering, free_port, get_json, redis_server_available, start, Process};
+
+/// `thirdbody new-key` with `args`: the key and its entry.
+fn new_key(args: &[&str]) -> (String, Value) {
+    let out = Command::new(env!("CARGO_BIN_EXE_thirdbody"))
+        .arg("new-key")
+        .args(args)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8(out.stdout).unwrap();
+    let mut lines = text.lines();
+    let key = lines.next().unwrap().to_string();
+    let entry = serde_json::from_str(lines.next().unwrap()).unwrap();
+    (key, entry)
+}
+
+fn write_keys(path: &std::path::Path, entries: &[&Value]) {
+    // Written whole then renamed, as an operator's tooling (or a Secret's update) does.
+    let partial = path.with_extension("partial");
+    std::fs::write(&partial, json!({ "keys": entries }).to_string()).unwrap();
+    std::fs::rename(&partial, path).unwrap();
+}
+
+/// `GET url` with `key`, read as JSON.
+async fn read(http: &Client, url: &str, key: &str) -> Value {
+    let response = http.get(url).header("x-api-key", key).send().await.unwrap();
+    response.json().await.unwrap()
+}
+
+async fn status(http: &Client, url: &str, key: &str) -> StatusCode {
+    http.get(url)
+        .header("x-api-key", key)
+        .send()
+        .await
+        .unwrap()
+        .status()
+}
+
+/// Polls until `url` answers `expected` to `key` (the file is read again every second).
+async fn until(http: &Client, url: &str, key: &str, expected: StatusCode) {
+    let start = Instant::now();
+    while status(http, url, key).await != expected {
+        assert!(
+            start.elapsed() < Duration::from_secs(10),
+            "{url} never answered {expected} to {key}"
+        );
+        tokio::time::sleep(Duration::from_millis(100)).await;
+    }
+}
+
+#[test]
+fn new_key_refuses_what_the_service_would_refuse() {
+    for (args, needle) in [
+        (&["--name", "a b"][..], "name: allowed"),
+        (
+            &["--name", "lab", "--scopes", "write"],
+            "unknown scope \"write\"",
+        ),
+        (
+            &["--name", "lab", "--expires", "tomorrow"],
+            "expires \"tomorrow\"",
+        ),
+    ] {
+        let out = Command::new(env!("CARGO_BIN_EXE_thirdbody"))
+            .arg("new-key")
+            .args(args)
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(2), "{args:?}");
+        let error = String::from_utf8_lossy(&out.stderr);
+        assert!(error.contains(needle), "{args:?}: {error}");
+    }
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn keys_are_added_rotated_and_revoked_without_a_restart() {
+    let dir = std::env::temp_dir().join(format!("thirdbody-keys-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("keys.json");
+    let (old, old_entry) = new_key(&["--name", "lab-a"]);
+    let (ops, ops_entry) = new_key(&["--name", "ops", "--scopes", "admin"]);
+    write_keys(&file, &[&old_entry, &ops_entry]);
+
+    let port = free_port();
+    let _service = Process(
+        Command::new(env!("CARGO_BIN_EXE_thirdbody"))
+            .args(["serve", "--bind", &format!("127.0.0.1:{port}")])
+            .args(["--database", ":memory:", "--anonymous", "none"])
+            .args(["--api-keys", file.to_str().unwrap()])
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .spawn()
+            .unwrap(),
+    );
+    let http = Client::new();
+    let base = answering(&http, port).await;
+    let docs = format!("{base}/openapi.json");
+    assert_eq!(status(&http, &docs, &old).await, StatusCode::OK);
+
+    // A job of lab-a's, submitted with the old key.
+    let request = http
+        .post(format!("{base}/v1/jobs"))
+        .header("x-api-key", &old);
+    let response = request
+        .json(&json!({"kind": "rolling", "input": {}}))
+        .send();
+    let submitted: Value = response.await.unwrap().json().await.unwrap();
+    let job = format!("{base}/v1/jobs/{}", submitted["id"].as_str().unwrap());
+
+    // Rotation: a new key of the same name added, then the old one removed.
+    let (new, new_entry) = new_key(&["--name", "lab-a"]);
+    write_keys(&file, &[&old_entry, &new_entry, &ops_entry]);
+    until(&http, &job, &new, StatusCode::OK).await;
+    assert_eq!(status(&http, &job, &old).await, StatusCode::OK);
+    write_keys(&file, &[&new_entry, &ops_entry]);
+    until(&http, &docs, &old, StatusCode::UNAUTHORIZED).await;
+    // The tenant's job is the new key's: listed to it.
+    let page = read(&http, &format!("{base}/v1/jobs"), &new).await;
+    assert_eq!(page["jobs"][0]["id"], submitted["id"], "{page}");
+
+    // A broken file leaves the keys as they were, and /readyz says so.
+    std::fs::write(&file, "{\"keys\": [").unwrap();
+    tokio::time::sleep(Duration::from_millis(1500)).await;
+    assert_eq!(status(&http, &docs, &new).await, StatusCode::OK);
+    let ready = get_json(&http, format!("{base}/readyz")).await;
+    assert_eq!(ready["status"], "degraded", "{ready}");
+    assert!(
+        ready["reasons"][0]
+            .as_str()
+            .unwrap()
+            .contains("is not valid"),
+        "{ready}"
+    );
+    // An admin key revoked; then the file removed: no key is accepted.
+    write_keys(&file, &[&new_entry]);
+    until(&http, &docs, &ops, StatusCode::UNAUTHORIZED).await;
+    assert_eq!(
+        get_json(&http, format!("{base}/readyz")).await["status"],
+        "ready"
+    );
+    std::fs::remove_file(&file).unwrap();
+    until(&http, &docs, &new, StatusCode::UNAUTHORIZED).await;
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn tenants_hold_across_a_fleet_on_a_redis_with_a_password() {
+    if !redis_server_available() {
+        eprintln!("SKIPPED: redis-server is not on PATH (`.ci/run` installs it)");
+        return;
+    }
+    const PASSWORD: &str = "s3cret-of-the-fleet";
+    let redis = free_port();
+    let _redis = Process(
+        Command::new("redis-server")
+            .args(["--port", &redis.to_string(), "--bind", "127.0.0.1"])
+            .args([
+                "--save",
+                "",
+                "--appendonly",
+                "no",
+                "--requirepass",
+                PASSWORD,
+            ])
+            .stdout(Stdio::null())
+            .spawn()
+            .expect("redis-server starts"),
+    );
+    while std::net::TcpStream::connect(("127.0.0.1", redis)).is_err() {
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    let (a, a_entry) = new_key(&["--name", "lab-a"]);
+    let (b, b_entry) = new_key(&["--name", "lab-b"]);
+    let (ops, ops_entry) = new_key(&["--name", "ops", "--scopes", "admin"]);
+    let keys = json!({"keys": [a_entry, b_entry, ops_entry]}).to_string();
+    let http = Client::new();
+    let url = format!("redis://:{PASSWORD}@127.0.0.1:{redis}");
+    let flags = ["--redis-url", url.as_str(), "--api-keys", keys.as_str()];
+    let (one_port, two_port) = (free_port(), free_port());
+    let (_one, one_log) = start("serve", redis, Some(one_port), &flags);
+    let (_two, two_log) = start("serve", redis, Some(two_port), &flags);
+    let one = answering(&http, one_port).await;
+    let two = answering(&http, two_port).await;
+
+    // lab-a's sweep, submitted to one process, runs on the fleet and is read from the other.
+    let sweep = json!({"kind": "sweep", "input": {"base": {"radius": "30 nm"},
+        "vary": {"load": ["1 nN", "2 nN", "3 nN"]}}});
+    let response = http
+        .post(format!("{one}/v1/jobs"))
+        .header("authorization", format!("Bearer {a}"))
+        .json(&sweep)
+        .send()
+        .await
+        .unwrap();
+    assert_eq!(response.status(), StatusCode::ACCEPTED);
+    let id = response.json::<Value>().await.unwrap()["id"]
+        .as_str()
+        .unwrap()
+        .to_string();
+    let job = format!("{two}/v1/jobs/{id}");
+    let start_at = Instant::now();
+    loop {
+        let view = read(&http, &job, &a).await;
+        if view["status"] == "succeeded" {
+            break;
+        }
+        assert!(start_at.elapsed() < Duration::from_secs(30), "{view}");
+        tokio::time::sleep(Duration::from_millis(50)).await;
+    }
+    assert_eq!(
+        status(&http, &format!("{job}/result"), &a).await,
+        StatusCode::OK
+    );
+    // Not lab-b's, on either process; the admin's on both.
+    for base in [&one, &two] {
+        let url = format!("{base}/v1/jobs/{id}");
+        assert_eq!(status(&http, &url, &b).await, StatusCode::NOT_FOUND);
+        assert_eq!(
+            status(&http, &format!("{url}/result"), &b).await,
+            StatusCode::NOT_FOUND
+        );
+        assert_eq!(status(&http, &url, &ops).await, StatusCode::OK);
+        let listed = read(&http, &format!("{base}/v1/jobs?tenant=lab-a"), &ops).await;
+        assert_eq!(listed["jobs"][0]["id"], id.as_str(), "{listed}");
+    }
+    let deleted = http
+        .delete(&job)
+        .header("x-api-key", &b)
+        .send()
+        .await
+        .unwrap();
+    assert_eq!(deleted.status(), StatusCode::NOT_FOUND);
+
+    // The password is in no log line; a wrong one is told, without it.
+    for log in [&one_log, &two_log] {
+        assert!(log
+            .lock()
+            .unwrap()
+            .iter()
+            .all(|line| !line.contains(PASSWORD)));
+    }
+    let wrong = format!("redis://:not-{PASSWORD}@127.0.0.1:{redis}");
+    let port = free_port();
+    let (_three, three_log) = start("serve", redis, Some(port), &["--redis-url", &wrong]);
+    let three = answering(&http, port).await;
+    let start_at = Instant::now();
+    let ready = loop {
+        let ready = get_json(&http, format!("{three}/readyz")).await;
+        if ready["status"] == "degraded" || start_at.elapsed() > Duration::from_secs(10) {
+            break ready;
+        }
+        tokio::time::sleep(Duration::from_millis(100)).await;
+    };
+    assert_eq!(ready["redis"]["jobs"], "denied", "{ready}");
+    let reasons = ready["reasons"].to_string();
+    assert!(
+        reasons.contains("refuses this process's credentials"),
+        "{reasons}"
+    );
+    assert!(!reasons.contains(PASSWORD), "{reasons}");
+    let refused = http
+        .post(format!("{three}/v1/jobs"))
+        .json(&sweep)
+        .send()
+        .await
+        .unwrap();
+    assert_eq!(refused.status(), StatusCode::SERVICE_UNAVAILABLE);
+    let problem = refused.text().await.unwrap();
+    assert!(
+        problem.contains("credentials") && !problem.contains(PASSWORD),
+        "{problem}"
+    );
+    assert!(three_log
+        .lock()
+        .unwrap()
+        .iter()
+        .all(|line| !line.contains(PASSWORD)));
+}
