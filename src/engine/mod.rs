@@ -23,6 +23,7 @@ mod local;
 mod memo;
 pub mod metrics;
 pub mod pool;
+pub mod quota;
 mod service;
 mod solver;
 pub mod spill;

@@ -20,6 +20,7 @@ use super::fleet::Shared;
 use super::lifecycle::Lifecycle;
 use super::local::LocalJobStore;
 use super::metrics::{self as names, Metrics};
+use super::quota::{Exceeded, PointCounts};
 use super::solver::{CacheStatus, Solver};
 use super::spill::SpillDir;
 use super::store::{JobRecord, JobStatus, JobStore, Listing, MemoryJobStore, Owner, Page, Refusal};
@@ -136,6 +137,8 @@ pub struct Engine {
     solve_deadline: Duration,
     solver: Arc<Solver>,
     jobs: Arc<Lifecycle>,
+    /// The points each tenant asked for in the current minute (its quota's count).
+    points: PointCounts,
 }
 
 impl Engine {
@@ -153,6 +156,7 @@ impl Engine {
             }
         }
         let solver = Arc::new(Solver::new(&config, metrics.clone(), storage.cache));
+        let points = PointCounts::new(storage.fleet.as_ref().map(|s| s.fleet.clone()));
         let jobs = Lifecycle::new(
             config.clone(),
             &metrics,
@@ -164,7 +168,32 @@ impl Engine {
             solve_deadline: config.solve_deadline,
             solver,
             jobs: Arc::new(jobs),
+            points,
         })
+    }
+
+    /// Charges `points` of work to `tenant`, unless its points this minute would pass
+    /// `limit` (counted fleet-wide in a fleet).
+    pub async fn charge(&self, tenant: &str, points: u64, limit: u64) -> Result<(), Exceeded> {
+        self.points
+            .charge(tenant, points, limit, std::time::SystemTime::now())
+            .await
+    }
+
+    /// The jobs of `owner` not finished yet (queued or running), as the job store lists them.
+    pub async fn unfinished_of(&self, owner: &Owner) -> Result<usize, EngineError> {
+        let mut unfinished = 0;
+        for status in [JobStatus::Queued, JobStatus::Running] {
+            let listing = Listing {
+                owner: owner.clone(),
+                kind: None,
+                status: Some(status),
+                offset: 0,
+                limit: 1,
+            };
+            unfinished += self.jobs.list(&listing).await?.total;
+        }
+        Ok(unfinished)
     }
 
     pub fn metrics(&self) -> &Metrics {

@@ -11,7 +11,7 @@ use std::time::Duration;
 use axum::http::HeaderValue;
 use clap::{Parser, ValueEnum};
 
-use super::access::{Access, Keys, Scopes, Source};
+use super::access::{Access, Keys, Quota, Quotas, Scopes, Source};
 use super::server::{BodyPace, ConnectionLimits};
 use crate::engine::fleet::FleetConfig;
 use crate::engine::EngineConfig;
@@ -153,6 +153,21 @@ pub struct ServeArgs {
         default_value = "submit,read,metrics"
     )]
     pub anonymous: String,
+
+    /// Points (a sweep's points, a figure's, one for a single contact or a fit) each API
+    /// key's tenant may ask to be computed in a minute, fleet-wide; more are refused with 429
+    /// until the minute ends (0: no limit). An answer already cached costs nothing.
+    #[arg(long, env = "THIRDBODY_QUOTA_POINTS", default_value_t = 0)]
+    pub quota_points: u64,
+
+    /// Unfinished asynchronous jobs each API key's tenant may have at once (0: no limit).
+    #[arg(long, env = "THIRDBODY_QUOTA_JOBS", default_value_t = 0)]
+    pub quota_jobs: usize,
+
+    /// Points per minute for all callers without an API key together: their share, so that
+    /// anonymous traffic cannot starve the tenants (0: no limit).
+    #[arg(long, env = "THIRDBODY_ANONYMOUS_QUOTA_POINTS", default_value_t = 0)]
+    pub anonymous_quota_points: u64,
 
     /// Log format.
     #[arg(long, env = "THIRDBODY_LOG_FORMAT", value_enum, default_value_t = LogFormat::Json)]
@@ -411,7 +426,17 @@ impl ServeArgs {
                 Some((dir, bytes))
             }
         };
-        let access = access(self.api_keys.as_deref(), &self.anonymous)?;
+        let mut access = access(self.api_keys.as_deref(), &self.anonymous)?;
+        access.quotas = Quotas {
+            keyed: Quota {
+                points_per_minute: self.quota_points,
+                jobs: self.quota_jobs,
+            },
+            anonymous: Quota {
+                points_per_minute: self.anonymous_quota_points,
+                jobs: 0,
+            },
+        };
         Ok(Config {
             bind: self.bind,
             fleet: self.fleet.validate()?,

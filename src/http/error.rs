@@ -8,6 +8,7 @@ use axum::http::{header, HeaderValue, StatusCode};
 use axum::response::{IntoResponse, Response};
 use serde::Serialize;
 use serde_json::{Map, Value};
+use std::time::Duration;
 use utoipa::ToSchema;
 
 use crate::check::Report;
@@ -38,8 +39,10 @@ pub struct Problem {
     /// scope, or the job is another's to change; a refused cross-origin preflight),
     /// `not-found` (404), `interrupted` (410: the service stopped
     /// before the job finished), `not-ready` (409: the job has no result yet), `cancelled`
-    /// (409), `overloaded` (429), `too-many-streams` (429: every event stream the service
-    /// follows at once is open; poll the job instead),
+    /// (409), `overloaded` (429), `quota-exceeded` (429: the caller's quota of points a
+    /// minute, or of unfinished jobs, is used up; `Retry-After` when waiting helps),
+    /// `too-many-streams` (429: every event stream the service follows at once is open; poll
+    /// the job instead),
     /// `draining` (503), `unavailable` (503: the shared job store cannot be reached),
     /// `results-full` (503: no room to keep the job's result now; retry after `Retry-After`),
     /// `result-too-large` (422: the job's result would not fit even in an empty store),
@@ -82,6 +85,7 @@ enum Kind {
     NotReady,
     Cancelled,
     Overloaded,
+    QuotaExceeded,
     TooManyStreams,
     Draining,
     Unavailable,
@@ -112,7 +116,9 @@ impl Kind {
             Kind::NotFound => StatusCode::NOT_FOUND,
             Kind::Interrupted => StatusCode::GONE,
             Kind::Cancelled | Kind::NotReady => StatusCode::CONFLICT,
-            Kind::Overloaded | Kind::TooManyStreams => StatusCode::TOO_MANY_REQUESTS,
+            Kind::Overloaded | Kind::QuotaExceeded | Kind::TooManyStreams => {
+                StatusCode::TOO_MANY_REQUESTS
+            }
             Kind::Draining | Kind::Unavailable | Kind::ResultsFull => {
                 StatusCode::SERVICE_UNAVAILABLE
             }
@@ -143,6 +149,7 @@ impl Kind {
             Kind::NotReady => ("not-ready", "The job has no result yet"),
             Kind::Cancelled => ("cancelled", "The job was cancelled"),
             Kind::Overloaded => ("overloaded", "Every solver thread is busy"),
+            Kind::QuotaExceeded => ("quota-exceeded", "The caller's quota is used up"),
             Kind::TooManyStreams => ("too-many-streams", "Too many event streams are open"),
             Kind::Draining => ("draining", "The service is shutting down"),
             Kind::Unavailable => (
@@ -258,6 +265,15 @@ impl ApiError {
         ApiError {
             internal: Some(detail.into()),
             ..ApiError::new(Kind::Internal, INTERNAL_DETAIL)
+        }
+    }
+
+    /// The caller's quota is used up: retry after `retry_after`, if waiting helps.
+    pub fn quota_exceeded(detail: impl Into<String>, retry_after: Option<Duration>) -> Self {
+        ApiError {
+            retry_after: retry_after
+                .map(|wait| wait.as_secs().clamp(1, u64::from(u32::MAX)) as u32),
+            ..ApiError::new(Kind::QuotaExceeded, detail)
         }
     }
 

@@ -164,8 +164,9 @@ impl IntoResponses for ChecksFailed {
 problems!(
     /// Refusals of new work.
     Busy {
-        (429, "overloaded: every solver thread is busy (or the job queue is full); no queue",
-            true),
+        (429, "overloaded: every solver thread is busy (or the job queue is full); no queue. \
+            Or quota-exceeded: the caller's points this minute (or, for a job, its tenant's \
+            unfinished jobs) are at its quota", true),
         (503, DRAINING, true),
     }
 );

@@ -407,3 +407,147 @@ async fn a_cross_origin_preflight_not_allowed_names_the_flag() {
         "{detail}"
     );
 }
+
+/// A refusal for a quota: 429 with `Retry-After` (within the minute) and its detail.
+async fn over_quota(response: Response) -> String {
+    let retry_after: u64 = response.headers()["retry-after"]
+        .to_str()
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert!((1..=60).contains(&retry_after), "{retry_after}");
+    refused(response, StatusCode::TOO_MANY_REQUESTS, "quota-exceeded").await
+}
+
+#[tokio::test]
+async fn points_a_minute_are_each_tenants_and_anonymous_callers_share_theirs() {
+    let flags = ["--quota-points", "5", "--anonymous-quota-points", "2"];
+    let app = spawn_app(&[&["--api-keys", &keys()][..], &flags[..]].concat()).await;
+    crate::clock::early_in_a_minute().await;
+    let rolling = |radius: &str| json!({"radius": radius});
+    // Callers without a key: two points a minute between them.
+    for radius in ["20 nm", "21 nm"] {
+        let solved = app.post("/v1/rolling", &rolling(radius)).await;
+        assert_eq!(solved.status(), StatusCode::OK);
+    }
+    let detail = over_quota(app.post("/v1/rolling", &rolling("22 nm")).await).await;
+    assert!(
+        detail.contains("a caller without an API key asked for 2 points this minute, of the 2"),
+        "{detail}"
+    );
+    // An answer already cached costs nothing.
+    assert_eq!(
+        app.post("/v1/rolling", &rolling("20 nm")).await.status(),
+        StatusCode::OK
+    );
+
+    // A tenant's five are its own: a sweep of three points and two contacts, then no more,
+    // whichever of its keys asks; another tenant is not held back.
+    let sweep = json!({"base": {"radius": "30 nm"}, "vary": {"load": ["1 nN", "2 nN", "3 nN"]}});
+    let swept = send(&app, Method::POST, "/v1/sweeps", Some(LAB_A), Some(&sweep)).await;
+    assert_eq!(swept.status(), StatusCode::OK);
+    let job = rolling_job("23 nm");
+    submit(&app, Some(LAB_A_ROTATED), &job).await;
+    let solved = send(
+        &app,
+        Method::POST,
+        "/v1/rolling",
+        Some(LAB_A),
+        Some(&rolling("24 nm")),
+    )
+    .await;
+    assert_eq!(solved.status(), StatusCode::OK);
+    let past = send(
+        &app,
+        Method::POST,
+        "/v1/rolling",
+        Some(LAB_A),
+        Some(&rolling("25 nm")),
+    )
+    .await;
+    let detail = over_quota(past).await;
+    assert!(
+        detail.contains("\"lab-a\" asked for 5 points this minute, of the 5"),
+        "{detail}"
+    );
+    let job = send(
+        &app,
+        Method::POST,
+        "/v1/jobs",
+        Some(LAB_A),
+        Some(&rolling_job("26 nm")),
+    )
+    .await;
+    over_quota(job).await;
+    let theirs = send(
+        &app,
+        Method::POST,
+        "/v1/rolling",
+        Some(LAB_B),
+        Some(&rolling("25 nm")),
+    )
+    .await;
+    assert_eq!(theirs.status(), StatusCode::OK);
+    // More than a minute's points at once: no wait would help.
+    let big =
+        json!({"base": {}, "vary": {"load": ["1 nN", "2 nN", "3 nN", "4 nN", "5 nN", "6 nN"]}});
+    let response = send(&app, Method::POST, "/v1/sweeps", Some(LAB_B), Some(&big)).await;
+    assert!(response.headers().get("retry-after").is_none());
+    let detail = refused(response, StatusCode::TOO_MANY_REQUESTS, "quota-exceeded").await;
+    assert!(
+        detail.contains("asks for 6 points, more than the 5"),
+        "{detail}"
+    );
+}
+
+#[tokio::test]
+async fn a_tenant_has_at_most_its_quota_of_unfinished_jobs() {
+    let app = spawn_app(&[
+        "--api-keys",
+        &keys(),
+        "--quota-jobs",
+        "1",
+        "--pool-size",
+        "2",
+    ])
+    .await;
+    let first = submit(&app, Some(LAB_A), &crate::helpers::long_sweep(40)).await;
+    let second = send(
+        &app,
+        Method::POST,
+        "/v1/jobs",
+        Some(LAB_A_ROTATED),
+        Some(&rolling_job("27 nm")),
+    )
+    .await;
+    let detail = over_quota(second).await;
+    assert!(detail.contains("has 1 unfinished jobs"), "{detail}");
+    // Another tenant's jobs, and anonymous ones, are not counted.
+    submit(&app, Some(LAB_B), &rolling_job("27 nm")).await;
+    submit(&app, None, &rolling_job("28 nm")).await;
+    // Once the first ends (cancelled), another is taken.
+    let cancelled = send(
+        &app,
+        Method::POST,
+        &format!("{first}/cancel"),
+        Some(LAB_A),
+        None,
+    )
+    .await;
+    assert_eq!(cancelled.status(), StatusCode::OK);
+    crate::helpers::within(async {
+        loop {
+            let job: Value = send(&app, Method::GET, &first, Some(LAB_A), None)
+                .await
+                .json()
+                .await
+                .unwrap();
+            if job["status"] == "cancelled" {
+                break;
+            }
+            tokio::time::sleep(std::time::Duration::from_millis(10)).await;
+        }
+    })
+    .await;
+    submit(&app, Some(LAB_A), &rolling_job("29 nm")).await;
+}

@@ -3,6 +3,8 @@
 
 mod access;
 mod checks;
+#[path = "../shared/clock.rs"]
+mod clock;
 mod continuum;
 mod errors;
 mod fits;

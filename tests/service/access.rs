@@ -291,3 +291,51 @@ async fn tenants_hold_across_a_fleet_on_a_redis_with_a_password() {
         .iter()
         .all(|line| !line.contains(PASSWORD)));
 }
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_tenants_points_are_counted_once_for_the_whole_fleet() {
+    let Some((redis, _redis)) = crate::fleet::fresh_redis() else {
+        return;
+    };
+    let (key, entry) = new_key(&["--name", "lab-a"]);
+    let keys = json!({"keys": [entry]}).to_string();
+    let flags = ["--api-keys", keys.as_str(), "--quota-points", "3"];
+    let (one_port, two_port) = (free_port(), free_port());
+    let (_one, _) = start("serve", redis, Some(one_port), &flags);
+    let (_two, _) = start("serve", redis, Some(two_port), &flags);
+    let http = Client::new();
+    let one = answering(&http, one_port).await;
+    let two = answering(&http, two_port).await;
+    // Early in a minute: the count is per minute.
+    crate::clock::early_in_a_minute().await;
+    let solve = |base: &String, radius: &str| {
+        http.post(format!("{base}/v1/rolling"))
+            .header("x-api-key", &key)
+            .json(&json!({"radius": radius}))
+            .send()
+    };
+    for (base, radius) in [(&one, "20 nm"), (&two, "21 nm"), (&one, "22 nm")] {
+        assert_eq!(solve(base, radius).await.unwrap().status(), StatusCode::OK);
+    }
+    for base in [&one, &two] {
+        let refused = solve(base, "23 nm").await.unwrap();
+        assert_eq!(refused.status(), StatusCode::TOO_MANY_REQUESTS);
+        assert!(refused.headers().contains_key("retry-after"));
+    }
+    // The count lives as long as its minute and the next.
+    let keys = crate::fleet::redis_cli(redis, &["--scan", "--pattern", "thirdbody:quota:*"]);
+    let counted = keys.lines().next().expect("a count in Redis");
+    assert!(
+        counted.starts_with("thirdbody:quota:key:lab-a:"),
+        "{counted}"
+    );
+    assert_eq!(
+        crate::fleet::redis_cli(redis, &["GET", counted]).trim(),
+        "3"
+    );
+    let ttl: i64 = crate::fleet::redis_cli(redis, &["TTL", counted])
+        .trim()
+        .parse()
+        .unwrap();
+    assert!((1..=120).contains(&ttl), "{ttl}");
+}

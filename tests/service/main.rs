@@ -4,6 +4,8 @@
 
 mod access;
 mod cli;
+#[path = "../shared/clock.rs"]
+mod clock;
 mod deploy;
 mod fit;
 mod fit_continuum;

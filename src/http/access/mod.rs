@@ -16,7 +16,7 @@ use std::time::SystemTime;
 
 use axum::extract::{FromRequestParts, Request, State};
 use axum::http::request::Parts;
-use axum::http::{header, HeaderMap, Method};
+use axum::http::{header, Extensions, HeaderMap, Method};
 use axum::middleware::Next;
 use axum::response::{IntoResponse, Response};
 
@@ -25,26 +25,47 @@ pub use keys::{Keys, Scopes, Source};
 use super::config::CorsOrigins;
 use super::error::ApiError;
 use super::AppState;
+use crate::engine::quota::Exceeded;
 use crate::engine::store::Owner;
+use crate::job::{Job, Keyed, Work};
 
 /// The header that carries an API key (`Authorization: Bearer` does too).
 pub const API_KEY_HEADER: &str = "x-api-key";
 
-/// The service's access rules: its keys and what anonymous callers may do.
+/// The service's access rules: its keys, what anonymous callers may do, and the quotas.
 #[derive(Debug)]
 pub struct Access {
     pub keys: Keys,
     /// What a caller without a key may do.
     pub anonymous: Scopes,
+    pub quotas: Quotas,
     /// Whether a refused cross-origin preflight has been logged (it is, once).
     preflight_logged: AtomicBool,
 }
 
+/// What one tenant may use (0: no limit).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Quota {
+    /// Points asked to be computed in a minute.
+    pub points_per_minute: u64,
+    /// Unfinished asynchronous jobs at once.
+    pub jobs: usize,
+}
+
+/// The quota of each API key's tenant, and the one share of all anonymous callers.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Quotas {
+    pub keyed: Quota,
+    pub anonymous: Quota,
+}
+
 impl Access {
+    /// Keys and anonymous scopes, without quotas.
     pub fn new(keys: Keys, anonymous: Scopes) -> Access {
         Access {
             keys,
             anonymous,
+            quotas: Quotas::default(),
             preflight_logged: AtomicBool::new(false),
         }
     }
@@ -172,6 +193,14 @@ impl Caller {
         self.key.as_ref().map(|key| key.name.as_str())
     }
 
+    /// The quota this caller draws on, and the name it is counted under.
+    fn quota(&self, quotas: &Quotas) -> (Quota, String) {
+        match &self.key {
+            Some(key) => (quotas.keyed, format!("key:{}", key.name)),
+            None => (quotas.anonymous, "anonymous".to_string()),
+        }
+    }
+
     /// The caller, in a sentence.
     pub fn describe(&self) -> String {
         match &self.key {
@@ -182,9 +211,10 @@ impl Caller {
 }
 
 impl Caller {
-    /// The caller [`admit`] let in (a route it does not guard has a caller with no scope).
-    pub fn of(parts: &Parts) -> Caller {
-        parts.extensions.get::<Caller>().cloned().unwrap_or(Caller {
+    /// The caller [`admit`] let in (a route it does not guard has a caller with no scope),
+    /// from a request's extensions.
+    pub fn of(extensions: &Extensions) -> Caller {
+        extensions.get::<Caller>().cloned().unwrap_or(Caller {
             key: None,
             scopes: Scopes::NONE,
         })
@@ -195,8 +225,72 @@ impl<S: Send + Sync> FromRequestParts<S> for Caller {
     type Rejection = std::convert::Infallible;
 
     async fn from_request_parts(parts: &mut Parts, _: &S) -> Result<Self, Self::Rejection> {
-        Ok(Caller::of(parts))
+        Ok(Caller::of(&parts.extensions))
     }
+}
+
+/// The points a job asks to be computed, as quotas count them: a sweep's or a figure's
+/// points, one for a single contact or a fit.
+fn points(job: &Job) -> u64 {
+    match job.work() {
+        Work::Known(n) => n as u64,
+        Work::Unknown => 1,
+    }
+}
+
+/// Charges the points of `keyed` to `caller`'s quota, unless its answer is cached (it costs
+/// nothing then); past the quota, 429 `quota-exceeded` with `Retry-After` (the end of the
+/// minute).
+pub async fn charge(state: &AppState, caller: &Caller, keyed: &Keyed) -> Result<(), ApiError> {
+    let (quota, tenant) = caller.quota(&state.config().access.quotas);
+    let limit = quota.points_per_minute;
+    if limit == 0 || state.engine().cached(keyed.key()).await.is_some() {
+        return Ok(());
+    }
+    let points = points(keyed.job());
+    let Err(Exceeded { used, retry_after }) = state.engine().charge(&tenant, points, limit).await
+    else {
+        return Ok(());
+    };
+    let whose = caller.describe();
+    let detail = match retry_after {
+        None => format!(
+            "this asks for {points} points, more than the {limit} a minute {whose} may ask \
+             for (--quota-points): split it"
+        ),
+        Some(wait) => format!(
+            "{whose} asked for {used} points this minute, of the {limit} it may; this asks for \
+             {points} more. Retry in {} s, or ask an admin for a larger quota",
+            wait.as_secs()
+        ),
+    };
+    Err(ApiError::quota_exceeded(detail, retry_after))
+}
+
+/// A job `caller` submits (owned by `owner`): within its tenant's unfinished jobs, and its
+/// points charged.
+pub async fn admit_job(
+    state: &AppState,
+    caller: &Caller,
+    owner: Option<&Owner>,
+    keyed: &Keyed,
+) -> Result<(), ApiError> {
+    let (quota, _) = caller.quota(&state.config().access.quotas);
+    if let (Some(owner), true) = (owner.filter(|_| caller.key.is_some()), quota.jobs > 0) {
+        let unfinished = state.engine().unfinished_of(owner).await?;
+        if unfinished >= quota.jobs {
+            return Err(ApiError::quota_exceeded(
+                format!(
+                    "{} has {unfinished} unfinished jobs, as many as it may have at once \
+                     (--quota-jobs {}): wait for one to end, or cancel one",
+                    caller.describe(),
+                    quota.jobs
+                ),
+                Some(std::time::Duration::from_secs(5)),
+            ));
+        }
+    }
+    charge(state, caller, keyed).await
 }
 
 /// The scope a request needs: the API's reads `read` and its other methods `submit`,

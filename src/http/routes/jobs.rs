@@ -21,7 +21,7 @@ use super::{Answering, FormatQuery};
 use crate::engine::store::{JobRecord, JobState, JobStatus, Owner};
 use crate::engine::{Engine, Unknown};
 use crate::http::accept::{Accept, AcceptsJson};
-use crate::http::access::Caller;
+use crate::http::access::{self, Caller};
 use crate::http::body::JsonBody;
 use crate::http::error::{ApiError, Problem};
 use crate::http::responses::{
@@ -126,7 +126,7 @@ impl FromRequestParts<AppState> for FoundJob {
             .map_err(|_| ApiError::not_found("no such job: its id is a UUID"))?;
         let engine = state.engine();
         if let Some(record) = engine.job(id).await {
-            let caller = Caller::of(parts);
+            let caller = Caller::of(&parts.extensions);
             if !caller.may_read(record.owner.as_ref()) {
                 return Err(never_issued(id, state));
             }
@@ -212,6 +212,7 @@ pub async fn submit(
             Ok(Job::from_value(envelope, &limits)?.keyed())
         })
         .await?;
+    access::admit_job(&state, &caller, owner.as_ref(), &keyed).await?;
     let record = state.engine().submit(keyed, owner).await?;
     let location = format!("/v1/jobs/{}", record.id);
     let view = JobView::of(&record);

@@ -22,6 +22,7 @@ use utoipa_axum::router::OpenApiRouter;
 use utoipa_axum::routes;
 
 use super::accept::Accept;
+use super::access::{self, Caller};
 use super::body::{offload, JsonBody};
 use super::error::ApiError;
 use super::AppState;
@@ -291,6 +292,7 @@ impl Answering {
 /// answer is to be sent.
 pub struct SolveRequest {
     state: AppState,
+    caller: Caller,
     answering: Answering,
     body: JsonBody,
 }
@@ -300,9 +302,11 @@ impl FromRequest<AppState> for SolveRequest {
 
     async fn from_request(request: Request, state: &AppState) -> Result<Self, ApiError> {
         let answering = Answering::read(request.headers(), request.uri().query())?;
+        let caller = Caller::of(request.extensions());
         let body = JsonBody::from_request(request, state).await?;
         Ok(SolveRequest {
             state: state.clone(),
+            caller,
             answering,
             body,
         })
@@ -312,7 +316,7 @@ impl FromRequest<AppState> for SolveRequest {
 impl SolveRequest {
     /// Answers the input as a job of the kind named `kind` ([`crate::engine::Engine::answer`]:
     /// an input seen before, the same JSON up to key order and spacing, is answered from the
-    /// cache without being validated again).
+    /// cache without being validated again, and costs the caller's quota nothing).
     pub async fn solve(self, kind: &'static str) -> Result<Response, ApiError> {
         let state = &self.state;
         let (input, text) = self
@@ -323,13 +327,19 @@ impl SolveRequest {
             })
             .await?;
         let limits = state.config().limits;
-        let validate = offload(state, text.len(), move || {
+        let valid = offload(state, text.len(), move || {
             let job = Job::from_input(kind, input, &limits)?;
             match job.asynchronous_only() {
                 Some(refusal) => Err(refusal.into()),
                 None => Ok(job.keyed()),
             }
         });
+        let caller = &self.caller;
+        let validate = async move {
+            let keyed = valid.await?;
+            access::charge(state, caller, &keyed).await?;
+            Ok::<_, ApiError>(keyed)
+        };
         let (solved, cache) = state.engine().answer(text, validate).await?;
         self.answering.respond(&solved, Some(cache))
     }

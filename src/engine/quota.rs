@@ -1,0 +1,142 @@
+//! Quotas of work: the points a tenant may ask to be computed in a minute (a sweep's points,
+//! a figure's, one for a single contact or a fit), counted in fixed windows of a minute, in
+//! this process's memory or, in a fleet, in the job store's Redis, so that every process of
+//! the fleet counts the same. Who a tenant is and what it may use is the caller's to say.
+
+use std::collections::HashMap;
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, SystemTime};
+
+use super::fleet::Fleet;
+
+/// The length of a window.
+const WINDOW: Duration = Duration::from_secs(60);
+
+/// A charge refused: what the tenant used in the window already, and when the window ends
+/// (none if the charge alone is over the limit: waiting cannot help).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Exceeded {
+    pub used: u64,
+    pub retry_after: Option<Duration>,
+}
+
+/// The points charged to each tenant in the current window.
+pub struct PointCounts {
+    /// Tenant → (window, points), when there is no fleet (or its Redis cannot be reached).
+    local: Mutex<HashMap<String, (u64, u64)>>,
+    fleet: Option<Arc<Fleet>>,
+}
+
+impl PointCounts {
+    pub fn new(fleet: Option<Arc<Fleet>>) -> PointCounts {
+        PointCounts {
+            local: Mutex::new(HashMap::new()),
+            fleet,
+        }
+    }
+
+    /// Charges `points` to `tenant` in the window of `now`, unless its points there would
+    /// pass `limit`.
+    pub async fn charge(
+        &self,
+        tenant: &str,
+        points: u64,
+        limit: u64,
+        now: SystemTime,
+    ) -> Result<(), Exceeded> {
+        let since = now
+            .duration_since(std::time::UNIX_EPOCH)
+            .unwrap_or_default()
+            .as_secs();
+        let window = since / WINDOW.as_secs();
+        let retry_after = Duration::from_secs(WINDOW.as_secs() - since % WINDOW.as_secs());
+        if points > limit {
+            return Err(Exceeded {
+                used: 0,
+                retry_after: None,
+            });
+        }
+        let shared = match &self.fleet {
+            Some(fleet) => {
+                self.charge_fleet(fleet, tenant, window, points, limit)
+                    .await
+            }
+            None => None,
+        };
+        match shared.unwrap_or_else(|| self.charge_here(tenant, window, points, limit)) {
+            Ok(()) => Ok(()),
+            Err(used) => Err(Exceeded {
+                used,
+                retry_after: Some(retry_after),
+            }),
+        }
+    }
+
+    /// In this process: the points used before, if the charge is refused.
+    fn charge_here(&self, tenant: &str, window: u64, points: u64, limit: u64) -> Result<(), u64> {
+        let mut counts = self.local.lock().unwrap_or_else(|p| p.into_inner());
+        let count = counts.entry(tenant.to_string()).or_insert((window, 0));
+        if count.0 != window {
+            *count = (window, 0);
+        }
+        if count.1 + points > limit {
+            return Err(count.1);
+        }
+        count.1 += points;
+        Ok(())
+    }
+
+    /// In the fleet's Redis (added, then taken back if over the limit); `None` if it cannot
+    /// be reached (this process then counts alone: a quota is not a reason to refuse work).
+    async fn charge_fleet(
+        &self,
+        fleet: &Fleet,
+        tenant: &str,
+        window: u64,
+        points: u64,
+        limit: u64,
+    ) -> Option<Result<(), u64>> {
+        let key = format!("thirdbody:quota:{tenant}:{window}");
+        let mut pipe = redis::pipe();
+        pipe.atomic()
+            .incr(&key, points)
+            .expire(&key, 2 * WINDOW.as_secs() as i64)
+            .ignore();
+        let (used,): (u64,) = fleet.jobs.pipe(&pipe).await.ok()?;
+        if used <= limit {
+            return Some(Ok(()));
+        }
+        let _ = fleet
+            .jobs
+            .query::<i64>(&redis::Cmd::decr(&key, points))
+            .await;
+        Some(Err(used - points))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[tokio::test]
+    async fn a_tenant_gets_its_points_per_window_and_no_more() {
+        let counts = PointCounts::new(None);
+        let at = |s: u64| std::time::UNIX_EPOCH + Duration::from_secs(s);
+        // 60 000 s is the start of a window; 10 points a window.
+        assert_eq!(counts.charge("a", 6, 10, at(60_000)).await, Ok(()));
+        assert_eq!(counts.charge("a", 4, 10, at(60_010)).await, Ok(()));
+        assert_eq!(
+            counts.charge("a", 1, 10, at(60_015)).await,
+            Err(Exceeded {
+                used: 10,
+                retry_after: Some(Duration::from_secs(45))
+            })
+        );
+        // Another tenant counts apart; the next window starts afresh.
+        assert_eq!(counts.charge("b", 10, 10, at(60_015)).await, Ok(()));
+        assert_eq!(counts.charge("a", 10, 10, at(60_060)).await, Ok(()));
+        // More than the limit at once: waiting cannot help.
+        let alone = counts.charge("c", 11, 10, at(60_000)).await;
+        assert_eq!(alone.unwrap_err().retry_after, None);
+    }
+}
