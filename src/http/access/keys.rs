@@ -48,9 +48,17 @@ impl Scopes {
         if list.trim() == "none" {
             return Ok(Scopes::NONE);
         }
-        list.split(',')
-            .map(str::trim)
-            .filter(|name| !name.is_empty())
+        Scopes::of_names(
+            list.split(',')
+                .map(str::trim)
+                .filter(|name| !name.is_empty()),
+        )
+    }
+
+    /// The scopes named in `names`; an error names the first unknown one.
+    fn of_names<'a>(names: impl IntoIterator<Item = &'a str>) -> Result<Scopes, String> {
+        names
+            .into_iter()
             .try_fold(Scopes::NONE, |all, name| Ok(all.with(Scopes::named(name)?)))
     }
 
@@ -140,11 +148,7 @@ impl Ring {
             let hash = hex32(&entry.sha256).ok_or_else(|| {
                 at("sha256: allowed 64 hexadecimal digits, the SHA-256 of the key".into())
             })?;
-            let scopes = entry
-                .scopes
-                .iter()
-                .try_fold(Scopes::NONE, |all, name| Ok(all.with(Scopes::named(name)?)))
-                .map_err(at)?;
+            let scopes = Scopes::of_names(entry.scopes.iter().map(String::as_str)).map_err(at)?;
             if scopes == Scopes::NONE {
                 return Err(at(
                     "scopes: allowed a list of submit, read, metrics, admin".into()
@@ -283,14 +287,13 @@ pub enum Lookup {
 impl Keys {
     /// The keys of `source` (none: no key is accepted); an error if they cannot be read.
     pub fn load(source: Option<Source>) -> Result<Keys, String> {
-        let text = match &source {
-            Some(source) => source.read()?,
-            None => String::new(),
-        };
-        let ring = if source.is_some() {
-            Ring::parse(&text).map_err(|e| format!("--api-keys: {e}"))?
-        } else {
-            Ring::default()
+        let (text, ring) = match &source {
+            Some(source) => {
+                let text = source.read()?;
+                let ring = Ring::parse(&text).map_err(|e| format!("--api-keys: {e}"))?;
+                (text, ring)
+            }
+            None => (String::new(), Ring::default()),
         };
         Ok(Keys {
             source,

@@ -267,17 +267,13 @@ pub async fn charge(state: &AppState, caller: &Caller, keyed: &Keyed) -> Result<
     Err(ApiError::quota_exceeded(detail, retry_after))
 }
 
-/// A job `caller` submits (owned by `owner`): within its tenant's unfinished jobs, and its
-/// points charged.
-pub async fn admit_job(
-    state: &AppState,
-    caller: &Caller,
-    owner: Option<&Owner>,
-    keyed: &Keyed,
-) -> Result<(), ApiError> {
+/// A job `caller` submits: within its tenant's unfinished jobs (a key's tenant: anonymous
+/// callers have no such quota), and its points charged.
+pub async fn admit_job(state: &AppState, caller: &Caller, keyed: &Keyed) -> Result<(), ApiError> {
     let (quota, _) = caller.quota(&state.config().access.quotas);
-    if let (Some(owner), true) = (owner.filter(|_| caller.key.is_some()), quota.jobs > 0) {
-        let unfinished = state.engine().unfinished_of(owner).await?;
+    let tenant = caller.tenant().map(Owner::of_tenant);
+    if let Some(owner) = tenant.filter(|_| quota.jobs > 0) {
+        let unfinished = state.engine().unfinished_of(&owner).await?;
         if unfinished >= quota.jobs {
             return Err(ApiError::quota_exceeded(
                 format!(

@@ -212,7 +212,7 @@ pub async fn submit(
             Ok(Job::from_value(envelope, &limits)?.keyed())
         })
         .await?;
-    access::admit_job(&state, &caller, owner.as_ref(), &keyed).await?;
+    access::admit_job(&state, &caller, &keyed).await?;
     let record = state.engine().submit(keyed, owner).await?;
     let location = format!("/v1/jobs/{}", record.id);
     let view = JobView::of(&record);
