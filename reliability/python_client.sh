@@ -6,10 +6,10 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 command -v openapi-python-client >/dev/null \
   || python3 -m pip install --quiet 'openapi-python-client>=0.26,<1'
-cargo build --release --locked --quiet --bin thirdbody
+. reliability/binary.sh
 work=$(mktemp -d)
 port=$(python3 -c 'import socket; s=socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])')
-target/release/thirdbody serve --bind "127.0.0.1:$port" --log-format text --database "$work/thirdbody.db" >"$work/log" 2>&1 &
+"$bin" serve --bind "127.0.0.1:$port" --log-format text --database "$work/thirdbody.db" >"$work/log" 2>&1 &
 server=$!
 trap 'kill $server 2>/dev/null; wait $server 2>/dev/null || true; rm -rf "$work"' EXIT
 (cd "$work" && openapi-python-client generate --path "$OLDPWD/openapi/openapi.json" \

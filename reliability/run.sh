@@ -6,9 +6,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 bounded=false
 [ "${1:-}" = "--bounded" ] && bounded=true
-if [ -z "${THIRDBODY_BIN:-}" ]; then
-  cargo build --release --locked --quiet --bin thirdbody
-fi
+. reliability/binary.sh
 if $bounded; then
   durations=(10 10 15 8)
 else

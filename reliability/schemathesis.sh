@@ -1,15 +1,15 @@
 #!/usr/bin/env bash
-# Schemathesis (PyPI) against the release binary on a loopback port: every operation of
-# /openapi.json with every check; fails on a 5xx, a response the spec does not describe, or
-# any other check. Usage: reliability/schemathesis.sh [max examples per operation]
+# Schemathesis (PyPI) against the release binary (or THIRDBODY_BIN) on a loopback port: every
+# operation of /openapi.json with every check; fails on a 5xx, a response the spec does not
+# describe, or any other check. Usage: reliability/schemathesis.sh [max examples per operation]
 set -euo pipefail
 cd "$(dirname "$0")/.."
 examples="${1:-50}"
 command -v st >/dev/null || python3 -m pip install --quiet 'schemathesis>=4.3,<5'
-cargo build --release --locked --quiet --bin thirdbody
+. reliability/binary.sh
 port=$(python3 -c 'import socket; s=socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])')
 log=$(mktemp)
-target/release/thirdbody serve --bind "127.0.0.1:$port" --log-format text --database :memory: >"$log" 2>&1 &
+"$bin" serve --bind "127.0.0.1:$port" --log-format text --database :memory: >"$log" 2>&1 &
 server=$!
 trap 'kill $server 2>/dev/null; wait $server 2>/dev/null || true; rm -f "$log"' EXIT
 for _ in $(seq 50); do

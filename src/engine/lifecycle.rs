@@ -516,9 +516,11 @@ impl Lifecycle {
             Ok(permits) => permits,
             Err(state) => return state,
         };
+        // Counted as running before anyone can read it so: a client that saw the job
+        // running and then reads the gauge finds it counted.
+        let _running = self.solver.running();
         self.jobs.update(id, JobState::Running, 0).await;
         live.status.send_replace(JobStatus::Running);
-        let running = self.solver.running();
         let (started, work) = (Instant::now(), keyed.job().work());
         let result = self
             .solver
@@ -533,7 +535,8 @@ impl Lifecycle {
         };
         let solved = done.saturating_sub(live.control.recalled());
         ticket.ran(solved, started.elapsed());
-        drop(running);
+        // The job is still running (its status says so) while its answer is kept: the
+        // guard goes with this function.
         match result {
             Ok(solved) => {
                 self.solver.keep(solved.clone()).await;
