@@ -132,42 +132,62 @@ fn fit(c: &mut Criterion) {
 /// One rolling request through the whole router (as `thirdbody serve` builds it, no socket):
 /// the same input every time (a cache hit after the first), and a new load every time
 /// (solved). Their difference is what a solve adds to a request in the process; the
-/// throughput ratio of the two over HTTP is `loadtest/ratio.sh`'s.
+/// throughput ratio of the two over HTTP is `loadtest/ratio.sh`'s. The cache hit again on
+/// a service that requires an API key: what the access rules add to a request.
 fn http(c: &mut Criterion) {
     use axum::body::Body;
     use axum::http::Request;
+    use axum::Router;
     use clap::Parser;
+    use thirdbody::http::access::keys::hash_hex;
     use thirdbody::http::{app, AppState, ServeArgs};
     use tower::ServiceExt;
 
-    let config = ServeArgs::try_parse_from(["serve"])
-        .unwrap()
-        .validate()
-        .unwrap();
+    const KEY: &str = "tb_key-of-the-benchmark-0000000000000001";
     let runtime = tokio::runtime::Builder::new_current_thread()
         .enable_all()
         .build()
         .unwrap();
-    let router = runtime.block_on(async { app(AppState::new(config).unwrap()) });
-    let post = |body: String| {
-        let request = Request::post("/v1/rolling")
-            .header("content-type", "application/json")
-            .body(Body::from(body))
-            .unwrap();
+    let router = |flags: &[&str]| -> Router {
+        let config =
+            ServeArgs::try_parse_from([&["serve", "--database", ":memory:"][..], flags].concat())
+                .unwrap()
+                .validate()
+                .unwrap();
+        runtime.block_on(async { app(AppState::new(config).unwrap()) })
+    };
+    let (open, keys) = (
+        router(&[]),
+        serde_json::json!({"keys": [{"name": "lab", "sha256": hash_hex(KEY), "scopes": ["submit"]}]})
+            .to_string(),
+    );
+    let keyed = router(&["--api-keys", &keys, "--anonymous", "none"]);
+    let post = |router: &Router, key: Option<&str>, body: String| {
+        let mut request = Request::post("/v1/rolling").header("content-type", "application/json");
+        if let Some(key) = key {
+            request = request.header("x-api-key", key);
+        }
+        let request = request.body(Body::from(body)).unwrap();
         let response = runtime.block_on(router.clone().oneshot(request)).unwrap();
         assert!(response.status().is_success());
         response
     };
     // The layer's similarity table, which a first answer has built in the background.
-    post("{}".to_string());
+    post(&open, None, "{}".to_string());
+    post(&keyed, Some(KEY), "{}".to_string());
     std::thread::sleep(Duration::from_millis(200));
     let mut group = c.benchmark_group("http");
-    group.bench_function("rolling_cached", |b| b.iter(|| post("{}".to_string())));
+    group.bench_function("rolling_cached", |b| {
+        b.iter(|| post(&open, None, "{}".to_string()))
+    });
+    group.bench_function("rolling_cached_keyed", |b| {
+        b.iter(|| post(&keyed, Some(KEY), "{}".to_string()))
+    });
     let mut load = 1e-9;
     group.bench_function("rolling_uncached", |b| {
         b.iter(|| {
             load *= 1.0 + 1e-9;
-            post(format!("{{\"load\": {load:e}}}"))
+            post(&open, None, format!("{{\"load\": {load:e}}}"))
         })
     });
     group.finish();

@@ -3,6 +3,7 @@ send requests with the standard library only, sample the server's memory, and su
 latencies. Every script takes the binary in THIRDBODY_BIN (default: the release build), so
 the same measurement runs against any build (RELIABILITY.md compares before and after)."""
 
+import hashlib
 import http.client
 import json
 import os
@@ -14,6 +15,21 @@ import time
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 BIN = os.environ.get("THIRDBODY_BIN", os.path.join(ROOT, "target", "release", "thirdbody"))
+# With THIRDBODY_RELIABILITY_KEYS=1 (`run.sh --keys`), every server requires an API key
+# (`--anonymous none`) and every client presents it, the hostile ones too: the figures then
+# include the access rules on every request.
+KEYED = os.environ.get("THIRDBODY_RELIABILITY_KEYS") == "1"
+KEY = "tb_reliability-key-of-the-measurements-0001"
+KEYS = json.dumps({"keys": [{
+    "name": "reliability",
+    "sha256": hashlib.sha256(KEY.encode()).hexdigest(),
+    "scopes": ["submit", "read", "metrics"],
+}]})
+
+
+def key_headers():
+    """The headers that present the key, when the servers require one."""
+    return {"x-api-key": KEY} if KEYED else {}
 
 
 def free_port():
@@ -39,6 +55,8 @@ class Server:
         self.data = tempfile.mkdtemp(prefix="thirdbody-reliability-")
         if "--database" not in flags and supports("--database"):
             flags = (*flags, "--database", os.path.join(self.data, "thirdbody.db"))
+        if KEYED:
+            flags = (*flags, "--api-keys", KEYS, "--anonymous", "none")
         self.proc = subprocess.Popen(
             [BIN, "serve", "--bind", f"127.0.0.1:{self.port}", *flags],
             stdout=self.log,
@@ -79,6 +97,7 @@ def request(port, method, path, body=None, headers=None, timeout=30):
     conn = http.client.HTTPConnection("127.0.0.1", port, timeout=timeout)
     data = body if isinstance(body, (bytes, type(None))) else json.dumps(body).encode()
     hdrs = {"content-type": "application/json"} if data is not None else {}
+    hdrs.update(key_headers())
     hdrs.update(headers or {})
     start = time.perf_counter()
     try:

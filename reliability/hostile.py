@@ -22,9 +22,11 @@ import sys
 import threading
 import time
 
-from common import Server, latency_line, probe_health, request
+from common import Server, key_headers, latency_line, probe_health, request
 
 MODES = ["slow-readers", "keep-alive", "slow-bodies", "sse"]
+# The header lines that present the API key, when the servers require one (common.py).
+KEY_LINES = "".join(f"{name}: {value}\r\n" for name, value in key_headers().items())
 HOSTILE = 511
 TCP_ESTABLISHED = 1
 SWEEP = json.dumps({"vary": {"load": [f"{1 + i / 5000} nN" for i in range(5000)]}}).encode()
@@ -49,7 +51,7 @@ def post(path, body, length=None):
     length = len(body) if length is None else length
     return (
         f"POST {path} HTTP/1.1\r\nHost: x\r\nContent-Type: application/json\r\n"
-        f"Content-Length: {length}\r\n\r\n"
+        f"{KEY_LINES}Content-Length: {length}\r\n\r\n"
     ).encode() + body
 
 
@@ -72,7 +74,7 @@ class Holder:
             self.send(post("/v1/rolling", b"", length=1000))
         elif mode == "sse":
             self.send(
-                f"GET /v1/jobs/{job()}/events HTTP/1.1\r\nHost: x\r\n"
+                f"GET /v1/jobs/{job()}/events HTTP/1.1\r\nHost: x\r\n{KEY_LINES}"
                 "Accept: text/event-stream\r\n\r\n".encode()
             )
 

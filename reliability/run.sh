@@ -2,10 +2,18 @@
 # The reliability measurements of RELIABILITY.md, each printing its figure, against the
 # release build (or THIRDBODY_BIN). `--bounded` runs shorter versions (as CI does) and fails
 # when a promise is broken: a lost job, an unanswered /healthz, a server that died.
+# `--keys` runs them with API keys required (every client, hostile ones too, presents one).
+# Usage: reliability/run.sh [--bounded] [--keys]
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bounded=false
-[ "${1:-}" = "--bounded" ] && bounded=true
+for flag in "$@"; do
+  case "$flag" in
+    --bounded) bounded=true ;;
+    --keys) export THIRDBODY_RELIABILITY_KEYS=1 ;;
+    *) echo "usage: reliability/run.sh [--bounded] [--keys]" >&2; exit 2 ;;
+  esac
+done
 . reliability/binary.sh
 if $bounded; then
   durations=(10 10 15 8)

@@ -58,9 +58,9 @@ enum Command {
     },
     /// Serve the HTTP API (see /docs once it runs); every flag has a THIRDBODY_* variable.
     Serve(Box<ServeArgs>),
-    /// Take work from the fleet's Redis stream, with no HTTP (needs --redis-url; the other
+    /// Take work from the fleet's Redis stream, with no API (needs --redis-url; the other
     /// flags of `serve` that concern solving apply, those of HTTP are ignored).
-    Worker(Box<ServeArgs>),
+    Worker(Box<WorkerArgs>),
     /// Print the OpenAPI description of the HTTP API.
     Openapi,
     /// Make an API key: prints the key on the first line (give it to its holder: it is kept
@@ -84,6 +84,17 @@ enum Command {
         #[arg(long, env = "THIRDBODY_BIND", default_value = "127.0.0.1:8080")]
         bind: std::net::SocketAddr,
     },
+}
+
+/// `thirdbody worker`: the flags of `serve`, and where to serve its operations' routes.
+#[derive(Args)]
+struct WorkerArgs {
+    /// Serve /metrics, /healthz and /readyz on this address (e.g. 0.0.0.0:9100), for
+    /// Prometheus and probes, under the access rules of `serve`; nothing if absent.
+    #[arg(long, env = "THIRDBODY_METRICS_BIND")]
+    metrics_bind: Option<std::net::SocketAddr>,
+    #[command(flatten)]
+    serve: ServeArgs,
 }
 
 /// How an answer is printed.
@@ -293,38 +304,49 @@ fn start(command: &str, args: ServeArgs) -> Result<(Config, tokio::runtime::Runt
 
 /// `thirdbody worker`: works the fleet's stream until SIGTERM or Ctrl-C, then finishes the
 /// part it holds (within the shutdown timeout; what it cannot finish, another process takes
-/// over).
-fn worker(args: ServeArgs) -> ExitCode {
-    if args.fleet.redis_url.is_none() {
+/// over). With `--metrics-bind`, serves its operations' routes meanwhile.
+fn worker(args: WorkerArgs) -> ExitCode {
+    if args.serve.fleet.redis_url.is_none() {
         eprintln!(
             "thirdbody worker: invalid setting: --redis-url (or THIRDBODY_REDIS_URL) is required"
         );
         return ExitCode::from(INVALID_JOB);
     }
-    let (config, runtime) = match start("worker", args) {
+    let (config, runtime) = match start("worker", args.serve) {
         Ok(started) => started,
         Err(code) => return code,
     };
-    runtime.block_on(async {
+    let worked = runtime.block_on(async {
         let timeout = config.shutdown_timeout;
         let pool_size = config.engine.pool_size;
-        let state = match AppState::new(config) {
-            Ok(state) => state,
-            Err(e) => {
-                eprintln!("thirdbody worker: {e}");
-                return ExitCode::FAILURE;
-            }
+        let state = AppState::new(config)?;
+        let operations = match args.metrics_bind {
+            Some(bind) => Some(
+                tokio::net::TcpListener::bind(bind)
+                    .await
+                    .map_err(|e| format!("cannot listen on {bind} (--metrics-bind): {e}"))?,
+            ),
+            None => None,
         };
-        let engine = state.engine();
+        let engine = state.engine().clone();
         engine.start_workers(pool_size, false);
         tracing::info!(workers = pool_size, "taking work from Redis");
+        let _served = operations.map(|listener| http::serve_operations(listener, state.clone()));
+        let _chores = http::chores(&state);
         Signals::new().next().await;
         engine.begin_drain();
         engine
             .finish_jobs(tokio::time::Instant::now() + timeout)
             .await;
-        ExitCode::SUCCESS
-    })
+        Ok::<_, String>(())
+    });
+    match worked {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("thirdbody worker: {e}");
+            ExitCode::FAILURE
+        }
+    }
 }
 
 /// `thirdbody serve`: validates the settings, then serves until SIGTERM or Ctrl-C, and drains

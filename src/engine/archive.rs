@@ -43,6 +43,7 @@ CREATE TABLE IF NOT EXISTS jobs (
     finished INTEGER,
     error TEXT,
     result TEXT
+    -- and result_bytes: see ADDED_COLUMN
 );
 CREATE INDEX IF NOT EXISTS jobs_by_owner ON jobs (owner, submitted DESC);
 CREATE INDEX IF NOT EXISTS jobs_by_input ON jobs (input_hash, finished DESC);
@@ -54,9 +55,13 @@ CREATE TABLE IF NOT EXISTS results (
 );
 ";
 
+/// The column added to the jobs since their first version (a database made by that version
+/// gets it when opened): the bytes a job's answer may take, which a tenant's quota counts.
+const ADDED_COLUMN: &str = "result_bytes INTEGER NOT NULL DEFAULT 0";
+
 /// The columns a record is read from, in [`Archive::record`]'s order.
-const COLUMNS: &str =
-    "id, owner, kind, status, done, total, input_hash, submitted, finished, error, result";
+const COLUMNS: &str = "id, owner, kind, status, done, total, input_hash, submitted, finished, \
+                       error, result, result_bytes";
 
 /// The database of saved analyses.
 pub struct Archive {
@@ -97,6 +102,17 @@ impl Archive {
         )
         .map_err(failed)?;
         db.execute_batch(SCHEMA).map_err(failed)?;
+        let added: i64 = db
+            .query_row(
+                "SELECT COUNT(*) FROM pragma_table_info('jobs') WHERE name = 'result_bytes'",
+                [],
+                |row| row.get(0),
+            )
+            .map_err(failed)?;
+        if added == 0 {
+            db.execute_batch(&format!("ALTER TABLE jobs ADD COLUMN {ADDED_COLUMN}"))
+                .map_err(failed)?;
+        }
         let now = millis(SystemTime::now());
         let interrupted = db
             .execute(
@@ -143,7 +159,7 @@ impl Archive {
         };
         self.db().execute(
             "INSERT OR IGNORE INTO jobs (id, owner, kind, status, done, total, input_hash, \
-             submitted) VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8)",
+             submitted, result_bytes) VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9)",
             params![
                 record.id.to_string(),
                 record.owner.as_ref().map(Owner::as_str),
@@ -153,6 +169,7 @@ impl Archive {
                 total,
                 record.input_hash,
                 millis(record.submitted_at),
+                i64::try_from(record.result_bytes).unwrap_or(i64::MAX),
             ],
         )?;
         Ok(())
@@ -360,6 +377,7 @@ impl Archive {
             owner: row.get::<_, Option<String>>(1)?.map(Owner::stored),
             submitted_at: time(row.get(7)?),
             finished_at: row.get::<_, Option<i64>>(8)?.map(time),
+            result_bytes: u64::try_from(row.get::<_, i64>(11)?).unwrap_or(0),
         }))
     }
 }
@@ -391,5 +409,60 @@ impl ResultPlace for Saved {
         body.map(Bytes::from).ok_or_else(|| {
             std::io::Error::other("the job's result was deleted, or expired, meanwhile")
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::job::RollingJob;
+
+    /// A database made before jobs counted their answers' bytes gains the column when
+    /// opened: its jobs hold nothing, new ones what they said.
+    #[test]
+    fn a_database_of_an_earlier_version_gains_the_bytes_column() {
+        let path = std::env::temp_dir().join(format!("thirdbody-{}.db", Uuid::new_v4()));
+        let path = path.to_str().unwrap().to_string();
+        let owner = Owner::of_tenant("lab");
+        let old = Uuid::new_v4();
+        {
+            let db = Connection::open(&path).unwrap();
+            db.execute_batch(SCHEMA).unwrap();
+            db.execute(
+                "INSERT INTO jobs (id, owner, kind, status, done, input_hash, submitted) \
+                 VALUES (?1, ?2, 'rolling', 'queued', 0, 'k', 1)",
+                params![old.to_string(), owner.as_str()],
+            )
+            .unwrap();
+        }
+        let archive = Archive::open(&path, Duration::from_secs(60)).unwrap();
+        let new = JobRecord::queued(
+            Uuid::new_v4(),
+            KindName::of::<RollingJob>(),
+            Work::Known(1),
+            "k",
+        )
+        .owned_by(Some(owner.clone()))
+        .holding(4096);
+        archive.insert(&new).unwrap();
+        let listing = Listing {
+            owner,
+            kind: None,
+            status: None,
+            offset: 0,
+            limit: 10,
+        };
+        let held: Vec<(Uuid, u64)> = archive
+            .list(&listing)
+            .unwrap()
+            .jobs
+            .iter()
+            .map(|job| (job.id, job.result_bytes))
+            .collect();
+        assert_eq!(held, [(new.id, 4096), (old, 0)]);
+        drop(archive);
+        for suffix in ["", "-wal", "-shm"] {
+            let _ = std::fs::remove_file(format!("{path}{suffix}"));
+        }
     }
 }

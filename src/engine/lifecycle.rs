@@ -177,16 +177,20 @@ impl Lifecycle {
     ) -> Result<JobRecord, EngineError> {
         self.store_reachable()?;
         let (kind, work) = (keyed.job().kind(), keyed.job().work());
-        let queued = |id| JobRecord::queued(id, kind, work, keyed.key()).owned_by(owner.clone());
+        let queued = |id| {
+            JobRecord::queued(id, kind, work, keyed.key())
+                .owned_by(owner.clone())
+                .holding(keyed.job().result_bytes())
+        };
         // A job whose answer is cached is answered at once: it takes no place in the queue.
         if let Some(solved) = self.solver.cached(keyed.key()).await {
-            let mut record = queued(self.ids.next());
+            let mut record = queued(self.ids.next()).holding(solved.weight());
             let done = match work {
                 Work::Known(total) => total,
                 Work::Unknown => 0,
             };
             self.jobs
-                .insert(record.clone(), solved.weight())
+                .insert(record.clone())
                 .await
                 .map_err(EngineError::from)?;
             let state = JobState::Succeeded(JobResult::Ready(solved));
@@ -223,8 +227,7 @@ impl Lifecycle {
         };
         let record = queued(self.ids.next());
         let id = record.id;
-        let result_bytes = keyed.job().result_bytes();
-        if let Err(refusal) = self.jobs.insert(record.clone(), result_bytes).await {
+        if let Err(refusal) = self.jobs.insert(record.clone()).await {
             self.queued.fetch_sub(1, Ordering::SeqCst);
             return Err(refusal.into());
         }
@@ -249,10 +252,12 @@ impl Lifecycle {
                     _ => live.control.done(),
                 };
                 state.log_end(id);
-                lifecycle.jobs.update(id, state, done).await;
+                // Owed to its client before anyone can read it finished: a client that read
+                // it between the two would leave it owed forever, and a drain waiting for it.
                 lifecycle
                     .uncollected()
                     .insert(id, lifecycle.config.max_jobs);
+                lifecycle.jobs.update(id, state, done).await;
                 lifecycle.live().remove(&id);
                 live.status.send_replace(status);
             }

@@ -47,8 +47,8 @@ impl LocalJobStore {
 
 #[async_trait]
 impl JobStore for LocalJobStore {
-    async fn insert(&self, record: JobRecord, result_bytes: u64) -> Result<(), Refusal> {
-        self.memory.insert(record.clone(), result_bytes).await?;
+    async fn insert(&self, record: JobRecord) -> Result<(), Refusal> {
+        self.memory.insert(record.clone()).await?;
         self.db("save a job", move |db| db.insert(&record)).await;
         Ok(())
     }

@@ -31,7 +31,7 @@ pub mod store;
 
 pub use backlog::Backlogged;
 pub use ids::Unknown;
-pub use service::{Engine, EngineConfig, EngineError, Storage};
+pub use service::{Engine, EngineConfig, EngineError, Held, Storage};
 pub use solver::{CacheStatus, Solver};
 
 use crate::job::{Control, Job, JobError};

@@ -132,9 +132,24 @@ impl From<JobError> for EngineError {
     }
 }
 
+/// The most jobs of one owner [`Engine::held_by`] reads (as many as a fleet lists).
+const HELD_LISTED: usize = 10_000;
+
+/// The bytes the answers of one owner's jobs may take, kept for their retention.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Held {
+    pub bytes: u64,
+    /// The jobs holding them.
+    pub jobs: usize,
+    /// When some of them are freed at the earliest (`None`: nothing is held).
+    pub freed_in: Option<Duration>,
+}
+
 /// The compute service: the solve path and the asynchronous jobs.
 pub struct Engine {
     solve_deadline: Duration,
+    /// How long a finished job and its answer are kept (what holds a tenant's bytes).
+    job_retention: Duration,
     solver: Arc<Solver>,
     jobs: Arc<Lifecycle>,
     /// The points each tenant asked for in the current minute (its quota's count).
@@ -166,6 +181,7 @@ impl Engine {
         );
         Arc::new(Engine {
             solve_deadline: config.solve_deadline,
+            job_retention: config.job_retention,
             solver,
             jobs: Arc::new(jobs),
             points,
@@ -178,6 +194,37 @@ impl Engine {
         self.points
             .charge(tenant, points, limit, std::time::SystemTime::now())
             .await
+    }
+
+    /// What the jobs of `owner` within their retention hold (the newest [`HELD_LISTED`]),
+    /// as the job store lists them.
+    pub async fn held_by(&self, owner: &Owner) -> Result<Held, EngineError> {
+        let listing = Listing {
+            owner: owner.clone(),
+            kind: None,
+            status: None,
+            offset: 0,
+            limit: HELD_LISTED,
+        };
+        let jobs = self.jobs.list(&listing).await?.jobs;
+        let now = std::time::SystemTime::now();
+        // A finished job's bytes are freed when its retention ends; an unfinished one's
+        // retention has not begun.
+        let freed_in = jobs
+            .iter()
+            .filter(|job| job.result_bytes > 0)
+            .map(|job| match job.finished_at {
+                Some(at) => (at + self.job_retention)
+                    .duration_since(now)
+                    .unwrap_or_default(),
+                None => self.job_retention,
+            })
+            .min();
+        Ok(Held {
+            bytes: jobs.iter().map(|job| job.result_bytes).sum(),
+            jobs: jobs.len(),
+            freed_in,
+        })
     }
 
     /// The jobs of `owner` not finished yet (queued or running), as the job store lists them.

@@ -189,6 +189,9 @@ pub struct JobRecord {
     pub submitted_at: SystemTime,
     /// When it finished, once it has.
     pub finished_at: Option<SystemTime>,
+    /// Bytes its answer may take, at most: the room made for it when it was accepted, held
+    /// for its retention (what a tenant's `--quota-result-bytes` counts).
+    pub result_bytes: u64,
 }
 
 impl JobRecord {
@@ -204,12 +207,21 @@ impl JobRecord {
             owner: None,
             submitted_at: SystemTime::now(),
             finished_at: None,
+            result_bytes: 0,
         }
     }
 
     /// The same record, owned by `owner`.
     pub fn owned_by(self, owner: Option<Owner>) -> JobRecord {
         JobRecord { owner, ..self }
+    }
+
+    /// The same record, its answer taking at most `result_bytes`.
+    pub fn holding(self, result_bytes: u64) -> JobRecord {
+        JobRecord {
+            result_bytes,
+            ..self
+        }
     }
 
     fn expired(&self, retention: Duration, now: SystemTime) -> bool {
@@ -339,10 +351,10 @@ pub enum Refusal {
 /// Where the records of asynchronous jobs are kept.
 #[async_trait]
 pub trait JobStore: Send + Sync {
-    /// Records a job just accepted, whose result will take at most `result_bytes`: room is
-    /// made for it now, so that the result is kept for its retention once the work is done,
-    /// or the job is refused before any work.
-    async fn insert(&self, record: JobRecord, result_bytes: u64) -> Result<(), Refusal>;
+    /// Records a job just accepted, whose result will take at most its `result_bytes`: room
+    /// is made for it now, so that the result is kept for its retention once the work is
+    /// done, or the job is refused before any work.
+    async fn insert(&self, record: JobRecord) -> Result<(), Refusal>;
     /// The job `id`, unless unknown or expired.
     async fn get(&self, id: Uuid) -> Option<JobRecord>;
     /// Moves the job `id` to `state` with `done` units of work done; a finished state
@@ -553,7 +565,8 @@ fn megabytes(n: u64) -> String {
 /// The in-memory half of [`super::local::LocalJobStore`]: the [`JobStore`] calls that it
 /// answers alone.
 impl MemoryJobStore {
-    pub async fn insert(&self, record: JobRecord, result_bytes: u64) -> Result<(), Refusal> {
+    pub async fn insert(&self, record: JobRecord) -> Result<(), Refusal> {
+        let result_bytes = record.result_bytes;
         let now = SystemTime::now();
         let mut records = self.records();
         records.purge(self.retention, now);
@@ -713,10 +726,10 @@ mod tests {
         for _ in 0..3 {
             let r = record();
             ids.push(r.id);
-            store.insert(r, 3_000).await.unwrap();
+            store.insert(r.holding(3_000)).await.unwrap();
         }
         // Room for three results of 3 kB is made: a fourth does not fit, now.
-        match store.insert(record(), 3_000).await {
+        match store.insert(record().holding(3_000)).await {
             Err(Refusal::Full { what, retry_after }) => {
                 assert!(what.contains("0.0 MB of 0.0 MB on disk"), "{what}");
                 assert!(retry_after <= Duration::from_secs(60));
@@ -725,7 +738,7 @@ mod tests {
         }
         // Too large for an empty store: said so, with both numbers.
         assert_eq!(
-            store.insert(record(), 20_000).await,
+            store.insert(record().holding(20_000)).await,
             Err(Refusal::TooLarge {
                 needed: 20_000,
                 limit: 10_000
@@ -740,10 +753,10 @@ mod tests {
             assert!(matches!(state, JobState::Succeeded(JobResult::Ready(_))));
         }
         // A result that weighs less than its room gives the rest back: one more 1 kB job fits.
-        store.insert(record(), 1_000).await.unwrap();
+        store.insert(record().holding(1_000)).await.unwrap();
         // Forgetting a job makes room.
         store.remove(ids[0]).await;
-        store.insert(record(), 3_000).await.unwrap();
+        store.insert(record().holding(3_000)).await.unwrap();
     }
 
     #[tokio::test]
@@ -753,8 +766,8 @@ mod tests {
         let store = MemoryJobStore::new(Duration::from_secs(60), 100, 4_000, Some(spill));
         let (small, large) = (record(), record());
         let (small_id, large_id) = (small.id, large.id);
-        store.insert(small, 3_000).await.unwrap();
-        store.insert(large, 100_000).await.unwrap();
+        store.insert(small.holding(3_000)).await.unwrap();
+        store.insert(large.holding(100_000)).await.unwrap();
         succeed(&store, small_id, 2_000).await;
         succeed(&store, large_id, 90_000).await;
         assert!(matches!(
@@ -782,19 +795,19 @@ mod tests {
         for _ in 0..3 {
             let r = record();
             ids.push(r.id);
-            store.insert(r, 100).await.unwrap();
+            store.insert(r.holding(100)).await.unwrap();
             let cancelled = JobState::Cancelled { partial: None };
             store.update(ids[ids.len() - 1], cancelled, 0).await;
         }
         assert!(matches!(
-            store.insert(record(), 100).await,
+            store.insert(record().holding(100)).await,
             Err(Refusal::Full { .. })
         ));
         for id in &ids {
             assert!(store.get(*id).await.is_some());
         }
         store.remove(ids[0]).await;
-        store.insert(record(), 100).await.unwrap();
+        store.insert(record().holding(100)).await.unwrap();
     }
 
     #[tokio::test]
@@ -802,11 +815,11 @@ mod tests {
         let store = MemoryJobStore::new(Duration::from_millis(20), 1, 1 << 20, None);
         let first = record();
         let id = first.id;
-        store.insert(first, 100).await.unwrap();
+        store.insert(first.holding(100)).await.unwrap();
         succeed(&store, id, 50).await;
-        assert!(store.insert(record(), 100).await.is_err());
+        assert!(store.insert(record().holding(100)).await.is_err());
         tokio::time::sleep(Duration::from_millis(30)).await;
-        store.insert(record(), 100).await.unwrap();
+        store.insert(record().holding(100)).await.unwrap();
         assert!(store.get(id).await.is_none());
     }
 }

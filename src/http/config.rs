@@ -164,6 +164,12 @@ pub struct ServeArgs {
     #[arg(long, env = "THIRDBODY_QUOTA_JOBS", default_value_t = 0)]
     pub quota_jobs: usize,
 
+    /// Bytes each API key's tenant may hold in the answers of its jobs, kept for their
+    /// retention: a job is refused (429) if its answer's room would pass it, until a job is
+    /// deleted or expires (0: no limit). A job counts the most its answer may take.
+    #[arg(long, env = "THIRDBODY_QUOTA_RESULT_BYTES", default_value_t = 0)]
+    pub quota_result_bytes: u64,
+
     /// Points per minute for all callers without an API key together: their share, so that
     /// anonymous traffic cannot starve the tenants (0: no limit).
     #[arg(long, env = "THIRDBODY_ANONYMOUS_QUOTA_POINTS", default_value_t = 0)]
@@ -431,10 +437,11 @@ impl ServeArgs {
             keyed: Quota {
                 points_per_minute: self.quota_points,
                 jobs: self.quota_jobs,
+                result_bytes: self.quota_result_bytes,
             },
             anonymous: Quota {
                 points_per_minute: self.anonymous_quota_points,
-                jobs: 0,
+                ..Quota::default()
             },
         };
         Ok(Config {

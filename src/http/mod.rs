@@ -267,8 +267,7 @@ pub async fn run(
     let workers = config.engine.pool_size.saturating_sub(1).max(1);
     state.engine().start_workers(workers, true);
     let stop_accepting = CancellationToken::new();
-    let housekeeping = tokio::spawn(housekeeping(state.clone()));
-    let keys = tokio::spawn(reread_keys(state.clone()));
+    let _chores = chores(&state);
     let deadline = Arc::new(std::sync::Mutex::new(None::<tokio::time::Instant>));
     let remaining = {
         let deadline = deadline.clone();
@@ -287,11 +286,7 @@ pub async fn run(
         remaining,
     ));
     tokio::select! {
-        result = &mut server => {
-            housekeeping.abort();
-            keys.abort();
-            return result?;
-        }
+        result = &mut server => return result?,
         () = shutdown => {}
     }
     let engine = state.engine();
@@ -318,10 +313,59 @@ pub async fn run(
         tokio::time::sleep_until(end).await;
     }
     stop_accepting.cancel();
-    let served = server.await;
-    housekeeping.abort();
-    keys.abort();
-    served?
+    server.await?
+}
+
+/// Tasks of a process that stop when this is dropped.
+pub struct Tasks(Vec<tokio::task::JoinHandle<()>>);
+
+impl Drop for Tasks {
+    fn drop(&mut self) {
+        for task in &self.0 {
+            task.abort();
+        }
+    }
+}
+
+/// The chores of every process, `serve` or `worker`: [`housekeeping`] and [`reread_keys`].
+pub fn chores(state: &AppState) -> Tasks {
+    Tasks(vec![
+        tokio::spawn(housekeeping(state.clone())),
+        tokio::spawn(reread_keys(state.clone())),
+    ])
+}
+
+/// The routes for operators of a process without the API (`thirdbody worker
+/// --metrics-bind`): `/metrics`, `/healthz` and `/readyz`, under the same access rules and
+/// with the same problems as the service's.
+pub fn operations_app(state: AppState) -> Router {
+    use axum::routing::get;
+    Router::new()
+        .route("/metrics", get(routes::ops::metrics))
+        .route("/healthz", get(routes::ops::healthz))
+        .route("/readyz", get(routes::ops::readyz))
+        .fallback(not_found)
+        .layer(middleware::from_fn_with_state(state.clone(), access::admit))
+        .layer(middleware::map_response(error::problem_for_errors))
+        .with_state(state)
+}
+
+/// Serves [`operations_app`] on `listener`, with the service's limits on connections,
+/// until the returned task is dropped.
+pub fn serve_operations(listener: TcpListener, state: AppState) -> Tasks {
+    if let Ok(address) = listener.local_addr() {
+        tracing::info!(%address, "serving /metrics, /healthz and /readyz");
+    }
+    let limits = state.config().connections;
+    let app = operations_app(state);
+    Tasks(vec![tokio::spawn(async move {
+        let served = server::serve(listener, app, limits, CancellationToken::new(), || {
+            Duration::ZERO
+        });
+        if let Err(e) = served.await {
+            tracing::error!(error = %e, "the operations' routes stopped");
+        }
+    })])
 }
 
 /// Periodic chores: drain the metrics histograms (they buffer samples until rendered) and

@@ -551,3 +551,76 @@ async fn a_tenant_has_at_most_its_quota_of_unfinished_jobs() {
     .await;
     submit(&app, Some(LAB_A), &rolling_job("29 nm")).await;
 }
+
+/// The most the answer of `job` may take, as the service counts it.
+fn room_of(job: &Value) -> u64 {
+    use thirdbody::job::{Job, Limits};
+    Job::from_value(job.clone(), &Limits::default())
+        .unwrap()
+        .result_bytes()
+}
+
+#[tokio::test]
+async fn a_tenant_holds_at_most_its_quota_of_result_bytes() {
+    let sweep = |first: u32, n: u32| {
+        let loads: Vec<String> = (first..first + n).map(|i| format!("{i} pN")).collect();
+        json!({"kind": "sweep", "input": {"vary": {"load": loads}}})
+    };
+    // Room for one sweep of 50 points and not two.
+    let one = room_of(&sweep(1000, 50));
+    let limit = (2 * one - 1).to_string();
+    let app = spawn_app(&[
+        "--api-keys",
+        &keys(),
+        "--quota-result-bytes",
+        &limit,
+        "--job-retention",
+        "40s",
+    ])
+    .await;
+    let first = submit(&app, Some(LAB_A), &sweep(1000, 50)).await;
+    within_done(&app, &first, LAB_A).await;
+    let response = send(
+        &app,
+        Method::POST,
+        "/v1/jobs",
+        Some(LAB_A_ROTATED),
+        Some(&sweep(2000, 50)),
+    )
+    .await;
+    // Retry when the first job expires: within its retention.
+    let retry_after: u64 = response.headers()["retry-after"]
+        .to_str()
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert!((1..=40).contains(&retry_after), "{retry_after}");
+    let detail = refused(response, StatusCode::TOO_MANY_REQUESTS, "quota-exceeded").await;
+    assert!(
+        detail.contains(&format!(
+            "holds {one} bytes in the answers of its 1 jobs kept"
+        )),
+        "{detail}"
+    );
+    assert!(
+        detail.contains(&format!("this job's may take {one} more")),
+        "{detail}"
+    );
+    // Another tenant's bytes are its own; a job whose answer alone is over: no wait helps.
+    submit(&app, Some(LAB_B), &sweep(2000, 50)).await;
+    let alone = send(
+        &app,
+        Method::POST,
+        "/v1/jobs",
+        Some(LAB_B),
+        Some(&sweep(1, 150)),
+    )
+    .await;
+    assert!(alone.headers().get("retry-after").is_none());
+    let detail = refused(alone, StatusCode::TOO_MANY_REQUESTS, "quota-exceeded").await;
+    assert!(detail.contains("more than the"), "{detail}");
+    // A job deleted frees its room.
+    let deleted = send(&app, Method::DELETE, &first, Some(LAB_A), None).await;
+    assert!(deleted.status().is_success());
+    submit(&app, Some(LAB_A), &sweep(2000, 50)).await;
+}

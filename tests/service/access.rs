@@ -8,7 +8,10 @@ use std::time::{Duration, Instant};
 use reqwest::{Client, StatusCode};
 use serde_json::{json, Value};
 
-use crate::fleet::{answering, free_port, get_json, redis_server_available, start, Process};
+use crate::fleet::{
+    answering, finished, free_port, fresh_redis, get_json, heavy_sweep, metric_in,
+    redis_server_available, redis_with, start, submit, taken_by, text_of, Process,
+};
 
 /// `thirdbody new-key` with `args`: the key and its entry.
 fn new_key(args: &[&str]) -> (String, Value) {
@@ -61,6 +64,15 @@ async fn until(http: &Client, url: &str, key: &str, expected: StatusCode) {
         );
         tokio::time::sleep(Duration::from_millis(100)).await;
     }
+}
+
+/// Two `serve` processes of a fleet on `redis`, with `flags`: the processes, their URLs.
+async fn two_services(http: &Client, redis: u16, flags: &[&str]) -> ([Process; 2], [String; 2]) {
+    let ports = [free_port(), free_port()];
+    let processes = ports.map(|port| start("serve", redis, Some(port), flags).0);
+    let one = answering(http, ports[0]).await;
+    let two = answering(http, ports[1]).await;
+    (processes, [one, two])
 }
 
 #[test]
@@ -166,24 +178,10 @@ async fn tenants_hold_across_a_fleet_on_a_redis_with_a_password() {
     }
     const PASSWORD: &str = "s3cret-of-the-fleet";
     let redis = free_port();
-    let _redis = Process(
-        Command::new("redis-server")
-            .args(["--port", &redis.to_string(), "--bind", "127.0.0.1"])
-            .args([
-                "--save",
-                "",
-                "--appendonly",
-                "no",
-                "--requirepass",
-                PASSWORD,
-            ])
-            .stdout(Stdio::null())
-            .spawn()
-            .expect("redis-server starts"),
+    let _redis = redis_with(
+        redis,
+        &["--port", &redis.to_string(), "--requirepass", PASSWORD],
     );
-    while std::net::TcpStream::connect(("127.0.0.1", redis)).is_err() {
-        std::thread::sleep(Duration::from_millis(20));
-    }
     let (a, a_entry) = new_key(&["--name", "lab-a"]);
     let (b, b_entry) = new_key(&["--name", "lab-b"]);
     let (ops, ops_entry) = new_key(&["--name", "ops", "--scopes", "admin"]);
@@ -300,12 +298,8 @@ async fn a_tenants_points_are_counted_once_for_the_whole_fleet() {
     let (key, entry) = new_key(&["--name", "lab-a"]);
     let keys = json!({"keys": [entry]}).to_string();
     let flags = ["--api-keys", keys.as_str(), "--quota-points", "3"];
-    let (one_port, two_port) = (free_port(), free_port());
-    let (_one, _) = start("serve", redis, Some(one_port), &flags);
-    let (_two, _) = start("serve", redis, Some(two_port), &flags);
     let http = Client::new();
-    let one = answering(&http, one_port).await;
-    let two = answering(&http, two_port).await;
+    let (_fleet, [one, two]) = two_services(&http, redis, &flags).await;
     // Early in a minute: the count is per minute.
     crate::clock::early_in_a_minute().await;
     let solve = |base: &String, radius: &str| {
@@ -338,4 +332,82 @@ async fn a_tenants_points_are_counted_once_for_the_whole_fleet() {
         .parse()
         .unwrap();
     assert!((1..=120).contains(&ttl), "{ttl}");
+}
+
+/// A tenant's answers held are counted from the records in Redis: a job kept by one
+/// process counts in the other.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_tenants_result_bytes_are_counted_once_for_the_whole_fleet() {
+    let Some((redis, _redis)) = fresh_redis() else {
+        return;
+    };
+    let (key, entry) = new_key(&["--name", "lab-a"]);
+    let keys = json!({"keys": [entry]}).to_string();
+    let job = |radius: &str| json!({"kind": "rolling", "input": {"radius": radius}});
+    let room = thirdbody::job::Job::from_value(job("20 nm"), &Default::default())
+        .unwrap()
+        .result_bytes();
+    let limit = (2 * room - 1).to_string();
+    let flags = ["--api-keys", &keys, "--quota-result-bytes", &limit];
+    let http = Client::new();
+    let (_fleet, [one, two]) = two_services(&http, redis, &flags).await;
+    let submit = |base: &String, radius: &str| {
+        http.post(format!("{base}/v1/jobs"))
+            .header("x-api-key", &key)
+            .json(&job(radius))
+            .send()
+    };
+    let kept = submit(&one, "20 nm").await.unwrap();
+    assert_eq!(
+        kept.status(),
+        StatusCode::ACCEPTED,
+        "{}",
+        kept.text().await.unwrap()
+    );
+    let refused = submit(&two, "21 nm").await.unwrap();
+    assert_eq!(refused.status(), StatusCode::TOO_MANY_REQUESTS);
+    assert!(refused.headers().contains_key("retry-after"));
+    let problem: Value = refused.json().await.unwrap();
+    let detail = problem["detail"].as_str().unwrap();
+    assert!(
+        detail.contains(&format!("holds {room} bytes in the answers of its 1 jobs")),
+        "{detail}"
+    );
+}
+
+/// A worker's routes for operators (`--metrics-bind`): a probe reads its health and
+/// readiness, Prometheus the parts it solved, under the access rules of `serve`.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_worker_serves_its_metrics_and_probes_to_whom_the_keys_allow() {
+    let Some((redis, _redis)) = fresh_redis() else {
+        return;
+    };
+    let (scraper, scraper_entry) = new_key(&["--name", "prometheus", "--scopes", "metrics"]);
+    let (lab, lab_entry) = new_key(&["--name", "lab"]);
+    let keys = json!({"keys": [scraper_entry, lab_entry]}).to_string();
+    let access = ["--api-keys", keys.as_str(), "--anonymous", "submit,read"];
+    let (ops_port, port) = (free_port(), free_port());
+    let bind = format!("127.0.0.1:{ops_port}");
+    let worker_flags = [&access[..], &["--metrics-bind", bind.as_str()]].concat();
+    let (_worker, log) = start("worker", redis, None, &worker_flags);
+    let (_service, _) = start("serve", redis, Some(port), &access);
+    let http = Client::new();
+    let worker = answering(&http, ops_port).await;
+    let base = answering(&http, port).await;
+    let ready = get_json(&http, format!("{worker}/readyz")).await;
+    assert_eq!(ready["status"], "ready", "{ready}");
+
+    let metrics = format!("{worker}/metrics");
+    let anonymous = http.get(&metrics).send().await.unwrap();
+    assert_eq!(anonymous.status(), StatusCode::UNAUTHORIZED);
+    assert_eq!(status(&http, &metrics, &lab).await, StatusCode::FORBIDDEN);
+    let id = submit(&http, &base, heavy_sweep()).await;
+    taken_by(&log, &id).await;
+    assert_eq!(finished(&http, &base, &id).await["status"], "succeeded");
+    let text = text_of(http.get(&metrics).header("x-api-key", &scraper)).await;
+    let solved = metric_in(&text, "thirdbody_parts_total", "succeeded");
+    assert!(solved >= 1.0, "{text}");
+    // Nothing else is served there: the API is the replicas'.
+    let elsewhere = format!("{worker}/v1/jobs/{id}");
+    assert_eq!(status(&http, &elsewhere, &lab).await, StatusCode::NOT_FOUND);
 }

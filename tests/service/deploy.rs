@@ -6,7 +6,7 @@
 //! Secret each Redis asks for, the job store on a claim, Redis reachable from the API's pods
 //! alone, the autoscaler and the disruption budget on the Deployment; the compose file
 //! builds with the commit and runs two replicas, a worker, Redis and Prometheus scraping
-//! both replicas.
+//! all three.
 
 use std::path::Path;
 
@@ -60,11 +60,27 @@ fn the_kustomize_base_wires_probes_drain_redis_autoscaler_and_budget() {
             container["resources"][bound]["cpu"].is_string(),
             "{bound} cpu"
         );
-        assert!(
-            container["resources"][bound]["memory"].is_string(),
-            "{bound} memory"
-        );
     }
+    // The memory the pod is given holds its budget and what the process needs besides
+    // (measured: 93 MiB at most, reliability/pod_memory.py), and the limit is above it.
+    let mebibytes = |bound: &str| -> u64 {
+        let text = container["resources"][bound]["memory"].as_str().unwrap();
+        text.strip_suffix("Mi").unwrap().parse().unwrap()
+    };
+    let literals = strings(&kustomization["configMapGenerator"][0]["literals"]);
+    let budget: u64 = literals
+        .iter()
+        .find_map(|l| l.strip_prefix("THIRDBODY_MEMORY_BUDGET="))
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert!(
+        mebibytes("requests") >= (budget >> 20) + 100,
+        "a request of {} MiB for a budget of {} MiB",
+        mebibytes("requests"),
+        budget >> 20
+    );
+    assert!(mebibytes("limits") > mebibytes("requests"));
     let pre_stop = &container["lifecycle"]["preStop"]["exec"]["command"];
     assert_eq!(pre_stop[0], "sleep");
     let sleep: u64 = pre_stop[1].as_str().unwrap().parse().unwrap();
@@ -213,7 +229,7 @@ fn the_kustomize_base_wires_probes_drain_redis_autoscaler_and_budget() {
 }
 
 #[test]
-fn compose_runs_two_replicas_a_worker_two_redis_roles_and_prometheus_scraping_both() {
+fn compose_runs_two_replicas_a_worker_two_redis_roles_and_prometheus_scraping_all_three() {
     let compose = one("deploy/compose.yaml");
     let services = compose["services"].as_mapping().unwrap();
     let get = |name: &str| &services[&Value::from(name)];
@@ -258,10 +274,21 @@ fn compose_runs_two_replicas_a_worker_two_redis_roles_and_prometheus_scraping_bo
             .unwrap()
             .ends_with(":8080"));
     }
-    assert_eq!(get("worker")["command"][0], "worker");
+    let worker = get("worker");
+    assert_eq!(worker["command"][0], "worker");
+    // The worker serves its metrics on a port of its own, its health check asks there.
+    let bind = worker["environment"]["THIRDBODY_METRICS_BIND"]
+        .as_str()
+        .unwrap();
+    assert_eq!(bind, "0.0.0.0:9100");
+    assert_eq!(
+        strings(&worker["healthcheck"]["test"])[1..],
+        ["thirdbody", "healthcheck", "--bind", "127.0.0.1:9100"]
+    );
     let prometheus = one("deploy/prometheus.yml");
     let targets = &prometheus["scrape_configs"][0]["static_configs"][0]["targets"];
     assert_eq!(targets[0], "thirdbody-a:8080");
     assert_eq!(targets[1], "thirdbody-b:8080");
+    assert_eq!(targets[2], "worker:9100");
     assert_eq!(prometheus["scrape_configs"][0]["metrics_path"], "/metrics");
 }

@@ -37,16 +37,15 @@ pub(crate) fn redis_server_available() -> bool {
 
 /// A Redis server on `port`, without persistence.
 pub(crate) fn start_redis(port: u16) -> Process {
+    redis_with(port, &["--port", &port.to_string()])
+}
+
+/// A redis-server on loopback without persistence, with `args` (its ports among them), once
+/// it accepts connections on `port`.
+pub(crate) fn redis_with(port: u16, args: &[&str]) -> Process {
     let child = Command::new("redis-server")
-        .args([
-            "--port",
-            &port.to_string(),
-            "--save",
-            "",
-            "--appendonly",
-            "no",
-        ])
-        .args(["--bind", "127.0.0.1"])
+        .args(["--bind", "127.0.0.1", "--save", "", "--appendonly", "no"])
+        .args(args)
         .stdout(Stdio::null())
         .spawn()
         .expect("redis-server starts");
@@ -167,14 +166,17 @@ pub(crate) async fn one_service(
 
 /// The value of the metric `name` (summed over its label sets matching `filter`).
 pub(crate) async fn metric(http: &reqwest::Client, base: &str, name: &str, filter: &str) -> f64 {
-    let text = http
-        .get(format!("{base}/metrics"))
-        .send()
-        .await
-        .unwrap()
-        .text()
-        .await
-        .unwrap();
+    let text = text_of(http.get(format!("{base}/metrics"))).await;
+    metric_in(&text, name, filter)
+}
+
+/// The body of the answer to `request`, as text.
+pub(crate) async fn text_of(request: reqwest::RequestBuilder) -> String {
+    request.send().await.unwrap().text().await.unwrap()
+}
+
+/// The sum of the samples of `name` whose line holds `filter`, in the exposition `text`.
+pub(crate) fn metric_in(text: &str, name: &str, filter: &str) -> f64 {
     text.lines()
         .filter(|l| l.starts_with(name) && l.contains(filter))
         .filter_map(|l| l.rsplit(' ').next()?.parse::<f64>().ok())
@@ -247,7 +249,7 @@ pub(crate) async fn taken_by(log: &Mutex<Vec<String>>, id: &str) {
 }
 
 /// A sweep of 2,000 points with a fine rule, parts long enough to kill a worker in one.
-fn heavy_sweep() -> Value {
+pub(crate) fn heavy_sweep() -> Value {
     let loads: Vec<String> = (0..40)
         .map(|i| format!("{} nN", 1.0 + 0.05 * f64::from(i)))
         .collect();

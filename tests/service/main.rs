@@ -17,3 +17,4 @@ mod jobs;
 mod kinds;
 mod pictures;
 mod three_body;
+mod tls;

@@ -183,12 +183,14 @@ impl Link {
         u64::try_from(self.opened.elapsed().as_millis()).unwrap_or(u64::MAX)
     }
 
-    fn set_up(&self, up: bool) {
+    /// Records whether the server was reached; `why` not (logged once, when it changes: a
+    /// refused connection, a certificate not trusted, a timeout).
+    fn set_up(&self, up: bool, why: &str) {
         if self.up.swap(up, Ordering::Relaxed) != up {
             if up {
                 tracing::info!(role = self.role, "Redis reachable again");
             } else {
-                tracing::warn!(role = self.role, "Redis unreachable");
+                tracing::warn!(role = self.role, error = why, "Redis unreachable");
             }
         }
         if let Some(gauge) = self.gauge.get() {
@@ -204,7 +206,7 @@ impl Link {
         match result {
             Ok(Ok(value)) => {
                 self.denied.store(false, Ordering::Relaxed);
-                self.set_up(true);
+                self.set_up(true, "");
                 Ok(value)
             }
             Ok(Err(e)) => {
@@ -217,7 +219,7 @@ impl Link {
                     || matches!(e.code(), Some("NOAUTH" | "WRONGPASS"));
                 self.denied.store(denied, Ordering::Relaxed);
                 if lost || denied {
-                    self.set_up(false);
+                    self.set_up(false, &e.to_string());
                 }
                 let code = e.code().map(str::to_string);
                 let role = self.role;
@@ -243,11 +245,12 @@ impl Link {
                 Err(Failure { why, code })
             }
             Err(_) => {
-                self.set_up(false);
-                Err(Failure::new(format!(
+                let why = format!(
                     "Redis ({}) cannot be reached: no answer within {CALL_TIMEOUT:?}",
                     self.role
-                )))
+                );
+                self.set_up(false, &why);
+                Err(Failure::new(why))
             }
         }
     }

@@ -209,13 +209,15 @@ impl RedisJobStore {
         let submitted = unix_millis(record.submitted_at);
         let (work, submitted_text) = (work_text(record.work), submitted.to_string());
         let owner = record.owner.as_ref().map_or("", Owner::as_str);
-        let fields: [(&str, &str); 6] = [
+        let bytes = record.result_bytes.to_string();
+        let fields: [(&str, &str); 7] = [
             ("kind", record.kind.name()),
             ("work", &work),
             ("done", "0"),
             ("parts_done", "0"),
             ("owner", owner),
             ("submitted", &submitted_text),
+            ("bytes", &bytes),
         ];
         pipe.hset_multiple(&key, &fields).ignore();
         if let Some(owner) = &record.owner {
@@ -424,7 +426,7 @@ impl RedisJobStore {
     }
 
     /// The fields a status needs: not the job's text, which may be long (a fit's data).
-    const FIELDS: [&'static str; 11] = [
+    const FIELDS: [&'static str; 12] = [
         "kind",
         "work",
         "status",
@@ -436,6 +438,7 @@ impl RedisJobStore {
         "owner",
         "submitted",
         "deadline",
+        "bytes",
     ];
 
     /// The record of job `id`, without its result (which stays in Redis until a client
@@ -452,6 +455,11 @@ impl RedisJobStore {
         &self,
         ids: &[Uuid],
     ) -> Result<Vec<Result<Option<JobRecord>, Failure>>, Failure> {
+        // An empty pipeline is an error to Redis's client ("empty command"): an owner with
+        // no jobs has no records to read.
+        if ids.is_empty() {
+            return Ok(Vec::new());
+        }
         let mut pipe = redis::pipe();
         for id in ids {
             pipe.hmget(keys::job(*id).record, &Self::FIELDS[..]);
@@ -527,6 +535,8 @@ impl RedisJobStore {
                 .or_else(|| time("deadline"))
                 .unwrap_or(std::time::UNIX_EPOCH),
             finished_at: time("finished_at"),
+            // A record of the version before results were bounded: nothing counted.
+            result_bytes: text("bytes").parse().unwrap_or(0),
         }))
     }
 
@@ -575,7 +585,7 @@ impl ResultPlace for InRedis {
 impl JobStore for RedisJobStore {
     /// The results are kept in Redis, whose memory bounds them (its `maxmemory`): no room
     /// is made here.
-    async fn insert(&self, record: JobRecord, _result_bytes: u64) -> Result<(), Refusal> {
+    async fn insert(&self, record: JobRecord) -> Result<(), Refusal> {
         let fields = [
             ("status", record.state.status().as_str()),
             ("key", &record.input_hash),

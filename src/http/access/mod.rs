@@ -12,7 +12,7 @@ pub mod keys;
 
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
-use std::time::SystemTime;
+use std::time::{Duration, SystemTime};
 
 use axum::extract::{FromRequestParts, Request, State};
 use axum::http::request::Parts;
@@ -50,6 +50,8 @@ pub struct Quota {
     pub points_per_minute: u64,
     /// Unfinished asynchronous jobs at once.
     pub jobs: usize,
+    /// Bytes of the answers of its jobs within their retention.
+    pub result_bytes: u64,
 }
 
 /// The quota of each API key's tenant, and the one share of all anonymous callers.
@@ -267,11 +269,15 @@ pub async fn charge(state: &AppState, caller: &Caller, keyed: &Keyed) -> Result<
     Err(ApiError::quota_exceeded(detail, retry_after))
 }
 
-/// A job `caller` submits: within its tenant's unfinished jobs (a key's tenant: anonymous
-/// callers have no such quota), and its points charged.
+/// A job `caller` submits: within its tenant's unfinished jobs and the bytes its answers
+/// hold (a key's tenant: anonymous callers share the service's own limits instead), and its
+/// points charged.
 pub async fn admit_job(state: &AppState, caller: &Caller, keyed: &Keyed) -> Result<(), ApiError> {
     let (quota, _) = caller.quota(&state.config().access.quotas);
     let tenant = caller.tenant().map(Owner::of_tenant);
+    if let Some(owner) = tenant.as_ref().filter(|_| quota.result_bytes > 0) {
+        hold(state, caller, owner, quota.result_bytes, keyed).await?;
+    }
     if let Some(owner) = tenant.filter(|_| quota.jobs > 0) {
         let unfinished = state.engine().unfinished_of(&owner).await?;
         if unfinished >= quota.jobs {
@@ -282,11 +288,50 @@ pub async fn admit_job(state: &AppState, caller: &Caller, keyed: &Keyed) -> Resu
                     caller.describe(),
                     quota.jobs
                 ),
-                Some(std::time::Duration::from_secs(5)),
+                Some(Duration::from_secs(5)),
             ));
         }
     }
     charge(state, caller, keyed).await
+}
+
+/// Lets `owner`'s job `keyed` in if the room its answer may take, added to what the
+/// tenant's jobs hold, is within `limit`; else 429, with `Retry-After` when the first of
+/// them is freed (none when the job alone is over the limit).
+async fn hold(
+    state: &AppState,
+    caller: &Caller,
+    owner: &Owner,
+    limit: u64,
+    keyed: &Keyed,
+) -> Result<(), ApiError> {
+    let needed = keyed.job().result_bytes();
+    let whose = caller.describe();
+    if needed > limit {
+        return Err(ApiError::quota_exceeded(
+            format!(
+                "this job's answer may take {needed} bytes, more than the {limit} {whose} may                  hold (--quota-result-bytes): split it"
+            ),
+            None,
+        ));
+    }
+    let held = state.engine().held_by(owner).await?;
+    if held.bytes.saturating_add(needed) <= limit {
+        return Ok(());
+    }
+    let wait = held
+        .freed_in
+        .unwrap_or_default()
+        .max(Duration::from_secs(1));
+    Err(ApiError::quota_exceeded(
+        format!(
+            "{whose} holds {} bytes in the answers of its {} jobs kept, of the {limit} it may              (--quota-result-bytes); this job's may take {needed} more. Delete a job it no              longer needs (DELETE /v1/jobs/{{id}}), or retry in {} s, when the first expires",
+            held.bytes,
+            held.jobs,
+            wait.as_secs()
+        ),
+        Some(wait),
+    ))
 }
 
 /// The scope a request needs: the API's reads `read` and its other methods `submit`,
