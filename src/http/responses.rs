@@ -166,7 +166,7 @@ problems!(
     Busy {
         (429, "overloaded: every solver thread is busy (or the job queue is full); no queue. \
             Or quota-exceeded: the caller's points this minute (or, for a job, its tenant's \
-            unfinished jobs) are at its quota", true),
+            unfinished jobs or the bytes its kept answers hold) are at its quota", true),
         (503, DRAINING, true),
     }
 );

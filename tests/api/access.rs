@@ -603,7 +603,10 @@ async fn a_tenant_holds_at_most_its_quota_of_result_bytes() {
         "{detail}"
     );
     assert!(
-        detail.contains(&format!("this job's may take {one} more")),
+        detail.contains(&format!(
+            "of the {limit} it may (--quota-result-bytes); this job's may take {one} more. \
+             Delete a job it no longer needs"
+        )),
         "{detail}"
     );
     // Another tenant's bytes are its own; a job whose answer alone is over: no wait helps.
@@ -618,9 +621,55 @@ async fn a_tenant_holds_at_most_its_quota_of_result_bytes() {
     .await;
     assert!(alone.headers().get("retry-after").is_none());
     let detail = refused(alone, StatusCode::TOO_MANY_REQUESTS, "quota-exceeded").await;
-    assert!(detail.contains("more than the"), "{detail}");
+    assert!(
+        detail.contains(&format!(
+            "more than the {limit} the API key of \"lab-b\" may hold (--quota-result-bytes)"
+        )),
+        "{detail}"
+    );
     // A job deleted frees its room.
     let deleted = send(&app, Method::DELETE, &first, Some(LAB_A), None).await;
     assert!(deleted.status().is_success());
     submit(&app, Some(LAB_A), &sweep(2000, 50)).await;
+}
+
+#[tokio::test]
+async fn a_checks_suite_is_charged_its_points_whole_before_it_runs() {
+    let app = spawn_app(&["--api-keys", &keys(), "--quota-points", "3"]).await;
+    crate::clock::early_in_a_minute().await;
+    let suite = |radii: &[&str]| {
+        let checks: Vec<Value> = radii
+            .iter()
+            .map(|radius| {
+                json!({"name": radius, "job": rolling_job(radius),
+                    "expect": {"friction_coefficient": {"max": 1}}})
+            })
+            .collect();
+        json!({ "checks": checks })
+    };
+    let run = |radii: &'static [&'static str]| {
+        let body = suite(radii);
+        let app = &app;
+        async move { send(app, Method::POST, "/v1/checks", Some(LAB_A), Some(&body)).await }
+    };
+    // Four checks are more points than a minute's: refused whole, no wait would help.
+    let response = run(&["20 nm", "21 nm", "22 nm", "23 nm"]).await;
+    assert!(response.headers().get("retry-after").is_none());
+    let detail = refused(response, StatusCode::TOO_MANY_REQUESTS, "quota-exceeded").await;
+    assert!(
+        detail.contains("asks for 4 points, more than the 3"),
+        "{detail}"
+    );
+    // Three run; the same three again are cached and cost nothing; one more is over.
+    for _ in 0..2 {
+        assert_eq!(
+            run(&["20 nm", "21 nm", "22 nm"]).await.status(),
+            StatusCode::OK
+        );
+    }
+    let detail = over_quota(run(&["23 nm"]).await).await;
+    assert!(
+        detail.contains("\"lab-a\" asked for 3 points this minute, of the 3"),
+        "{detail}"
+    );
 }

@@ -244,12 +244,26 @@ fn points(job: &Job) -> u64 {
 /// nothing then); past the quota, 429 `quota-exceeded` with `Retry-After` (the end of the
 /// minute).
 pub async fn charge(state: &AppState, caller: &Caller, keyed: &Keyed) -> Result<(), ApiError> {
+    charge_all(state, caller, std::slice::from_ref(keyed)).await
+}
+
+/// Charges the points of all of `jobs` (a checks suite's) to `caller`'s quota at once, as
+/// [`charge`] does one's: all are let in, or none.
+pub async fn charge_all(state: &AppState, caller: &Caller, jobs: &[Keyed]) -> Result<(), ApiError> {
     let (quota, tenant) = caller.quota(&state.config().access.quotas);
     let limit = quota.points_per_minute;
-    if limit == 0 || state.engine().cached(keyed.key()).await.is_some() {
+    if limit == 0 {
         return Ok(());
     }
-    let points = points(keyed.job());
+    let mut points = 0;
+    for keyed in jobs {
+        if state.engine().cached(keyed.key()).await.is_none() {
+            points += self::points(keyed.job());
+        }
+    }
+    if points == 0 {
+        return Ok(());
+    }
     let Err(Exceeded { used, retry_after }) = state.engine().charge(&tenant, points, limit).await
     else {
         return Ok(());
@@ -310,7 +324,8 @@ async fn hold(
     if needed > limit {
         return Err(ApiError::quota_exceeded(
             format!(
-                "this job's answer may take {needed} bytes, more than the {limit} {whose} may                  hold (--quota-result-bytes): split it"
+                "this job's answer may take {needed} bytes, more than the {limit} {whose} may \
+                 hold (--quota-result-bytes): split it"
             ),
             None,
         ));
@@ -325,7 +340,9 @@ async fn hold(
         .max(Duration::from_secs(1));
     Err(ApiError::quota_exceeded(
         format!(
-            "{whose} holds {} bytes in the answers of its {} jobs kept, of the {limit} it may              (--quota-result-bytes); this job's may take {needed} more. Delete a job it no              longer needs (DELETE /v1/jobs/{{id}}), or retry in {} s, when the first expires",
+            "{whose} holds {} bytes in the answers of its {} jobs kept, of the {limit} it may \
+             (--quota-result-bytes); this job's may take {needed} more. Delete a job it no \
+             longer needs (DELETE /v1/jobs/{{id}}), or retry in {} s, when the first expires",
             held.bytes,
             held.jobs,
             wait.as_secs()

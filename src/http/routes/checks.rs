@@ -10,11 +10,12 @@ use serde_json::Value;
 use crate::check::{CheckReport, ChecksInput, Report, Suite};
 use crate::engine::EngineError;
 use crate::http::accept::Accept;
+use crate::http::access::{self, Caller};
 use crate::http::body::JsonBody;
 use crate::http::error::ApiError;
 use crate::http::responses::{BadBody, Busy, ChecksFailed, NotAcceptable};
 use crate::http::AppState;
-use crate::job::JobError;
+use crate::job::{JobError, Keyed};
 
 /// The forms of a report: JSON, or JUnit XML for CI systems.
 const FORMS: [&str; 2] = ["application/json", "application/xml"];
@@ -42,6 +43,7 @@ const FORMS: [&str; 2] = ["application/json", "application/xml"];
 )]
 pub async fn run(
     State(state): State<AppState>,
+    caller: Caller,
     headers: HeaderMap,
     body: JsonBody,
 ) -> Result<Response, ApiError> {
@@ -68,11 +70,14 @@ pub async fn run(
         }
         .into());
     }
+    // Its points are the caller's, charged at once: the suite runs whole or not at all.
+    let jobs: Vec<Keyed> = suite.checks.iter().map(|c| c.job.clone().keyed()).collect();
+    access::charge_all(&state, &caller, &jobs).await?;
     // One deadline for the whole suite, so that its cost is that of one solve at most,
     // however many checks it holds; each answer is judged and let go before the next.
     let deadline = Instant::now() + state.config().engine.solve_deadline;
     let mut reports = Vec::with_capacity(suite.checks.len());
-    for spec in &suite.checks {
+    for (spec, keyed) in suite.checks.iter().zip(jobs) {
         if Instant::now() >= deadline {
             let mut report = CheckReport::new(&spec.name, spec.job.kind().name());
             report.fail_with(format!(
@@ -84,7 +89,6 @@ pub async fn run(
             reports.push(report);
             continue;
         }
-        let keyed = spec.job.clone().keyed();
         let answer = match state.engine().solve_by(keyed, deadline).await {
             Ok((solved, _)) => serde_json::from_slice::<Value>(solved.json())
                 .map_err(|e| JobError::Internal(e.to_string())),
