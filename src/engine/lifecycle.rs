@@ -214,11 +214,7 @@ impl Lifecycle {
         {
             return Err(EngineError::Overloaded);
         }
-        let units = match work {
-            Work::Known(units) => units,
-            Work::Unknown => 1,
-        };
-        let ticket = match self.backlog.admit(keyed.job().cost_class(), units) {
+        let ticket = match self.backlog.admit(keyed.job().cost_class(), work.units()) {
             Ok(ticket) => ticket,
             Err(backlogged) => {
                 self.queued.fetch_sub(1, Ordering::SeqCst);

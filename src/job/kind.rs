@@ -27,6 +27,17 @@ pub enum Work {
     Unknown,
 }
 
+impl Work {
+    /// The units the job counts for where it must count for something (the queue's
+    /// estimate, a quota's points): its own, or one when it cannot tell.
+    pub fn units(self) -> usize {
+        match self {
+            Work::Known(units) => units,
+            Work::Unknown => 1,
+        }
+    }
+}
+
 /// A job of kind `K` as validated, and what was implausible in its input.
 #[derive(Debug)]
 pub struct Validated<K> {

@@ -27,7 +27,7 @@ use super::error::ApiError;
 use super::AppState;
 use crate::engine::quota::Exceeded;
 use crate::engine::store::Owner;
-use crate::job::{Job, Keyed, Work};
+use crate::job::Keyed;
 
 /// The header that carries an API key (`Authorization: Bearer` does too).
 pub const API_KEY_HEADER: &str = "x-api-key";
@@ -195,10 +195,10 @@ impl Caller {
         self.key.as_ref().map(|key| key.name.as_str())
     }
 
-    /// The quota this caller draws on, and the name it is counted under.
+    /// The quota this caller draws on, and the name it is counted under (its tenant's).
     fn quota(&self, quotas: &Quotas) -> (Quota, String) {
-        match &self.key {
-            Some(key) => (quotas.keyed, format!("key:{}", key.name)),
+        match self.owner(None) {
+            Some(tenant) => (quotas.keyed, tenant.as_str().to_string()),
             None => (quotas.anonymous, "anonymous".to_string()),
         }
     }
@@ -210,9 +210,7 @@ impl Caller {
             None => "a caller without an API key".to_string(),
         }
     }
-}
 
-impl Caller {
     /// The caller [`admit`] let in (a route it does not guard has a caller with no scope),
     /// from a request's extensions.
     pub fn of(extensions: &Extensions) -> Caller {
@@ -231,15 +229,6 @@ impl<S: Send + Sync> FromRequestParts<S> for Caller {
     }
 }
 
-/// The points a job asks to be computed, as quotas count them: a sweep's or a figure's
-/// points, one for a single contact or a fit.
-fn points(job: &Job) -> u64 {
-    match job.work() {
-        Work::Known(n) => n as u64,
-        Work::Unknown => 1,
-    }
-}
-
 /// Charges the points of `keyed` to `caller`'s quota, unless its answer is cached (it costs
 /// nothing then); past the quota, 429 `quota-exceeded` with `Retry-After` (the end of the
 /// minute).
@@ -255,10 +244,11 @@ pub async fn charge_all(state: &AppState, caller: &Caller, jobs: &[Keyed]) -> Re
     if limit == 0 {
         return Ok(());
     }
+    // A sweep's or a figure's points, one for a single contact or a fit.
     let mut points = 0;
     for keyed in jobs {
         if state.engine().cached(keyed.key()).await.is_none() {
-            points += self::points(keyed.job());
+            points += keyed.job().work().units() as u64;
         }
     }
     if points == 0 {
@@ -288,7 +278,7 @@ pub async fn charge_all(state: &AppState, caller: &Caller, jobs: &[Keyed]) -> Re
 /// points charged.
 pub async fn admit_job(state: &AppState, caller: &Caller, keyed: &Keyed) -> Result<(), ApiError> {
     let (quota, _) = caller.quota(&state.config().access.quotas);
-    let tenant = caller.tenant().map(Owner::of_tenant);
+    let tenant = caller.owner(None);
     if let Some(owner) = tenant.as_ref().filter(|_| quota.result_bytes > 0) {
         hold(state, caller, owner, quota.result_bytes, keyed).await?;
     }
