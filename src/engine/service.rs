@@ -148,8 +148,9 @@ pub struct Held {
 /// The compute service: the solve path and the asynchronous jobs.
 pub struct Engine {
     solve_deadline: Duration,
-    /// How long a finished job and its answer are kept (what holds a tenant's bytes).
-    job_retention: Duration,
+    /// How long the job store lists a finished job and keeps its answer (its history's
+    /// retention: what holds a tenant's bytes, after the job leaves memory too).
+    history_retention: Duration,
     solver: Arc<Solver>,
     jobs: Arc<Lifecycle>,
     /// The points each tenant asked for in the current minute (its quota's count).
@@ -181,7 +182,7 @@ impl Engine {
         );
         Arc::new(Engine {
             solve_deadline: config.solve_deadline,
-            job_retention: config.job_retention,
+            history_retention: config.history_retention,
             solver,
             jobs: Arc::new(jobs),
             points,
@@ -208,16 +209,16 @@ impl Engine {
         };
         let jobs = self.jobs.list(&listing).await?.jobs;
         let now = std::time::SystemTime::now();
-        // A finished job's bytes are freed when its retention ends; an unfinished one's
-        // retention has not begun.
+        // A finished job's bytes are freed when the store forgets it (the history's
+        // retention, not the shorter one in memory); an unfinished one's has not begun.
         let freed_in = jobs
             .iter()
             .filter(|job| job.result_bytes > 0)
             .map(|job| match job.finished_at {
-                Some(at) => (at + self.job_retention)
+                Some(at) => (at + self.history_retention)
                     .duration_since(now)
                     .unwrap_or_default(),
-                None => self.job_retention,
+                None => self.history_retention,
             })
             .min();
         Ok(Held {

@@ -164,9 +164,10 @@ pub struct ServeArgs {
     #[arg(long, env = "THIRDBODY_QUOTA_JOBS", default_value_t = 0)]
     pub quota_jobs: usize,
 
-    /// Bytes each API key's tenant may hold in the answers of its jobs, kept for their
-    /// retention: a job is refused (429) if its answer's room would pass it, until a job is
-    /// deleted or expires (0: no limit). A job counts the most its answer may take.
+    /// Bytes each API key's tenant may hold in the answers of its jobs, kept for the
+    /// history's retention: a job is refused (429) if its answer's room would pass it, until
+    /// a job is deleted or forgotten (0: no limit). A job counts the most its answer may
+    /// take.
     #[arg(long, env = "THIRDBODY_QUOTA_RESULT_BYTES", default_value_t = 0)]
     pub quota_result_bytes: u64,
 
