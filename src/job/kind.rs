@@ -12,7 +12,8 @@ use std::sync::Arc;
 use serde_json::Value;
 use utoipa::ToSchema;
 
-use super::meta::{InputWarning, Meta, References};
+use super::input;
+use super::meta::{Canonical, InputWarning, Meta, References};
 use super::picture::{draw, Picture};
 use super::registry::KindName;
 use super::{Control, JobError, Limits};
@@ -70,6 +71,13 @@ pub trait Kind: fmt::Debug + PartialEq + Send + Sync + Sized + 'static {
     /// The canonical input: every default filled in, every quantity an SI number. Equal
     /// canonical inputs have equal answers.
     fn canonical(&self) -> Value;
+
+    /// The canonical input's text, which its cache key is the hash of. A kind answered
+    /// synchronously writes it straight from its input struct ([`input::canonical_text`]),
+    /// without building [`Kind::canonical`]'s tree on every request.
+    fn canonical_text(&self) -> Canonical {
+        input::canonical_text(&self.canonical())
+    }
 
     /// The papers behind the answer.
     fn references(&self) -> &'static References;
@@ -177,6 +185,7 @@ pub const SMALL_ANSWER: u64 = 24 << 10;
 trait Dispatch: fmt::Debug + Send + Sync {
     fn kind(&self) -> KindName;
     fn canonical(&self) -> Value;
+    fn canonical_text(&self) -> Canonical;
     fn references(&self) -> &'static References;
     fn work(&self) -> Work;
     fn cost_class(&self) -> &'static str;
@@ -203,6 +212,10 @@ impl<K: Kind> Dispatch for K {
 
     fn canonical(&self) -> Value {
         Kind::canonical(self)
+    }
+
+    fn canonical_text(&self) -> Canonical {
+        Kind::canonical_text(self)
     }
 
     fn references(&self) -> &'static References {
@@ -307,7 +320,7 @@ impl Job {
         let kind = &self.kind;
         Meta::new(
             kind.kind().name(),
-            kind.canonical(),
+            kind.canonical_text(),
             kind.references(),
             self.warnings.clone(),
             kind.units(),
@@ -421,5 +434,51 @@ impl Job {
 impl PartialEq for Job {
     fn eq(&self, other: &Job) -> bool {
         self.kind.same(other.kind.as_any()) && self.warnings == other.warnings
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use serde_json::json;
+
+    use super::*;
+
+    /// A kind that writes its canonical text straight from its input writes its tree's
+    /// text: the cache key of every input stays what it was.
+    #[test]
+    fn a_kinds_canonical_text_is_its_trees() {
+        let layer = json!({"elastic_modulus": "3 GPa", "thickness": "100 nm",
+                           "retardation_time": "0.5 s", "relaxation_time": "100 ms"});
+        let inputs = [
+            ("rolling", json!({})),
+            (
+                "rolling",
+                json!({"load": "1 nN", "options": {"pressure_grid": 8}}),
+            ),
+            (
+                "rolling",
+                json!({"layer": {"model": "continuum", "elastic_modulus": "3 GPa",
+                                 "prony": [{"modulus": "12 GPa", "time": "100 ms"}],
+                                 "temperature": "310 K",
+                                 "wlf": {"reference_temperature": "300 K",
+                                         "c1": 17.4, "c2": 51.6}}}),
+            ),
+            (
+                "three_body",
+                json!({"distribution": {"mean_diameter": "50 nm", "std_diameter": "5 nm",
+                                        "areal_density": "1e12 m^-2"},
+                       "nominal_area": "1 mm^2",
+                       "upper_surface": {"elastic_modulus": "210 GPa", "poisson_ratio": 0.3,
+                                         "contact": "elastic"},
+                       "layer": layer, "velocity": "4 nm/s",
+                       "operating": {"total_load": "1 mN"}}),
+            ),
+        ];
+        for (kind, input) in inputs {
+            let job = Job::from_input(kind, input.clone(), &Limits::default())
+                .unwrap_or_else(|e| panic!("{input}: {e:?}"));
+            let tree = serde_json::to_string(&job.canonical()).unwrap();
+            assert_eq!(job.kind.canonical_text().get(), tree, "{input}");
+        }
     }
 }

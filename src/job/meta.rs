@@ -179,9 +179,9 @@ pub struct Meta {
 pub struct Canonical(Box<RawValue>);
 
 impl Canonical {
-    /// The canonical text of `input`.
-    pub fn new(input: &Value) -> Canonical {
-        Canonical(serde_json::value::to_raw_value(input).expect("a JSON value writes as JSON"))
+    /// A canonical text written directly ([`crate::job::input::canonical_text`]).
+    pub fn from_text(text: String) -> Canonical {
+        Canonical(RawValue::from_string(text).expect("a canonical text is JSON"))
     }
 
     /// The JSON text.
@@ -198,16 +198,15 @@ impl PartialEq for Canonical {
 }
 
 impl Meta {
-    /// The meta block of a job of `kind` whose canonical input is `canonical`, with the
+    /// The meta block of a job of `kind` whose canonical input is `input`, with the
     /// `warnings` its input raised and the `units` of its answer.
     pub fn new(
         kind: &str,
-        canonical: Value,
+        input: Canonical,
         references: &'static References,
         warnings: Vec<InputWarning>,
         units: &'static UnitTable,
     ) -> Self {
-        let input = Canonical::new(&canonical);
         Meta {
             model_version: MODEL_VERSION,
             software: SOFTWARE,

@@ -7,6 +7,7 @@
 //! takes the error path from the struct field itself, serde takes the wire name from it,
 //! and the canonical form is the input struct filled in and serialized ([`canonical`]).
 
+mod canonical;
 mod checker;
 mod json;
 mod layer;
@@ -20,6 +21,7 @@ use serde::{Deserialize, Deserializer, Serialize};
 use serde_json::Value;
 use utoipa::ToSchema;
 
+pub use canonical::{canonical, canonical_text};
 pub use checker::Checker;
 pub use json::parse;
 pub use layer::{LayerInput, LayerModel};
@@ -152,23 +154,4 @@ pub fn validate<I: DeserializeOwned, T>(
     let mut checker = Checker::new();
     let job = read(&input, &mut checker);
     checker.finish(job)
-}
-
-/// The canonical form of an input filled in: its JSON with the absent (`null`) fields left
-/// out, so that it reads back as the same input.
-pub fn canonical<T: Serialize>(input: &T) -> Value {
-    /// In place: rebuilding the maps cost an allocation per key on every request.
-    fn strip_nulls(value: &mut Value) {
-        match value {
-            Value::Object(map) => {
-                map.retain(|_, v| !v.is_null());
-                map.values_mut().for_each(strip_nulls);
-            }
-            Value::Array(items) => items.iter_mut().for_each(strip_nulls),
-            _ => {}
-        }
-    }
-    let mut value = serde_json::to_value(input).expect("an input serializes to JSON");
-    strip_nulls(&mut value);
-    value
 }

@@ -11,7 +11,7 @@ use utoipa::ToSchema;
 
 use super::input::{self, field, Checker, LayerInput, LayerModel, QuadratureKind, Quantity};
 use super::kind::SMALL_ANSWER;
-use super::meta::{CONTINUUM_REFERENCES, ROLLING_REFERENCES};
+use super::meta::{Canonical, CONTINUUM_REFERENCES, ROLLING_REFERENCES};
 use super::points::{self, PointNotes, PointNotesFields, PointStatus, Row, SweepVerification};
 use super::validity::{self, PointValidity, Subject, ValidityOutput};
 use super::{Control, JobError, Kind, Limits, Meta, References, Validated, Work};
@@ -148,6 +148,10 @@ impl Kind for RollingJob {
     /// A valid input itself.
     fn canonical(&self) -> Value {
         input::canonical(&self.input())
+    }
+
+    fn canonical_text(&self) -> Canonical {
+        input::canonical_text(&self.input())
     }
 
     fn references(&self) -> &'static References {

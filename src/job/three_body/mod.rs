@@ -12,7 +12,7 @@ use utoipa::ToSchema;
 
 use super::input::units::Dimension;
 use super::input::{self, field, Checker, LayerInput, QuadratureKind, Quantity};
-use super::meta::{REFERENCES, THREE_BODY_CONTINUUM_REFERENCES};
+use super::meta::{Canonical, REFERENCES, THREE_BODY_CONTINUUM_REFERENCES};
 use super::points::{self, PointNotes, PointNotesFields, PointStatus, Row, SweepVerification};
 use super::validity::{self, PointValidity, Subject, ValidityOutput};
 use super::{Control, JobError, Kind, Limits, Meta, References, Validated, Work};
@@ -444,6 +444,10 @@ impl Kind for ThreeBodyJob {
     /// A valid input itself.
     fn canonical(&self) -> Value {
         input::canonical(&self.input())
+    }
+
+    fn canonical_text(&self) -> Canonical {
+        input::canonical_text(&self.input())
     }
 
     fn references(&self) -> &'static References {
