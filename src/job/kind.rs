@@ -12,7 +12,6 @@ use std::sync::Arc;
 use serde_json::Value;
 use utoipa::ToSchema;
 
-use super::input;
 use super::meta::{Canonical, InputWarning, Meta, References};
 use super::picture::{draw, Picture};
 use super::registry::KindName;
@@ -72,11 +71,12 @@ pub trait Kind: fmt::Debug + PartialEq + Send + Sync + Sized + 'static {
     /// canonical inputs have equal answers.
     fn canonical(&self) -> Value;
 
-    /// The canonical input's text, which its cache key is the hash of. A kind answered
-    /// synchronously writes it straight from its input struct ([`input::canonical_text`]),
-    /// without building [`Kind::canonical`]'s tree on every request.
+    /// The canonical input's text, which its cache key is the hash of: [`Kind::canonical`]
+    /// written out. Rolling and three-body jobs, solved on requests that must answer fast,
+    /// write it straight from their input struct
+    /// ([`crate::job::input::canonical_text`]) instead.
     fn canonical_text(&self) -> Canonical {
-        input::canonical_text(&self.canonical())
+        Canonical::new(&self.canonical())
     }
 
     /// The papers behind the answer.

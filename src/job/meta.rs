@@ -179,7 +179,13 @@ pub struct Meta {
 pub struct Canonical(Box<RawValue>);
 
 impl Canonical {
-    /// A canonical text written directly ([`crate::job::input::canonical_text`]).
+    /// The canonical text of `input`, a canonical tree.
+    pub fn new(input: &Value) -> Canonical {
+        Canonical(serde_json::value::to_raw_value(input).expect("a JSON value writes as JSON"))
+    }
+
+    /// A canonical text written directly ([`crate::job::input::canonical_text`]), checked to
+    /// be JSON once more (its cost is in BENCHMARKS.md's figures, issue 25).
     pub fn from_text(text: String) -> Canonical {
         Canonical(RawValue::from_string(text).expect("a canonical text is JSON"))
     }

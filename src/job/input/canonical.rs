@@ -32,7 +32,8 @@ pub fn canonical<T: Serialize>(input: &T) -> Value {
 /// The text of [`canonical`]`(input)`, written without building the tree: an uncached
 /// request computes it for its cache key, and the tree (a `String` and a map node per key,
 /// written out, then freed) made validating a rolling input and keying it 25 % slower
-/// (BENCHMARKS.md, issue 25).
+/// (BENCHMARKS.md, issue 25). An input holds no JSON already written (`RawValue`): the tree
+/// would parse one, this writer would not.
 pub fn canonical_text<T: Serialize>(input: &T) -> Canonical {
     let mut text = Vec::with_capacity(512);
     input
@@ -149,17 +150,18 @@ impl<'a> Object<'a> {
     ) -> Result<(), Error> {
         let from = self.out.len();
         value.serialize(Writer { out: self.out })?;
-        // A member whose value is null is left out, as from the tree.
+        // A null value is kept as an empty range: a later member of the same key (a
+        // flattened field) replaces an earlier one before the nulls are left out, as in
+        // the tree.
         if &self.out[from..] == b"null" {
             self.out.truncate(from);
-        } else {
-            self.members.push((key, from, self.out.len()));
         }
+        self.members.push((key, from, self.out.len()));
         Ok(())
     }
 
     /// Closes the object, its members in key order (the last of equal keys kept, as a map
-    /// keeps it) in place of its values as written.
+    /// keeps it, then the null ones left out) in place of its values as written.
     fn close(self) -> Writer<'a> {
         let Object {
             out,
@@ -176,7 +178,8 @@ impl<'a> Object<'a> {
             same
         });
         let values = out.split_off(start);
-        for (i, (key, from, to)) in members.iter().enumerate() {
+        let present = members.iter().filter(|(_, from, to)| from < to);
+        for (i, (key, from, to)) in present.enumerate() {
             if i > 0 {
                 out.push(b',');
             }
@@ -498,7 +501,8 @@ impl ser::SerializeStructVariant for Variant<Object<'_>> {
     }
 }
 
-/// A map's key as the tree has it: a string, a character, a number or a boolean as its text.
+/// A map's key as the tree has it: a string, a character, a finite number or a boolean as
+/// its text.
 struct Key;
 
 impl Key {
@@ -560,12 +564,27 @@ impl ser::Serializer for Key {
         self.text(v)
     }
 
-    fn serialize_f32(self, _: f32) -> Result<String, Error> {
-        self.refused()
+    fn serialize_i128(self, v: i128) -> Result<String, Error> {
+        self.text(v)
     }
 
-    fn serialize_f64(self, _: f64) -> Result<String, Error> {
-        self.refused()
+    fn serialize_u128(self, v: u128) -> Result<String, Error> {
+        self.text(v)
+    }
+
+    /// A finite float, as its own shortest text (a 32-bit one is not widened).
+    fn serialize_f32(self, v: f32) -> Result<String, Error> {
+        match v.is_finite() {
+            true => self.text(zmij::Buffer::new().format_finite(v)),
+            false => self.refused(),
+        }
+    }
+
+    fn serialize_f64(self, v: f64) -> Result<String, Error> {
+        match v.is_finite() {
+            true => self.text(zmij::Buffer::new().format_finite(v)),
+            false => self.refused(),
+        }
     }
 
     fn serialize_char(self, v: char) -> Result<String, Error> {
@@ -791,5 +810,56 @@ mod tests {
             text.get(),
             r#"{"by_flag":{"false":"f","true":"t"},"by_number":{"10":1.0,"9":2.5},"bytes":[97,98],"layer":{"model":"local","thickness":1e-7},"other":{"model":"continuum"},"shapes":["Unit",{},{"Newtype":3},{"Tuple":[-4,0.10000000149011612]},{"Struct":{"a":[1,2],"z":"\""}}],"z_last":1e-9,"zeta":7}"#
         );
+    }
+
+    #[derive(Serialize)]
+    struct Repeated {
+        a: Option<u8>,
+        #[serde(flatten)]
+        inner: RepeatedInner,
+    }
+
+    #[derive(Serialize)]
+    struct RepeatedInner {
+        a: Option<u8>,
+    }
+
+    /// Keys of every kind a map may have in a tree, written as the tree writes them.
+    struct Keys;
+
+    impl Serialize for Keys {
+        fn serialize<S: ser::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+            use ser::SerializeMap;
+            let mut map = s.serialize_map(None)?;
+            map.serialize_entry(&0.1f32, "f32")?;
+            map.serialize_entry(&2.5e-9, "f64")?;
+            map.serialize_entry(&u128::MAX, "u128")?;
+            map.serialize_entry(&-3i128, "i128")?;
+            map.serialize_entry(&'k', "char")?;
+            map.end()
+        }
+    }
+
+    /// A flattened field repeating a key replaces the earlier member before the nulls are
+    /// left out, as a tree's map does; maps keyed by floats and wide integers.
+    #[test]
+    fn repeated_keys_and_every_kind_of_key_are_written_as_the_tree_has_them() {
+        for (a, inner) in [
+            (Some(1), None),
+            (None, Some(2)),
+            (Some(1), Some(2)),
+            (None, None),
+        ] {
+            let input = Repeated {
+                a,
+                inner: RepeatedInner { a: inner },
+            };
+            assert_eq!(
+                canonical_text(&input).get(),
+                of_tree(&input),
+                "{a:?} {inner:?}"
+            );
+        }
+        assert_eq!(canonical_text(&Keys).get(), of_tree(&Keys));
     }
 }
