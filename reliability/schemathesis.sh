@@ -16,5 +16,9 @@ for _ in $(seq 50); do
   curl -sf "http://127.0.0.1:$port/healthz" >/dev/null && break
   sleep 0.1
 done
+# One worker: with two, schemathesis inspects its lambdas' source (`ast`) from two threads, and
+# CPython before 3.11.8 (this machine has 3.11.7) loses count of the AST constructor's depth
+# between them: "SystemError: AST constructor recursion depth mismatch" (CPython gh-106905), a
+# crash of the tool, not a finding, that failed CI twice.
 st --config-file reliability/schemathesis.toml run "http://127.0.0.1:$port/openapi.json" \
-  --checks all --max-examples "$examples" --workers 2 --seed 7 --no-color
+  --checks all --max-examples "$examples" --workers 1 --seed 7 --no-color
