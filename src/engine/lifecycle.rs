@@ -248,13 +248,14 @@ impl Lifecycle {
                     _ => live.control.done(),
                 };
                 state.log_end(id);
-                // Owed to its client before anyone can read it finished: a client that read
-                // it between the two would leave it owed forever, and a drain waiting for it.
+                // Owed to its client, and no longer running, before anyone can read it
+                // finished: a drain begun in between would otherwise count it owed (as
+                // running, or unread) after its client had read it, and wait for it forever.
                 lifecycle
                     .uncollected()
                     .insert(id, lifecycle.config.max_jobs);
-                lifecycle.jobs.update(id, state, done).await;
                 lifecycle.live().remove(&id);
+                lifecycle.jobs.update(id, state, done).await;
                 live.status.send_replace(status);
             }
             .instrument(span),
