@@ -9,6 +9,7 @@ use memchr::memmem;
 use serde::Serialize;
 use serde_json::ser::Formatter;
 
+use super::compact::{self, Style, Writer};
 use super::RenderError;
 
 /// `value` as JSON: compact, or with `pretty` one field or list element a line ([`Rows`]).
@@ -46,6 +47,7 @@ pub(super) const SCRATCH_KEPT: usize = 64 << 10;
 pub(super) struct Scratch {
     pub(super) buffer: Vec<u8>,
     numbers: Numbers,
+    fields: Fields,
 }
 
 impl Scratch {
@@ -53,6 +55,7 @@ impl Scratch {
         Scratch {
             buffer: Vec::new(),
             numbers: Numbers::new(),
+            fields: Fields::new(),
         }
     }
 
@@ -63,14 +66,23 @@ impl Scratch {
         value: &T,
         pretty: bool,
     ) -> serde_json::Result<Vec<u8>> {
-        let Scratch { buffer, numbers } = self;
+        let Scratch {
+            buffer,
+            numbers,
+            fields,
+        } = self;
         if pretty {
             let mut json = Vec::with_capacity(SCRATCH_KEPT);
-            serialize(value, &mut json, Rows::new(numbers))?;
+            value.serialize(&mut serde_json::Serializer::with_formatter(
+                &mut json,
+                Rows::new(numbers),
+            ))?;
             return Ok(json);
         }
         buffer.clear();
-        let written = serialize(value, buffer, Compact { numbers }).map(|()| buffer.to_vec());
+        let written = value
+            .serialize(Writer::new(buffer, &mut Answer { numbers, fields }))
+            .map(|()| buffer.to_vec());
         if buffer.capacity() > SCRATCH_KEPT {
             *buffer = Vec::new();
         }
@@ -78,41 +90,115 @@ impl Scratch {
     }
 }
 
-fn serialize<T: Serialize + ?Sized>(
-    value: &T,
-    out: &mut Vec<u8>,
-    formatter: impl Formatter,
-) -> serde_json::Result<()> {
-    value.serialize(&mut serde_json::Serializer::with_formatter(
-        Tokens(out),
-        formatter,
-    ))
+/// An answer's compact text: serde_json's, its numbers through [`Numbers`], `null` refused,
+/// embedded JSON searched for `null` as it is copied.
+struct Answer<'a> {
+    numbers: &'a mut Numbers,
+    fields: &'a mut Fields,
 }
 
-/// The vector serde_json writes an answer into, a token at a time. Most tokens are one byte
-/// (`"`, `,`, `:`, brackets), which `Vec`'s own `write_all` copies through a call to
-/// `memcpy`; they are pushed here (a rolling answer has about 1,200 tokens).
-struct Tokens<'a>(&'a mut Vec<u8>);
+impl Style for Answer<'_> {
+    const SORTED: bool = false;
 
-impl Write for Tokens<'_> {
     #[inline]
-    fn write(&mut self, bytes: &[u8]) -> io::Result<usize> {
-        self.write_all(bytes)?;
-        Ok(bytes.len())
+    fn number(&mut self, out: &mut Vec<u8>, x: f64) {
+        self.numbers.push(out, x);
     }
 
-    #[inline]
-    fn write_all(&mut self, bytes: &[u8]) -> io::Result<()> {
-        match bytes {
-            [byte] => self.0.push(*byte),
-            _ => self.0.extend_from_slice(bytes),
+    fn float(&mut self, out: &mut Vec<u8>, x: f32) {
+        out.extend_from_slice(zmij::Buffer::new().format_finite(x).as_bytes());
+    }
+
+    fn null(&mut self, _: &mut Vec<u8>) -> Result<(), compact::Error> {
+        refuse_null().map_err(compact::Error::io)
+    }
+
+    fn raw(&mut self, json: &[u8]) -> Result<(), compact::Error> {
+        match has_null(json) {
+            true => self.null(&mut Vec::new()),
+            false => Ok(()),
         }
-        Ok(())
     }
 
-    fn flush(&mut self) -> io::Result<()> {
-        Ok(())
+    #[inline]
+    fn field(&mut self, out: &mut Vec<u8>, key: &'static str) {
+        self.fields.push(out, key);
     }
+}
+
+/// Places in the memo of [`Fields`] (a power of two): a rolling answer has about 60 field
+/// names.
+const FIELD_SLOTS: usize = 128;
+
+/// The longest `"name":` [`Fields`] keeps.
+const FIELD_TEXT: usize = 32;
+
+/// The names of answers' fields as written, `"name":`, copied rather than checked for
+/// characters to escape again: a rolling answer writes 180 of them (a third of its
+/// rendering time went to them, BENCHMARKS.md, issue 25). A field's name is a `&'static
+/// str`, so its address and length name its text for good. Direct-mapped by the address.
+pub(super) struct Fields {
+    slots: [Field; FIELD_SLOTS],
+}
+
+/// A field name's address and length (0 and 0: an empty place) and its text as written.
+#[derive(Clone, Copy)]
+struct Field {
+    name: (usize, usize),
+    len: u8,
+    text: [u8; FIELD_TEXT],
+}
+
+impl Fields {
+    const fn new() -> Fields {
+        const EMPTY: Field = Field {
+            name: (0, 0),
+            len: 0,
+            text: [0; FIELD_TEXT],
+        };
+        Fields {
+            slots: [EMPTY; FIELD_SLOTS],
+        }
+    }
+
+    /// Writes `"name":`.
+    #[inline]
+    fn push(&mut self, out: &mut Vec<u8>, name: &'static str) {
+        let address = name.as_ptr() as usize;
+        let hash = (address as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15);
+        let slot = &mut self.slots[(hash >> (64 - FIELD_SLOTS.trailing_zeros())) as usize];
+        if slot.name != (address, name.len()) && !slot.keep(name) {
+            return compact::write_field(out, name);
+        }
+        push_prefix(out, &slot.text, slot.len);
+    }
+}
+
+impl Field {
+    /// Keeps `name` here, unless its text is longer than a place holds. Out of line: the
+    /// writing of a name already kept is the loop of every answer.
+    #[cold]
+    #[inline(never)]
+    fn keep(&mut self, name: &'static str) -> bool {
+        let mut text = Vec::with_capacity(FIELD_TEXT);
+        compact::write_field(&mut text, name);
+        if text.len() > FIELD_TEXT {
+            return false;
+        }
+        self.text[..text.len()].copy_from_slice(&text);
+        self.len = text.len() as u8;
+        self.name = (name.as_ptr() as usize, name.len());
+        true
+    }
+}
+
+/// Pushes the first `len` bytes of `text`: the whole array copied (a copy of a known size,
+/// without a call to `memcpy`), then the rest cut off again.
+#[inline]
+fn push_prefix<const N: usize>(out: &mut Vec<u8>, text: &[u8; N], len: u8) {
+    let end = out.len() + usize::from(len);
+    out.extend_from_slice(text);
+    out.truncate(end);
 }
 
 /// Places in the memo of [`Numbers`] (a power of two): enough that a rolling answer's
@@ -152,22 +238,51 @@ impl Numbers {
         }
     }
 
-    /// Writes `x`, finite (serde_json sends non-finite numbers to `write_null`).
-    fn write<W: ?Sized + Write>(&mut self, w: &mut W, x: f64) -> io::Result<()> {
+    /// Pushes the text of `x`, finite ([`Numbers::text`]).
+    #[inline]
+    fn push(&mut self, out: &mut Vec<u8>, x: f64) {
+        let negative = x.is_sign_negative();
+        let slot = self.slot(x);
+        match negative {
+            true => push_prefix(out, &slot.text, slot.len + 1),
+            false => {
+                let text: &[u8; 24] = slot.text[1..].try_into().expect("24 bytes");
+                push_prefix(out, text, slot.len)
+            }
+        }
+    }
+
+    /// The text of `x`, finite (serde_json sends non-finite numbers to `write_null`).
+    fn text(&mut self, x: f64) -> &[u8] {
+        let start = usize::from(!x.is_sign_negative());
+        let slot = self.slot(x);
+        &slot.text[start..=usize::from(slot.len)]
+    }
+
+    /// The place of `|x|`, its text written there if it was not.
+    #[inline]
+    fn slot(&mut self, x: f64) -> &Slot {
         let magnitude = x.abs();
         let bits = magnitude.to_bits();
         let place = bits.wrapping_mul(0x9E37_79B9_7F4A_7C15) >> (64 - SLOTS.trailing_zeros());
         let slot = &mut self.slots[place as usize];
         if slot.inverted != !bits {
-            let mut shortest = zmij::Buffer::new();
-            let text = shortest.format_finite(magnitude).as_bytes();
-            slot.text[0] = b'-';
-            slot.text[1..=text.len()].copy_from_slice(text);
-            slot.len = text.len() as u8;
-            slot.inverted = !bits;
+            slot.keep(magnitude);
         }
-        let start = usize::from(!x.is_sign_negative());
-        w.write_all(&slot.text[start..=usize::from(slot.len)])
+        slot
+    }
+}
+
+impl Slot {
+    /// Keeps `magnitude` and its text here. Out of line, as [`Field::keep`].
+    #[inline(never)]
+    fn keep(&mut self, magnitude: f64) {
+        let mut shortest = zmij::Buffer::new();
+        let text = shortest.format_finite(magnitude).as_bytes();
+        self.text[0] = b'-';
+        self.text[1..=text.len()].copy_from_slice(text);
+        self.len = text.len() as u8;
+        self.inverted = !magnitude.to_bits();
     }
 }
 
@@ -215,37 +330,6 @@ fn has_null(json: &[u8]) -> bool {
         }
     }
     false
-}
-
-/// The values both layouts write alike: numbers through the formatter's [`Numbers`], `null`
-/// refused, embedded JSON searched for `null` as it is copied.
-macro_rules! answer_values {
-    () => {
-        fn write_f64<W: ?Sized + Write>(&mut self, w: &mut W, value: f64) -> io::Result<()> {
-            self.numbers.write(w, value)
-        }
-
-        fn write_null<W: ?Sized + Write>(&mut self, _: &mut W) -> io::Result<()> {
-            refuse_null()
-        }
-
-        fn write_raw_fragment<W: ?Sized + Write>(
-            &mut self,
-            w: &mut W,
-            fragment: &str,
-        ) -> io::Result<()> {
-            write_raw(w, fragment)
-        }
-    };
-}
-
-/// serde_json's compact form, its numbers through [`Numbers`].
-struct Compact<'a> {
-    numbers: &'a mut Numbers,
-}
-
-impl Formatter for Compact<'_> {
-    answer_values!();
 }
 
 /// JSON for people: objects indented a field a line, as `serde_json`'s pretty form, but each
@@ -326,7 +410,21 @@ impl<'a> Rows<'a> {
 }
 
 impl Formatter for Rows<'_> {
-    answer_values!();
+    fn write_f64<W: ?Sized + Write>(&mut self, w: &mut W, value: f64) -> io::Result<()> {
+        w.write_all(self.numbers.text(value))
+    }
+
+    fn write_null<W: ?Sized + Write>(&mut self, _: &mut W) -> io::Result<()> {
+        refuse_null()
+    }
+
+    fn write_raw_fragment<W: ?Sized + Write>(
+        &mut self,
+        w: &mut W,
+        fragment: &str,
+    ) -> io::Result<()> {
+        write_raw(w, fragment)
+    }
 
     fn begin_array<W: ?Sized + Write>(&mut self, w: &mut W) -> io::Result<()> {
         self.open(w, true)
@@ -369,9 +467,14 @@ impl Formatter for Rows<'_> {
 
 #[cfg(test)]
 mod tests {
+    use std::collections::BTreeMap;
+
     use proptest::prelude::*;
+    use serde_json::value::RawValue;
+    use serde_json::Value;
 
     use super::*;
+    use crate::render::compact::tests::{json, Flat, Shapes, Tagged};
 
     /// Numbers drawn so that many repeat, in either sign, among every kind of double.
     fn numbers() -> impl Strategy<Value = Vec<f64>> {
@@ -410,6 +513,108 @@ mod tests {
             let unspaced: String = pretty.split_whitespace().collect();
             prop_assert_eq!(unspaced.as_bytes(), &compact[..]);
         }
+    }
+
+    /// Whether `value` holds a `null` anywhere.
+    fn holds_null(value: &Value) -> bool {
+        match value {
+            Value::Null => true,
+            Value::Array(items) => items.iter().any(holds_null),
+            Value::Object(map) => map.values().any(holds_null),
+            _ => false,
+        }
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(2000))]
+
+        /// Any JSON, as itself and embedded already written: serde_json's text, or refused
+        /// if it holds a `null`.
+        #[test]
+        fn answers_are_written_as_serde_json_writes_them(value in json()) {
+            let raw = RawValue::from_string(value.to_string()).unwrap();
+            let answer = serde_json::json!({"value": value, "raw": raw});
+            let expected = serde_json::to_vec(&(&value, &raw)).unwrap();
+            match write(&(&value, &raw), false) {
+                Ok(compact) => {
+                    prop_assert!(!holds_null(&value));
+                    prop_assert_eq!(&compact, &expected);
+                }
+                Err(refused) => {
+                    prop_assert!(holds_null(&value), "{}", answer);
+                    prop_assert_eq!(refused, RenderError::non_finite());
+                }
+            }
+        }
+    }
+
+    /// Every form serde's attributes and an enum's variants give an answer, in declaration
+    /// order, with maps keyed by every kind of key serde_json takes.
+    #[derive(Serialize)]
+    struct Typed {
+        z_first: f64,
+        some: Option<&'static str>,
+        layer: Tagged,
+        other: Tagged,
+        shapes: Vec<Shapes>,
+        by_number: BTreeMap<i128, f32>,
+        by_flag: BTreeMap<bool, &'static str>,
+        by_char: BTreeMap<char, u128>,
+        #[serde(flatten)]
+        flat: Flat,
+        bytes: &'static [u8],
+        input: Box<RawValue>,
+        pair: (i64, bool),
+        /// Names to escape, one longer than [`Fields`] keeps.
+        #[serde(rename = "tab\tname")]
+        tab: u8,
+        #[serde(rename = "a \"quoted\" name longer than 32 bytes")]
+        long: u8,
+    }
+
+    #[test]
+    fn a_typed_answer_is_written_as_serde_json_writes_it() {
+        let typed = Typed {
+            z_first: -1e-9,
+            some: Some("quote \" and \u{1}"),
+            layer: Tagged::Local {
+                thickness: 1e-7,
+                spare: Some(0.5),
+            },
+            other: Tagged::Continuum,
+            shapes: vec![
+                Shapes::Unit,
+                Shapes::Newtype(Some(3)),
+                Shapes::Tuple(-4, 0.1),
+                Shapes::Struct {
+                    z: '"',
+                    a: vec![1, 2],
+                },
+            ],
+            by_number: BTreeMap::from([(-10, 1.5), (9, 0.1)]),
+            by_flag: BTreeMap::from([(true, "t"), (false, "f")]),
+            by_char: BTreeMap::from([('é', u128::MAX)]),
+            flat: Flat {
+                zeta: 7,
+                skipped: None,
+            },
+            bytes: b"ab",
+            input: RawValue::from_string(r#"{"b": [1, 2.5e-9], "a": "x"}"#.into()).unwrap(),
+            pair: (i64::MIN, false),
+            tab: 1,
+            long: 2,
+        };
+        let compact = String::from_utf8(write(&typed, false).unwrap()).unwrap();
+        assert_eq!(compact, serde_json::to_string(&typed).unwrap());
+        assert!(compact.starts_with(r#"{"z_first":-1e-9,"some":"quote \" and \u0001","#));
+        assert!(compact.contains(r#""input":{"b": [1, 2.5e-9], "a": "x"},"#));
+        assert!(compact.ends_with(r#""tab\tname":1,"a \"quoted\" name longer than 32 bytes":2}"#));
+        // A second time, its names from the memo.
+        assert_eq!(write(&typed, false).unwrap(), compact.as_bytes());
+        // Rows lays out the same text.
+        let pretty = String::from_utf8(write(&typed, true).unwrap()).unwrap();
+        let parsed: Value = serde_json::from_str(&pretty).unwrap();
+        assert_eq!(parsed, serde_json::from_str::<Value>(&compact).unwrap());
     }
 
     #[test]

@@ -3,6 +3,7 @@
 //! and the command line choose a [`Format`] ([`negotiate`] for HTTP) and render an
 //! [`Answer`] into bytes.
 
+pub(crate) mod compact;
 pub mod fields;
 pub mod fixed;
 mod json;
