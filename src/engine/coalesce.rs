@@ -17,11 +17,15 @@ pub type Solving = BoxFuture<'static, Result<Arc<Solved>, EngineError>>;
 /// solve has gone (clients hung up), the solve is dropped, and with it cancelled.
 #[derive(Default)]
 pub struct Coalescer {
-    in_flight: Mutex<HashMap<String, WeakShared<Solving>>>,
+    in_flight: Mutex<InFlight>,
 }
 
+/// The solves in flight, by key, hashed as the engine's other maps are ([`super::KeyHasher`]:
+/// SipHash was 1,300 of an uncached request's instructions here).
+type InFlight = HashMap<String, WeakShared<Solving>, super::KeyHasher>;
+
 impl Coalescer {
-    fn in_flight(&self) -> MutexGuard<'_, HashMap<String, WeakShared<Solving>>> {
+    fn in_flight(&self) -> MutexGuard<'_, InFlight> {
         self.in_flight.lock().unwrap_or_else(|p| p.into_inner())
     }
 

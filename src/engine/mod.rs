@@ -37,8 +37,8 @@ pub use solver::{CacheStatus, Solver};
 use crate::job::{Control, Job, JobError};
 use crate::render::Answer;
 
-/// The hasher of the engine's in-process maps (answers, input keys, sweep points) and of the
-/// doorkeeper. Their keys churn at the request rate: with SipHash, hashing was a tenth of an
+/// The hasher of the engine's in-process maps (answers, input keys, sweep points, solves in
+/// flight) and of the doorkeeper. Their keys churn at the request rate: with SipHash, hashing was a tenth of an
 /// uncached request's CPU (under moka, which rehashed its table as entries came and went).
 /// foldhash is seeded per process, so keys cannot be chosen to collide without knowing the
 /// seed.

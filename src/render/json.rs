@@ -36,16 +36,17 @@ thread_local! {
     pub(super) static SCRATCH: RefCell<Scratch> = const { RefCell::new(Scratch::new()) };
 }
 
-/// Buffers larger than this are not kept for the next answer.
-pub(super) const SCRATCH_KEPT: usize = 64 << 10;
+/// The room a pretty answer (for a terminal, written once) starts with.
+const PRETTY_ROOM: usize = 64 << 10;
 
-/// A buffer to write answers into and the memo of their numbers. Written into a fresh
-/// vector, a 7 kB rolling answer grew through seven reallocations and their copies, and the
-/// large ones made the allocator consolidate its free lists: on an uncached request's path
-/// (BENCHMARKS.md, issue 12). The memo is kept too: made anew for each answer, its 10 kB
-/// cost more than it saved.
+/// What a thread keeps between the answers it writes: the size of its last answer and the
+/// memos of numbers and field names. Written into a fresh vector, a 7 kB rolling answer
+/// grew through seven reallocations and their copies (BENCHMARKS.md, issue 12), and written
+/// into a buffer kept here, it was copied out once more; the next answer is most often of
+/// the same kind and size, so it is written into a vector of that room. The memos are kept
+/// too: made anew for each answer, the numbers' 10 kB cost more than they saved.
 pub(super) struct Scratch {
-    pub(super) buffer: Vec<u8>,
+    last: usize,
     numbers: Numbers,
     fields: Fields,
 }
@@ -53,40 +54,40 @@ pub(super) struct Scratch {
 impl Scratch {
     const fn new() -> Scratch {
         Scratch {
-            buffer: Vec::new(),
+            last: 0,
             numbers: Numbers::new(),
             fields: Fields::new(),
         }
     }
 
-    /// `value` as JSON, in a vector of its exact size (compact) or of room to spare (pretty,
-    /// for a terminal: written once).
+    /// `value` as JSON, in a vector of its size or little more (compact) or of room to
+    /// spare (pretty).
     fn write<T: Serialize + ?Sized>(
         &mut self,
         value: &T,
         pretty: bool,
     ) -> serde_json::Result<Vec<u8>> {
         let Scratch {
-            buffer,
+            last,
             numbers,
             fields,
         } = self;
         if pretty {
-            let mut json = Vec::with_capacity(SCRATCH_KEPT);
+            let mut json = Vec::with_capacity(PRETTY_ROOM);
             value.serialize(&mut serde_json::Serializer::with_formatter(
                 &mut json,
                 Rows::new(numbers),
             ))?;
             return Ok(json);
         }
-        buffer.clear();
-        let written = value
-            .serialize(Writer::new(buffer, &mut Answer { numbers, fields }))
-            .map(|()| buffer.to_vec());
-        if buffer.capacity() > SCRATCH_KEPT {
-            *buffer = Vec::new();
+        let mut json = Vec::with_capacity(*last + *last / 16 + 64);
+        value.serialize(Writer::new(&mut json, &mut Answer { numbers, fields }))?;
+        *last = json.len();
+        // A small answer after a large one does not keep the large one's room.
+        if json.capacity() > json.len() + json.len() / 8 + 64 {
+            json.shrink_to_fit();
         }
-        written
+        Ok(json)
     }
 }
 
@@ -128,7 +129,7 @@ impl Style for Answer<'_> {
 
 /// Places in the memo of [`Fields`] (a power of two): a rolling answer has about 60 field
 /// names.
-const FIELD_SLOTS: usize = 128;
+const FIELD_SLOTS: usize = 512;
 
 /// The longest `"name":` [`Fields`] keeps.
 const FIELD_TEXT: usize = 32;

@@ -369,25 +369,23 @@ mod tests {
     }
 
     #[test]
-    fn an_answer_written_while_another_is_and_one_larger_than_the_scratch_kept_render_whole() {
+    fn an_answer_written_while_another_is_and_one_after_a_larger_one_render_whole() {
         let holder = Answer::new(Holder {
             inner: Answer::new(Point { x: 0.5 }),
             points: vec![0.25; 2],
         });
         let json = holder.render(Format::Json).unwrap();
         assert_eq!(json, br#"{"inner":{"x":0.5},"points":[0.25,0.25]}"#);
-        assert_eq!(json.capacity(), json.len());
         let large = Answer::new(Holder {
             inner: Answer::new(Point { x: 1.0 }),
             points: vec![0.125; 20_000],
         });
         let json = large.render(Format::Json).unwrap();
-        assert!(json.len() > json::SCRATCH_KEPT);
+        assert!(json.len() > 100_000);
         assert!(json.ends_with(b",0.125]}"));
-        json::SCRATCH.with_borrow(|s| assert!(s.buffer.capacity() <= json::SCRATCH_KEPT));
-        assert_eq!(
-            holder.render(Format::Json).unwrap(),
-            br#"{"inner":{"x":0.5},"points":[0.25,0.25]}"#
-        );
+        // Written into the large one's room, and not left holding it.
+        let json = holder.render(Format::Json).unwrap();
+        assert_eq!(json, br#"{"inner":{"x":0.5},"points":[0.25,0.25]}"#);
+        assert!(json.capacity() <= json.len() + json.len() / 8 + 64);
     }
 }
