@@ -35,7 +35,8 @@ pub(crate) trait Style {
     /// Accepts or refuses `json`, JSON already written (a `RawValue`) just copied out.
     fn raw(&mut self, json: &[u8]) -> Result<(), Error>;
 
-    /// Writes a struct's field name and its colon, `"key":`, in order.
+    /// Writes a struct's field name and its colon, `"key":`, in order (a style in key order
+    /// writes its names when its objects close).
     fn field(&mut self, out: &mut Vec<u8>, key: &'static str) {
         write_field(out, key);
     }
@@ -84,8 +85,7 @@ impl<'a, S: Style> Writer<'a, S> {
     /// has that one member, never null).
     fn variant(self, variant: &'static str) -> Writer<'a, S> {
         self.out.push(b'{');
-        write_str(self.out, variant);
-        self.out.push(b':');
+        write_field(self.out, variant);
         self
     }
 
@@ -198,8 +198,11 @@ impl<'a, S: Style> Object<'a, S> {
         value: &T,
     ) -> Result<(), Error> {
         if self.raw {
+            if key != RAW_VALUE {
+                return Err(Error::custom("a RawValue's one field is its text"));
+            }
             let from = self.writer.out.len();
-            value.serialize(Key(self.writer.out))?;
+            value.serialize(Key::new(self.writer.out, false))?;
             return self.writer.style.raw(&self.writer.out[from..]);
         }
         if !S::SORTED {
@@ -238,7 +241,7 @@ impl<'a, S: Style> Object<'a, S> {
             let out = &mut *self.writer.out;
             out.push(b'"');
             let from = out.len();
-            key.serialize(Key(out))?;
+            key.serialize(Key::new(out, true))?;
             if plain_prefix(&out[from..]) < out.len() - from {
                 let text = out.split_off(from);
                 write_str_contents(out, &text);
@@ -249,7 +252,7 @@ impl<'a, S: Style> Object<'a, S> {
             return Ok(());
         }
         let mut text = Vec::new();
-        key.serialize(Key(&mut text))?;
+        key.serialize(Key::new(&mut text, false))?;
         let text = String::from_utf8(text).map_err(Error::custom)?;
         self.key = Some(Cow::Owned(text));
         Ok(())
@@ -603,11 +606,19 @@ impl<S: Style> ser::SerializeMap for Object<'_, S> {
 /// A map's key as serde_json has it, its text written unescaped at the end of the vector: a
 /// string, a character, a finite number or a boolean as its text. (Also the text of a
 /// `RawValue`, a string.)
-struct Key<'a>(&'a mut Vec<u8>);
+struct Key<'a> {
+    out: &'a mut Vec<u8>,
+    /// Whether `Some(key)` is the key's (serde_json's writer), or refused (its tree).
+    some: bool,
+}
 
-impl Key<'_> {
+impl<'a> Key<'a> {
+    fn new(out: &'a mut Vec<u8>, some: bool) -> Key<'a> {
+        Key { out, some }
+    }
+
     fn text(self, text: impl std::fmt::Display) -> Result<(), Error> {
-        write!(self.0, "{text}").map_err(Error::io)
+        write!(self.out, "{text}").map_err(Error::io)
     }
 
     fn refused<T>(self) -> Result<T, Error> {
@@ -649,7 +660,7 @@ impl ser::Serializer for Key<'_> {
     }
 
     fn serialize_str(self, v: &str) -> Result<(), Error> {
-        self.0.extend_from_slice(v.as_bytes());
+        self.out.extend_from_slice(v.as_bytes());
         Ok(())
     }
 
@@ -668,8 +679,11 @@ impl ser::Serializer for Key<'_> {
         }
     }
 
-    fn serialize_some<T: Serialize + ?Sized>(self, _: &T) -> Result<(), Error> {
-        self.refused()
+    fn serialize_some<T: Serialize + ?Sized>(self, key: &T) -> Result<(), Error> {
+        match self.some {
+            true => key.serialize(self),
+            false => self.refused(),
+        }
     }
 
     forward!(unit_variant_and_newtype_struct);

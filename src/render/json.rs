@@ -25,7 +25,8 @@ pub(super) fn write<T: Serialize + ?Sized>(
         Err(_) => Scratch::new().write(value, pretty),
     });
     written.map_err(|e| match e.is_io() {
-        // The writer is a vector, which never fails: the error is the formatter's refusal.
+        // The writer is a vector, which never fails: the error is the style's (or the
+        // pretty formatter's) refusal of a null.
         true => RenderError::non_finite(),
         false => RenderError(format!("cannot write the result: {e}")),
     })
@@ -168,28 +169,28 @@ impl Fields {
         let address = name.as_ptr() as usize;
         let hash = (address as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15);
         let slot = &mut self.slots[(hash >> (64 - FIELD_SLOTS.trailing_zeros())) as usize];
-        if slot.name != (address, name.len()) && !slot.keep(name) {
-            return compact::write_field(out, name);
+        match slot.name == (address, name.len()) {
+            true => push_prefix(out, &slot.text, slot.len),
+            false => slot.keep(out, name),
         }
-        push_prefix(out, &slot.text, slot.len);
     }
 }
 
 impl Field {
-    /// Keeps `name` here, unless its text is longer than a place holds. Out of line: the
-    /// writing of a name already kept is the loop of every answer.
+    /// Writes `"name":` and keeps it here, unless it is longer than a place holds (such a
+    /// name is written each time). Out of line: the writing of a name already kept is the
+    /// loop of every answer.
     #[cold]
     #[inline(never)]
-    fn keep(&mut self, name: &'static str) -> bool {
-        let mut text = Vec::with_capacity(FIELD_TEXT);
-        compact::write_field(&mut text, name);
-        if text.len() > FIELD_TEXT {
-            return false;
+    fn keep(&mut self, out: &mut Vec<u8>, name: &'static str) {
+        let from = out.len();
+        compact::write_field(out, name);
+        let text = &out[from..];
+        if text.len() <= FIELD_TEXT {
+            self.text[..text.len()].copy_from_slice(text);
+            self.len = text.len() as u8;
+            self.name = (name.as_ptr() as usize, name.len());
         }
-        self.text[..text.len()].copy_from_slice(&text);
-        self.len = text.len() as u8;
-        self.name = (name.as_ptr() as usize, name.len());
-        true
     }
 }
 
@@ -561,6 +562,7 @@ mod tests {
         by_number: BTreeMap<i128, f32>,
         by_flag: BTreeMap<bool, &'static str>,
         by_char: BTreeMap<char, u128>,
+        by_some: BTreeMap<Option<u8>, u8>,
         #[serde(flatten)]
         flat: Flat,
         bytes: &'static [u8],
@@ -595,6 +597,7 @@ mod tests {
             by_number: BTreeMap::from([(-10, 1.5), (9, 0.1)]),
             by_flag: BTreeMap::from([(true, "t"), (false, "f")]),
             by_char: BTreeMap::from([('é', u128::MAX)]),
+            by_some: BTreeMap::from([(Some(1), 2)]),
             flat: Flat {
                 zeta: 7,
                 skipped: None,
@@ -609,6 +612,7 @@ mod tests {
         assert_eq!(compact, serde_json::to_string(&typed).unwrap());
         assert!(compact.starts_with(r#"{"z_first":-1e-9,"some":"quote \" and \u0001","#));
         assert!(compact.contains(r#""input":{"b": [1, 2.5e-9], "a": "x"},"#));
+        assert!(compact.contains(r#""by_some":{"1":2},"#));
         assert!(compact.ends_with(r#""tab\tname":1,"a \"quoted\" name longer than 32 bytes":2}"#));
         // A second time, its names from the memo.
         assert_eq!(write(&typed, false).unwrap(), compact.as_bytes());

@@ -31,7 +31,7 @@ pub fn canonical<T: Serialize>(input: &T) -> Value {
 /// request computes it for its cache key, and the tree (a `String` and a map node per key,
 /// written out, then freed) made validating a rolling input and keying it 25 % slower
 /// (BENCHMARKS.md, issue 25). An input holds no JSON already written (`RawValue`): the tree
-/// would parse one, this writer would not.
+/// would parse one, this writer refuses it (a panic here, a bug in the input's type).
 pub fn canonical_text<T: Serialize>(input: &T) -> Canonical {
     let mut text = Vec::with_capacity(512);
     input
