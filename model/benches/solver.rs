@@ -9,6 +9,7 @@ use std::hint::black_box;
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use thirdbody_model::continuum;
+use thirdbody_model::Stop;
 use thirdbody_model::rolling::penetration_contact;
 use thirdbody_model::similarity::SimilarityTable;
 use thirdbody_model::spectrum::Terms;
@@ -123,7 +124,7 @@ fn continuum(c: &mut Criterion) {
             ..Rolling::default()
         };
         group.bench_function(format!("answer_V={velocity:e}"), |b| {
-            b.iter(|| continuum::solve(black_box(&point), &SolveOptions::default()).unwrap())
+            b.iter(|| continuum::solve(black_box(&point), &SolveOptions::default(), Stop::NEVER).unwrap())
         });
     }
     group.finish();
@@ -158,7 +159,7 @@ fn prony(c: &mut Criterion) {
         b.iter(|| three_body::solve(black_box(&system), &ThreeBodyOptions::default()).unwrap())
     });
     group.bench_function("continuum_answer_4_terms", |b| {
-        b.iter(|| continuum::solve(black_box(&point), &SolveOptions::default()).unwrap())
+        b.iter(|| continuum::solve(black_box(&point), &SolveOptions::default(), Stop::NEVER).unwrap())
     });
     group.finish();
 }

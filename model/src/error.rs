@@ -50,6 +50,8 @@ pub enum ModelError {
     OutOfModel(String),
     /// A bracketed root finder ran out of iterations.
     NoConvergence { what: &'static str, iterations: u32 },
+    /// The caller asked the solve to stop ([`crate::Stop`]): past its deadline, cancelled.
+    Stopped,
 }
 
 impl fmt::Display for ModelError {
@@ -68,6 +70,7 @@ impl fmt::Display for ModelError {
             ModelError::NoConvergence { what, iterations } => {
                 write!(f, "the {what} did not converge in {iterations} iterations")
             }
+            ModelError::Stopped => f.write_str("the solve was stopped by its caller"),
         }
     }
 }

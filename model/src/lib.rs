@@ -14,6 +14,7 @@ mod roots;
 pub mod similarity;
 mod special;
 pub mod spectrum;
+mod stop;
 pub mod strip;
 pub mod tables;
 pub mod text;
@@ -24,6 +25,7 @@ pub use error::{ModelError, OptionError, SolveOption};
 pub use layer::{Layer, Parameter, ParameterError};
 pub use quadrature::Quadrature;
 pub use rolling::{solve, Rolling, RollingSolution, SolveOptions};
+pub use stop::Stop;
 
 /// Version of the model's numbers: part of every cache key, bumped whenever a result changes.
 pub const MODEL_VERSION: &str = "1.5.0";

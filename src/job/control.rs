@@ -13,7 +13,7 @@ use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
 use super::JobError;
-use crate::model::ModelError;
+use crate::model::{ModelError, Stop};
 
 /// A solved unit of work, as kept.
 pub type Kept = Arc<dyn Any + Send + Sync>;
@@ -159,10 +159,30 @@ impl Control {
         }
     }
 
-    /// One unit of work: checked first, counted when it succeeds.
-    pub fn solve<R>(&self, solve: impl FnOnce() -> Result<R, ModelError>) -> Result<R, JobError> {
+    /// Whether the job must stop now (cancelled, past its deadline): what a [`Stop`] made
+    /// of this control asks inside a long solve.
+    pub fn must_stop(&self) -> bool {
+        self.check().is_err()
+    }
+
+    /// Why a solve failed: the control's own error for one it stopped (a [`Stop`] asking
+    /// [`Control::must_stop`]), else the model's.
+    pub fn failed(&self, e: ModelError) -> JobError {
+        match e {
+            ModelError::Stopped => self.check().err().unwrap_or(JobError::Cancelled),
+            e => e.into(),
+        }
+    }
+
+    /// One unit of work: checked first, stopped within by this control (through the
+    /// [`Stop`] it is given), counted when it succeeds.
+    pub fn solve<R>(
+        &self,
+        solve: impl FnOnce(Stop) -> Result<R, ModelError>,
+    ) -> Result<R, JobError> {
         self.check()?;
-        let solution = solve()?;
+        let asked = || self.must_stop();
+        let solution = solve(Stop::when(&asked)).map_err(|e| self.failed(e))?;
         self.advance(1);
         Ok(solution)
     }
@@ -232,19 +252,28 @@ impl Control {
         let next = AtomicUsize::new(0);
         let stop: Mutex<Option<JobError>> = Mutex::new(None);
         let halted = AtomicBool::new(false);
+        let halt = |e: JobError| {
+            halted.store(true, Ordering::Relaxed);
+            stop.lock()
+                .unwrap_or_else(|p| p.into_inner())
+                .get_or_insert(e);
+        };
         let worker = || {
             let mut solved = Vec::new();
             while !halted.load(Ordering::Relaxed) {
                 let i = next.fetch_add(1, Ordering::Relaxed);
                 let Some(item) = items.get(i) else { break };
                 if let Err(e) = self.check() {
-                    halted.store(true, Ordering::Relaxed);
-                    stop.lock()
-                        .unwrap_or_else(|p| p.into_inner())
-                        .get_or_insert(e);
+                    halt(e);
                     break;
                 }
                 let outcome = solve(item);
+                // An item that failed because the job was stopped inside it (by a [`Stop`]
+                // asking this control) was not reached.
+                if let (Err(_), Err(e)) = (&outcome, self.check()) {
+                    halt(e);
+                    break;
+                }
                 self.advance(1);
                 if outcome.is_err() && on_refusal == OnRefusal::Fail {
                     halted.store(true, Ordering::Relaxed);

@@ -110,6 +110,8 @@ impl From<ModelError> for JobError {
             ModelError::NotRepresentable { .. }
             | ModelError::OutOfModel(_)
             | ModelError::NoConvergence { .. } => JobError::Unsolvable(message),
+            // Only a job's control stops a solve, and it says why ([`super::Control::failed`]).
+            ModelError::Stopped => JobError::Cancelled,
         }
     }
 }

@@ -12,7 +12,7 @@ use serde_json::{json, Value};
 use thirdbody::job::{Control, Job, JobError, Limits};
 use thirdbody::model::fit::{Law, Measured, Point, Setting};
 use thirdbody::model::three_body::{OperatingPoint, ThreeBody, ThreeBodyOptions};
-use thirdbody::model::Layer;
+use thirdbody::model::{Layer, Stop};
 use thirdbody::render::Format;
 
 /// The answer to the fit `input`, as JSON.
@@ -32,7 +32,7 @@ fn model(layer: &Layer, measured: Measured, radius: f64, load: f64, speed: f64) 
         velocity: speed * 1e-9,
         measured,
     };
-    point.value(layer, Law::Local).unwrap()
+    point.value(layer, Law::Local, Stop::NEVER).unwrap()
 }
 
 /// Normal deviates from a seeded xorshift generator (Box–Muller).
@@ -256,7 +256,7 @@ fn system_friction(layer: &Layer, total_load: f64, speed: f64) -> f64 {
         velocity: speed * 1e-9,
         measured: Measured::FrictionCoefficient,
     };
-    point.value(layer, Law::Local).unwrap()
+    point.value(layer, Law::Local, Stop::NEVER).unwrap()
 }
 
 #[test]

@@ -7,7 +7,7 @@
 
 use serde_json::{json, Value};
 use thirdbody::model::fit::{Law, Measured, Point, Setting};
-use thirdbody::model::Layer;
+use thirdbody::model::{Layer, Stop};
 
 use crate::fit::{fit, value, Noise};
 
@@ -29,7 +29,7 @@ fn friction(layer: &Layer, radius: f64, load: f64, speed: f64) -> f64 {
         velocity: speed * 1e-9,
         measured: Measured::FrictionCoefficient,
     };
-    point.value(layer, Law::Continuum).unwrap()
+    point.value(layer, Law::Continuum, Stop::NEVER).unwrap()
 }
 
 /// Radius (nm) and load (nN) of the static points.

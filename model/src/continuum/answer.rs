@@ -1,51 +1,30 @@
 //! A rolling answer on the layer as a continuum (docs/model.md §8): the same quantities as the
 //! local law's answer (§3), with their error.
 //!
-//! On the grid ([`super::roll`]), three marches: a fine grid, a coarse one (two thirds of
-//! the pixels a side) and a coarse one reaching twice as far behind. The grid is sized from
-//! the static continuum contact radius a₀ (the table of [`super::static_area`]):
-//! a₀·[`MARGIN`] to each side and ahead (the rolling contact is never wider than the static
-//! one), and behind that the wake where the layer is still recovering, min(3 V θ, 6 a₀), θ
-//! the layer's longest retardation time (T_ε; none for an elastic layer).
-//! The pixel is a twelfth of the smallest contact's radius (the instantaneous elastic one,
-//! V → ∞), at most the layer's thickness. The answer is the fine grid's; the others' differences from it are its error.
+//! On the grid ([`super::roll`]), three marches ([`super::plan`] sizes them before any
+//! starts): a fine grid, a coarse one (two thirds of the pixels a side) and a coarse one
+//! reaching twice as far behind. The answer is the fine grid's; the others' differences
+//! from it are its error.
 //!
-//! On a layer much thinner than the contact (r₀/H ≥ [`THIN`], ν ≤ [`THIN_POISSON`]) the
+//! On a layer much thinner than the contact (r₀/H ≥ [`super::THIN`], ν ≤ [`super::THIN_POISSON`]) the
 //! continuum is the local law to within a few per cent (§8's thin-layer fast path), and
 //! a grid would need pixels finer than the layer: the answer is §3's exact local solution,
-//! its error the two laws' difference at rest from the axisymmetric solver.
+//! its error the two laws' difference at rest ([`super::thin_error`]).
 
 use std::f64::consts::PI;
 
-use super::axisymmetric::static_contact;
 use super::grid::{Grid, Influence};
+use super::plan::{plan, Domain, Marches, Route, PER_RADIUS};
 use super::pressed::GridContact;
 use super::rolling::{at_rest, roll, Rolled, RolledContact};
 use super::shape::{boundary, chords, lateral_half_width, pressure_grid, resampled};
-use super::table::static_area;
-use crate::limits::{relaxed, ElasticContact};
-use crate::{ModelError, Rolling, RollingSolution, SolveOptions};
-
-/// Pixels in the radius of the smallest contact the sphere can have, the instantaneous
-/// elastic one (V → ∞), on the fine grid: every rolling contact is at least 24 pixels
-/// across (the `resolution` row warns below).
-pub const PER_RADIUS: usize = 12;
-
-/// The grid reaches this many static contact radii to each side of the contact and ahead.
-const MARGIN: f64 = 1.25;
+use super::thin::thin_error;
+use crate::limits::ElasticContact;
+use crate::{ModelError, Rolling, RollingSolution, SolveOptions, Stop};
 
 /// The march stops when a step changes the pressure by less than this share of its sum
 /// (it then lies within about ten times that of its steady state).
 const TOLERANCE: f64 = 1e-5;
-
-/// Pixels a grid may have: a finer grid is refused rather than left to run for minutes.
-const MAX_PIXELS: usize = 256 * 256;
-
-/// Contacts of a radius r₀ = √(2Rδ₀) (the local law's at rest) at least this many
-/// thicknesses are answered by the local law ...
-pub const THIN: f64 = 20.0;
-/// ... on layers of a Poisson ratio up to this (a thin incompressible layer is never local).
-pub const THIN_POISSON: f64 = 0.4;
 
 /// How an answer on the layer as a continuum was found, and how far it can be trusted.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -131,12 +110,14 @@ pub fn area_floor(area: f64, pixel: f64, thickness: f64) -> f64 {
 }
 
 /// The steady rolling answer of `rolling` on the layer as a continuum, with `options`'
-/// boundary points and pressure grid (its quadrature is the local law's and unused here).
+/// boundary points and pressure grid (its quadrature is the local law's and unused here),
+/// stopped when `stop` says so.
 pub fn solve(
     rolling: &Rolling,
     options: &SolveOptions,
+    stop: Stop,
 ) -> Result<RollingSolution<ContinuumVerification>, ModelError> {
-    solve_at(rolling, options, PER_RADIUS)
+    solve_at(rolling, options, PER_RADIUS, stop)
 }
 
 /// [`solve`] with `per_radius` pixels in the smallest contact's radius on the fine grid (the
@@ -146,6 +127,7 @@ pub fn solve_at(
     rolling: &Rolling,
     options: &SolveOptions,
     per_radius: usize,
+    stop: Stop,
 ) -> Result<RollingSolution<ContinuumVerification>, ModelError> {
     if let Some(error) = rolling.violations().into_iter().next() {
         return Err(error.into());
@@ -153,14 +135,9 @@ pub fn solve_at(
     if let Some(error) = options.violations().into_iter().next() {
         return Err(ModelError::InvalidOption(error));
     }
-    let layer = &rolling.layer;
-    // r₀ in closed form: the local answer itself is solved only where it is the answer.
-    let r0 = relaxed(rolling.radius, rolling.load, layer).half_width;
-    let thin = r0 >= THIN * layer.thickness && layer.poisson_ratio <= THIN_POISSON;
-    let solution = if thin {
-        thin_layer(rolling, crate::solve(rolling, options)?)?
-    } else {
-        on_grid(rolling, options, per_radius)?
+    let solution = match plan(rolling, per_radius)?.route {
+        Route::Thin { ratio } => thin_layer(rolling, ratio, crate::solve(rolling, options)?),
+        Route::Grid(marches) => on_grid(rolling, options, &marches, stop)?,
     };
     let e = &solution.verification.errors;
     let bounds = [e.relative(), e.centroid_shift, e.pressure_centre_shift];
@@ -177,16 +154,14 @@ pub fn solve_at(
     Ok(solution)
 }
 
-/// §8's thin-layer fast path: `local`, the exact local answer, with the two laws' relative
-/// difference at rest (from the axisymmetric solver, with its own error) as its error.
+/// §8's thin-layer fast path: `local`, the exact local answer at r₀/H = `ratio`, with the
+/// two laws' relative difference at rest ([`thin_error`]) as its error.
 fn thin_layer(
     rolling: &Rolling,
+    ratio: f64,
     local: RollingSolution,
-) -> Result<RollingSolution<ContinuumVerification>, ModelError> {
-    let rest = static_contact(rolling.radius, rolling.load, &rolling.layer)?;
-    let off = |local: f64, continuum: f64| (local / continuum - 1.0).abs() + rest.relative_error;
-    let area = off(local.static_contact.contact_area, rest.contact_area);
-    let penetration = off(local.static_contact.penetration, rest.penetration);
+) -> RollingSolution<ContinuumVerification> {
+    let (penetration, area) = thin_error(ratio, rolling.layer.poisson_ratio);
     let extent = local.boundary.iter().fold(local.half_width, |m, b| {
         m.max(b.exit.abs()).max(b.entry.abs())
     });
@@ -198,7 +173,7 @@ fn thin_layer(
         static_penetration: penetration,
         static_contact_area: area,
     };
-    Ok(RollingSolution {
+    RollingSolution {
         penetration: local.penetration,
         contact_area: local.contact_area,
         half_width: local.half_width,
@@ -215,14 +190,16 @@ fn thin_layer(
             extent,
             grid: None,
         },
-    })
+    }
 }
 
-/// The answer on the grid: fine, coarse, and coarse reaching twice as far behind.
+/// The answer on the grid: fine, coarse, and coarse reaching twice as far behind, as
+/// `marches` plans them.
 fn on_grid(
     rolling: &Rolling,
     options: &SolveOptions,
-    per_radius: usize,
+    marches: &Marches,
+    stop: Stop,
 ) -> Result<RollingSolution<ContinuumVerification>, ModelError> {
     let Rolling {
         radius,
@@ -230,28 +207,15 @@ fn on_grid(
         velocity,
         layer,
     } = *rolling;
-    let a0 = (static_area(radius, load, &layer) / PI).sqrt();
-    // The contact at V → ∞: the layer with the instantaneous modulus.
-    let stiff = layer.instantaneous();
-    let smallest = (static_area(radius, load, &stiff) / PI).sqrt();
-    let wake = if velocity > 0.0 {
-        (3.0 * velocity * layer.creep().terms.longest()).min(6.0 * a0)
-    } else {
-        0.0
-    };
-    // The pixel: at most the layer's thickness (finer, the layer's correction would vary
-    // across a pixel faster than its Gauss rule follows).
-    let fine_pixel = (smallest / per_radius as f64).min(layer.thickness);
-    // A march on a grid of `pixel` reaching `wake` behind, from `start` (a contact on
-    // another grid, resampled; else the contact at rest on this grid, solved here, from
-    // `rest_from` resampled if given): its steady contact, and its contact at rest.
-    let march = |pixel: f64,
-                 wake: f64,
+    // A march on `domain`, from `start` (a contact on another grid, resampled; else the
+    // contact at rest on this grid, solved here, from `rest_from` resampled if given): its
+    // steady contact, and its contact at rest.
+    let march = |domain: &Domain,
                  start: Option<&GridContact>,
                  rest_from: Option<&GridContact>|
      -> Result<Solved, ModelError> {
-        let (grid, middle) = domain(a0, pixel, wake)?;
-        let influence = Influence::new(&layer, grid);
+        let Domain { grid, middle } = *domain;
+        let influence = Influence::new(&layer, grid, stop)?;
         let rolled = Rolled {
             radius,
             load,
@@ -259,6 +223,7 @@ fn on_grid(
             layer: &layer,
             surface: &influence,
             middle,
+            stop,
         };
         let resample = |contact: &GridContact| resampled(contact, &grid, middle);
         let rest = match start {
@@ -279,15 +244,13 @@ fn on_grid(
         Ok(Solved { rolled, rest })
     };
     // The coarse march first, from rest: the others start from its steady contact.
-    let coarse_pixel = 1.5 * fine_pixel;
-    let coarse = march(coarse_pixel, wake, None, None)?;
+    let coarse = march(&marches.coarse, None, None)?;
     let coarse_rest = coarse.rest.as_ref();
-    let far = if wake > 0.0 {
-        march(coarse_pixel, 2.0 * wake, Some(&coarse.rolled.contact), None)?
-    } else {
-        coarse.clone()
+    let far = match &marches.far {
+        Some(far) => march(far, Some(&coarse.rolled.contact), None)?,
+        None => coarse.clone(),
     };
-    let fine = march(fine_pixel, wake, Some(&coarse.rolled.contact), coarse_rest)?;
+    let fine = march(&marches.fine, Some(&coarse.rolled.contact), coarse_rest)?;
     // Each quantity's change to the fine grid and to the far domain, from the coarse grid
     // (at rest the far domain is the same problem: no change).
     let changes = |f: fn(&Solved) -> f64| {
@@ -373,34 +336,6 @@ fn on_grid(
 struct Solved {
     rolled: RolledContact,
     rest: Option<GridContact>,
-}
-
-/// The grid of pixels of side `pixel` around the static contact of radius `a0`, and its
-/// middle's x: `MARGIN` radii to each side and ahead, and `wake` more behind.
-///
-/// The middle is a whole number of pixels from the sphere's centre, so the centre lies on a
-/// pixel boundary along x as it does across: the lattice then sits alike under every
-/// contact, and an answer moves smoothly with the layer's times (a middle anywhere made the
-/// area jump by up to 1e-3 when T_ε moved by 1e-3, as the wake moved the lattice under the
-/// contact; a fit's differences need better). The grid has a pixel to spare for that.
-fn domain(a0: f64, pixel: f64, wake: f64) -> Result<(Grid, f64), ModelError> {
-    let side = MARGIN * a0;
-    let (front, back) = (side, side + wake);
-    let even = |length: f64| 2 * (0.5 * length / pixel).ceil() as usize;
-    let grid = Grid {
-        nx: even(front + back + pixel),
-        ny: even(2.0 * side),
-        pixel,
-    };
-    if grid.pixels() > MAX_PIXELS {
-        return Err(ModelError::OutOfModel(format!(
-            "the layer as a continuum would need a grid of {} × {} pixels here (at most \
-             {MAX_PIXELS}): the contact is too wide for its pixels, which must be finer than \
-             the layer (a thin, nearly incompressible layer)",
-            grid.nx, grid.ny
-        )));
-    }
-    Ok((grid, (0.5 * (front - back) / pixel).round() * pixel))
 }
 
 /// Whether a pixel on the grid's border carries pressure (the contact is cut off there).

@@ -21,7 +21,7 @@ use super::compliance::contact_modulus;
 use super::table::static_area;
 use crate::limits::hertz_force;
 use crate::roots::brent;
-use crate::{Layer, ModelError, Quadrature, Rolling, RollingSolution, SolveOptions};
+use crate::{Layer, ModelError, Quadrature, Rolling, RollingSolution, SolveOptions, Stop};
 
 /// Nodes per decade of the static contact radius that places them
 /// ([`PenetrationCurve::problems`]).
@@ -98,9 +98,12 @@ impl PenetrationCurve {
         SolveOptions::integrals_only(Quadrature::default())
     }
 
-    /// Solves `problem` (one of [`PenetrationCurve::problems`]).
-    pub fn solve(problem: &Rolling) -> Result<RollingSolution<ContinuumVerification>, ModelError> {
-        solve(problem, &Self::options())
+    /// Solves `problem` (one of [`PenetrationCurve::problems`]), stopped when `stop` says so.
+    pub fn solve(
+        problem: &Rolling,
+        stop: Stop,
+    ) -> Result<RollingSolution<ContinuumVerification>, ModelError> {
+        solve(problem, &Self::options(), stop)
     }
 
     /// The curve from the answers to [`PenetrationCurve::problems`], in their order.
@@ -153,12 +156,13 @@ impl PenetrationCurve {
     }
 
     /// The curve of `layer` at `velocity` up to c = `reach`, solved here one node after
-    /// another (a caller with threads solves [`PenetrationCurve::problems`] itself).
+    /// another, to the end (a caller with threads, or one that may stop it, solves
+    /// [`PenetrationCurve::problems`] itself).
     pub fn build(layer: &Layer, velocity: f64, reach: f64) -> Result<PenetrationCurve, ModelError> {
         let problems = Self::problems(layer, velocity, reach);
         let answers = problems
             .iter()
-            .map(Self::solve)
+            .map(|p| Self::solve(p, Stop::NEVER))
             .collect::<Result<Vec<_>, _>>()?;
         Ok(Self::from_answers(layer, velocity, &problems, &answers))
     }

@@ -14,7 +14,7 @@ use rustfft::{Fft, FftPlanner};
 
 use super::compliance::{contact_modulus, correction_rule};
 use crate::quadrature::{gauss_legendre, GaussRule};
-use crate::Layer;
+use crate::{Layer, ModelError, Stop};
 
 /// A grid of pixels: `nx` along the rolling direction x, `ny` across it, of side `pixel`.
 /// Pixel (i, j) is at x = x₀ + (i + ½ − nx/2) h, y = (j + ½ − ny/2) h (x₀ the grid's
@@ -59,8 +59,9 @@ pub struct Influence {
 }
 
 impl Influence {
-    /// The influence on `grid` on `layer`.
-    pub fn new(layer: &Layer, grid: Grid) -> Influence {
+    /// The influence on `grid` on `layer`, stopped when `stop` says so (its kernel takes
+    /// about a tenth of a second on the largest grid).
+    pub fn new(layer: &Layer, grid: Grid, stop: Stop) -> Result<Influence, ModelError> {
         let (mx, my) = (2 * grid.nx, 2 * grid.ny);
         let mut real = RealFftPlanner::<f64>::new();
         let mut complex = FftPlanner::<f64>::new();
@@ -74,7 +75,7 @@ impl Influence {
             columns_back: complex.plan_fft_inverse(mx),
         };
         let h = grid.pixel;
-        let correction = correction(layer, &grid);
+        let correction = correction(layer, &grid, stop)?;
         let e_star = contact_modulus(layer);
         // The kernel at every offset, wrapped: offset −k sits at index m − k.
         let offset = |i: usize, n: usize| {
@@ -86,10 +87,13 @@ impl Influence {
         };
         let rule = pixel_rule(h, layer.thickness);
         // The kernel is even in x and y: computed once per distance, placed four times.
-        let quarter: Vec<f64> = (0..=grid.nx)
-            .flat_map(|i| (0..=grid.ny).map(move |j| (i, j)))
-            .map(|(i, j)| pixel_response(i as f64 * h, j as f64 * h, h, e_star, &correction, &rule))
-            .collect();
+        let mut quarter = Vec::with_capacity((grid.nx + 1) * (grid.ny + 1));
+        for i in 0..=grid.nx {
+            stop.check()?;
+            quarter.extend((0..=grid.ny).map(|j| {
+                pixel_response(i as f64 * h, j as f64 * h, h, e_star, &correction, &rule)
+            }));
+        }
         let mut kernel = vec![0.0; mx * my];
         for i in 0..mx {
             for j in 0..my {
@@ -99,7 +103,7 @@ impl Influence {
         }
         influence.own = kernel[0];
         influence.kernel = influence.forward(&kernel, my, mx);
-        influence
+        Ok(influence)
     }
 
     /// A pixel's deflection at its own centre under unit pressure on it.
@@ -268,8 +272,9 @@ const FAR: f64 = 15.0;
 /// interpolation between steps of H/32 errs by about 1e-4 of it.
 const STEPS_PER_THICKNESS: f64 = 32.0;
 
-/// The correction out past the grid's diagonal (or to [`FAR`] thicknesses).
-fn correction(layer: &Layer, grid: &Grid) -> Correction {
+/// The correction out past the grid's diagonal (or to [`FAR`] thicknesses), stopped when
+/// `stop` says so.
+fn correction(layer: &Layer, grid: &Grid, stop: Stop) -> Result<Correction, ModelError> {
     let (nu, thickness) = (layer.poisson_ratio, layer.thickness);
     let step = thickness / STEPS_PER_THICKNESS;
     let far = FAR * thickness;
@@ -278,18 +283,20 @@ fn correction(layer: &Layer, grid: &Grid) -> Correction {
     let count = (extent / step).ceil() as usize + 2;
     let nodes = correction_rule(nu, extent / thickness);
     let far_scale = 1.0 / (PI * contact_modulus(layer));
-    let values = (0..count)
-        .map(|i| {
-            let r = i as f64 * step / thickness;
-            far_scale / thickness * nodes.iter().map(|(s, w)| w * libm::j0(s * r)).sum::<f64>()
-        })
-        .collect();
-    Correction {
+    let mut values = Vec::with_capacity(count);
+    for i in 0..count {
+        stop.check()?;
+        let r = i as f64 * step / thickness;
+        values.push(
+            far_scale / thickness * nodes.iter().map(|(s, w)| w * libm::j0(s * r)).sum::<f64>(),
+        );
+    }
+    Ok(Correction {
         step,
         values,
         far,
         far_scale,
-    }
+    })
 }
 
 #[cfg(test)]
@@ -316,13 +323,13 @@ mod tests {
         let layer = Layer::default();
         let (nx, ny, h) = (8, 6, 1e-9);
         let grid = Grid { nx, ny, pixel: h };
-        let influence = Influence::new(&layer, grid);
+        let influence = Influence::new(&layer, grid, Stop::NEVER).unwrap();
         let mut pressure = vec![0.0; nx * ny];
         pressure[0] = 1.0; // a corner pixel
         pressure[3 * ny + 5] = 2.0;
         let w = influence.deflect(&pressure);
         let e_star = contact_modulus(&layer);
-        let corr = correction(&layer, &grid);
+        let corr = correction(&layer, &grid, Stop::NEVER).unwrap();
         let rule = pixel_rule(h, layer.thickness);
         let single = |di: f64, dj: f64| pixel_response(di * h, dj * h, h, e_star, &corr, &rule);
         for (i, j) in [(0, 0), (7, 5), (0, 5), (3, 5), (6, 1), (7, 0)] {

@@ -5,7 +5,7 @@
 //! and, against the axisymmetric solver, the check of the grid's influence.
 
 use super::grid::{Grid, Influence};
-use crate::ModelError;
+use crate::{ModelError, Stop};
 
 /// Iterations allowed: conjugate gradients on N pixels settle in far fewer than N.
 const MAX_ITERATIONS: u32 = 2000;
@@ -89,6 +89,8 @@ pub struct Pressing<'a> {
     pub instant: f64,
     /// The deflection the layer's memory of earlier pressure adds at each pixel.
     pub memory: Option<&'a [f64]>,
+    /// Asked at every iteration whether to stop.
+    pub stop: Stop<'a>,
 }
 
 /// The pressure of `pressing`, from `start` (else uniform on a disc in the grid's middle),
@@ -106,6 +108,7 @@ pub fn press(
         middle,
         instant,
         memory,
+        stop,
     } = *pressing;
     let grid = surface.grid();
     let (ny, count) = (grid.ny, grid.pixels());
@@ -152,6 +155,7 @@ pub fn press(
     let mut deflection = deflect(&pressure);
     let mut exact = true;
     for iteration in 1..=MAX_ITERATIONS {
+        stop.check()?;
         let mut gap: Vec<f64> = deflection
             .iter()
             .zip(&profile)
@@ -346,7 +350,7 @@ mod tests {
             ny: n,
             pixel: a / q,
         };
-        let influence = Influence::new(layer, grid);
+        let influence = Influence::new(layer, grid, Stop::NEVER).unwrap();
         let pressing = Pressing {
             surface: &influence,
             radius,
@@ -354,6 +358,7 @@ mod tests {
             middle: 0.0,
             instant: 1.0,
             memory: None,
+            stop: Stop::NEVER,
         };
         (press(&pressing, None, 1e-10).unwrap(), exact)
     }

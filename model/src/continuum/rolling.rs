@@ -16,7 +16,7 @@
 
 use super::grid::Grid;
 use super::pressed::{press, GridContact, Pressing, Surface};
-use crate::{Layer, ModelError};
+use crate::{Layer, ModelError, Stop};
 
 /// Steps allowed per pixel along x: the history crosses the grid in nx/stride steps, and
 /// settles a pixel a step.
@@ -55,6 +55,8 @@ pub struct Rolled<'a> {
     pub surface: &'a dyn Surface,
     /// x₀ (m), the x of the grid's middle from the sphere's centre.
     pub middle: f64,
+    /// Asked at every step (and every step's every iteration) whether to stop.
+    pub stop: Stop<'a>,
 }
 
 impl Rolled<'_> {
@@ -67,6 +69,7 @@ impl Rolled<'_> {
             middle: self.middle,
             instant: 1.0,
             memory: None,
+            stop: self.stop,
         }
     }
 }
@@ -129,6 +132,7 @@ pub fn roll(rolled: &Rolled, start: Vec<f64>, tolerance: f64) -> Result<RolledCo
     let mut last_change = f64::INFINITY;
     let max_steps = MAX_STEPS_PER_PIXEL * nx;
     for step in 1..=max_steps {
+        rolled.stop.check()?;
         let mut remembered = vec![0.0; nx * ny];
         for (memory, tail) in memories.iter().zip(&tails) {
             for (r, t) in remembered.iter_mut().zip(tail) {
@@ -267,6 +271,7 @@ mod tests {
             layer: &layer,
             surface,
             middle,
+            stop: Stop::NEVER,
         };
         let rest = at_rest(&rolled, None, 1e-9).unwrap();
         roll(&rolled, rest.pressure, 1e-8).unwrap()
@@ -274,7 +279,7 @@ mod tests {
 
     /// The default sphere on the default layer as a continuum, on 64 pixels a side.
     fn continuum(velocity: f64) -> RolledContact {
-        let influence = Influence::new(&Layer::default(), square(64));
+        let influence = Influence::new(&Layer::default(), square(64), Stop::NEVER).unwrap();
         rolled(velocity, &influence, 0.0)
     }
 
@@ -284,7 +289,7 @@ mod tests {
     fn fast_rolling_is_the_instantaneous_elastic_contact() {
         let layer = Layer::default();
         let fast = continuum(2e-5);
-        let influence = Influence::new(&layer, square(64));
+        let influence = Influence::new(&layer, square(64), Stop::NEVER).unwrap();
         let stiff = Pressing {
             surface: &influence,
             radius: 25e-9,
@@ -292,6 +297,7 @@ mod tests {
             middle: 0.0,
             instant: layer.relaxation_time / layer.retardation_time,
             memory: None,
+            stop: Stop::NEVER,
         };
         let instantaneous = press(&stiff, None, 1e-9).unwrap();
         let delta = fast.contact.penetration / instantaneous.penetration - 1.0;
@@ -354,6 +360,7 @@ mod tests {
             layer: &layer,
             surface: &springs,
             middle: 0.0,
+            stop: Stop::NEVER,
         };
         let rest = at_rest(&sphere, None, 1e-11).unwrap();
         let rolled = roll(&sphere, rest.pressure, 1e-10).unwrap();

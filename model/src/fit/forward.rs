@@ -21,8 +21,10 @@
 
 use super::super::continuum;
 use super::super::tables::{self, Use};
-use super::super::three_body::{self, LayerContact, OperatingPoint, ThreeBody, ThreeBodyOptions};
-use super::super::{Layer, ModelError, Quadrature, Rolling, SolveOptions};
+use super::super::three_body::{
+    self, LayerContact, LayerCurves, OperatingPoint, ThreeBody, ThreeBodyOptions,
+};
+use super::super::{Layer, ModelError, Quadrature, Rolling, SolveOptions, Stop};
 
 /// The layer's law the model is solved with.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
@@ -125,8 +127,8 @@ impl Point {
     }
 
     /// The model's value of what was measured, on `layer` under `law`.
-    pub fn value(&self, layer: &Layer, law: Law) -> Result<f64, ModelError> {
-        self.solve(layer, self.velocity, law)
+    pub fn value(&self, layer: &Layer, law: Law, stop: Stop) -> Result<f64, ModelError> {
+        self.solve(layer, self.velocity, law, stop)
     }
 
     /// The value and its sensitivities.
@@ -134,26 +136,33 @@ impl Point {
         &self,
         layer: &Layer,
         law: Law,
+        stop: Stop,
     ) -> Result<(f64, Sensitivity), ModelError> {
-        let y = self.value(layer, law)?;
+        let y = self.value(layer, law, stop)?;
         let sensitivity = match self.setting {
-            Setting::Particle { .. } => self.structured(layer, y, law)?,
-            Setting::System { .. } => self.differenced(layer, y, law)?,
+            Setting::Particle { .. } => self.structured(layer, y, law, stop)?,
+            Setting::System { .. } => self.differenced(layer, y, law, stop)?,
         };
         Ok((y, sensitivity))
     }
 
     /// The sensitivities of a particle, through the similarity structure (see the module
     /// doc): on the local law from g_V and ∂ ln α/∂κ, on the continuum from g_H as well.
-    fn structured(&self, layer: &Layer, y: f64, law: Law) -> Result<Sensitivity, ModelError> {
+    fn structured(
+        &self,
+        layer: &Layer,
+        y: f64,
+        law: Law,
+        stop: Stop,
+    ) -> Result<Sensitivity, ModelError> {
         let log_step = (1.0 + self.step(law)).ln();
         // At rest α = 1 whatever ξ and κ: only A₀ and τ_a depend on the layer.
         let (g, dk) = if self.velocity == 0.0 {
             (0.0, 0.0)
         } else {
-            let faster = self.solve(layer, self.velocity * (1.0 + self.step(law)), law)?;
+            let faster = self.solve(layer, self.velocity * (1.0 + self.step(law)), law, stop)?;
             let g = (faster / y).ln() / log_step;
-            (g, self.kappa_sensitivity(layer, y, law)?)
+            (g, self.kappa_sensitivity(layer, y, law, stop)?)
         };
         let thickness = match law {
             // ln A₀ has ½ ln H, ln ξ has −¼ ln H.
@@ -163,7 +172,7 @@ impl Point {
                     thickness: layer.thickness * (1.0 + self.step(law)),
                     ..*layer
                 };
-                (self.solve(&thicker, self.velocity, law)? / y).ln() / log_step
+                (self.solve(&thicker, self.velocity, law, stop)? / y).ln() / log_step
             }
         };
         let tau = match self.measured {
@@ -179,18 +188,24 @@ impl Point {
     }
 
     /// The sensitivities by forward differences in each of T_σ (κ fixed), κ, E_L and H.
-    fn differenced(&self, layer: &Layer, y: f64, law: Law) -> Result<Sensitivity, ModelError> {
+    fn differenced(
+        &self,
+        layer: &Layer,
+        y: f64,
+        law: Law,
+        stop: Stop,
+    ) -> Result<Sensitivity, ModelError> {
         let step = self.step(law);
         let log_step = (1.0 + step).ln();
         let along = |changed: Layer| -> Result<f64, ModelError> {
-            Ok((self.solve(&changed, self.velocity, law)? / y).ln() / log_step)
+            Ok((self.solve(&changed, self.velocity, law, stop)? / y).ln() / log_step)
         };
         let (relaxation_time, kappa) = if self.velocity == 0.0 {
             (0.0, 0.0)
         } else {
             (
                 along(layer.with_times_scaled(1.0 + step))?,
-                self.kappa_sensitivity(layer, y, law)?,
+                self.kappa_sensitivity(layer, y, law, stop)?,
             )
         };
         Ok(Sensitivity {
@@ -208,7 +223,13 @@ impl Point {
     }
 
     /// ∂ ln y/∂κ at fixed T_σ, by a forward difference.
-    fn kappa_sensitivity(&self, layer: &Layer, y: f64, law: Law) -> Result<f64, ModelError> {
+    fn kappa_sensitivity(
+        &self,
+        layer: &Layer,
+        y: f64,
+        law: Law,
+        stop: Stop,
+    ) -> Result<f64, ModelError> {
         let kappa = layer.kappa();
         // On the continuum κ moves the grid (its pixel follows the stiff layer's contact),
         // so its step is never below the grid's: relative to 1 + κ, not to κ.
@@ -220,10 +241,10 @@ impl Point {
             retardation_time: layer.relaxation_time * (1.0 + kappa + dkappa),
             ..*layer
         };
-        Ok((self.solve(&stiffer, self.velocity, law)? / y).ln() / dkappa)
+        Ok((self.solve(&stiffer, self.velocity, law, stop)? / y).ln() / dkappa)
     }
 
-    fn solve(&self, layer: &Layer, velocity: f64, law: Law) -> Result<f64, ModelError> {
+    fn solve(&self, layer: &Layer, velocity: f64, law: Law, stop: Stop) -> Result<f64, ModelError> {
         match self.setting {
             Setting::Particle { radius, load } => {
                 let rolling = Rolling {
@@ -246,7 +267,7 @@ impl Point {
                         (area, layer.interfacial_shear_strength() * area / load)
                     }
                     Law::Continuum => {
-                        let s = continuum::solve(&rolling, &options)?;
+                        let s = continuum::solve(&rolling, &options, stop)?;
                         (s.contact_area, s.friction_coefficient)
                     }
                 };
@@ -270,7 +291,11 @@ impl Point {
                     },
                     ..system
                 };
-                Ok(three_body::solve(&system, &options)?
+                let curves = match system.layer_contact {
+                    LayerContact::Continuum => Some(LayerCurves::build(&system, stop)?),
+                    _ => None,
+                };
+                Ok(three_body::solve_with(&system, &options, curves.as_ref())?
                     .rolling
                     .friction_coefficient)
             }
@@ -321,7 +346,7 @@ mod tests {
                 velocity,
                 measured,
             };
-            let (y, s) = point.value_and_sensitivity(&base, law).unwrap();
+            let (y, s) = point.value_and_sensitivity(&base, law, Stop::NEVER).unwrap();
             let (h, tolerance) = match law {
                 Law::Local => (1e-4, 1e-4),
                 Law::Continuum => (1e-3, 1e-3),
@@ -336,8 +361,8 @@ mod tests {
                     law,
                 };
                 let x = parameter.of(&base);
-                let up = point.value(&p.layer(&[x * (1.0 + h)]), law).unwrap();
-                let down = point.value(&p.layer(&[x / (1.0 + h)]), law).unwrap();
+                let up = point.value(&p.layer(&[x * (1.0 + h)]), law, Stop::NEVER).unwrap();
+                let down = point.value(&p.layer(&[x / (1.0 + h)]), law, Stop::NEVER).unwrap();
                 let numeric = (up / down).ln() / (2.0 * (1.0 + h).ln());
                 let analytic = p.log_derivatives(&s, base.kappa())[0];
                 assert!(

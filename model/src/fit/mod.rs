@@ -15,7 +15,7 @@ pub use forward::{Law, Measured, Point, Sensitivity, Setting};
 
 use nalgebra::{DMatrix, DVector};
 
-use super::{Layer, ModelError, Parameter};
+use super::{Layer, ModelError, Parameter, Stop};
 use lm::{Evaluation, LeastSquares};
 use stats::Analysis;
 
@@ -229,8 +229,9 @@ pub struct Problem {
 }
 
 impl Problem {
-    /// Why the model fails at the start (no minimisation could begin there).
-    fn failure_at_start(&self) -> ModelError {
+    /// Why the model fails at the start (no minimisation could begin there), stopped when
+    /// `stop` says so.
+    fn failure_at_start(&self, stop: Stop) -> ModelError {
         let start: Vec<f64> = self.bounds.iter().map(|b| b.start).collect();
         let layer = self.parameterization.layer(&start);
         if let Some(e) = layer.violations().into_iter().next() {
@@ -240,7 +241,7 @@ impl Problem {
             .iter()
             .find_map(|d| {
                 d.point
-                    .value_and_sensitivity(&layer, self.parameterization.law)
+                    .value_and_sensitivity(&layer, self.parameterization.law, stop)
                     .err()
             })
             .unwrap_or_else(|| {
@@ -352,7 +353,12 @@ pub fn fit<E>(
         }
     }
     let Some(best) = best else {
-        return Err(FitError::Model(problem.failure_at_start()));
+        let asked = || check().is_err();
+        let failure = problem.failure_at_start(Stop::when(&asked));
+        return Err(match check() {
+            Err(e) if failure == ModelError::Stopped => FitError::Stopped(e),
+            _ => FitError::Model(failure),
+        });
     };
     let n = problem.data.len();
     let dof = n.saturating_sub(start.len());
@@ -403,9 +409,13 @@ impl<E> Residuals<'_, E> {
             return Ok(None);
         };
         let mut cost = 0.0;
+        let asked = || (self.check)().is_err();
         for d in &self.problem.data {
             (self.check)()?;
-            let Ok(y) = d.point.value(&layer, self.problem.parameterization.law) else {
+            let law = self.problem.parameterization.law;
+            let Ok(y) = d.point.value(&layer, law, Stop::when(&asked)) else {
+                // A solve the check stopped is the check's error, not a point outside.
+                (self.check)()?;
                 return Ok(None);
             };
             cost += ((y - d.value) / d.sigma()).powi(2);
@@ -424,10 +434,13 @@ impl<E> LeastSquares for Residuals<'_, E> {
         let (n, m) = (self.problem.data.len(), x.len());
         let mut residuals = DVector::zeros(n);
         let mut jacobian = DMatrix::zeros(n, m);
+        let asked = || (self.check)().is_err();
         for (i, d) in self.problem.data.iter().enumerate() {
             (self.check)()?;
             let law = self.problem.parameterization.law;
-            let Ok((y, s)) = d.point.value_and_sensitivity(&layer, law) else {
+            let Ok((y, s)) = d.point.value_and_sensitivity(&layer, law, Stop::when(&asked)) else {
+                // A solve the check stopped is the check's error, not a point outside.
+                (self.check)()?;
                 return Ok(None);
             };
             let weight = 1.0 / d.sigma();
@@ -503,7 +516,7 @@ mod tests {
                 };
                 Datum {
                     point,
-                    value: point.value(layer, Law::Local).unwrap(),
+                    value: point.value(layer, Law::Local, Stop::NEVER).unwrap(),
                     uncertainty: Some(1e-3),
                 }
             })

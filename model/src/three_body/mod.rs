@@ -21,7 +21,7 @@ use super::tables;
 use super::text::quantity;
 use super::{
     Layer, ModelError, OptionError, Parameter, ParameterError, Quadrature, Rolling,
-    RollingSolution, SolveOption,
+    RollingSolution, SolveOption, Stop,
 };
 
 /// Diameter nodes used when a job does not ask for a number: the particle sums then agree
@@ -430,10 +430,14 @@ impl LayerCurves {
         Ok(Self::from_answers(system, &problems, &answers))
     }
 
-    /// The curves of `system`, solved here one problem after another.
-    pub fn build(system: &ThreeBody) -> Result<LayerCurves, ModelError> {
+    /// The curves of `system`, solved here one problem after another, stopped when `stop`
+    /// says so.
+    pub fn build(system: &ThreeBody, stop: Stop) -> Result<LayerCurves, ModelError> {
         Self::solved_by(system, |problems| {
-            problems.iter().map(PenetrationCurve::solve).collect()
+            problems
+                .iter()
+                .map(|p| PenetrationCurve::solve(p, stop))
+                .collect()
         })
     }
 
@@ -472,7 +476,8 @@ impl LayerCurves {
 }
 
 /// Solves the three-body system (docs/model.md §4); with the `continuum` layer contact,
-/// its curves are built here ([`LayerCurves::build`]; [`solve_with`] takes them built).
+/// its curves are built here, to the end ([`LayerCurves::build`]; [`solve_with`] takes them
+/// built, as a caller that may stop them builds them).
 pub fn solve(
     system: &ThreeBody,
     options: &ThreeBodyOptions,
@@ -481,7 +486,7 @@ pub fn solve(
         return Err(e.into());
     }
     let curves = match system.layer_contact {
-        LayerContact::Continuum => Some(LayerCurves::build(system)?),
+        LayerContact::Continuum => Some(LayerCurves::build(system, Stop::NEVER)?),
         _ => None,
     };
     solve_with(system, options, curves.as_ref())

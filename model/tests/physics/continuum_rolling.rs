@@ -9,10 +9,10 @@ use std::f64::consts::PI;
 use thirdbody_model::continuum::{
     self, contact_modulus, static_contact, ContinuumVerification, THIN,
 };
-use thirdbody_model::{solve, Layer, Rolling, RollingSolution, SolveOptions};
+use thirdbody_model::{solve, Layer, Rolling, RollingSolution, SolveOptions, Stop};
 
 fn answer(rolling: &Rolling) -> RollingSolution<ContinuumVerification> {
-    continuum::solve(rolling, &SolveOptions::integrals_only(Default::default())).unwrap()
+    continuum::solve(rolling, &SolveOptions::integrals_only(Default::default()), Stop::NEVER).unwrap()
 }
 
 /// |got/want − 1|.
@@ -61,7 +61,7 @@ fn the_reported_error_bounds_the_change_to_a_finer_grid() {
             ..Rolling::default()
         };
         let s = answer(&rolling);
-        let finer = continuum::solve_at(&rolling, &options, 18).unwrap();
+        let finer = continuum::solve_at(&rolling, &options, 18, Stop::NEVER).unwrap();
         let e = s.verification.errors;
         let checks = [
             ("δ", off(finer.penetration, s.penetration), e.penetration),
@@ -175,7 +175,7 @@ fn slow_rolling_shifts_the_pressure_by_the_layers_lag() {
             velocity,
             ..Rolling::default()
         };
-        let s = continuum::solve_at(&rolling, &options, 18).unwrap();
+        let s = continuum::solve_at(&rolling, &options, 18, Stop::NEVER).unwrap();
         let layer = rolling.layer;
         let lag = velocity * (layer.retardation_time - layer.relaxation_time);
         let got = s.rolling_resistance_coefficient * rolling.radius;
@@ -261,7 +261,7 @@ fn the_pressure_map_carries_the_load_and_peaks_ahead() {
         pressure_grid: Some(81),
         ..SolveOptions::default()
     };
-    let s = continuum::solve(&rolling, &options).unwrap();
+    let s = continuum::solve(&rolling, &options, Stop::NEVER).unwrap();
     let map = s.pressure.unwrap();
     let step = map.x[1] - map.x[0];
     let edges = s

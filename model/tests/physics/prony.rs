@@ -5,6 +5,7 @@
 //! law on the same series.
 
 use thirdbody_model::continuum;
+use thirdbody_model::Stop;
 use thirdbody_model::limits::{instantaneous, relaxed, slow_rolling};
 use thirdbody_model::spectrum::Terms;
 use thirdbody_model::{solve, Layer, Rolling, RollingSolution, SolveOptions};
@@ -151,14 +152,14 @@ fn on_the_continuum_a_far_slow_term_is_a_spring() {
     let stiff = series(e, (k1, t1), &[(k2, t1 * 1e6)]);
     let spring = series(e * (1.0 + k2), (k1 / (1.0 + k2), t1), &[]);
     let options = SolveOptions::default();
-    let a = continuum::solve(&rolling(v, stiff), &options).unwrap();
-    let b = continuum::solve(&rolling(v, spring), &options).unwrap();
+    let a = continuum::solve(&rolling(v, stiff), &options, Stop::NEVER).unwrap();
+    let b = continuum::solve(&rolling(v, spring), &options, Stop::NEVER).unwrap();
     let (ea, eb) = (&a.verification.errors, &b.verification.errors);
     let area = ea.contact_area + eb.contact_area + 1e-5;
     let delta = ea.penetration + eb.penetration + 1e-5;
     assert!(rel(a.contact_area, b.contact_area) < area, "{a:?} vs {b:?}");
     assert!(rel(a.penetration, b.penetration) < delta);
     // And the series rolls: its area lies between the relaxed and instantaneous ones.
-    let rest = continuum::solve(&rolling(0.0, stiff), &options).unwrap();
+    let rest = continuum::solve(&rolling(0.0, stiff), &options, Stop::NEVER).unwrap();
     assert!(a.contact_area < rest.contact_area);
 }

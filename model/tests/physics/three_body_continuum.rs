@@ -6,7 +6,7 @@ use thirdbody_model::three_body::{
     self, squeeze, LayerContact, LayerCurves, LayerLaw, OperatingPoint, ThreeBody,
     ThreeBodyOptions, UpperLaw,
 };
-use thirdbody_model::{Layer, Rolling, SolveOptions};
+use thirdbody_model::{Layer, Rolling, SolveOptions, Stop};
 
 /// The default system (docs/model.md §5) on the continuum at `velocity` and separation 45 nm.
 fn system(velocity: f64) -> ThreeBody {
@@ -21,7 +21,7 @@ fn system(velocity: f64) -> ThreeBody {
 /// area of the single-particle continuum answer under that force, within the two errors.
 fn particles_agree_with_single_answers(velocity: f64) {
     let system = system(velocity);
-    let curves = LayerCurves::build(&system).unwrap();
+    let curves = LayerCurves::build(&system, Stop::NEVER).unwrap();
     let curve = if velocity > 0.0 {
         &curves.rolling
     } else {
@@ -42,8 +42,7 @@ fn particles_agree_with_single_answers(velocity: f64) {
                 velocity,
                 layer: Layer::default(),
             },
-            &SolveOptions::integrals_only(Default::default()),
-        )
+            &SolveOptions::integrals_only(Default::default()), Stop::NEVER)
         .unwrap();
         let e = single.verification.errors;
         let area_off = (s.layer_area / single.contact_area - 1.0).abs();
@@ -98,8 +97,7 @@ fn particles_of_one_size_give_the_single_particle_friction() {
             velocity: 4e-9,
             layer: Layer::default(),
         },
-        &SolveOptions::integrals_only(Default::default()),
-    )
+        &SolveOptions::integrals_only(Default::default()), Stop::NEVER)
     .unwrap();
     let error = s.verification.layer_contact_error.unwrap();
     let off = (state.friction_coefficient / single.friction_coefficient - 1.0).abs();
@@ -124,7 +122,7 @@ fn particles_of_one_size_give_the_single_particle_friction() {
 #[test]
 fn the_system_reports_its_layer_error_and_follows_eq_12() {
     let system = system(4e-9);
-    let curves = LayerCurves::build(&system).unwrap();
+    let curves = LayerCurves::build(&system, Stop::NEVER).unwrap();
     let s = three_body::solve_with(&system, &ThreeBodyOptions::default(), Some(&curves)).unwrap();
     let error = s.verification.layer_contact_error.unwrap();
     assert!(error > 0.0 && error <= curves.rolling.error().max(curves.resting.error()));
@@ -159,8 +157,7 @@ fn the_curve_interpolates_direct_solves() {
                 velocity: 4e-9,
                 layer,
             },
-            &SolveOptions::integrals_only(Default::default()),
-        )
+            &SolveOptions::integrals_only(Default::default()), Stop::NEVER)
         .unwrap();
         let (force, area) = curve.contact(25e-9, direct.penetration);
         let bound =

@@ -508,7 +508,7 @@ fn curve(
     }
     let mut curve_points = Vec::with_capacity(grid.len());
     for p in grid {
-        let y = control.solve(|| p.value(layer, law))?;
+        let y = control.solve(|stop| p.value(layer, law, stop))?;
         let (friction_coefficient, contact_area) = by_quantity(p.measured, y);
         curve_points.push(CurvePoint {
             at: where_measured(&p),

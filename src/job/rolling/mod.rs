@@ -1,5 +1,6 @@
 //! The rolling job: one particle rolling over the layer (docs/model.md §3).
 
+pub mod continuum;
 mod picture;
 pub use picture::RollingPicture;
 
@@ -15,12 +16,12 @@ use super::meta::{Canonical, CONTINUUM_REFERENCES, ROLLING_REFERENCES};
 use super::points::{self, PointNotes, PointNotesFields, PointStatus, Row, SweepVerification};
 use super::validity::{self, PointValidity, Subject, ValidityOutput};
 use super::{Control, JobError, Kind, Limits, Meta, References, Validated, Work};
-use crate::model::continuum::{self, ContinuumVerification};
+use crate::model::continuum::ContinuumVerification;
 use crate::model::rolling::{BoundaryPoint, PressureGrid, Verification};
 use crate::model::tables::{self, Use};
 use crate::model::validity::Check;
 use crate::model::{
-    self, ModelError, Parameter, Rolling, RollingSolution, SolveOption, SolveOptions,
+    self, ModelError, Parameter, Rolling, RollingSolution, SolveOption, SolveOptions, Stop,
 };
 use crate::render::{fields, Column, Field, Fields, Output, Table, UnitTable};
 use crate::{described, unit_table};
@@ -114,11 +115,14 @@ impl RollingJob {
     }
 
     /// The contact `point` (this job's, or a sweep's point over it) solved under the job's
-    /// law and options: the local law through its similarity table as `method` allows.
-    pub fn solve(&self, point: &Rolling, method: Use) -> Result<Solved, ModelError> {
+    /// law and options: the local law through its similarity table as `method` allows, the
+    /// continuum stopped when `stop` says so.
+    pub fn solve(&self, point: &Rolling, method: Use, stop: Stop) -> Result<Solved, ModelError> {
         match self.law {
             LayerModel::Local => tables::solve(point, &self.options, method).map(Solved::Local),
-            LayerModel::Continuum => continuum::solve(point, &self.options).map(Solved::Continuum),
+            LayerModel::Continuum => {
+                model::continuum::solve(point, &self.options, stop).map(Solved::Continuum)
+            }
         }
     }
 
@@ -141,8 +145,17 @@ impl Kind for RollingJob {
     type Picture = RollingPicture;
     type Output = RollingOutput;
 
+    /// On the continuum, a job whose answer would pass the grid's cap is refused here.
     fn validate(input: Value, _limits: &Limits) -> Result<Validated<Self>, JobError> {
-        input::validate(input, RollingJob::read)
+        input::validate(input, |input, checker| {
+            let job = RollingJob::read(input, checker);
+            if job.law == LayerModel::Continuum && job.rolling.violations().is_empty() {
+                let rolling = job.rolling;
+                let problems = |layer: &model::Layer| vec![Rolling { layer: *layer, ..rolling }];
+                continuum::check(&rolling.layer, &problems, checker);
+            }
+            job
+        })
     }
 
     /// A valid input itself.
@@ -196,7 +209,7 @@ impl Kind for RollingJob {
     }
 
     fn run(&self, meta: Meta, control: &Control) -> Result<RollingOutput, JobError> {
-        let solution = control.solve(|| self.solve(&self.rolling, Use::IfBuilt))?;
+        let solution = control.solve(|stop| self.solve(&self.rolling, Use::IfBuilt, stop))?;
         // Solved exactly, as the first answer on a layer is: the table for the answers after
         // it is built off this request's path.
         let local = self.law == LayerModel::Local;

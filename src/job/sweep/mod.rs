@@ -26,7 +26,7 @@ use crate::model::tables::Use;
 use crate::model::three_body::{
     Diameters, LayerContact, OperatingPoint, ThreeBody, ThreeBodySolution,
 };
-use crate::model::{Parameter, Rolling, SolveOptions, MODEL_VERSION};
+use crate::model::{Parameter, Rolling, SolveOptions, Stop, MODEL_VERSION};
 use crate::render::{self, Fields, Output, Table, UnitTable};
 use crate::{described, unit_table};
 
@@ -250,7 +250,8 @@ impl Kind for SweepJob {
                 let (options, law) = (&base.options, base.law);
                 let method = Use::for_solves(all.len(), options.quadrature);
                 let contacts = part(all, range)?;
-                let solve = |p: &Rolling| base.solve(p, method);
+                let asked = || control.must_stop();
+                let solve = |p: &Rolling| base.solve(p, method, Stop::when(&asked));
                 let swept = if method == Use::Build && law == LayerModel::Local {
                     // A point costs a microsecond: cheaper to solve again than to keep.
                     control.map_each(&contacts, on_refusal, |p| SweepPoint::new(p, &solve(p)?))

@@ -15,14 +15,16 @@ use super::input::{self, field, Checker, LayerInput, QuadratureKind, Quantity};
 use super::meta::{Canonical, REFERENCES, THREE_BODY_CONTINUUM_REFERENCES};
 use super::points::{self, PointNotes, PointNotesFields, PointStatus, Row, SweepVerification};
 use super::validity::{self, PointValidity, Subject, ValidityOutput};
-use super::{Control, JobError, Kind, Limits, Meta, References, Validated, Work};
+use super::{rolling, Control, JobError, Kind, Limits, Meta, References, Validated, Work};
 use crate::model::continuum::{ContinuumVerification, PenetrationCurve};
 use crate::model::three_body::{
     self, Asperities, ContactState, Diameters, LayerContact, LayerCurves, OperatingPoint, Particle,
     ThreeBody, ThreeBodyOptions, ThreeBodySolution, UpperContact, UpperSurface,
     DEFAULT_DIAMETER_NODES,
 };
-use crate::model::{ModelError, Parameter, Rolling, RollingSolution, SolveOption, MODEL_VERSION};
+use crate::model::{
+    Layer, ModelError, Parameter, Rolling, RollingSolution, SolveOption, Stop, MODEL_VERSION,
+};
 use crate::render::{fields, Column, Output, Table, UnitTable};
 use crate::{described, unit_table};
 
@@ -437,8 +439,19 @@ impl Kind for ThreeBodyJob {
     type Picture = ThreeBodyPicture;
     type Output = ThreeBodyOutput;
 
+    /// On the continuum, a system one of whose layer curves' nodes would pass the grid's
+    /// cap is refused here.
     fn validate(input: Value, _limits: &Limits) -> Result<Validated<Self>, JobError> {
-        input::validate(input, ThreeBodyJob::read)
+        input::validate(input, |input, checker| {
+            let job = ThreeBodyJob::read(input, checker);
+            let system = job.system;
+            if system.layer_contact == LayerContact::Continuum && system.violations().is_empty()
+            {
+                let problems = |layer: &Layer| LayerCurves::problems(&ThreeBody { layer: *layer, ..system });
+                rolling::continuum::check(&system.layer, &problems, checker);
+            }
+            job
+        })
     }
 
     /// A valid input itself.
@@ -475,7 +488,7 @@ impl Kind for ThreeBodyJob {
             _ => None,
         };
         let solution = control
-            .solve(|| three_body::solve_with(&self.system, &self.options, curves.as_ref()))?;
+            .solve(|_| three_body::solve_with(&self.system, &self.options, curves.as_ref()))?;
         ThreeBodyOutput::new(&self.system, &solution, meta)
     }
 }
@@ -507,7 +520,10 @@ pub fn kept_node(
     control.kept(
         |p: &Rolling| format!("{MODEL_VERSION} continuum curve node {p:?}"),
         |_| std::mem::size_of::<RollingSolution<ContinuumVerification>>(),
-        PenetrationCurve::solve,
+        move |p: &Rolling| {
+            let asked = || control.must_stop();
+            PenetrationCurve::solve(p, Stop::when(&asked))
+        },
     )
 }
 
