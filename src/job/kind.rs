@@ -38,6 +38,65 @@ impl Work {
     }
 }
 
+/// What a job is estimated to cost before it runs: the points a quota charges for it and the
+/// working memory its solve holds at once, which the engine sets aside before the solve
+/// allocates it.
+///
+/// A point is about ten microseconds of a solver thread, a local-law answer's work: a local
+/// sweep costs a point a point, as it always has, and a continuum answer what its grids
+/// cost ([`Cost::continuum`]: 7,000 points on the default grid, up to about 800,000 on the
+/// largest). An iterative job estimates its iterations; what it really took is charged
+/// after it ran ([`Cost::of_time`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Cost {
+    pub points: u64,
+    /// Bytes.
+    pub bytes: u64,
+}
+
+/// Points of a continuum answer a reference cost ([`crate::model::continuum::Plan::cost`]:
+/// three marches on 4,096 fine pixels): about 20 ms in a release build.
+const CONTINUUM_POINTS: f64 = 2000.0;
+
+/// A point's time on a solver thread.
+pub const POINT_TIME: std::time::Duration = std::time::Duration::from_micros(10);
+
+impl Cost {
+    /// `points` of work that holds no memory worth counting.
+    pub fn points(points: u64) -> Cost {
+        Cost { points, bytes: 0 }
+    }
+
+    /// A continuum answer's, as `plan` sizes it (a point at least).
+    pub fn continuum(plan: &crate::model::continuum::Plan) -> Cost {
+        Cost {
+            points: (plan.cost() * CONTINUUM_POINTS).ceil().max(1.0) as u64,
+            bytes: plan.bytes(),
+        }
+    }
+
+    /// This and `other` one after the other: their points, the larger memory.
+    pub fn then(self, other: Cost) -> Cost {
+        Cost {
+            points: self.points.saturating_add(other.points),
+            bytes: self.bytes.max(other.bytes),
+        }
+    }
+
+    /// This `times` over, one after the other.
+    pub fn times(self, times: u64) -> Cost {
+        Cost {
+            points: self.points.saturating_mul(times),
+            bytes: self.bytes,
+        }
+    }
+
+    /// The points `time` on a solver thread is worth (what a job really cost).
+    pub fn of_time(time: std::time::Duration) -> u64 {
+        (time.as_nanos() / POINT_TIME.as_nanos()).max(1) as u64
+    }
+}
+
 /// A job of kind `K` as validated, and what was implausible in its input.
 #[derive(Debug)]
 pub struct Validated<K> {
@@ -84,6 +143,12 @@ pub trait Kind: fmt::Debug + PartialEq + Send + Sync + Sized + 'static {
 
     /// The work the job takes.
     fn work(&self) -> Work;
+
+    /// What the job is estimated to cost ([`Cost`]): by default a point per unit of work,
+    /// and no memory worth counting.
+    fn cost(&self) -> Cost {
+        Cost::points(self.work().units() as u64)
+    }
 
     /// The jobs whose solve times estimate this one's cost per unit of work (admission by
     /// cost): the kind, unless its units cost differently within it.
@@ -277,6 +342,8 @@ impl<K: Kind> Dispatch for K {
 pub struct Job {
     kind: Arc<dyn Dispatch>,
     warnings: Vec<InputWarning>,
+    /// Estimated once, where the job is validated (a continuum sweep plans every point).
+    cost: Cost,
 }
 
 impl Job {
@@ -288,6 +355,7 @@ impl Job {
     /// A validated job of kind `K`, with its input's warnings.
     pub fn validated<K: Kind>(validated: Validated<K>) -> Job {
         Job {
+            cost: validated.job.cost(),
             kind: Arc::new(validated.job),
             warnings: validated.warnings,
         }
@@ -335,6 +403,11 @@ impl Job {
     /// The work the job takes.
     pub fn work(&self) -> Work {
         self.kind.work()
+    }
+
+    /// What it is estimated to cost ([`Kind::cost`]).
+    pub fn cost(&self) -> Cost {
+        self.cost
     }
 
     /// Bytes its answer takes at most, in JSON and CSV ([`Kind::result_bytes`]).

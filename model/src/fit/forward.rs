@@ -40,7 +40,7 @@ pub enum Law {
 impl Law {
     /// The law a point is solved with under the fit's law: a three-body system whose layer
     /// contact is the continuum's is on the continuum whatever the fit's law.
-    fn at(self, setting: &Setting) -> Law {
+    pub fn at(self, setting: &Setting) -> Law {
         match setting {
             Setting::System { system, .. } if system.layer_contact == LayerContact::Continuum => {
                 Law::Continuum
@@ -123,6 +123,19 @@ impl Point {
                 STATIC_CONTINUUM_STEP
             }
             (Law::Continuum, _) => CONTINUUM_STEP,
+        }
+    }
+
+    /// The solves a value with its sensitivities takes ([`Point::value_and_sensitivity`]):
+    /// the value's, and for a particle one each for its speed and κ when it rolls and its
+    /// thickness on the continuum; for a system one each for E_L and H, and T_σ and κ when
+    /// it rolls.
+    pub fn solves_with_sensitivity(&self, law: Law) -> u64 {
+        let rolls = u64::from(self.velocity > 0.0);
+        match (self.setting, law.at(&self.setting)) {
+            (Setting::Particle { .. }, Law::Local) => 1 + 2 * rolls,
+            (Setting::Particle { .. }, Law::Continuum) => 2 + 2 * rolls,
+            (Setting::System { .. }, _) => 3 + 2 * rolls,
         }
     }
 

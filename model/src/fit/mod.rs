@@ -293,6 +293,19 @@ pub enum FitError<E> {
 /// Minimisations run: from the given start and from the best other candidate.
 const STARTS: usize = 2;
 
+/// Steps a minimisation is expected to take ([`expected_evaluations`]); at most
+/// [`lm`]'s 200.
+const EXPECTED_STEPS: u64 = 20;
+
+/// How often a fit of `problem` is expected to evaluate its model at every datum, before it
+/// runs: its value alone at each candidate start (the start and the corners of the box's
+/// middle half), and with its sensitivities at each step of each minimisation. An estimate
+/// of its work for a quota, which charges what the fit really took after it.
+pub fn expected_evaluations(problem: &Problem) -> (u64, u64) {
+    let candidates = 1 + (1u64 << problem.bounds.len().min(32));
+    (candidates, STARTS as u64 * EXPECTED_STEPS)
+}
+
 /// Fits `problem`. `check` is called before each point is evaluated (one to five solves);
 /// an error from it stops the fit.
 /// The fit of `problem`, checking `check` between evaluations of the model. Stopped by it

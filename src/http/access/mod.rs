@@ -244,11 +244,11 @@ pub async fn charge_all(state: &AppState, caller: &Caller, jobs: &[Keyed]) -> Re
     if limit == 0 {
         return Ok(());
     }
-    // A sweep's or a figure's points, one for a single contact or a fit.
+    // What each job is estimated to cost (`Cost`: a point a local answer).
     let mut points = 0;
     for keyed in jobs {
         if state.engine().cached(keyed.key()).await.is_none() {
-            points += keyed.job().work().units() as u64;
+            points += keyed.job().cost().points;
         }
     }
     if points == 0 {

@@ -28,10 +28,43 @@ pub use output::{
 use super::input as wire;
 use super::kind::SMALL_ANSWER;
 use super::meta::{CONTINUUM_REFERENCES, ROLLING_REFERENCES};
-use super::{Control, FieldError, JobError, Kind, Limits, Meta, References, Validated, Work};
+use super::three_body::{system_cost, Nodes};
+use super::{
+    Control, Cost, FieldError, JobError, Kind, Limits, Meta, References, Validated, Work,
+};
 use crate::model::fit::stats;
 use crate::model::fit::{self, Datum, FitError, Fitted, Law, Point, Problem, Setting};
-use crate::model::Layer;
+use crate::model::continuum;
+use crate::model::three_body::{LayerContact, ThreeBody};
+use crate::model::{Layer, Rolling};
+
+/// What one solve of `point` on `layer` costs under the fit's `law`: a grid's answer for a
+/// rolling particle on the continuum, a system's continuum curves, a point otherwise (a
+/// particle at rest on the continuum is a table's).
+fn solve_cost(point: &Point, layer: &Layer, law: Law) -> Cost {
+    match (point.setting, law.at(&point.setting)) {
+        (Setting::Particle { radius, load }, Law::Continuum) if point.velocity > 0.0 => {
+            let rolling = Rolling {
+                radius,
+                load,
+                velocity: point.velocity,
+                layer: *layer,
+            };
+            continuum::plan(&rolling, continuum::PER_RADIUS)
+                .map_or(Cost::points(1), |plan| Cost::continuum(&plan))
+        }
+        (Setting::System { system, .. }, Law::Continuum) => {
+            let system = ThreeBody {
+                layer: *layer,
+                velocity: point.velocity,
+                layer_contact: LayerContact::Continuum,
+                ..system
+            };
+            system_cost(&system, &mut Nodes::default())
+        }
+        _ => Cost::points(1),
+    }
+}
 
 /// A validated fit.
 #[derive(Clone, Debug, PartialEq)]
@@ -122,6 +155,24 @@ impl Kind for FitJob {
 
     fn work(&self) -> Work {
         Work::Unknown
+    }
+
+    /// Its expected evaluations of the model ([`fit::expected_evaluations`]) at every datum,
+    /// each of so many solves, each what a solve of the datum costs at the start.
+    fn cost(&self) -> Cost {
+        let problem = &self.problem;
+        let (values, with_sensitivities) = fit::expected_evaluations(problem);
+        let law = problem.parameterization.law;
+        let start: Vec<f64> = problem.bounds.iter().map(|b| b.start).collect();
+        let layer = problem.parameterization.layer(&start);
+        problem
+            .data
+            .iter()
+            .map(|d| {
+                let solves = values + with_sensitivities * d.point.solves_with_sensitivity(law);
+                solve_cost(&d.point, &layer, law).times(solves)
+            })
+            .fold(Cost::default(), Cost::then)
     }
 
     /// A residual is a row of a dozen numbers in JSON and CSV (at most 1 kB), a fitted curve

@@ -15,7 +15,7 @@ use super::kind::SMALL_ANSWER;
 use super::meta::{Canonical, CONTINUUM_REFERENCES, ROLLING_REFERENCES};
 use super::points::{self, PointNotes, PointNotesFields, PointStatus, Row, SweepVerification};
 use super::validity::{self, PointValidity, Subject, ValidityOutput};
-use super::{Control, JobError, Kind, Limits, Meta, References, Validated, Work};
+use super::{Control, Cost, JobError, Kind, Limits, Meta, References, Validated, Work};
 use crate::model::continuum::ContinuumVerification;
 use crate::model::rolling::{BoundaryPoint, PressureGrid, Verification};
 use crate::model::tables::{self, Use};
@@ -126,6 +126,16 @@ impl RollingJob {
         }
     }
 
+    /// What solving `point` (this job's, or a sweep's point over it) costs: a point on the
+    /// local law, what its grids cost on the continuum.
+    pub fn cost_of(&self, point: &Rolling) -> Cost {
+        match self.law {
+            LayerModel::Local => Cost::points(1),
+            LayerModel::Continuum => model::continuum::plan(point, model::continuum::PER_RADIUS)
+                .map_or(Cost::points(1), |plan| Cost::continuum(&plan)),
+        }
+    }
+
     /// The input that gives this job: every field, in SI.
     pub fn input(&self) -> RollingInput {
         let r = &self.rolling;
@@ -176,6 +186,10 @@ impl Kind for RollingJob {
 
     fn work(&self) -> Work {
         Work::Known(1)
+    }
+
+    fn cost(&self) -> Cost {
+        self.cost_of(&self.rolling)
     }
 
     /// A continuum answer costs a hundred times a local one.

@@ -17,11 +17,13 @@ use super::kind::SMALL_ANSWER;
 use super::points::{self, SweepSummary};
 use super::rolling::{RollingInput, RollingJob, Solved};
 use super::three_body::{
-    operating_fields, references as three_body_references, slot, solve_kept, ThreeBodyInput,
-    ThreeBodyJob,
+    operating_fields, references as three_body_references, slot, solve_kept, system_cost, Nodes,
+    ThreeBodyInput, ThreeBodyJob,
 };
 use super::validity::Subject;
-use super::{Control, JobError, Kind, Limits, Meta, OnRefusal, References, Swept, Validated, Work};
+use super::{
+    Control, Cost, JobError, Kind, Limits, Meta, OnRefusal, References, Swept, Validated, Work,
+};
 use crate::model::tables::Use;
 use crate::model::three_body::{
     Diameters, LayerContact, OperatingPoint, ThreeBody, ThreeBodySolution,
@@ -197,6 +199,25 @@ impl Kind for SweepJob {
 
     fn work(&self) -> Work {
         self.size().map_or(Work::Unknown, Work::Known)
+    }
+
+    /// Each point's, its continuum nodes shared with the points before it as the memo
+    /// shares them.
+    fn cost(&self) -> Cost {
+        match &self.points {
+            SweepOfPoints::Rolling(s) => s
+                .points()
+                .iter()
+                .map(|p| s.base.cost_of(p))
+                .fold(Cost::default(), Cost::then),
+            SweepOfPoints::ThreeBody(s) => {
+                let mut counted = Nodes::default();
+                s.points()
+                    .iter()
+                    .map(|p| system_cost(p, &mut counted))
+                    .fold(Cost::default(), Cost::then)
+            }
+        }
     }
 
     /// A three-body point costs a hundred rolling points, a continuum point more.

@@ -4,6 +4,7 @@
 mod picture;
 pub use picture::ThreeBodyPicture;
 
+use std::collections::HashSet;
 use std::sync::LazyLock;
 
 use serde::{Deserialize, Serialize};
@@ -15,8 +16,10 @@ use super::input::{self, field, Checker, LayerInput, QuadratureKind, Quantity};
 use super::meta::{Canonical, REFERENCES, THREE_BODY_CONTINUUM_REFERENCES};
 use super::points::{self, PointNotes, PointNotesFields, PointStatus, Row, SweepVerification};
 use super::validity::{self, PointValidity, Subject, ValidityOutput};
-use super::{rolling, Control, JobError, Kind, Limits, Meta, References, Validated, Work};
-use crate::model::continuum::{ContinuumVerification, PenetrationCurve};
+use super::{
+    rolling, Control, Cost, JobError, Kind, Limits, Meta, References, Validated, Work,
+};
+use crate::model::continuum::{self, ContinuumVerification, PenetrationCurve};
 use crate::model::three_body::{
     self, Asperities, ContactState, Diameters, LayerContact, LayerCurves, OperatingPoint, Particle,
     ThreeBody, ThreeBodyOptions, ThreeBodySolution, UpperContact, UpperSurface,
@@ -472,6 +475,10 @@ impl Kind for ThreeBodyJob {
         Work::Known(1 + self.continuum_problems().len())
     }
 
+    fn cost(&self) -> Cost {
+        system_cost(&self.system, &mut Nodes::default())
+    }
+
     /// A system on the continuum costs a second, a thousand times one on the local law.
     fn cost_class(&self) -> &'static str {
         match self.system.layer_contact {
@@ -510,6 +517,41 @@ pub fn references(system: &ThreeBody) -> &'static References {
         LayerContact::Continuum => &THREE_BODY_CONTINUUM_REFERENCES,
         _ => &REFERENCES,
     }
+}
+
+/// The nodes of continuum layer curves counted already (as a job's memo shares them):
+/// their sphere, load and speed, and their layer's modulus, thickness and times.
+pub type Nodes = HashSet<[u64; 7]>;
+
+/// What solving `system` costs: a point, and on the continuum each node of its layer's
+/// curves not in `counted` (which it joins) as the continuum answer it is.
+pub fn system_cost(system: &ThreeBody, counted: &mut Nodes) -> Cost {
+    let nodes = match system.layer_contact {
+        LayerContact::Continuum => LayerCurves::problems(system),
+        _ => Vec::new(),
+    };
+    nodes
+        .iter()
+        .filter(|p| {
+            let l = &p.layer;
+            counted.insert(
+                [
+                    p.radius,
+                    p.load,
+                    p.velocity,
+                    l.elastic_modulus,
+                    l.thickness,
+                    l.relaxation_time,
+                    l.retardation_time,
+                ]
+                .map(f64::to_bits),
+            )
+        })
+        .map(|p| {
+            continuum::plan(p, continuum::PER_RADIUS)
+                .map_or(Cost::points(1), |plan| Cost::continuum(&plan))
+        })
+        .fold(Cost::points(1), Cost::then)
 }
 
 /// Solves one node of a continuum layer curve, kept in `control`'s memo: every system on
