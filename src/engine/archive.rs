@@ -29,6 +29,10 @@ use crate::job::{JobError, Work};
 /// The database path that keeps nothing past the process (SQLite's own name for it).
 pub const IN_MEMORY: &str = ":memory:";
 
+/// How to go on from a damaged database, said when it is refused at start-up.
+const DAMAGED: &str = ": the database is damaged; move the file aside (its saved analyses are \
+                       then not listed) or restore it from a backup, and start again";
+
 /// The tables: jobs (small rows, listed) and their results (large, read one at a time).
 const SCHEMA: &str = "
 CREATE TABLE IF NOT EXISTS jobs (
@@ -67,12 +71,21 @@ const COLUMNS: &str = "id, owner, kind, status, done, total, input_hash, submitt
 pub struct Archive {
     db: Mutex<Connection>,
     retention: Duration,
-    durable: bool,
+    /// The file and its identity (device, inode) when it was opened; none in memory.
+    file: Option<(String, (u64, u64))>,
+}
+
+/// A file's device and inode: what tells it from another put in its place.
+fn identity(path: &str) -> std::io::Result<(u64, u64)> {
+    use std::os::unix::fs::MetadataExt;
+    let meta = std::fs::metadata(path)?;
+    Ok((meta.dev(), meta.ino()))
 }
 
 impl Archive {
     /// Opens (or creates) the database at `path` (a file, or [`IN_MEMORY`]), keeping finished
-    /// jobs for `retention`. Jobs an earlier run left unfinished are marked interrupted:
+    /// jobs for `retention`, after a quick check of its integrity (a damaged file is refused,
+    /// saying how to go on). Jobs an earlier run left unfinished are marked interrupted:
     /// that run stopped before they ended.
     pub fn open(path: &str, retention: Duration) -> Result<Arc<Archive>, String> {
         let failed = |e: rusqlite::Error| {
@@ -80,6 +93,9 @@ impl Archive {
                 Some(rusqlite::ErrorCode::DatabaseBusy | rusqlite::ErrorCode::DatabaseLocked) => {
                     ": another thirdbody process has it open (give each process its own \
                      --database; a fleet keeps its history in Redis)"
+                }
+                Some(rusqlite::ErrorCode::DatabaseCorrupt | rusqlite::ErrorCode::NotADatabase) => {
+                    DAMAGED
                 }
                 _ => "",
             };
@@ -95,12 +111,21 @@ impl Archive {
             }
         }
         let db = Connection::open(path).map_err(failed)?;
+        // WAL with synchronous NORMAL: a transaction committed is in the file's log before
+        // the call returns, so a killed process loses nothing; the log is synced to the disk
+        // at each checkpoint, so a power cut may lose the last transactions (RELIABILITY.md).
         db.execute_batch(
             "PRAGMA locking_mode = EXCLUSIVE;
              PRAGMA journal_mode = WAL;
              PRAGMA synchronous = NORMAL;",
         )
         .map_err(failed)?;
+        let check: String = db
+            .query_row("PRAGMA quick_check", [], |row| row.get(0))
+            .map_err(failed)?;
+        if check != "ok" {
+            return Err(format!("--database {path}: {check}{DAMAGED}"));
+        }
         db.execute_batch(SCHEMA).map_err(failed)?;
         let added: i64 = db
             .query_row(
@@ -126,10 +151,17 @@ impl Archive {
                 "jobs left unfinished by the last run are marked interrupted"
             );
         }
+        let file = match durable {
+            true => Some((
+                path.to_string(),
+                identity(path).map_err(|e| format!("--database {path}: {e}"))?,
+            )),
+            false => None,
+        };
         let archive = Arc::new(Archive {
             db: Mutex::new(db),
             retention,
-            durable,
+            file,
         });
         archive.purge().map_err(failed)?;
         Ok(archive)
@@ -141,7 +173,23 @@ impl Archive {
 
     /// Whether the database is a file (it outlives the process).
     pub fn durable(&self) -> bool {
-        self.durable
+        self.file.is_some()
+    }
+
+    /// Why what is written now would be lost at a restart, if it would: the file opened was
+    /// removed or replaced while the process runs (it writes to the file it opened, which no
+    /// path names any more).
+    pub fn moved(&self) -> Option<String> {
+        let (path, opened) = self.file.as_ref()?;
+        let now = identity(path);
+        if now.as_ref().is_ok_and(|now| now == opened) {
+            return None;
+        }
+        let what = if now.is_err() { "removed" } else { "replaced" };
+        Some(format!(
+            "the database of saved analyses {path} was {what} while the service runs: what it \
+             saves now is lost at a restart; restart the service to open the file at that path"
+        ))
     }
 
     /// The earliest end (Unix ms) of a job still within its retention.
@@ -378,6 +426,7 @@ impl Archive {
             submitted_at: time(row.get(7)?),
             finished_at: row.get::<_, Option<i64>>(8)?.map(time),
             result_bytes: u64::try_from(row.get::<_, i64>(11)?).unwrap_or(0),
+            unsaved: false,
         }))
     }
 }

@@ -1,13 +1,17 @@
-//! One memory budget for everything the service keeps between requests: cached answers, the
-//! results of finished jobs, the input memo and the solved points of sweeps. Each part is
-//! bounded in bytes (estimated, with a fixed overhead per entry), so the process stays within
-//! the budget plus a fixed overhead whatever the traffic.
+//! One memory budget for everything the service keeps between requests (cached answers, the
+//! results of finished jobs, the input memo and the solved points of sweeps) and for what
+//! its solves hold while they run. Each part is bounded in bytes (estimated, with a fixed
+//! overhead per entry), so the process stays within the budget plus a fixed overhead
+//! whatever the traffic.
 
 /// The budget's shares, in bytes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Budget {
-    /// Cached answers (3/4).
+    /// Cached answers (9/16).
     pub answers: u64,
+    /// The working memory of the solves running (3/16): each sets aside its estimate
+    /// before it allocates ([`crate::job::Cost::bytes`], [`super::pool::Pool`]).
+    pub solves: u64,
     /// Results kept by finished asynchronous jobs beyond the cache (3/16).
     pub job_results: u64,
     /// The input memo: input text → cache key (1/32).
@@ -21,7 +25,8 @@ impl Budget {
     pub fn split(total: u64) -> Budget {
         let part = |numerator: u64, denominator: u64| total / denominator * numerator;
         Budget {
-            answers: part(3, 4),
+            answers: part(9, 16),
+            solves: part(3, 16),
             job_results: part(3, 16),
             inputs: part(1, 32),
             points: part(1, 32),
@@ -46,6 +51,9 @@ mod tests {
     #[test]
     fn the_shares_add_up_to_the_budget() {
         let b = Budget::split(256 << 20);
-        assert_eq!(b.answers + b.job_results + b.inputs + b.points, 256 << 20);
+        assert_eq!(
+            b.answers + b.solves + b.job_results + b.inputs + b.points,
+            256 << 20
+        );
     }
 }

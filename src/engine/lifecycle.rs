@@ -305,6 +305,11 @@ impl Lifecycle {
         }
     }
 
+    /// Why the job store cannot keep new jobs now, if it cannot.
+    pub(super) fn store_problem(&self) -> Option<String> {
+        self.jobs.problem()
+    }
+
     /// The reachability of each Redis role, when the engine works in a fleet.
     pub(super) fn fleet_health(&self) -> Option<[(&'static str, Health); 2]> {
         self.fleet.as_ref().map(|shared| shared.fleet.health())
@@ -508,7 +513,7 @@ impl Lifecycle {
                 () = live.cancel.cancelled() => Err(live.stopped(None)),
                 permits = async {
                     let slot = self.job_slots.clone().acquire_owned().await;
-                    (slot, self.solver.permit().await)
+                    (slot, self.solver.permit(keyed.job().cost().bytes).await)
                 } => Ok(permits),
             },
         };

@@ -1,7 +1,9 @@
 //! Admission control for the compute threads: one permit per solver thread, sized to the
-//! cores. A synchronous request that finds no permit free is refused at once (the caller
-//! answers 429) rather than queued without bound; an asynchronous job waits for one in the
-//! job store's bounded queue.
+//! cores, and the working memory a solve holds, set aside from the memory budget's share
+//! before it allocates ([`crate::job::Cost::bytes`]: a continuum answer holds up to 34 MB).
+//! A synchronous request that finds no thread or not memory enough free is refused at once
+//! (the caller answers 429) rather than queued without bound; an asynchronous job waits for
+//! both in the job store's bounded queue.
 
 use std::sync::Arc;
 
@@ -9,32 +11,66 @@ use tokio::sync::{OwnedSemaphorePermit, Semaphore};
 
 use crate::job::{Control, JobError};
 
-/// The permits of the solver threads.
+/// The permits of the solver threads, and of the working memory, in KiB.
 #[derive(Clone, Debug)]
 pub struct Pool {
     permits: Arc<Semaphore>,
+    memory: Arc<Semaphore>,
+    /// The memory's permits in all.
+    memory_kib: u32,
+}
+
+/// A solve's right to run: its thread, and its working memory (none when it holds little).
+#[derive(Debug)]
+pub struct Permit {
+    _thread: OwnedSemaphorePermit,
+    _memory: Option<OwnedSemaphorePermit>,
 }
 
 impl Pool {
-    /// A pool of `size` permits (at least one).
-    pub fn new(size: usize) -> Self {
+    /// A pool of `size` thread permits (at least one) and `memory` bytes of working memory.
+    pub fn new(size: usize, memory: u64) -> Self {
+        let memory_kib = u32::try_from(memory >> 10).unwrap_or(u32::MAX).max(1);
         Pool {
             permits: Arc::new(Semaphore::new(size.max(1))),
+            memory: Arc::new(Semaphore::new(memory_kib as usize)),
+            memory_kib,
         }
     }
 
-    /// A permit if one is free now.
-    pub fn try_acquire(&self) -> Option<OwnedSemaphorePermit> {
-        self.permits.clone().try_acquire_owned().ok()
+    /// The memory permits a solve of `bytes` takes: all of them for a solve larger than the
+    /// whole share, which then runs alone.
+    fn kib(&self, bytes: u64) -> u32 {
+        u32::try_from(bytes.div_ceil(1024))
+            .unwrap_or(u32::MAX)
+            .min(self.memory_kib)
     }
 
-    /// Waits for a permit (first come, first served).
-    pub async fn acquire(&self) -> OwnedSemaphorePermit {
-        self.permits
-            .clone()
-            .acquire_owned()
-            .await
-            .expect("the pool's semaphore is never closed")
+    /// A thread and `bytes` of working memory if both are free now.
+    pub fn try_acquire(&self, bytes: u64) -> Option<Permit> {
+        let thread = self.permits.clone().try_acquire_owned().ok()?;
+        let memory = match self.kib(bytes) {
+            0 => None,
+            kib => Some(self.memory.clone().try_acquire_many_owned(kib).ok()?),
+        };
+        Some(Permit {
+            _thread: thread,
+            _memory: memory,
+        })
+    }
+
+    /// Waits for a thread, then for `bytes` of working memory (first come, first served).
+    pub async fn acquire(&self, bytes: u64) -> Permit {
+        let closed = "the pool's semaphores are never closed";
+        let thread = self.permits.clone().acquire_owned().await.expect(closed);
+        let memory = match self.kib(bytes) {
+            0 => None,
+            kib => Some(self.memory.clone().acquire_many_owned(kib).await.expect(closed)),
+        };
+        Permit {
+            _thread: thread,
+            _memory: memory,
+        }
     }
 
     /// Runs `work` on a blocking thread (below the async threads, [`super::heavy`]) that holds `permit` until it returns, inside the
@@ -42,7 +78,7 @@ impl Pool {
     /// out), `control` is cancelled: the solver stops at its next check instead of burning a
     /// core for nobody.
     pub async fn run<T, F>(
-        permit: OwnedSemaphorePermit,
+        permit: Permit,
         control: Arc<Control>,
         work: F,
     ) -> Result<T, JobError>
@@ -76,5 +112,28 @@ impl Drop for CancelOnDrop {
         if let Some(control) = &self.0 {
             control.cancel();
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A solve holds its working memory until it ends: another that would pass the share
+    /// waits (or, synchronous, is refused); one larger than the whole share runs alone; one
+    /// that holds little needs only a thread.
+    #[test]
+    fn solves_hold_their_working_memory_within_the_share() {
+        let pool = Pool::new(4, 10 << 20);
+        let big = pool.try_acquire(6 << 20).expect("room for 6 MiB");
+        assert!(pool.try_acquire(5 << 20).is_none(), "6 + 5 MiB passes 10");
+        let small = pool.try_acquire(4 << 20).expect("6 + 4 MiB fits");
+        let light = pool.try_acquire(0).expect("no memory: a thread is enough");
+        drop((big, small, light));
+        let alone = pool.try_acquire(1 << 30).expect("larger than the share: all of it");
+        assert!(pool.try_acquire(1).is_none(), "the share is taken whole");
+        assert!(pool.try_acquire(0).is_some(), "a thread without memory still runs");
+        drop(alone);
+        assert!(pool.try_acquire(10 << 20).is_some());
     }
 }

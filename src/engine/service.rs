@@ -122,6 +122,7 @@ impl From<Refusal> for EngineError {
         match refusal {
             Refusal::Full { what, retry_after } => EngineError::ResultsFull { what, retry_after },
             Refusal::TooLarge { needed, limit } => EngineError::ResultTooLarge { needed, limit },
+            Refusal::Unwritable { why } => EngineError::Unavailable(why),
         }
     }
 }
@@ -319,6 +320,12 @@ impl Engine {
     /// The reachability of each Redis role, when the engine works in a fleet.
     pub fn fleet_health(&self) -> Option<[(&'static str, super::fleet::Health); 2]> {
         self.jobs.fleet_health()
+    }
+
+    /// Why the job store cannot keep new jobs now (a database that cannot be written, or
+    /// was removed), if it cannot.
+    pub fn store_problem(&self) -> Option<String> {
+        self.jobs.store_problem()
     }
 
     /// The asynchronous job `id`, unless unknown or expired; a job this process runs has

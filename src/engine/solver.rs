@@ -8,7 +8,6 @@ use std::time::Instant;
 
 use futures_util::FutureExt;
 use metrics::{Counter, Gauge};
-use tokio::sync::OwnedSemaphorePermit;
 
 use super::background::Background;
 use super::bounded::Bounded;
@@ -18,7 +17,7 @@ use super::coalesce::Coalescer;
 use super::doorkeeper::Doorkeeper;
 use super::memo::PointMemo;
 use super::metrics::{self as names, Metrics, SolveDurations};
-use super::pool::Pool;
+use super::pool::{Permit, Pool};
 use super::{EngineConfig, EngineError};
 use crate::job::{Control, JobError, Keyed, Unfinished};
 
@@ -87,7 +86,7 @@ impl Solver {
     pub fn new(config: &EngineConfig, metrics: Metrics, cache: Arc<dyn ResultCache>) -> Self {
         let budget = Budget::split(config.memory_budget);
         Solver {
-            pool: Pool::new(config.pool_size),
+            pool: Pool::new(config.pool_size, budget.solves),
             cache,
             coalescer: Coalescer::default(),
             // An input and its key weigh about 100 bytes, and the entry's overhead more.
@@ -193,7 +192,8 @@ impl Solver {
         keyed: Keyed,
         deadline: Instant,
     ) -> Result<Arc<Solved>, EngineError> {
-        let permit = self.pool.try_acquire().ok_or(EngineError::Overloaded)?;
+        let bytes = keyed.job().cost().bytes;
+        let permit = self.pool.try_acquire(bytes).ok_or(EngineError::Overloaded)?;
         let control = Arc::new(self.control(deadline));
         let solved = self
             .execute(permit, keyed, control, false)
@@ -203,9 +203,10 @@ impl Solver {
         Ok(solved)
     }
 
-    /// Waits for a solver thread's permit (first come, first served).
-    pub(super) async fn permit(&self) -> OwnedSemaphorePermit {
-        self.pool.acquire().await
+    /// Waits for a solver thread's permit and `bytes` of working memory (first come, first
+    /// served).
+    pub(super) async fn permit(&self, bytes: u64) -> Permit {
+        self.pool.acquire(bytes).await
     }
 
     /// The control of a job run by this engine: one thread, `deadline`, the point memo and
@@ -230,7 +231,7 @@ impl Solver {
     /// ([`Solved::kept`]), and a job stopped before its end keeps what it finished.
     pub(super) async fn execute(
         &self,
-        permit: OwnedSemaphorePermit,
+        permit: Permit,
         keyed: Keyed,
         control: Arc<Control>,
         keep: bool,

@@ -192,6 +192,9 @@ pub struct JobRecord {
     /// Bytes its answer may take, at most: the room made for it when it was accepted, held
     /// for its retention (what a tenant's `--quota-result-bytes` counts).
     pub result_bytes: u64,
+    /// Whether its end could not be saved where the store keeps jobs for good (a database
+    /// that cannot be written): it is then kept in memory only, and says so.
+    pub unsaved: bool,
 }
 
 impl JobRecord {
@@ -208,6 +211,7 @@ impl JobRecord {
             submitted_at: SystemTime::now(),
             finished_at: None,
             result_bytes: 0,
+            unsaved: false,
         }
     }
 
@@ -339,6 +343,9 @@ pub enum Refusal {
         what: String,
         retry_after: Duration,
     },
+    /// Where it keeps jobs for good cannot be written now (a full disk, a database removed
+    /// or damaged): the job is refused rather than accepted and lost.
+    Unwritable { why: String },
     /// The job's result would not fit even in an empty store.
     TooLarge {
         /// Bytes the result may take.
@@ -380,6 +387,11 @@ pub trait JobStore: Send + Sync {
     /// Whether the store outlives the process (a database file, Redis): a job of an earlier
     /// run that it does not know was deleted or expired, not lost with that run.
     fn durable(&self) -> bool;
+
+    /// Why it cannot keep new jobs now, if it cannot (`/readyz` says so).
+    fn problem(&self) -> Option<String> {
+        None
+    }
 }
 
 /// Where a job's result will be kept.
@@ -654,6 +666,13 @@ impl MemoryJobStore {
 
     pub async fn remove(&self, id: Uuid) {
         self.records().forget(&id);
+    }
+
+    /// Marks job `id` as kept in memory only: its end could not be saved for good.
+    pub fn mark_unsaved(&self, id: Uuid) {
+        if let Some(record) = self.records().jobs.get_mut(&id) {
+            record.unsaved = true;
+        }
     }
 
     pub async fn purge_expired(&self) -> usize {

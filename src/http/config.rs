@@ -53,8 +53,9 @@ pub struct ServeArgs {
     #[arg(long, env = "THIRDBODY_MAX_QUEUED_JOBS", default_value_t = 64)]
     pub max_queued_jobs: usize,
 
-    /// Memory for everything kept between requests, in bytes: cached answers (3/4), results
-    /// of finished jobs (3/16), the input memo and the solved points of sweeps (1/32 each).
+    /// Memory for everything kept between requests and what solves hold, in bytes: cached
+    /// answers (9/16), the working memory of the solves running (3/16), results of finished
+    /// jobs (3/16), the input memo and the solved points of sweeps (1/32 each).
     #[arg(long, env = "THIRDBODY_MEMORY_BUDGET", default_value_t = 256 << 20)]
     pub memory_budget: u64,
 

@@ -537,6 +537,7 @@ impl RedisJobStore {
             finished_at: time("finished_at"),
             // A record of the version before results were bounded: nothing counted.
             result_bytes: text("bytes").parse().unwrap_or(0),
+            unsaved: false,
         }))
     }
 

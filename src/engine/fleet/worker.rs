@@ -252,7 +252,7 @@ impl Worker {
         if runnable.status == JobStatus::Queued {
             let _ = store.set_state(id, &JobState::Running, None).await;
         }
-        let permit = self.solver.permit().await;
+        let permit = self.solver.permit(keyed.job().cost().bytes).await;
         let running = self.solver.running();
         let key = runnable.key.clone();
         let part = entry.part.clone();

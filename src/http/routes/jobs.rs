@@ -75,6 +75,12 @@ pub struct JobView {
     #[serde(skip_serializing_if = "Option::is_none")]
     #[schema(format = DateTime)]
     pub finished_at: Option<String>,
+    /// `true` (present only then) when the job's end could not be saved in the database of
+    /// saved analyses (a full disk): it is kept in memory only, for `--job-retention`, and
+    /// not across a restart.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    #[schema(value_type = Option<bool>)]
+    pub unsaved: bool,
 }
 
 impl JobView {
@@ -102,6 +108,7 @@ impl JobView {
             input_hash: record.input_hash.clone(),
             submitted_at: time(record.submitted_at),
             finished_at: record.finished_at.map(time),
+            unsaved: record.unsaved,
         }
     }
 }

@@ -49,8 +49,8 @@ pub async fn healthz(_: AcceptsJson) -> Json<Health> {
 }
 
 /// Readiness: the service takes new work (`degraded`, with the reasons, when a Redis of its
-/// fleet is down, slow or full: it still answers synchronous solves); 503 once it is
-/// shutting down.
+/// fleet is down, slow or full, or its database of saved analyses cannot be written: it
+/// still answers synchronous solves); 503 once it is shutting down.
 #[utoipa::path(
     get,
     path = "/readyz",
@@ -77,6 +77,7 @@ pub async fn readyz(
         .iter()
         .flatten()
         .filter_map(|(role, health)| health.reason(role))
+        .chain(engine.store_problem())
         .chain(state.config().access.keys.problem())
         .collect();
     Ok(Json(Health {
