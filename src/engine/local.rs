@@ -9,7 +9,8 @@
 //! failure was only logged: after a restart 235 of 250 jobs accepted on a full disk were
 //! unknown.) A job whose end cannot be saved stays in memory, marked unsaved.
 
-use std::sync::{Arc, Mutex};
+use std::sync::{Arc, Mutex, MutexGuard};
+use std::time::SystemTime;
 
 use async_trait::async_trait;
 use uuid::Uuid;
@@ -26,6 +27,8 @@ pub struct LocalJobStore {
     archive: Arc<Archive>,
     /// Why the last write to the database failed; none since one succeeded.
     failing: Mutex<Option<String>>,
+    /// Finished jobs whose end could not be saved (memory holds them).
+    unsaved: Mutex<Vec<Uuid>>,
 }
 
 impl LocalJobStore {
@@ -34,6 +37,7 @@ impl LocalJobStore {
             memory,
             archive,
             failing: Mutex::new(None),
+            unsaved: Mutex::new(Vec::new()),
         }
     }
 
@@ -75,6 +79,54 @@ impl LocalJobStore {
             )
             .ok()
     }
+
+    /// Saves the end of job `id`: its final state as memory `kept` it, its work `done`,
+    /// when it `finished`.
+    async fn save_end(
+        &self,
+        id: Uuid,
+        kept: JobState,
+        done: usize,
+        finished: SystemTime,
+    ) -> Result<(), String> {
+        let bodies = match kept.result() {
+            Some(result) => match result.bodies().await {
+                Ok(bodies) => Some(bodies),
+                Err(e) => {
+                    tracing::error!(error = %e, %id, "a job's result could not be read to save it");
+                    None
+                }
+            },
+            None => None,
+        };
+        self.write("save a job's end", move |db| {
+            db.finish(id, &kept, done, finished, bodies)
+        })
+        .await
+    }
+
+    /// The jobs whose end could not be saved, to save once writes succeed again.
+    fn unsaved(&self) -> MutexGuard<'_, Vec<Uuid>> {
+        self.unsaved.lock().unwrap_or_else(|p| p.into_inner())
+    }
+
+    /// Saves the ends not saved before (a disk that was full has room again) of the jobs
+    /// memory still holds: after this they are not lost at a restart.
+    async fn save_unsaved(&self) {
+        let pending = std::mem::take(&mut *self.unsaved());
+        for id in pending {
+            let Some(record) = self.memory.get(id).await else {
+                continue;
+            };
+            let Some(finished) = record.finished_at else {
+                continue;
+            };
+            match self.save_end(id, record.state, record.done, finished).await {
+                Ok(()) => self.memory.mark_unsaved(id, false),
+                Err(_) => self.unsaved().push(id),
+            }
+        }
+    }
 }
 
 #[async_trait]
@@ -89,6 +141,9 @@ impl JobStore for LocalJobStore {
             self.memory.remove(id).await;
             return Err(Refusal::Unwritable { why });
         }
+        if !self.unsaved().is_empty() {
+            self.save_unsaved().await;
+        }
         Ok(())
     }
 
@@ -100,7 +155,8 @@ impl JobStore for LocalJobStore {
     }
 
     /// The end is saved from the state as given (as memory kept it), not read back from
-    /// memory, which may have forgotten the job meanwhile.
+    /// memory, which may have forgotten the job meanwhile; an end not saved is kept in
+    /// memory, marked so, and saved once writes succeed again.
     async fn update(&self, id: Uuid, state: JobState, done: usize) {
         let status = state.status();
         let (kept, finished) = self.memory.update(id, state, done).await;
@@ -111,23 +167,9 @@ impl JobStore for LocalJobStore {
                 .await;
             return;
         };
-        let bodies = match kept.result() {
-            Some(result) => match result.bodies().await {
-                Ok(bodies) => Some(bodies),
-                Err(e) => {
-                    tracing::error!(error = %e, %id, "a job's result could not be read to save it");
-                    None
-                }
-            },
-            None => None,
-        };
-        let saved = self
-            .write("save a job's end", move |db| {
-                db.finish(id, &kept, done, finished, bodies)
-            })
-            .await;
-        if saved.is_err() {
-            self.memory.mark_unsaved(id);
+        if self.save_end(id, kept, done, finished).await.is_err() {
+            self.memory.mark_unsaved(id, true);
+            self.unsaved().push(id);
         }
     }
 

@@ -668,10 +668,11 @@ impl MemoryJobStore {
         self.records().forget(&id);
     }
 
-    /// Marks job `id` as kept in memory only: its end could not be saved for good.
-    pub fn mark_unsaved(&self, id: Uuid) {
+    /// Marks job `id` as kept in memory only (its end could not be saved for good), or no
+    /// longer.
+    pub fn mark_unsaved(&self, id: Uuid, unsaved: bool) {
         if let Some(record) = self.records().jobs.get_mut(&id) {
-            record.unsaved = true;
+            record.unsaved = unsaved;
         }
     }
 
