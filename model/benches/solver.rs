@@ -9,7 +9,6 @@ use std::hint::black_box;
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use thirdbody_model::continuum;
-use thirdbody_model::Stop;
 use thirdbody_model::rolling::penetration_contact;
 use thirdbody_model::similarity::SimilarityTable;
 use thirdbody_model::spectrum::Terms;
@@ -17,6 +16,7 @@ use thirdbody_model::tables::{self, Use};
 use thirdbody_model::three_body::{
     self, Asperities, LayerContact, OperatingPoint, ThreeBody, ThreeBodyOptions,
 };
+use thirdbody_model::Stop;
 use thirdbody_model::{solve, Quadrature, Rolling, SolveOptions};
 
 fn rolling(c: &mut Criterion) {
@@ -124,7 +124,9 @@ fn continuum(c: &mut Criterion) {
             ..Rolling::default()
         };
         group.bench_function(format!("answer_V={velocity:e}"), |b| {
-            b.iter(|| continuum::solve(black_box(&point), &SolveOptions::default(), Stop::NEVER).unwrap())
+            b.iter(|| {
+                continuum::solve(black_box(&point), &SolveOptions::default(), Stop::NEVER).unwrap()
+            })
         });
     }
     group.finish();
@@ -159,7 +161,9 @@ fn prony(c: &mut Criterion) {
         b.iter(|| three_body::solve(black_box(&system), &ThreeBodyOptions::default()).unwrap())
     });
     group.bench_function("continuum_answer_4_terms", |b| {
-        b.iter(|| continuum::solve(black_box(&point), &SolveOptions::default(), Stop::NEVER).unwrap())
+        b.iter(|| {
+            continuum::solve(black_box(&point), &SolveOptions::default(), Stop::NEVER).unwrap()
+        })
     });
     group.finish();
 }

@@ -31,6 +31,10 @@ impl<'a> Stop<'a> {
 
 impl fmt::Debug for Stop<'_> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(if self.0.is_some() { "Stop(when asked)" } else { "Stop(never)" })
+        f.write_str(if self.0.is_some() {
+            "Stop(when asked)"
+        } else {
+            "Stop(never)"
+        })
     }
 }

@@ -65,7 +65,13 @@ impl Pool {
         let thread = self.permits.clone().acquire_owned().await.expect(closed);
         let memory = match self.kib(bytes) {
             0 => None,
-            kib => Some(self.memory.clone().acquire_many_owned(kib).await.expect(closed)),
+            kib => Some(
+                self.memory
+                    .clone()
+                    .acquire_many_owned(kib)
+                    .await
+                    .expect(closed),
+            ),
         };
         Permit {
             _thread: thread,
@@ -77,11 +83,7 @@ impl Pool {
     /// caller's tracing span. If the caller stops waiting (a client hung up, a request timed
     /// out), `control` is cancelled: the solver stops at its next check instead of burning a
     /// core for nobody.
-    pub async fn run<T, F>(
-        permit: Permit,
-        control: Arc<Control>,
-        work: F,
-    ) -> Result<T, JobError>
+    pub async fn run<T, F>(permit: Permit, control: Arc<Control>, work: F) -> Result<T, JobError>
     where
         T: Send + 'static,
         F: FnOnce(&Control) -> Result<T, JobError> + Send + 'static,
@@ -130,9 +132,14 @@ mod tests {
         let small = pool.try_acquire(4 << 20).expect("6 + 4 MiB fits");
         let light = pool.try_acquire(0).expect("no memory: a thread is enough");
         drop((big, small, light));
-        let alone = pool.try_acquire(1 << 30).expect("larger than the share: all of it");
+        let alone = pool
+            .try_acquire(1 << 30)
+            .expect("larger than the share: all of it");
         assert!(pool.try_acquire(1).is_none(), "the share is taken whole");
-        assert!(pool.try_acquire(0).is_some(), "a thread without memory still runs");
+        assert!(
+            pool.try_acquire(0).is_some(),
+            "a thread without memory still runs"
+        );
         drop(alone);
         assert!(pool.try_acquire(10 << 20).is_some());
     }

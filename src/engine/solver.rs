@@ -193,7 +193,10 @@ impl Solver {
         deadline: Instant,
     ) -> Result<Arc<Solved>, EngineError> {
         let bytes = keyed.job().cost().bytes;
-        let permit = self.pool.try_acquire(bytes).ok_or(EngineError::Overloaded)?;
+        let permit = self
+            .pool
+            .try_acquire(bytes)
+            .ok_or(EngineError::Overloaded)?;
         let control = Arc::new(self.control(deadline));
         let solved = self
             .execute(permit, keyed, control, false)
@@ -237,11 +240,10 @@ impl Solver {
         keep: bool,
     ) -> Result<Arc<Solved>, Stopped> {
         self.cache_misses.increment(1);
-        let (job, meta) = keyed.into_parts();
+        let (job, meta, key) = keyed.into_parts();
         let (kind, small) = (job.kind(), job.is_small());
         let start = Instant::now();
         let solve = move |control: &Control| {
-            let key = meta.input_hash.clone();
             let kept = |solved: Solved| match keep {
                 true => solved.kept().map_err(|e| JobError::Internal(e.to_string())),
                 false => Ok(solved),

@@ -474,6 +474,23 @@ impl Job {
 pub struct Keyed {
     job: Job,
     meta: Meta,
+    /// The cache key when it is a tenant's ([`Keyed::scoped`]).
+    scoped: Option<String>,
+}
+
+/// What joins a tenant's name to an input's hash in a cache key ([`Keyed::scoped`]); never
+/// in a hash (hexadecimal) or a tenant's name.
+const SCOPE: char = '@';
+
+/// The input's hash of a cache key, without its tenant ([`Keyed::scoped`]): what a client
+/// reads as `input_hash` and `X-Input-Hash`.
+pub fn input_hash_of(key: &str) -> &str {
+    key.split(SCOPE).next().unwrap_or(key)
+}
+
+/// The tenant of a cache key, if it is a tenant's.
+pub fn tenant_of(key: &str) -> Option<&str> {
+    key.split_once(SCOPE).map(|(_, tenant)| tenant)
 }
 
 impl Keyed {
@@ -485,14 +502,25 @@ impl Keyed {
         &self.meta
     }
 
-    /// The cache key: the hash of the canonical input and the model version.
+    /// The cache key: the hash of the canonical input and the model version, and for a
+    /// tenant's job its tenant ([`Keyed::scoped`]).
     pub fn key(&self) -> &str {
-        &self.meta.input_hash
+        self.scoped.as_deref().unwrap_or(&self.meta.input_hash)
     }
 
-    /// The job and its meta, to run it ([`Job::run`]).
-    pub fn into_parts(self) -> (Job, Meta) {
-        (self.job, self.meta)
+    /// The same job, its answers kept and found among `tenant`'s only (none: among those of
+    /// callers without an API key). An answer is a pure function of its input, but whether
+    /// it is cached tells that somebody asked for it: a tenant learns from the cache (its
+    /// `X-Cache`, its input's link) only what it asked itself.
+    pub fn scoped(self, tenant: Option<&str>) -> Keyed {
+        let scoped = tenant.map(|t| format!("{}{SCOPE}{t}", self.meta.input_hash));
+        Keyed { scoped, ..self }
+    }
+
+    /// The job, its meta and its cache key, to run it ([`Job::run`]).
+    pub fn into_parts(self) -> (Job, Meta, String) {
+        let key = self.key().to_string();
+        (self.job, self.meta, key)
     }
 }
 
@@ -500,7 +528,11 @@ impl Job {
     /// The job with its [`Meta`] (computing it costs a few µs: once per request).
     pub fn keyed(self) -> Keyed {
         let meta = self.meta();
-        Keyed { job: self, meta }
+        Keyed {
+            job: self,
+            meta,
+            scoped: None,
+        }
     }
 }
 

@@ -320,16 +320,71 @@ async fn a_tenants_jobs_are_its_keys_and_the_admins_alone() {
     assert_eq!(deleted.status(), StatusCode::OK);
     let gone = send(&app, Method::GET, &theirs, Some(LAB_B), None).await;
     assert_eq!(gone.status(), StatusCode::NOT_FOUND);
-    // The input's link answers from the cache (a solve of that input would too).
-    let by_input = send(
-        &app,
-        Method::GET,
-        &format!("/v1/results/{hash}"),
-        Some(LAB_B),
-        None,
-    )
-    .await;
-    assert_eq!(by_input.status(), StatusCode::OK);
+    // The input's link: lab-a's answer to lab-a's keys and, by name, to the admin; not to
+    // another tenant, even while it is cached (that would tell what lab-a asked).
+    let link = format!("/v1/results/{hash}");
+    let status_of = |path: String, key: &'static str| {
+        let app = &app;
+        async move {
+            send(app, Method::GET, &path, Some(key), None)
+                .await
+                .status()
+        }
+    };
+    assert_eq!(status_of(link.clone(), LAB_A).await, StatusCode::OK);
+    assert_eq!(status_of(link.clone(), LAB_B).await, StatusCode::NOT_FOUND);
+    let named = format!("{link}?tenant=lab-a");
+    assert_eq!(status_of(named.clone(), ADMIN).await, StatusCode::OK);
+    assert_eq!(status_of(named, LAB_B).await, StatusCode::FORBIDDEN);
+}
+
+/// What one tenant asked for is not told to another: its solve of the same input is a miss
+/// (and costs it), and the input's link does not find the other's answer.
+#[tokio::test]
+async fn a_tenant_learns_nothing_of_what_another_asked() {
+    let app = service("submit,read").await;
+    let cache = |response: &Response| response.headers()["x-cache"].to_str().unwrap().to_string();
+    let first = solve_with(&app, LAB_A).await;
+    assert_eq!(cache(&first), "miss");
+    let answer: Value = first.json().await.unwrap();
+    let link = format!(
+        "/v1/results/{}",
+        answer["meta"]["input_hash"].as_str().unwrap()
+    );
+    assert_eq!(cache(&solve_with(&app, LAB_A).await), "hit");
+    let read = |key: Option<&'static str>| {
+        let (app, link) = (&app, &link);
+        async move { send(app, Method::GET, link, key, None).await.status() }
+    };
+    assert_eq!(read(Some(LAB_A)).await, StatusCode::OK);
+    assert_eq!(read(Some(LAB_B)).await, StatusCode::NOT_FOUND);
+    assert_eq!(read(None).await, StatusCode::NOT_FOUND);
+    assert_eq!(cache(&solve_with(&app, LAB_B).await), "miss");
+    assert_eq!(cache(&solve_with(&app, LAB_B).await), "hit");
+    assert_eq!(read(Some(LAB_B)).await, StatusCode::OK);
+    let anonymous = send(&app, Method::POST, "/v1/rolling", None, Some(&json!({}))).await;
+    assert_eq!(cache(&anonymous), "miss");
+}
+
+/// Both tenants ran one input, lab-b the later: out of the cache each tenant's link finds
+/// its own job's answer (it found the newest job's, lab-b's, and so none for lab-a).
+#[tokio::test]
+async fn each_tenants_link_finds_its_own_job_out_of_the_cache() {
+    let app = spawn_app(&["--api-keys", &keys(), "--cache-ttl", "1ms"]).await;
+    let job = rolling_job("34 nm");
+    let ours = submit(&app, Some(LAB_A), &job).await;
+    let ours = within_done(&app, &ours, LAB_A).await;
+    let theirs = submit(&app, Some(LAB_B), &job).await;
+    let theirs = within_done(&app, &theirs, LAB_B).await;
+    let hash = ours["input_hash"].as_str().unwrap();
+    assert_eq!(theirs["input_hash"], hash);
+    tokio::time::sleep(std::time::Duration::from_millis(20)).await;
+    for key in [LAB_A, LAB_B] {
+        let link = format!("/v1/results/{hash}");
+        let response = send(&app, Method::GET, &link, Some(key), None).await;
+        assert_eq!(response.status(), StatusCode::OK, "{key}");
+        assert_eq!(response.headers()["x-input-hash"], hash);
+    }
 }
 
 #[tokio::test]

@@ -196,7 +196,10 @@ async fn a_database_removed_while_running_degrades_readiness_and_refuses_jobs() 
     let (_, ready) = get(&http, format!("{base}/readyz")).await;
     assert_eq!(ready["status"], "degraded", "{ready}");
     let reason = ready["reasons"][0].as_str().unwrap();
-    assert!(reason.contains("was removed while the service runs"), "{reason}");
+    assert!(
+        reason.contains("was removed while the service runs"),
+        "{reason}"
+    );
     let (status, refused) = submit(&http, &base, &job(1)).await;
     assert_eq!(status, StatusCode::SERVICE_UNAVAILABLE, "{refused}");
     let _ = std::fs::remove_dir_all(&dir);
@@ -208,7 +211,9 @@ fn a_damaged_database_is_refused_at_start_saying_how_to_go_on() {
     std::fs::create_dir_all(&dir).unwrap();
     let database = dir.join("analyses.db");
     // 4 KiB of bytes that are no database.
-    let noise: Vec<u8> = (0..4096u32).map(|i| (i.wrapping_mul(2654435761) >> 13) as u8).collect();
+    let noise: Vec<u8> = (0..4096u32)
+        .map(|i| (i.wrapping_mul(2654435761) >> 13) as u8)
+        .collect();
     std::fs::write(&database, noise).unwrap();
     let out = Command::new(env!("CARGO_BIN_EXE_thirdbody"))
         .args(["serve", "--bind", &format!("127.0.0.1:{}", free_port())])

@@ -315,7 +315,10 @@ mod tests {
             plan(&rolling, PER_RADIUS)
         };
         let thinnest = with(|l| l.thickness = 1e-300).unwrap();
-        assert!(matches!(thinnest.route, Route::Thin { ratio } if ratio > 1e200), "{thinnest:?}");
+        assert!(
+            matches!(thinnest.route, Route::Thin { ratio } if ratio > 1e200),
+            "{thinnest:?}"
+        );
         for stiff in [
             with(|l| l.relaxation_time = 1e-30).unwrap_err(),
             with(|l| l.retardation_time = 1e30).unwrap_err(),
@@ -330,7 +333,10 @@ mod tests {
         .unwrap_err();
         assert_eq!(squeezed.cause, Fineness::Thickness);
         let message = ModelError::from(squeezed).to_string();
-        assert!(message.contains("at most 65,536 pixels in all"), "{message}");
+        assert!(
+            message.contains("at most 65,536 pixels in all"),
+            "{message}"
+        );
     }
 
     proptest! {

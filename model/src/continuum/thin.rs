@@ -27,7 +27,10 @@ const NNU: usize = 9;
 /// layer of Poisson ratio `nu` ≤ [`THIN_POISSON`], under a contact of relaxed local radius
 /// r₀ = `ratio`·H, `ratio` ≥ [`THIN`]: (δ, A). Between two columns, the larger of theirs.
 pub fn thin_error(ratio: f64, nu: f64) -> (f64, f64) {
-    debug_assert!(ratio >= THIN && nu <= THIN_POISSON, "the thin-layer path's domain");
+    debug_assert!(
+        ratio >= THIN && nu <= THIN_POISSON,
+        "the thin-layer path's domain"
+    );
     let column = (nu.clamp(0.0, THIN_POISSON) / DNU).min((NNU - 1) as f64);
     let (low, high) = (column.floor() as usize, column.ceil() as usize);
     let at = |j: usize, quantity: usize| {
@@ -87,11 +90,23 @@ mod tests {
     /// stays within the bound.
     #[test]
     fn the_bound_holds_between_the_nodes_and_beyond() {
-        for (ratio, nu) in [(28.3, 0.35), (28.3, 0.175), (56.6, 0.2), (30.0, 0.0), (30.0, 0.4)] {
+        for (ratio, nu) in [
+            (28.3, 0.35),
+            (28.3, 0.175),
+            (56.6, 0.2),
+            (30.0, 0.0),
+            (30.0, 0.4),
+        ] {
             let [d, a, _] = measured(ratio, nu);
             let (bound_d, bound_a) = thin_error(ratio, nu);
-            assert!(d.abs() <= bound_d, "δ at r₀/H = {ratio}, ν = {nu}: {d:e} > {bound_d:e}");
-            assert!(a.abs() <= bound_a, "A at r₀/H = {ratio}, ν = {nu}: {a:e} > {bound_a:e}");
+            assert!(
+                d.abs() <= bound_d,
+                "δ at r₀/H = {ratio}, ν = {nu}: {d:e} > {bound_d:e}"
+            );
+            assert!(
+                a.abs() <= bound_a,
+                "A at r₀/H = {ratio}, ν = {nu}: {a:e} > {bound_a:e}"
+            );
         }
     }
 
@@ -105,7 +120,10 @@ mod tests {
             for k in 0..=60 {
                 let ratio = THIN * 10f64.powi(k * 5);
                 let (d, a) = thin_error(ratio.min(f64::MAX), nu);
-                assert!(d > 0.0 && a > 0.0 && d.is_finite() && a.is_finite(), "{ratio:e}, {nu}");
+                assert!(
+                    d > 0.0 && a > 0.0 && d.is_finite() && a.is_finite(),
+                    "{ratio:e}, {nu}"
+                );
                 assert!(d <= last.0 && a <= last.1, "r₀/H = {ratio:e}, ν = {nu}");
                 last = (d, a);
             }

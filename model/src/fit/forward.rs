@@ -359,7 +359,9 @@ mod tests {
                 velocity,
                 measured,
             };
-            let (y, s) = point.value_and_sensitivity(&base, law, Stop::NEVER).unwrap();
+            let (y, s) = point
+                .value_and_sensitivity(&base, law, Stop::NEVER)
+                .unwrap();
             let (h, tolerance) = match law {
                 Law::Local => (1e-4, 1e-4),
                 Law::Continuum => (1e-3, 1e-3),
@@ -374,8 +376,12 @@ mod tests {
                     law,
                 };
                 let x = parameter.of(&base);
-                let up = point.value(&p.layer(&[x * (1.0 + h)]), law, Stop::NEVER).unwrap();
-                let down = point.value(&p.layer(&[x / (1.0 + h)]), law, Stop::NEVER).unwrap();
+                let up = point
+                    .value(&p.layer(&[x * (1.0 + h)]), law, Stop::NEVER)
+                    .unwrap();
+                let down = point
+                    .value(&p.layer(&[x / (1.0 + h)]), law, Stop::NEVER)
+                    .unwrap();
                 let numeric = (up / down).ln() / (2.0 * (1.0 + h).ln());
                 let analytic = p.log_derivatives(&s, base.kappa())[0];
                 assert!(

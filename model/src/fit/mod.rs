@@ -451,7 +451,10 @@ impl<E> LeastSquares for Residuals<'_, E> {
         for (i, d) in self.problem.data.iter().enumerate() {
             (self.check)()?;
             let law = self.problem.parameterization.law;
-            let Ok((y, s)) = d.point.value_and_sensitivity(&layer, law, Stop::when(&asked)) else {
+            let Ok((y, s)) = d
+                .point
+                .value_and_sensitivity(&layer, law, Stop::when(&asked))
+            else {
                 // A solve the check stopped is the check's error, not a point outside.
                 (self.check)()?;
                 return Ok(None);

@@ -12,7 +12,12 @@ use thirdbody_model::continuum::{
 use thirdbody_model::{solve, Layer, Rolling, RollingSolution, SolveOptions, Stop};
 
 fn answer(rolling: &Rolling) -> RollingSolution<ContinuumVerification> {
-    continuum::solve(rolling, &SolveOptions::integrals_only(Default::default()), Stop::NEVER).unwrap()
+    continuum::solve(
+        rolling,
+        &SolveOptions::integrals_only(Default::default()),
+        Stop::NEVER,
+    )
+    .unwrap()
 }
 
 /// |got/want − 1|.

@@ -5,9 +5,9 @@
 //! law on the same series.
 
 use thirdbody_model::continuum;
-use thirdbody_model::Stop;
 use thirdbody_model::limits::{instantaneous, relaxed, slow_rolling};
 use thirdbody_model::spectrum::Terms;
+use thirdbody_model::Stop;
 use thirdbody_model::{solve, Layer, Rolling, RollingSolution, SolveOptions};
 
 fn rel(a: f64, b: f64) -> f64 {

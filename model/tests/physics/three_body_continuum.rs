@@ -42,7 +42,9 @@ fn particles_agree_with_single_answers(velocity: f64) {
                 velocity,
                 layer: Layer::default(),
             },
-            &SolveOptions::integrals_only(Default::default()), Stop::NEVER)
+            &SolveOptions::integrals_only(Default::default()),
+            Stop::NEVER,
+        )
         .unwrap();
         let e = single.verification.errors;
         let area_off = (s.layer_area / single.contact_area - 1.0).abs();
@@ -97,7 +99,9 @@ fn particles_of_one_size_give_the_single_particle_friction() {
             velocity: 4e-9,
             layer: Layer::default(),
         },
-        &SolveOptions::integrals_only(Default::default()), Stop::NEVER)
+        &SolveOptions::integrals_only(Default::default()),
+        Stop::NEVER,
+    )
     .unwrap();
     let error = s.verification.layer_contact_error.unwrap();
     let off = (state.friction_coefficient / single.friction_coefficient - 1.0).abs();
@@ -157,7 +161,9 @@ fn the_curve_interpolates_direct_solves() {
                 velocity: 4e-9,
                 layer,
             },
-            &SolveOptions::integrals_only(Default::default()), Stop::NEVER)
+            &SolveOptions::integrals_only(Default::default()),
+            Stop::NEVER,
+        )
         .unwrap();
         let (force, area) = curve.contact(25e-9, direct.penetration);
         let bound =

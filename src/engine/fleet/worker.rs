@@ -30,7 +30,7 @@ use crate::engine::solver::Solver;
 use crate::engine::spill::JobResult;
 use crate::engine::store::{JobState, JobStatus};
 use crate::job::parts::{self, RenderedPart};
-use crate::job::{Control, Job, JobError, Keyed, Unfinished, Work};
+use crate::job::{tenant_of, Control, Job, JobError, Keyed, Unfinished, Work};
 
 /// How long a worker's read of the stream waits for an entry (well within a call's bound);
 /// an entry added meanwhile is taken at once.
@@ -228,7 +228,8 @@ impl Worker {
                 return;
             }
         };
-        let keyed = job.keyed();
+        // Kept among its tenant's answers, as it was accepted ([`Keyed::scoped`]).
+        let keyed = job.keyed().scoped(tenant_of(&runnable.key));
         if keyed.key() != runnable.key {
             let error = JobError::Internal(
                 "the job read back from the job store is not the job accepted".to_string(),
@@ -254,9 +255,8 @@ impl Worker {
         }
         let permit = self.solver.permit(keyed.job().cost().bytes).await;
         let running = self.solver.running();
-        let key = runnable.key.clone();
         let part = entry.part.clone();
-        let (solving, meta) = keyed.clone().into_parts();
+        let (solving, meta, key) = keyed.clone().into_parts();
         let started = Instant::now();
         let kept = |solved: Solved| {
             solved

@@ -71,7 +71,11 @@ pub async fn run(
         .into());
     }
     // Its points are the caller's, charged at once: the suite runs whole or not at all.
-    let jobs: Vec<Keyed> = suite.checks.iter().map(|c| c.job.clone().keyed()).collect();
+    let jobs: Vec<Keyed> = suite
+        .checks
+        .iter()
+        .map(|c| c.job.clone().keyed().scoped(caller.tenant()))
+        .collect();
     access::charge_all(&state, &caller, &jobs).await?;
     // One deadline for the whole suite, so that its cost is that of one solve at most,
     // however many checks it holds; each answer is judged and let go before the next.

@@ -290,20 +290,31 @@ pub struct InputHash {
     input_hash: String,
 }
 
+/// Whose answers an input's link is looked up among: an admin may name a tenant.
+#[derive(IntoParams)]
+#[into_params(parameter_in = Query)]
+#[allow(dead_code)]
+pub struct LinkQuery {
+    /// The tenant whose answer to give (an admin's API key only; default: the caller's own).
+    #[param(pattern = r"^[A-Za-z0-9._-]{1,64}$")]
+    tenant: Option<String>,
+}
+
 /// An input's answer, at a stable link.
 ///
 /// Answers are content-addressed: equal inputs (in canonical form) have equal answers. This
 /// is the answer to the input whose hash is `input_hash`, as cached, or as the newest job
 /// on it that succeeded within the history's retention left it; in the form the client
-/// accepts (or `?format=`), as `GET /v1/jobs/{id}/result` gives it. A job's answer is
-/// given to a caller who may read the job (an API key's tenant's jobs, to its keys); a
-/// cached answer to anyone, as a solve of the same input would.
+/// accepts (or `?format=`), as `GET /v1/jobs/{id}/result` gives it. Answers are found
+/// among those the caller's tenant asked for (an API key's), or among those of callers
+/// without a key: whether an answer exists tells that somebody asked for it, so a tenant
+/// learns of its own only. An admin names another tenant with `?tenant=`.
 #[utoipa::path(
     get,
     path = "/v1/results/{input_hash}",
     operation_id = "get_result_by_input",
     tag = "jobs",
-    params(InputHash, FormatQuery),
+    params(InputHash, FormatQuery, LinkQuery),
     responses(ReadBack, NotModified, NotFound, NotAcceptable, HistoryUnreadable)
 )]
 pub async fn by_input(
@@ -311,13 +322,35 @@ pub async fn by_input(
     caller: Caller,
     answering: Answering,
     Path(InputHash { input_hash }): Path<InputHash>,
+    RawQuery(query): RawQuery,
 ) -> Result<Response, ApiError> {
+    let named = query
+        .as_deref()
+        .and_then(|q| q.split('&').find_map(|pair| pair.strip_prefix("tenant=")));
+    let tenant = match named {
+        Some(name) if !is_tenant_name(name) => {
+            return Err(invalid("tenant", name.into(), "a tenant's name"))
+        }
+        Some(name) if caller.is_admin() || caller.tenant() == Some(name) => Some(name),
+        Some(name) => {
+            return Err(ApiError::forbidden(format!(
+                "tenant={name}: only an admin's API key reads another tenant's answers ({} is \
+                 not one)",
+                caller.describe()
+            )))
+        }
+        None => caller.tenant(),
+    };
+    let key = match tenant {
+        Some(tenant) => format!("{input_hash}@{tenant}"),
+        None => input_hash.clone(),
+    };
     let engine = state.engine();
-    if let Some(solved) = engine.cached(&input_hash).await {
+    if let Some(solved) = engine.cached(&key).await {
         return answering.respond(&solved, None);
     }
     let record = engine
-        .with_input(&input_hash)
+        .with_input(&key)
         .await
         .map_err(unreadable)?
         .filter(|record| caller.may_read(record.owner.as_ref()));

@@ -30,7 +30,7 @@ use crate::http::responses::{
 };
 use crate::http::AppState;
 use crate::job::registry::{Envelope, KindName};
-use crate::job::{Job, JobError, Work};
+use crate::job::{input_hash_of, Job, JobError, Work};
 
 /// How often a progress stream looks at a running job's count of solves.
 const PROGRESS_INTERVAL: Duration = Duration::from_millis(100);
@@ -105,7 +105,7 @@ impl JobView {
                 JobState::Failed { error, .. } => Some(ApiError::from(error.clone()).problem()),
                 _ => None,
             },
-            input_hash: record.input_hash.clone(),
+            input_hash: input_hash_of(&record.input_hash).to_string(),
             submitted_at: time(record.submitted_at),
             finished_at: record.finished_at.map(time),
             unsaved: record.unsaved,
@@ -214,9 +214,12 @@ pub async fn submit(
 ) -> Result<Response, ApiError> {
     let owner = caller.owner(token);
     let limits = state.config().limits;
+    let tenant = caller.tenant().map(str::to_string);
     let keyed = body
         .read(&state, move |envelope| {
-            Ok(Job::from_value(envelope, &limits)?.keyed())
+            Ok(Job::from_value(envelope, &limits)?
+                .keyed()
+                .scoped(tenant.as_deref()))
         })
         .await?;
     access::admit_job(&state, &caller, &keyed).await?;

@@ -30,7 +30,7 @@ use crate::engine::cache::{picture, Solved};
 use crate::engine::spill::JobResult;
 use crate::engine::{heavy, CacheStatus};
 use crate::job::meta::{GIT_COMMIT, SOFTWARE_VERSION};
-use crate::job::{Job, Keyed};
+use crate::job::{input_hash_of, Job, Keyed};
 use crate::model::MODEL_VERSION;
 use crate::render::Format;
 
@@ -49,7 +49,12 @@ pub const PROVENANCE: [HeaderName; 4] = [
 
 /// The values of [`PROVENANCE`] for the answer whose cache key is `key`.
 fn provenance(key: &str) -> [&str; 4] {
-    [MODEL_VERSION, SOFTWARE_VERSION, GIT_COMMIT, key]
+    [
+        MODEL_VERSION,
+        SOFTWARE_VERSION,
+        GIT_COMMIT,
+        input_hash_of(key),
+    ]
 }
 
 /// The API's routes with their OpenAPI operations. A synchronous endpoint of a new job kind
@@ -319,10 +324,13 @@ impl SolveRequest {
     /// cache without being validated again, and costs the caller's quota nothing).
     pub async fn solve(self, kind: &'static str) -> Result<Response, ApiError> {
         let state = &self.state;
+        // A tenant's inputs are remembered, and their answers kept, apart ([`Keyed::scoped`]).
+        let tenant = self.caller.tenant().map(str::to_string);
+        let scope = tenant.clone().unwrap_or_default();
         let (input, text) = self
             .body
             .read(state, move |input: Value| {
-                let text = format!("{kind}\n{input}");
+                let text = format!("{scope}\n{kind}\n{input}");
                 Ok((input, text))
             })
             .await?;
@@ -331,7 +339,7 @@ impl SolveRequest {
             let job = Job::from_input(kind, input, &limits)?;
             match job.asynchronous_only() {
                 Some(refusal) => Err(refusal.into()),
-                None => Ok(job.keyed()),
+                None => Ok(job.keyed().scoped(tenant.as_deref())),
             }
         });
         let caller = &self.caller;

@@ -29,12 +29,10 @@ use super::input as wire;
 use super::kind::SMALL_ANSWER;
 use super::meta::{CONTINUUM_REFERENCES, ROLLING_REFERENCES};
 use super::three_body::{system_cost, Nodes};
-use super::{
-    Control, Cost, FieldError, JobError, Kind, Limits, Meta, References, Validated, Work,
-};
+use super::{Control, Cost, FieldError, JobError, Kind, Limits, Meta, References, Validated, Work};
+use crate::model::continuum;
 use crate::model::fit::stats;
 use crate::model::fit::{self, Datum, FitError, Fitted, Law, Point, Problem, Setting};
-use crate::model::continuum;
 use crate::model::three_body::{LayerContact, ThreeBody};
 use crate::model::{Layer, Rolling};
 

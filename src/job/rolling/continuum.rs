@@ -66,16 +66,46 @@ fn slower(layer: &Layer, problems: Problems) -> Option<ParameterError> {
     let ratio = |l: &Layer| l.retardation_time / l.relaxation_time;
     let (parameter, value, bound, side) = if by_relaxation {
         let set = |l: &mut Layer, t: f64| l.relaxation_time = t;
-        let t = boundary(layer, problems, layer.relaxation_time, layer.retardation_time, set)?;
-        (Parameter::RelaxationTime, layer.relaxation_time, t, "at least")
+        let t = boundary(
+            layer,
+            problems,
+            layer.relaxation_time,
+            layer.retardation_time,
+            set,
+        )?;
+        (
+            Parameter::RelaxationTime,
+            layer.relaxation_time,
+            t,
+            "at least",
+        )
     } else {
         let set = |l: &mut Layer, t: f64| l.retardation_time = t;
-        let t = boundary(layer, problems, layer.retardation_time, layer.relaxation_time, set)?;
-        (Parameter::RetardationTime, layer.retardation_time, t, "at most")
+        let t = boundary(
+            layer,
+            problems,
+            layer.retardation_time,
+            layer.relaxation_time,
+            set,
+        )?;
+        (
+            Parameter::RetardationTime,
+            layer.retardation_time,
+            t,
+            "at most",
+        )
     };
     let answered = Layer {
-        relaxation_time: if by_relaxation { bound } else { layer.relaxation_time },
-        retardation_time: if by_relaxation { layer.retardation_time } else { bound },
+        relaxation_time: if by_relaxation {
+            bound
+        } else {
+            layer.relaxation_time
+        },
+        retardation_time: if by_relaxation {
+            layer.retardation_time
+        } else {
+            bound
+        },
         ..*layer
     };
     Some(ParameterError {

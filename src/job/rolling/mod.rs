@@ -161,7 +161,12 @@ impl Kind for RollingJob {
             let job = RollingJob::read(input, checker);
             if job.law == LayerModel::Continuum && job.rolling.violations().is_empty() {
                 let rolling = job.rolling;
-                let problems = |layer: &model::Layer| vec![Rolling { layer: *layer, ..rolling }];
+                let problems = |layer: &model::Layer| {
+                    vec![Rolling {
+                        layer: *layer,
+                        ..rolling
+                    }]
+                };
                 continuum::check(&rolling.layer, &problems, checker);
             }
             job

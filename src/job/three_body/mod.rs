@@ -16,9 +16,7 @@ use super::input::{self, field, Checker, LayerInput, QuadratureKind, Quantity};
 use super::meta::{Canonical, REFERENCES, THREE_BODY_CONTINUUM_REFERENCES};
 use super::points::{self, PointNotes, PointNotesFields, PointStatus, Row, SweepVerification};
 use super::validity::{self, PointValidity, Subject, ValidityOutput};
-use super::{
-    rolling, Control, Cost, JobError, Kind, Limits, Meta, References, Validated, Work,
-};
+use super::{rolling, Control, Cost, JobError, Kind, Limits, Meta, References, Validated, Work};
 use crate::model::continuum::{self, ContinuumVerification, PenetrationCurve};
 use crate::model::three_body::{
     self, Asperities, ContactState, Diameters, LayerContact, LayerCurves, OperatingPoint, Particle,
@@ -448,9 +446,13 @@ impl Kind for ThreeBodyJob {
         input::validate(input, |input, checker| {
             let job = ThreeBodyJob::read(input, checker);
             let system = job.system;
-            if system.layer_contact == LayerContact::Continuum && system.violations().is_empty()
-            {
-                let problems = |layer: &Layer| LayerCurves::problems(&ThreeBody { layer: *layer, ..system });
+            if system.layer_contact == LayerContact::Continuum && system.violations().is_empty() {
+                let problems = |layer: &Layer| {
+                    LayerCurves::problems(&ThreeBody {
+                        layer: *layer,
+                        ..system
+                    })
+                };
                 rolling::continuum::check(&system.layer, &problems, checker);
             }
             job
