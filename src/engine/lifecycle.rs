@@ -38,6 +38,8 @@ struct LiveJob {
     interrupted: AtomicBool,
     /// The job's status, for those who wait for a change.
     status: watch::Sender<JobStatus>,
+    /// Whether no API key's tenant owns it (callers without a key share one quota of jobs).
+    anonymous: bool,
 }
 
 impl LiveJob {
@@ -234,6 +236,7 @@ impl Lifecycle {
             cancel: CancellationToken::new(),
             interrupted: AtomicBool::new(false),
             status: watch::Sender::new(JobStatus::Queued),
+            anonymous: owner.as_ref().is_none_or(|o| !o.is_tenant()),
         });
         self.live().insert(id, live.clone());
         let span = tracing::info_span!("job", id = %id, kind = %kind);
@@ -303,6 +306,11 @@ impl Lifecycle {
             }
             _ => Ok(()),
         }
+    }
+
+    /// The jobs no tenant owns that this process runs or queues.
+    pub(super) fn unfinished_anonymous(&self) -> usize {
+        self.live().values().filter(|job| job.anonymous).count()
     }
 
     /// Why the job store cannot keep new jobs now, if it cannot.

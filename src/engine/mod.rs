@@ -7,6 +7,7 @@
 //! ([`Solver`]) and the life of asynchronous jobs (`lifecycle`); the fleet's workers
 //! ([`fleet::Worker`]) solve through the same [`Solver`].
 
+pub mod admission;
 pub mod archive;
 mod background;
 mod backlog;

@@ -12,11 +12,12 @@ use std::time::{Duration, Instant};
 use tokio::sync::watch;
 use uuid::Uuid;
 
+use super::admission::{Admissions, Turn};
 use super::archive::Archive;
 use super::backlog::Backlogged;
 use super::budget::Budget;
 use super::cache::{MemoryCache, ResultCache, Solved};
-use super::fleet::Shared;
+use super::fleet::{Fleet, Shared};
 use super::lifecycle::Lifecycle;
 use super::local::LocalJobStore;
 use super::metrics::{self as names, Metrics};
@@ -156,6 +157,9 @@ pub struct Engine {
     jobs: Arc<Lifecycle>,
     /// The points each tenant asked for in the current minute (its quota's count).
     points: PointCounts,
+    /// One admission at a time per tenant (its quotas counted, then its job stored).
+    admissions: Admissions,
+    fleet: Option<Arc<Fleet>>,
 }
 
 impl Engine {
@@ -173,7 +177,8 @@ impl Engine {
             }
         }
         let solver = Arc::new(Solver::new(&config, metrics.clone(), storage.cache));
-        let points = PointCounts::new(storage.fleet.as_ref().map(|s| s.fleet.clone()));
+        let fleet = storage.fleet.as_ref().map(|s| s.fleet.clone());
+        let points = PointCounts::new(fleet.clone());
         let jobs = Lifecycle::new(
             config.clone(),
             &metrics,
@@ -187,7 +192,21 @@ impl Engine {
             solver,
             jobs: Arc::new(jobs),
             points,
+            admissions: Admissions::default(),
+            fleet,
         })
+    }
+
+    /// `tenant`'s turn to admit a job (whose quotas are counted, then the job stored), after
+    /// its admissions before, in this process and across a fleet ([`Admissions`]).
+    pub async fn turn(&self, tenant: &str) -> Result<Turn, EngineError> {
+        self.admissions.turn(tenant, self.fleet.as_ref()).await
+    }
+
+    /// The jobs without a tenant that this process runs or queues (in a fleet, which runs
+    /// jobs on its workers, none).
+    pub fn unfinished_anonymous(&self) -> usize {
+        self.jobs.unfinished_anonymous()
     }
 
     /// Charges `points` of work to `tenant`, unless its points this minute would pass

@@ -155,9 +155,10 @@ pub struct ServeArgs {
     )]
     pub anonymous: String,
 
-    /// Points (a sweep's points, a figure's, one for a single contact or a fit) each API
-    /// key's tenant may ask to be computed in a minute, fleet-wide; more are refused with 429
-    /// until the minute ends (0: no limit). An answer already cached costs nothing.
+    /// Points (about ten microseconds of a solver thread each: a local-law answer is one, a
+    /// continuum answer what its grid costs, 7,000 on the default grid) each API key's tenant
+    /// may ask to be computed in a minute, fleet-wide; more are refused with 429 until the
+    /// minute ends (0: no limit). An answer already cached costs nothing.
     #[arg(long, env = "THIRDBODY_QUOTA_POINTS", default_value_t = 0)]
     pub quota_points: u64,
 
@@ -176,6 +177,12 @@ pub struct ServeArgs {
     /// anonymous traffic cannot starve the tenants (0: no limit).
     #[arg(long, env = "THIRDBODY_ANONYMOUS_QUOTA_POINTS", default_value_t = 0)]
     pub anonymous_quota_points: u64,
+
+    /// Unfinished asynchronous jobs all callers without an API key may have at once,
+    /// together, in this process (0: no limit beyond --max-queued-jobs). A fleet runs jobs on
+    /// its workers: there it does not apply.
+    #[arg(long, env = "THIRDBODY_ANONYMOUS_QUOTA_JOBS", default_value_t = 0)]
+    pub anonymous_quota_jobs: usize,
 
     /// Log format.
     #[arg(long, env = "THIRDBODY_LOG_FORMAT", value_enum, default_value_t = LogFormat::Json)]
@@ -443,6 +450,7 @@ impl ServeArgs {
             },
             anonymous: Quota {
                 points_per_minute: self.anonymous_quota_points,
+                jobs: self.anonymous_quota_jobs,
                 ..Quota::default()
             },
         };

@@ -607,6 +607,47 @@ async fn a_tenant_has_at_most_its_quota_of_unfinished_jobs() {
     submit(&app, Some(LAB_A), &rolling_job("29 nm")).await;
 }
 
+/// Concurrent submissions take the last places one at a time: 20 at once under a quota of
+/// 2 unfinished jobs let exactly 2 in (each was counted before the others were stored, and
+/// 5 got in); anonymous callers have their one share too.
+#[tokio::test]
+async fn concurrent_submissions_pass_a_quota_of_jobs_no_more_than_it_allows() {
+    let app = spawn_app(&[
+        "--api-keys",
+        &keys(),
+        "--quota-jobs",
+        "2",
+        "--anonymous-quota-jobs",
+        "3",
+        "--anonymous",
+        "submit,read",
+    ])
+    .await;
+    for (key, quota) in [(Some(LAB_A), 2), (None, 3)] {
+        let statuses = futures_util::future::join_all((0..20).map(|i| {
+            let job = crate::helpers::long_sweep(20 + i);
+            let app = &app;
+            async move {
+                send(app, Method::POST, "/v1/jobs", key, Some(&job))
+                    .await
+                    .status()
+            }
+        }))
+        .await;
+        let accepted = statuses
+            .iter()
+            .filter(|s| **s == StatusCode::ACCEPTED)
+            .count();
+        assert_eq!(accepted, quota, "{key:?}: {statuses:?}");
+        assert!(
+            statuses
+                .iter()
+                .all(|s| [StatusCode::ACCEPTED, StatusCode::TOO_MANY_REQUESTS].contains(s)),
+            "{statuses:?}"
+        );
+    }
+}
+
 /// The most the answer of `job` may take, as the service counts it.
 fn room_of(job: &Value) -> u64 {
     use thirdbody::job::{Job, Limits};

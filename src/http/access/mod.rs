@@ -25,6 +25,7 @@ pub use keys::{Keys, Scopes, Source};
 use super::config::CorsOrigins;
 use super::error::ApiError;
 use super::AppState;
+use crate::engine::admission::Turn;
 use crate::engine::quota::Exceeded;
 use crate::engine::store::Owner;
 use crate::job::Keyed;
@@ -274,29 +275,50 @@ pub async fn charge_all(state: &AppState, caller: &Caller, jobs: &[Keyed]) -> Re
 }
 
 /// A job `caller` submits: within its tenant's unfinished jobs and the bytes its answers
-/// hold (a key's tenant: anonymous callers share the service's own limits instead), and its
-/// points charged.
-pub async fn admit_job(state: &AppState, caller: &Caller, keyed: &Keyed) -> Result<(), ApiError> {
-    let (quota, _) = caller.quota(&state.config().access.quotas);
+/// hold (anonymous callers: within their one share of unfinished jobs, and the service's own
+/// limits), and its points charged. The quotas are counted in the tenant's turn
+/// ([`Engine::turn`](crate::engine::Engine::turn)), which the caller holds until the job
+/// is stored: two submissions never both pass the last place.
+pub async fn admit_job(
+    state: &AppState,
+    caller: &Caller,
+    keyed: &Keyed,
+) -> Result<Option<Turn>, ApiError> {
+    let (quota, name) = caller.quota(&state.config().access.quotas);
     let tenant = caller.owner(None);
-    if let Some(owner) = tenant.as_ref().filter(|_| quota.result_bytes > 0) {
+    let holds = tenant.is_some() && quota.result_bytes > 0;
+    let turn = match quota.jobs > 0 || holds {
+        true => Some(state.engine().turn(&name).await?),
+        false => None,
+    };
+    if let Some(owner) = tenant.as_ref().filter(|_| holds) {
         hold(state, caller, owner, quota.result_bytes, keyed).await?;
     }
-    if let Some(owner) = tenant.filter(|_| quota.jobs > 0) {
-        let unfinished = state.engine().unfinished_of(&owner).await?;
+    if quota.jobs > 0 {
+        let (unfinished, flag) = match &tenant {
+            Some(owner) => (state.engine().unfinished_of(owner).await?, "--quota-jobs"),
+            None => (
+                state.engine().unfinished_anonymous(),
+                "--anonymous-quota-jobs",
+            ),
+        };
         if unfinished >= quota.jobs {
+            let who = match tenant {
+                Some(_) => format!("{} has", caller.describe()),
+                None => "the callers without an API key together have".to_string(),
+            };
             return Err(ApiError::quota_exceeded(
                 format!(
-                    "{} has {unfinished} unfinished jobs, as many as it may have at once \
-                     (--quota-jobs {}): wait for one to end, or cancel one",
-                    caller.describe(),
+                    "{who} {unfinished} unfinished jobs, as many as allowed at once ({flag} \
+                     {}): wait for one to end, or cancel one",
                     quota.jobs
                 ),
                 Some(Duration::from_secs(5)),
             ));
         }
     }
-    charge(state, caller, keyed).await
+    charge(state, caller, keyed).await?;
+    Ok(turn)
 }
 
 /// Lets `owner`'s job `keyed` in if the room its answer may take, added to what the

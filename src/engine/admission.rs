@@ -1,0 +1,118 @@
+//! One admission at a time per tenant: a quota of unfinished jobs is a count and then an
+//! insert, and two submissions between them both pass it (20 concurrent submissions under
+//! `--quota-jobs 2` let 5 in). The count and the insert are made under a lock of the
+//! tenant's: in this process an async mutex, and in a fleet also a lock in the job store's
+//! Redis (`SET NX` with a lease, freed by its holder), so that processes take turns too.
+
+use std::collections::HashMap;
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+
+use tokio::sync::OwnedMutexGuard;
+
+use super::fleet::Fleet;
+use super::EngineError;
+
+/// The longest a fleet's lock is held if its holder dies: far longer than a count and an
+/// insert take.
+const LEASE: Duration = Duration::from_secs(10);
+
+/// How long an admission waits for another process's turn before it is refused.
+const PATIENCE: Duration = Duration::from_secs(5);
+
+/// Frees the lock only if it is still its holder's (a lease may have passed to another).
+const RELEASE: &str = "if redis.call('GET', KEYS[1]) == ARGV[1] then \
+                       return redis.call('DEL', KEYS[1]) else return 0 end";
+
+/// The tenants' locks.
+#[derive(Default)]
+pub struct Admissions {
+    local: Mutex<HashMap<String, Arc<tokio::sync::Mutex<()>>>>,
+}
+
+/// A tenant's turn to admit a job: held until the job is in the store, or refused.
+pub struct Turn {
+    _local: OwnedMutexGuard<()>,
+    fleet: Option<(Arc<Fleet>, String, String)>,
+}
+
+impl Drop for Turn {
+    fn drop(&mut self) {
+        if let Some((fleet, key, token)) = self.fleet.take() {
+            tokio::spawn(async move {
+                let script = redis::Script::new(RELEASE);
+                let released = fleet
+                    .jobs
+                    .script::<i64>(&script, &[&key], &[token.as_bytes()])
+                    .await;
+                if let Err(e) = released {
+                    tracing::warn!(error = %e.why, "a tenant's admission lock waits out its lease");
+                }
+            });
+        }
+    }
+}
+
+impl Admissions {
+    /// `tenant`'s turn: after the admissions of its before it, here and in `fleet`.
+    pub async fn turn(
+        &self,
+        tenant: &str,
+        fleet: Option<&Arc<Fleet>>,
+    ) -> Result<Turn, EngineError> {
+        let lock = self
+            .local
+            .lock()
+            .unwrap_or_else(|p| p.into_inner())
+            .entry(tenant.to_string())
+            .or_default()
+            .clone();
+        let local = lock.lock_owned().await;
+        self.forget_idle();
+        let Some(fleet) = fleet else {
+            return Ok(Turn {
+                _local: local,
+                fleet: None,
+            });
+        };
+        let key = format!("thirdbody:admitting:{tenant}");
+        let token = uuid::Uuid::new_v4().to_string();
+        let start = Instant::now();
+        loop {
+            let mut set = redis::cmd("SET");
+            set.arg(&key)
+                .arg(&token)
+                .arg("NX")
+                .arg("PX")
+                .arg(LEASE.as_millis() as u64);
+            let taken: Option<String> = fleet
+                .jobs
+                .query(&set)
+                .await
+                .map_err(|e| EngineError::Unavailable(e.why))?;
+            if taken.is_some() {
+                return Ok(Turn {
+                    _local: local,
+                    fleet: Some((fleet.clone(), key, token)),
+                });
+            }
+            if start.elapsed() > PATIENCE {
+                return Err(EngineError::Unavailable(format!(
+                    "another process of the fleet has been admitting this tenant's jobs for \
+                     {} s: try again",
+                    PATIENCE.as_secs()
+                )));
+            }
+            tokio::time::sleep(Duration::from_millis(5)).await;
+        }
+    }
+
+    /// Forgets the locks nobody holds or waits for, so that the map stays as small as the
+    /// tenants admitting now.
+    fn forget_idle(&self) {
+        let mut local = self.local.lock().unwrap_or_else(|p| p.into_inner());
+        if local.len() > 64 {
+            local.retain(|_, lock| Arc::strong_count(lock) > 1);
+        }
+    }
+}
