@@ -3,7 +3,7 @@
 //! works in one. Their solving goes through the [`Solver`], the one solve path.
 
 use std::collections::{HashMap, HashSet, VecDeque};
-use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex, MutexGuard};
 use std::time::{Duration, Instant};
 
@@ -40,7 +40,13 @@ struct LiveJob {
     status: watch::Sender<JobStatus>,
     /// Whether no API key's tenant owns it (callers without a key share one quota of jobs).
     anonymous: bool,
+    /// How long it held a solver thread (ns; 0 until it ran): what it really cost.
+    solved_in: AtomicU64,
 }
+
+/// Called with what a job really cost (its time on a solver thread) when it ends: a quota
+/// trues up the estimate it charged ([`super::Engine::submit`]).
+pub type OnEnd = Box<dyn FnOnce(Duration) + Send>;
 
 impl LiveJob {
     /// Asks the job to stop: at once if it is queued, at the solver's next check if it runs.
@@ -172,10 +178,13 @@ impl Lifecycle {
 
     /// Queues `keyed` to run in the background; returns its record. Refused when the queue
     /// is full, the service is draining, or there is no room to keep the job's result.
+    /// `on_end` is told what the job cost when it ends here (a job the fleet's workers run
+    /// ends elsewhere: it is dropped).
     pub(super) async fn submit(
         self: &Arc<Self>,
         keyed: Keyed,
         owner: Option<Owner>,
+        on_end: Option<OnEnd>,
     ) -> Result<JobRecord, EngineError> {
         self.store_reachable()?;
         let (kind, work) = (keyed.job().kind(), keyed.job().work());
@@ -237,6 +246,7 @@ impl Lifecycle {
             interrupted: AtomicBool::new(false),
             status: watch::Sender::new(JobStatus::Queued),
             anonymous: owner.as_ref().is_none_or(|o| !o.is_tenant()),
+            solved_in: AtomicU64::new(0),
         });
         self.live().insert(id, live.clone());
         let span = tracing::info_span!("job", id = %id, kind = %kind);
@@ -245,6 +255,9 @@ impl Lifecycle {
             async move {
                 let state = lifecycle.run_job(&live, id, keyed, &ticket).await;
                 drop(ticket);
+                if let Some(on_end) = on_end {
+                    on_end(Duration::from_nanos(live.solved_in.load(Ordering::Relaxed)));
+                }
                 let status = state.status();
                 let done = match (status, work) {
                     (JobStatus::Succeeded, Work::Known(total)) => total,
@@ -549,7 +562,10 @@ impl Lifecycle {
             (Err(_), Work::Unknown) => 0,
         };
         let solved = done.saturating_sub(live.control.recalled());
-        ticket.ran(solved, started.elapsed());
+        let took = started.elapsed();
+        ticket.ran(solved, took);
+        let nanos = u64::try_from(took.as_nanos()).unwrap_or(u64::MAX);
+        live.solved_in.store(nanos, Ordering::Relaxed);
         // The job is still running (its status says so) while its answer is kept: the
         // guard goes with this function.
         match result {

@@ -8,9 +8,22 @@ use std::sync::{Arc, Mutex};
 use std::time::{Duration, SystemTime};
 
 use super::fleet::Fleet;
+use crate::job::Cost;
 
 /// The length of a window.
 const WINDOW: Duration = Duration::from_secs(60);
+
+/// Seconds since the epoch of `now`.
+fn seconds(now: SystemTime) -> u64 {
+    now.duration_since(std::time::UNIX_EPOCH)
+        .unwrap_or_default()
+        .as_secs()
+}
+
+/// The window `now` falls in.
+fn window_of(now: SystemTime) -> u64 {
+    seconds(now) / WINDOW.as_secs()
+}
 
 /// A charge refused: what the tenant used in the window already, and when the window ends
 /// (none if the charge alone is over the limit: waiting cannot help).
@@ -18,6 +31,13 @@ const WINDOW: Duration = Duration::from_secs(60);
 pub struct Exceeded {
     pub used: u64,
     pub retry_after: Option<Duration>,
+}
+
+/// Points charged to a tenant before its work, to true up after it ([`PointCounts::true_up`]).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Charge {
+    pub tenant: String,
+    pub points: u64,
 }
 
 /// The points charged to each tenant in the current window.
@@ -44,11 +64,8 @@ impl PointCounts {
         limit: u64,
         now: SystemTime,
     ) -> Result<(), Exceeded> {
-        let since = now
-            .duration_since(std::time::UNIX_EPOCH)
-            .unwrap_or_default()
-            .as_secs();
-        let window = since / WINDOW.as_secs();
+        let since = seconds(now);
+        let window = window_of(now);
         let retry_after = Duration::from_secs(WINDOW.as_secs() - since % WINDOW.as_secs());
         if points > limit {
             return Err(Exceeded {
@@ -70,6 +87,42 @@ impl PointCounts {
                 retry_after: Some(retry_after),
             }),
         }
+    }
+
+    /// Trues up `charge`, made before the work, by what the work really `took` on a solver
+    /// thread ([`crate::job::Cost::of_time`]).
+    pub async fn true_up(&self, charge: &Charge, took: Duration) {
+        let took = i64::try_from(Cost::of_time(took)).unwrap_or(i64::MAX);
+        let charged = i64::try_from(charge.points).unwrap_or(i64::MAX);
+        self.adjust(&charge.tenant, took - charged, SystemTime::now())
+            .await;
+    }
+
+    /// Trues up a charge made before the work: `delta` more points (fewer, if negative) for
+    /// `tenant` in the window of `now`, whatever its limit (the work is done).
+    pub async fn adjust(&self, tenant: &str, delta: i64, now: SystemTime) {
+        if delta == 0 {
+            return;
+        }
+        let window = window_of(now);
+        if let Some(fleet) = &self.fleet {
+            let key = format!("thirdbody:quota:{tenant}:{window}");
+            let mut pipe = redis::pipe();
+            pipe.atomic()
+                .incr(&key, delta)
+                .ignore()
+                .expire(&key, 2 * WINDOW.as_secs() as i64)
+                .ignore();
+            if fleet.jobs.pipe::<()>(&pipe).await.is_ok() {
+                return;
+            }
+        }
+        let mut counts = self.local.lock().unwrap_or_else(|p| p.into_inner());
+        let count = counts.entry(tenant.to_string()).or_insert((window, 0));
+        if count.0 != window {
+            *count = (window, 0);
+        }
+        count.1 = count.1.saturating_add_signed(delta);
     }
 
     /// In this process: the points used before, if the charge is refused.
@@ -138,5 +191,21 @@ mod tests {
         // More than the limit at once: waiting cannot help.
         let alone = counts.charge("c", 11, 10, at(60_000)).await;
         assert_eq!(alone.unwrap_err().retry_after, None);
+    }
+
+    /// A charge is trued up by what the work took: a refund makes room, work beyond the
+    /// estimate takes it (past the limit, even: the work is done).
+    #[tokio::test]
+    async fn a_charge_is_trued_up_after_the_work() {
+        let counts = PointCounts::new(None);
+        let at = |s: u64| std::time::UNIX_EPOCH + Duration::from_secs(s);
+        assert_eq!(counts.charge("a", 8, 10, at(60_000)).await, Ok(()));
+        counts.adjust("a", -6, at(60_001)).await;
+        assert_eq!(counts.charge("a", 8, 10, at(60_002)).await, Ok(()));
+        counts.adjust("a", 5, at(60_003)).await;
+        let over = counts.charge("a", 1, 10, at(60_004)).await.unwrap_err();
+        assert_eq!(over.used, 15);
+        counts.adjust("b", -5, at(60_005)).await;
+        assert_eq!(counts.charge("b", 10, 10, at(60_006)).await, Ok(()));
     }
 }

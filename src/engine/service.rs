@@ -18,10 +18,10 @@ use super::backlog::Backlogged;
 use super::budget::Budget;
 use super::cache::{MemoryCache, ResultCache, Solved};
 use super::fleet::{Fleet, Shared};
-use super::lifecycle::Lifecycle;
+use super::lifecycle::{Lifecycle, OnEnd};
 use super::local::LocalJobStore;
 use super::metrics::{self as names, Metrics};
-use super::quota::{Exceeded, PointCounts};
+use super::quota::{Charge, Exceeded, PointCounts};
 use super::solver::{CacheStatus, Solver};
 use super::spill::SpillDir;
 use super::store::{JobRecord, JobStatus, JobStore, Listing, MemoryJobStore, Owner, Page, Refusal};
@@ -156,7 +156,7 @@ pub struct Engine {
     solver: Arc<Solver>,
     jobs: Arc<Lifecycle>,
     /// The points each tenant asked for in the current minute (its quota's count).
-    points: PointCounts,
+    points: Arc<PointCounts>,
     /// One admission at a time per tenant (its quotas counted, then its job stored).
     admissions: Admissions,
     fleet: Option<Arc<Fleet>>,
@@ -178,7 +178,7 @@ impl Engine {
         }
         let solver = Arc::new(Solver::new(&config, metrics.clone(), storage.cache));
         let fleet = storage.fleet.as_ref().map(|s| s.fleet.clone());
-        let points = PointCounts::new(fleet.clone());
+        let points = Arc::new(PointCounts::new(fleet.clone()));
         let jobs = Lifecycle::new(
             config.clone(),
             &metrics,
@@ -313,14 +313,28 @@ impl Engine {
     /// Queues `keyed` to run in the background; returns its record. Refused when the
     /// queue is full, the service is draining, or there is no room to keep the job's
     /// result.
+    /// `charged`: the points a quota charged for it, trued up by what it really took when it
+    /// ends (in this process; a fleet's workers run jobs elsewhere, and the estimate stands).
     pub async fn submit(
         &self,
         keyed: Keyed,
         owner: Option<Owner>,
+        charged: Option<Charge>,
     ) -> Result<JobRecord, EngineError> {
         self.admit()?;
-        let record = self.jobs.submit(keyed, owner).await;
+        let points = self.points.clone();
+        let on_end = charged.map(|charge| -> OnEnd {
+            Box::new(move |took| {
+                tokio::spawn(async move { points.true_up(&charge, took).await });
+            })
+        });
+        let record = self.jobs.submit(keyed, owner, on_end).await;
         record.map_err(|e| self.refused(e))
+    }
+
+    /// Trues up `charge` by what its work really `took` on a solver thread.
+    pub async fn true_up(&self, charge: &Charge, took: Duration) {
+        self.points.true_up(charge, took).await;
     }
 
     /// Starts `loops` workers on the fleet's stream (none without a fleet). With

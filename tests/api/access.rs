@@ -648,6 +648,57 @@ async fn concurrent_submissions_pass_a_quota_of_jobs_no_more_than_it_allows() {
     }
 }
 
+/// A point is about ten microseconds of a solver thread: a local answer is one, a continuum
+/// answer what its grid costs (7,000 points on the default grid), a continuum fit its
+/// expected evaluations (each counted one before). What a solve really took is charged after
+/// it (`engine::quota`'s tests: it depends on the machine's speed).
+#[tokio::test]
+async fn quotas_charge_what_work_costs() {
+    let app = spawn_app(&["--api-keys", &keys(), "--quota-points", "5000"]).await;
+    let asks = |detail: &str| -> u64 {
+        detail["this asks for ".len()..]
+            .split(' ')
+            .next()
+            .and_then(|n| n.parse().ok())
+            .unwrap_or_else(|| panic!("{detail}"))
+    };
+    let fit = json!({"kind": "fit", "input": {
+        "layer": {"model": "continuum"},
+        "series": [{"radius": "25 nm", "load": "1 nN", "quantity": "friction_coefficient",
+            "points": [{"velocity": "1 nm/s", "value": 0.01}, {"velocity": "2 nm/s", "value": 0.009},
+                       {"velocity": "4 nm/s", "value": 0.008}]}],
+        "parameters": {"relaxation_time": {}, "retardation_time": {}}}});
+    let refused_fit = send(&app, Method::POST, "/v1/jobs", Some(LAB_A), Some(&fit)).await;
+    let detail = refused(refused_fit, StatusCode::TOO_MANY_REQUESTS, "quota-exceeded").await;
+    assert!(detail.contains("more than the 5000 a minute"), "{detail}");
+    assert!(
+        asks(&detail) > 1_000_000,
+        "a continuum fit of 3 points: {detail}"
+    );
+    let continuum = json!({"layer": {"model": "continuum"}});
+    let refused_solve = send(
+        &app,
+        Method::POST,
+        "/v1/rolling",
+        Some(LAB_A),
+        Some(&continuum),
+    )
+    .await;
+    let detail = refused(
+        refused_solve,
+        StatusCode::TOO_MANY_REQUESTS,
+        "quota-exceeded",
+    )
+    .await;
+    assert!((6000..9000).contains(&asks(&detail)), "{detail}");
+    // A local answer is a point.
+    for radius in ["25 nm", "26 nm", "27 nm"] {
+        let local = json!({"radius": radius});
+        let response = send(&app, Method::POST, "/v1/rolling", Some(LAB_A), Some(&local)).await;
+        assert_eq!(response.status(), StatusCode::OK);
+    }
+}
+
 /// The most the answer of `job` may take, as the service counts it.
 fn room_of(job: &Value) -> u64 {
     use thirdbody::job::{Job, Limits};

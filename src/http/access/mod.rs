@@ -26,7 +26,7 @@ use super::config::CorsOrigins;
 use super::error::ApiError;
 use super::AppState;
 use crate::engine::admission::Turn;
-use crate::engine::quota::Exceeded;
+use crate::engine::quota::{Charge, Exceeded};
 use crate::engine::store::Owner;
 use crate::job::Keyed;
 
@@ -230,20 +230,29 @@ impl<S: Send + Sync> FromRequestParts<S> for Caller {
     }
 }
 
-/// Charges the points of `keyed` to `caller`'s quota, unless its answer is cached (it costs
-/// nothing then); past the quota, 429 `quota-exceeded` with `Retry-After` (the end of the
-/// minute).
-pub async fn charge(state: &AppState, caller: &Caller, keyed: &Keyed) -> Result<(), ApiError> {
+/// Charges the points `keyed` is estimated to cost to `caller`'s quota, unless its answer is
+/// cached (it costs nothing then); past the quota, 429 `quota-exceeded` with `Retry-After`
+/// (the end of the minute). The charge made, to true up once the work is done
+/// ([`crate::engine::Engine::true_up`]).
+pub async fn charge(
+    state: &AppState,
+    caller: &Caller,
+    keyed: &Keyed,
+) -> Result<Option<Charge>, ApiError> {
     charge_all(state, caller, std::slice::from_ref(keyed)).await
 }
 
 /// Charges the points of all of `jobs` (a checks suite's) to `caller`'s quota at once, as
 /// [`charge`] does one's: all are let in, or none.
-pub async fn charge_all(state: &AppState, caller: &Caller, jobs: &[Keyed]) -> Result<(), ApiError> {
+pub async fn charge_all(
+    state: &AppState,
+    caller: &Caller,
+    jobs: &[Keyed],
+) -> Result<Option<Charge>, ApiError> {
     let (quota, tenant) = caller.quota(&state.config().access.quotas);
     let limit = quota.points_per_minute;
     if limit == 0 {
-        return Ok(());
+        return Ok(None);
     }
     // What each job is estimated to cost (`Cost`: a point a local answer).
     let mut points = 0;
@@ -253,11 +262,11 @@ pub async fn charge_all(state: &AppState, caller: &Caller, jobs: &[Keyed]) -> Re
         }
     }
     if points == 0 {
-        return Ok(());
+        return Ok(None);
     }
     let Err(Exceeded { used, retry_after }) = state.engine().charge(&tenant, points, limit).await
     else {
-        return Ok(());
+        return Ok(Some(Charge { tenant, points }));
     };
     let whose = caller.describe();
     let detail = match retry_after {
@@ -283,7 +292,7 @@ pub async fn admit_job(
     state: &AppState,
     caller: &Caller,
     keyed: &Keyed,
-) -> Result<Option<Turn>, ApiError> {
+) -> Result<Admitted, ApiError> {
     let (quota, name) = caller.quota(&state.config().access.quotas);
     let tenant = caller.owner(None);
     let holds = tenant.is_some() && quota.result_bytes > 0;
@@ -317,8 +326,14 @@ pub async fn admit_job(
             ));
         }
     }
-    charge(state, caller, keyed).await?;
-    Ok(turn)
+    let charge = charge(state, caller, keyed).await?;
+    Ok(Admitted { turn, charge })
+}
+
+/// A job let in: its tenant's turn, held until the job is stored, and its points charged.
+pub struct Admitted {
+    pub turn: Option<Turn>,
+    pub charge: Option<Charge>,
 }
 
 /// Lets `owner`'s job `keyed` in if the room its answer may take, added to what the

@@ -76,10 +76,11 @@ pub async fn run(
         .iter()
         .map(|c| c.job.clone().keyed().scoped(caller.tenant()))
         .collect();
-    access::charge_all(&state, &caller, &jobs).await?;
+    let charged = access::charge_all(&state, &caller, &jobs).await?;
     // One deadline for the whole suite, so that its cost is that of one solve at most,
     // however many checks it holds; each answer is judged and let go before the next.
-    let deadline = Instant::now() + state.config().engine.solve_deadline;
+    let started = Instant::now();
+    let deadline = started + state.config().engine.solve_deadline;
     let mut reports = Vec::with_capacity(suite.checks.len());
     for (spec, keyed) in suite.checks.iter().zip(jobs) {
         if Instant::now() >= deadline {
@@ -103,6 +104,9 @@ pub async fn run(
         // The answer is kept for `thirdbody check --update` only.
         report.answer = None;
         reports.push(report);
+    }
+    if let Some(charge) = charged {
+        state.engine().true_up(&charge, started.elapsed()).await;
     }
     let report = Report::new(reports);
     let failed = (!report.passed).then(|| ApiError::checks_failed(&report));

@@ -223,9 +223,9 @@ pub async fn submit(
         })
         .await?;
     // The tenant's turn is held until the job is stored: its quotas were counted in it.
-    let turn = access::admit_job(&state, &caller, &keyed).await?;
-    let record = state.engine().submit(keyed, owner).await?;
-    drop(turn);
+    let admitted = access::admit_job(&state, &caller, &keyed).await?;
+    let record = state.engine().submit(keyed, owner, admitted.charge).await?;
+    drop(admitted.turn);
     let location = format!("/v1/jobs/{}", record.id);
     let view = JobView::of(&record);
     let headers = [

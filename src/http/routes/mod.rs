@@ -343,12 +343,25 @@ impl SolveRequest {
             }
         });
         let caller = &self.caller;
-        let validate = async move {
+        let charged = std::sync::Mutex::new(None);
+        let validate = async {
             let keyed = valid.await?;
-            access::charge(state, caller, &keyed).await?;
+            *charged.lock().unwrap_or_else(|p| p.into_inner()) =
+                access::charge(state, caller, &keyed).await?;
             Ok::<_, ApiError>(keyed)
         };
+        let started = std::time::Instant::now();
         let (solved, cache) = state.engine().answer(text, validate).await?;
+        // The estimate charged, trued up: what the solve took, nothing for an answer another
+        // request's solve gave.
+        let charged = charged.into_inner().unwrap_or_else(|p| p.into_inner());
+        if let Some(charge) = charged {
+            let took = match cache {
+                CacheStatus::Miss => started.elapsed(),
+                CacheStatus::Hit => std::time::Duration::ZERO,
+            };
+            state.engine().true_up(&charge, took).await;
+        }
         self.answering.respond(&solved, Some(cache))
     }
 }
