@@ -438,10 +438,19 @@ impl Lifecycle {
     /// Stops taking work: new solves and jobs are refused. The jobs accepted, queued or
     /// running, go on; [`Lifecycle::jobs_finished`] waits for them to finish and
     /// [`Lifecycle::jobs_collected`] for their clients to read them.
+    ///
+    /// The jobs that finished before the drain and were not read are owed to their clients
+    /// only if the store would lose them with the process (in memory, or a database that
+    /// cannot be written): a durable store gives them to the next process, and a client that
+    /// never comes back made every drain wait its whole timeout.
     pub(super) fn begin_drain(&self) {
         self.draining.cancel();
         let unfinished: Vec<Uuid> = self.live().keys().copied().collect();
-        let uncollected: Vec<Uuid> = self.uncollected().ids.iter().copied().collect();
+        let kept = self.jobs.durable() && self.jobs.problem().is_none();
+        let uncollected: Vec<Uuid> = match kept {
+            true => Vec::new(),
+            false => self.uncollected().ids.iter().copied().collect(),
+        };
         self.owed()
             .extend(unfinished.into_iter().chain(uncollected));
     }

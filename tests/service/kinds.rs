@@ -156,7 +156,7 @@ fn a_kind_of_unknown_size_runs_and_stops_on_cancel_and_deadline() {
 async fn the_engine_runs_an_unregistered_kind_reports_its_progress_and_cancels_it() {
     let engine = engine();
     let record = engine
-        .submit(Job::new(Countdown { steps: 1_000_000 }).keyed(), None)
+        .submit(Job::new(Countdown { steps: 1_000_000 }).keyed(), None, None)
         .await
         .unwrap();
     assert_eq!(
@@ -184,7 +184,7 @@ async fn the_engine_runs_an_unregistered_kind_reports_its_progress_and_cancels_i
     );
 
     let short = engine
-        .submit(Job::new(Countdown { steps: 30 }).keyed(), None)
+        .submit(Job::new(Countdown { steps: 30 }).keyed(), None, None)
         .await
         .unwrap();
     let mut status = engine.watch(short.id).unwrap();

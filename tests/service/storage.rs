@@ -227,3 +227,55 @@ fn a_damaged_database_is_refused_at_start_saying_how_to_go_on() {
     assert!(stderr.contains("move the file aside"), "{stderr}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A job finished before the shutdown and never read is in the database, for the next
+/// process to give: the drain does not wait out its timeout for its client (it did).
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn the_drain_does_not_wait_for_unread_jobs_the_database_keeps() {
+    let dir = std::env::temp_dir().join(format!("thirdbody-unread-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let database = dir.join("analyses.db");
+    let http = Client::new();
+    let port = free_port();
+    let child = Command::new(env!("CARGO_BIN_EXE_thirdbody"))
+        .args(["serve", "--bind", &format!("127.0.0.1:{port}")])
+        .arg("--database")
+        .arg(&database)
+        .args(["--shutdown-timeout", "10m"])
+        .env("THIRDBODY_DRAIN_DELAY", "0s")
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let mut server = Process(child);
+    let base = answering(&http, port).await;
+    let (status, view) = submit(&http, &base, &job(0)).await;
+    assert_eq!(status, StatusCode::ACCEPTED, "{view}");
+    let id = view["id"].as_str().unwrap().to_string();
+    // Finished, as the log of its end shows to a reader of the database after a restart;
+    // not read by its client here.
+    let start = Instant::now();
+    let pid = server.0.id().to_string();
+    tokio::time::sleep(Duration::from_millis(200)).await;
+    assert!(Command::new("kill")
+        .args(["-TERM", &pid])
+        .status()
+        .unwrap()
+        .success());
+    let exited = loop {
+        if let Some(status) = server.0.try_wait().unwrap() {
+            break status;
+        }
+        // Far below the drain's bound of ten minutes, far above what exiting takes.
+        assert!(
+            start.elapsed() < Duration::from_secs(60),
+            "the drain waited for the unread job"
+        );
+        tokio::time::sleep(Duration::from_millis(20)).await;
+    };
+    assert!(exited.success(), "{exited}");
+    let (_server, base) = serve(&http, &database).await;
+    let read = finished(&http, &base, &id).await;
+    assert_eq!(read["status"], "succeeded", "{read}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
