@@ -16,5 +16,6 @@ mod honest_answers;
 mod jobs;
 mod kinds;
 mod pictures;
+mod processes;
 mod three_body;
 mod tls;
