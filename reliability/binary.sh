@@ -1,3 +1,4 @@
+# shellcheck shell=bash
 # Sourced by the reliability scripts: sets `bin` to the binary they run, THIRDBODY_BIN when
 # given (CI passes the one `cargo test` built, saving a second build of everything), else
 # the release build, built now if it is out of date.

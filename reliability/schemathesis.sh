@@ -5,7 +5,9 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 examples="${1:-50}"
-command -v st >/dev/null || python3 -m pip install --quiet 'schemathesis>=4.3,<5'
+# In the virtual environment of reliability/venv.sh unless it is on PATH already.
+. reliability/venv.sh
+python_tool st "$SCHEMATHESIS"
 . reliability/binary.sh
 port=$(python3 -c 'import socket; s=socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])')
 log=$(mktemp)
