@@ -278,6 +278,7 @@ async fn three_rolling_restarts_during_a_long_job_hand_its_parts_back_and_it_fin
     let id = submit(&http, &a.base, long_sweep()).await;
     let rolled = ["--shutdown-timeout", "10ms"];
     let mut handed_back = 0;
+    let mut logs = Vec::new();
     for _ in 0..3 {
         let (mut worker, log) = start("worker", port, None, &[&strict[..], &rolled[..]].concat());
         taken_by(&log, &id).await;
@@ -291,10 +292,17 @@ async fn three_rolling_restarts_during_a_long_job_hand_its_parts_back_and_it_fin
             .iter()
             .filter(|l| l.contains("handed a part back"))
             .count();
+        logs.push(crate::processes::tail(&log));
     }
     assert!(handed_back >= 1, "no drain interrupted a part");
     let view = finished(&http, &a.base, &id).await;
-    assert_eq!(view["status"], "succeeded", "{view}");
+    assert_eq!(
+        view["status"],
+        "succeeded",
+        "{view}\nworkers' logs:\n{}\n{}",
+        logs.join("\n---\n"),
+        logs_near(&a.base)
+    );
     let answer = result(&http, &a.base, &view).await;
     assert_eq!(answer["points"].as_array().unwrap().len(), 240);
 }
