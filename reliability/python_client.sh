@@ -17,10 +17,7 @@ server=$!
 trap 'kill $server 2>/dev/null; wait $server 2>/dev/null || true; rm -rf "$work"' EXIT
 (cd "$work" && openapi-python-client generate --path "$OLDPWD/openapi/openapi.json" \
   --meta none --output-path thirdbody_client --fail-on-warning)
-for _ in $(seq 50); do
-  curl -sf "http://127.0.0.1:$port/healthz" >/dev/null && break
-  sleep 0.1
-done
+await_server "$server" "$port" "$work/log"
 PYTHONPATH="$work" python3 - "$port" <<'PY'
 import json, pathlib, sys
 import thirdbody_client

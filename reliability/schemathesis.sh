@@ -14,10 +14,7 @@ log=$(mktemp)
 "$bin" serve --bind "127.0.0.1:$port" --log-format text --database :memory: >"$log" 2>&1 &
 server=$!
 trap 'kill $server 2>/dev/null; wait $server 2>/dev/null || true; rm -f "$log"' EXIT
-for _ in $(seq 50); do
-  curl -sf "http://127.0.0.1:$port/healthz" >/dev/null && break
-  sleep 0.1
-done
+await_server "$server" "$port" "$log"
 # One worker: with two, schemathesis inspects its lambdas' source (`ast`) from two threads, and
 # CPython before 3.11.8 (this machine has 3.11.7) loses count of the AST constructor's depth
 # between them: "SystemError: AST constructor recursion depth mismatch" (CPython gh-106905), a
