@@ -4,8 +4,11 @@
 # spec is complete enough for a generated client to work.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-command -v openapi-python-client >/dev/null \
-  || python3 -m pip install --quiet 'openapi-python-client>=0.26,<1'
+# In the virtual environment of reliability/venv.sh unless it is on PATH already; the
+# generated client is run by the python3 first on PATH, which has its dependencies (httpx,
+# attrs, python-dateutil) when it is the environment's.
+. reliability/venv.sh
+python_tool openapi-python-client "$OPENAPI_PYTHON_CLIENT"
 . reliability/binary.sh
 work=$(mktemp -d)
 port=$(python3 -c 'import socket; s=socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])')
@@ -14,10 +17,7 @@ server=$!
 trap 'kill $server 2>/dev/null; wait $server 2>/dev/null || true; rm -rf "$work"' EXIT
 (cd "$work" && openapi-python-client generate --path "$OLDPWD/openapi/openapi.json" \
   --meta none --output-path thirdbody_client --fail-on-warning)
-for _ in $(seq 50); do
-  curl -sf "http://127.0.0.1:$port/healthz" >/dev/null && break
-  sleep 0.1
-done
+await_server "$server" "$port" "$work/log"
 PYTHONPATH="$work" python3 - "$port" <<'PY'
 import json, pathlib, sys
 import thirdbody_client

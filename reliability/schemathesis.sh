@@ -5,17 +5,16 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 examples="${1:-50}"
-command -v st >/dev/null || python3 -m pip install --quiet 'schemathesis>=4.3,<5'
+# In the virtual environment of reliability/venv.sh unless it is on PATH already.
+. reliability/venv.sh
+python_tool st "$SCHEMATHESIS"
 . reliability/binary.sh
 port=$(python3 -c 'import socket; s=socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])')
 log=$(mktemp)
 "$bin" serve --bind "127.0.0.1:$port" --log-format text --database :memory: >"$log" 2>&1 &
 server=$!
 trap 'kill $server 2>/dev/null; wait $server 2>/dev/null || true; rm -f "$log"' EXIT
-for _ in $(seq 50); do
-  curl -sf "http://127.0.0.1:$port/healthz" >/dev/null && break
-  sleep 0.1
-done
+await_server "$server" "$port" "$log"
 # One worker: with two, schemathesis inspects its lambdas' source (`ast`) from two threads, and
 # CPython before 3.11.8 (this machine has 3.11.7) loses count of the AST constructor's depth
 # between them: "SystemError: AST constructor recursion depth mismatch" (CPython gh-106905), a

@@ -2,7 +2,6 @@
 //! restart (a key added, rotated, revoked), and tenants in a fleet whose Redis asks for a
 //! password (AUTH): a job belongs to its key's tenant in every process of the fleet.
 
-use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
 use reqwest::{Client, StatusCode};
@@ -12,14 +11,11 @@ use crate::fleet::{
     answering, finished, free_port, fresh_redis, get_json, heavy_sweep, metric_in,
     redis_server_available, redis_with, start, submit, taken_by, text_of, Process,
 };
+use crate::processes::{logs_near, spawn_logged, thirdbody, PATIENCE};
 
 /// `thirdbody new-key` with `args`: the key and its entry.
 fn new_key(args: &[&str]) -> (String, Value) {
-    let out = Command::new(env!("CARGO_BIN_EXE_thirdbody"))
-        .arg("new-key")
-        .args(args)
-        .output()
-        .unwrap();
+    let out = thirdbody().arg("new-key").args(args).output().unwrap();
     assert!(
         out.status.success(),
         "{}",
@@ -59,8 +55,9 @@ async fn until(http: &Client, url: &str, key: &str, expected: StatusCode) {
     let start = Instant::now();
     while status(http, url, key).await != expected {
         assert!(
-            start.elapsed() < Duration::from_secs(10),
-            "{url} never answered {expected} to {key}"
+            start.elapsed() < PATIENCE,
+            "{url} never answered {expected} to {key}\n{}",
+            logs_near(url)
         );
         tokio::time::sleep(Duration::from_millis(100)).await;
     }
@@ -88,11 +85,7 @@ fn new_key_refuses_what_the_service_would_refuse() {
             "expires \"tomorrow\"",
         ),
     ] {
-        let out = Command::new(env!("CARGO_BIN_EXE_thirdbody"))
-            .arg("new-key")
-            .args(args)
-            .output()
-            .unwrap();
+        let out = thirdbody().arg("new-key").args(args).output().unwrap();
         assert_eq!(out.status.code(), Some(2), "{args:?}");
         let error = String::from_utf8_lossy(&out.stderr);
         assert!(error.contains(needle), "{args:?}: {error}");
@@ -109,15 +102,14 @@ async fn keys_are_added_rotated_and_revoked_without_a_restart() {
     write_keys(&file, &[&old_entry, &ops_entry]);
 
     let port = free_port();
-    let _service = Process(
-        Command::new(env!("CARGO_BIN_EXE_thirdbody"))
+    let (_service, _) = spawn_logged(
+        thirdbody()
             .args(["serve", "--bind", &format!("127.0.0.1:{port}")])
             .args(["--database", ":memory:", "--anonymous", "none"])
-            .args(["--api-keys", file.to_str().unwrap()])
-            .stdout(Stdio::null())
-            .stderr(Stdio::null())
-            .spawn()
-            .unwrap(),
+            .args(["--api-keys", file.to_str().unwrap(), "--log-format", "text"]),
+        &format!("serve on port {port}"),
+        Some(port),
+        None,
     );
     let http = Client::new();
     let base = answering(&http, port).await;
@@ -217,7 +209,7 @@ async fn tenants_hold_across_a_fleet_on_a_redis_with_a_password() {
         if view["status"] == "succeeded" {
             break;
         }
-        assert!(start_at.elapsed() < Duration::from_secs(30), "{view}");
+        assert!(start_at.elapsed() < PATIENCE, "{view}\n{}", logs_near(&job));
         tokio::time::sleep(Duration::from_millis(50)).await;
     }
     assert_eq!(
@@ -259,7 +251,7 @@ async fn tenants_hold_across_a_fleet_on_a_redis_with_a_password() {
     let start_at = Instant::now();
     let ready = loop {
         let ready = get_json(&http, format!("{three}/readyz")).await;
-        if ready["status"] == "degraded" || start_at.elapsed() > Duration::from_secs(10) {
+        if ready["status"] == "degraded" || start_at.elapsed() > PATIENCE {
             break ready;
         }
         tokio::time::sleep(Duration::from_millis(100)).await;

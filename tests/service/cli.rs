@@ -7,7 +7,7 @@ use std::process::{Command, Output, Stdio};
 use serde_json::Value;
 
 fn thirdbody(args: &[&str], stdin: Option<&str>) -> Output {
-    let mut child = Command::new(env!("CARGO_BIN_EXE_thirdbody"))
+    let mut child = crate::processes::thirdbody()
         .args(args)
         .current_dir(env!("CARGO_MANIFEST_DIR"))
         .stdin(Stdio::piped())
@@ -262,7 +262,7 @@ fn the_container_configuration_starts_a_service_that_drains_on_sigterm() {
         .local_addr()
         .unwrap()
         .port();
-    let child = Command::new(env!("CARGO_BIN_EXE_thirdbody"))
+    let child = crate::processes::thirdbody()
         .arg("serve")
         .envs(env.iter().map(|(k, v)| (k.as_str(), v.as_str())))
         .env("THIRDBODY_BIND", format!("127.0.0.1:{port}"))
@@ -272,15 +272,17 @@ fn the_container_configuration_starts_a_service_that_drains_on_sigterm() {
         .stderr(Stdio::piped())
         .spawn()
         .unwrap();
-    let mut health = None;
-    for _ in 0..200 {
-        health = get(port, "/healthz");
-        if health.is_some() {
-            break;
+    let started = std::time::Instant::now();
+    let health = loop {
+        if let Some(health) = get(port, "/healthz") {
+            break health;
         }
+        assert!(
+            started.elapsed() < crate::processes::PATIENCE,
+            "the service does not answer /healthz"
+        );
         std::thread::sleep(std::time::Duration::from_millis(25));
-    }
-    let health = health.expect("the service answers /healthz");
+    };
     assert!(health.starts_with("HTTP/1.1 200"), "{health}");
     assert!(get(port, "/readyz").unwrap().starts_with("HTTP/1.1 200"));
     // The image's HEALTHCHECK command, with the container's bind address.
@@ -288,7 +290,7 @@ fn the_container_configuration_starts_a_service_that_drains_on_sigterm() {
         text.contains(r#"HEALTHCHECK"#) && text.contains(r#"CMD ["thirdbody", "healthcheck"]"#)
     );
     let healthcheck = |bind: String| {
-        Command::new(env!("CARGO_BIN_EXE_thirdbody"))
+        crate::processes::thirdbody()
             .arg("healthcheck")
             .env("THIRDBODY_BIND", bind)
             .stderr(Stdio::null())
@@ -355,7 +357,7 @@ fn ctrl_c_says_what_the_drain_waits_for_and_a_second_exits_at_once() {
     use std::time::{Duration, Instant};
     for format in ["json", "text"] {
         let port = free_port();
-        let mut child = Command::new(env!("CARGO_BIN_EXE_thirdbody"))
+        let mut child = crate::processes::thirdbody()
             .args(["serve", "--bind", &format!("127.0.0.1:{port}")])
             .args(["--log-format", format, "--shutdown-timeout", "30s"])
             // Without a database file: its results would outlive the process.
@@ -378,7 +380,7 @@ fn ctrl_c_says_what_the_drain_waits_for_and_a_second_exits_at_once() {
             }
         });
         let wait_for = |needle: &str| -> String {
-            let end = Instant::now() + Duration::from_secs(10);
+            let end = Instant::now() + crate::processes::PATIENCE;
             loop {
                 let left = end.saturating_duration_since(Instant::now());
                 match logged.recv_timeout(left) {

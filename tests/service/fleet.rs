@@ -2,23 +2,15 @@
 //! installs it; without it these tests say they were skipped): two `thirdbody serve` and one
 //! `thirdbody worker`, as `deploy/compose.yaml` runs them.
 
-use std::io::{BufRead, BufReader};
 use std::net::TcpListener;
-use std::process::{Child, Command, Stdio};
-use std::sync::{Arc, Mutex};
+use std::process::{Command, Stdio};
+use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use serde_json::{json, Value};
 
-/// A child process, killed when dropped.
-pub(crate) struct Process(pub Child);
-
-impl Drop for Process {
-    fn drop(&mut self) {
-        let _ = self.0.kill();
-        let _ = self.0.wait();
-    }
-}
+pub(crate) use crate::processes::Process;
+use crate::processes::{exited, logs_near, spawn_logged, tail, thirdbody, Log, PATIENCE, STALL};
 
 pub(crate) fn free_port() -> u16 {
     TcpListener::bind("127.0.0.1:0")
@@ -49,15 +41,19 @@ pub(crate) fn redis_with(port: u16, args: &[&str]) -> Process {
         .stdout(Stdio::null())
         .spawn()
         .expect("redis-server starts");
+    let mut redis = Process(child);
     let start = Instant::now();
     while std::net::TcpStream::connect(("127.0.0.1", port)).is_err() {
+        if let Some(status) = redis.0.try_wait().unwrap() {
+            panic!("redis-server on port {port} exited: {status}");
+        }
         assert!(
-            start.elapsed() < Duration::from_secs(10),
-            "redis-server did not start"
+            start.elapsed() < PATIENCE,
+            "redis-server did not start on port {port} in {PATIENCE:?}"
         );
         std::thread::sleep(Duration::from_millis(20));
     }
-    Process(child)
+    redis
 }
 
 /// A Redis server of its own on a free port; `None` (the test saying it is skipped) when
@@ -80,14 +76,15 @@ pub(crate) fn redis_cli(port: u16, args: &[&str]) -> String {
     String::from_utf8_lossy(&out.stdout).into_owned()
 }
 
-/// Starts `thirdbody <command>` on the fleet of Redis `redis`; its log lines are collected.
+/// Starts `thirdbody <command>` on the fleet of Redis `redis` (its database of saved
+/// analyses in memory unless `flags` name one); its log lines are collected.
 pub(crate) fn start(
     command: &str,
     redis: u16,
     port: Option<u16>,
     flags: &[&str],
-) -> (Process, Arc<Mutex<Vec<String>>>) {
-    let mut cmd = Command::new(env!("CARGO_BIN_EXE_thirdbody"));
+) -> (Process, Log) {
+    let mut cmd = thirdbody();
     let url = format!("redis://127.0.0.1:{redis}");
     let default_url = ["--redis-url", url.as_str()];
     cmd.arg(command)
@@ -106,22 +103,15 @@ pub(crate) fn start(
         })
         .args(["--pool-size", "2"])
         .env("RUST_LOG", "info")
-        .stdout(Stdio::null())
-        .stderr(Stdio::piped())
         .args(flags);
     if let Some(port) = port {
         cmd.args(["--bind", &format!("127.0.0.1:{port}")]);
     }
-    let mut child = cmd.spawn().expect("thirdbody starts");
-    let lines = Arc::new(Mutex::new(Vec::new()));
-    let stderr = child.stderr.take().unwrap();
-    let sink = lines.clone();
-    std::thread::spawn(move || {
-        for line in BufReader::new(stderr).lines().map_while(Result::ok) {
-            sink.lock().unwrap().push(line);
-        }
-    });
-    (Process(child), lines)
+    let name = match port {
+        Some(port) => format!("{command} on port {port}"),
+        None => command.to_string(),
+    };
+    spawn_logged(&mut cmd, &name, port, Some(redis))
 }
 
 pub(crate) struct Service {
@@ -129,14 +119,22 @@ pub(crate) struct Service {
     _process: Process,
 }
 
-/// Waits (up to 20 s) until a service answers on `port`; returns its base URL.
+/// Waits until a service answers on `port` (failing at once if its process exits, or after
+/// [`PATIENCE`]); returns its base URL.
 pub(crate) async fn answering(http: &reqwest::Client, port: u16) -> String {
     let base = format!("http://127.0.0.1:{port}");
     let start = Instant::now();
     while http.get(format!("{base}/healthz")).send().await.is_err() {
+        let gone = exited(port);
         assert!(
-            start.elapsed() < Duration::from_secs(20),
-            "serve did not start"
+            !gone && start.elapsed() < PATIENCE,
+            "the service on port {port} {}\n{}",
+            if gone {
+                "exited before it answered"
+            } else {
+                "did not answer /healthz"
+            },
+            logs_near(&base)
         );
         tokio::time::sleep(Duration::from_millis(50)).await;
     }
@@ -201,27 +199,39 @@ pub(crate) async fn result(http: &reqwest::Client, base: &str, view: &Value) -> 
     get_json(http, format!("{base}{url}")).await
 }
 
-/// Polls job `id` on `base` until it finished; returns its view.
+/// Polls job `id` on `base` until it finished; returns its view. Waits as long as the job
+/// moves (its status or its count of points done changes at least every [`STALL`]), and
+/// otherwise fails saying where it stood and what the fleet's processes logged.
 pub(crate) async fn finished(http: &reqwest::Client, base: &str, id: &str) -> Value {
     let start = Instant::now();
+    let (mut seen, mut moved) = (Value::Null, Instant::now());
     loop {
         let view = get_json(http, format!("{base}/v1/jobs/{id}")).await;
         if !matches!(view["status"].as_str(), Some("queued" | "running")) {
             return view;
         }
+        let now = json!([view["status"], view["progress"]]);
+        if now != seen {
+            (seen, moved) = (now, Instant::now());
+        }
         assert!(
-            start.elapsed() < Duration::from_secs(60),
-            "job {id} never finished"
+            moved.elapsed() < STALL,
+            "job {id} made no progress in {STALL:?} ({:.0?} since it was polled first): \
+             status {}, progress {} (done/total); its view: {view}\n{}",
+            start.elapsed(),
+            view["status"],
+            view["progress"],
+            logs_near(base)
         );
         tokio::time::sleep(Duration::from_millis(50)).await;
     }
 }
 
-/// Waits (up to `bound`) until `/readyz` on `base` satisfies `ok`; returns its answer.
+/// Waits (up to [`PATIENCE`]: the links are checked every half second) until `/readyz` on
+/// `base` satisfies `ok`; returns its answer.
 pub(crate) async fn readyz_until(
     http: &reqwest::Client,
     base: &str,
-    bound: Duration,
     ok: impl Fn(&Value) -> bool,
 ) -> Value {
     let start = Instant::now();
@@ -230,19 +240,24 @@ pub(crate) async fn readyz_until(
         if ok(&ready) {
             return ready;
         }
-        assert!(start.elapsed() < bound, "readyz stayed {ready}");
+        assert!(
+            start.elapsed() < PATIENCE,
+            "readyz stayed {ready} for {PATIENCE:?}\n{}",
+            logs_near(base)
+        );
         tokio::time::sleep(Duration::from_millis(50)).await;
     }
 }
 
 /// Waits until the process whose log is `log` is solving a part of job `id`.
-pub(crate) async fn taken_by(log: &Mutex<Vec<String>>, id: &str) {
+pub(crate) async fn taken_by(log: &Log, id: &str) {
     let start = Instant::now();
     let taken = |l: &String| l.contains("solving a part") && l.contains(id);
     while !log.lock().unwrap().iter().any(taken) {
         assert!(
-            start.elapsed() < Duration::from_secs(30),
-            "the worker took no part"
+            start.elapsed() < PATIENCE,
+            "the worker took no part of job {id} in {PATIENCE:?}; its log ends:\n{}",
+            tail(log)
         );
         tokio::time::sleep(Duration::from_millis(5)).await;
     }
@@ -405,7 +420,14 @@ async fn two_services_and_a_worker_share_answers_jobs_and_sweeps_through_redis()
         .map(|i| format!("{} nm/s", 100 + i))
         .collect::<Vec<_>>());
     let id = submit(&http, &a.base, long).await;
+    let start = Instant::now();
     while metric(&http, &a.base, "thirdbody_jobs_running", "").await < 1.0 {
+        assert!(
+            start.elapsed() < PATIENCE,
+            "job {id} never ran on {}\n{}",
+            a.base,
+            logs_near(&a.base)
+        );
         tokio::time::sleep(Duration::from_millis(5)).await;
     }
     let cancelled = http
@@ -420,9 +442,12 @@ async fn two_services_and_a_worker_share_answers_jobs_and_sweeps_through_redis()
         + metric(&http, &b.base, "thirdbody_jobs_running", "").await
         > 0.0
     {
+        // A running part looks for a cancel every 200 ms, and stops within a point.
         assert!(
             start.elapsed() < Duration::from_secs(5),
-            "the cancelled parts still run"
+            "the cancelled parts still run after {:?}\n{}",
+            start.elapsed(),
+            logs_near(&a.base)
         );
         tokio::time::sleep(Duration::from_millis(20)).await;
     }
@@ -447,10 +472,7 @@ async fn two_services_and_a_worker_share_answers_jobs_and_sweeps_through_redis()
     // Redis back: sharing resumes without a restart.
     let _redis = start_redis(redis_port);
     for base in [&a.base, &b.base] {
-        readyz_until(&http, base, Duration::from_secs(15), |r| {
-            r["status"] == "ready"
-        })
-        .await;
+        readyz_until(&http, base, |r| r["status"] == "ready").await;
     }
     let body = json!({"load": "2.3 nN"});
     let on_a = post(&http, format!("{}/v1/rolling", a.base), &body).await;
@@ -560,10 +582,7 @@ async fn a_worker_on_its_own_takes_a_job_from_the_stream_and_stores_its_answer()
         if now.state.status().is_finished() {
             break now;
         }
-        assert!(
-            start.elapsed() < Duration::from_secs(20),
-            "not answered: {now:?}"
-        );
+        assert!(start.elapsed() < PATIENCE, "not answered: {now:?}");
         tokio::time::sleep(Duration::from_millis(20)).await;
     };
     assert_eq!(answered.state.status(), JobStatus::Succeeded);

@@ -3,7 +3,7 @@
 //! database of a single `thirdbody serve`, and in Redis for a fleet.
 
 use std::path::PathBuf;
-use std::process::{Command, Stdio};
+use std::process::Command;
 use std::time::{Duration, Instant};
 
 use reqwest::{Client, StatusCode};
@@ -13,6 +13,7 @@ use crate::fleet::{
     answering, finished, free_port, fresh_redis, get_json, redis_cli, serve, Process,
 };
 use crate::fleet_faults::long_sweep;
+use crate::processes::{logs_near, spawn_logged, thirdbody, PATIENCE};
 
 const OWNER: &str = "owner-token-of-the-test-0001";
 const OTHER: &str = "another-owner-token-00000002";
@@ -42,16 +43,13 @@ impl Drop for TempDir {
 /// `thirdbody serve` alone (no Redis) on the database `database`, with `flags`.
 async fn single(http: &Client, database: &str, flags: &[&str]) -> (Process, String) {
     let port = free_port();
-    let child = Command::new(env!("CARGO_BIN_EXE_thirdbody"))
-        .args(["serve", "--bind", &format!("127.0.0.1:{port}")])
+    let mut cmd = thirdbody();
+    cmd.args(["serve", "--bind", &format!("127.0.0.1:{port}")])
         .args(["--database", database, "--log-format", "text"])
         .args(flags)
-        .env("THIRDBODY_DRAIN_DELAY", "0s")
-        .stdout(Stdio::null())
-        .stderr(Stdio::null())
-        .spawn()
-        .expect("thirdbody starts");
-    let process = Process(child);
+        .env("THIRDBODY_DRAIN_DELAY", "0s");
+    let name = format!("serve on port {port} ({database})");
+    let (process, _) = spawn_logged(&mut cmd, &name, Some(port), None);
     (process, answering(http, port).await)
 }
 
@@ -127,7 +125,7 @@ async fn saved_analyses_outlive_a_restart_of_the_embedded_database() {
     let (mut first, base) = single(&http, &database, &[]).await;
 
     // Another process on the same file is refused at start, saying why.
-    let out = Command::new(env!("CARGO_BIN_EXE_thirdbody"))
+    let out = thirdbody()
         .args(["serve", "--bind", "127.0.0.1:0", "--database", &database])
         .output()
         .unwrap();
@@ -157,7 +155,11 @@ async fn saved_analyses_outlive_a_restart_of_the_embedded_database() {
     let long_id = long["id"].as_str().unwrap().to_string();
     let start = Instant::now();
     while get_json(&http, format!("{base}/v1/jobs/{long_id}")).await["status"] != "running" {
-        assert!(start.elapsed() < Duration::from_secs(20), "it never ran");
+        assert!(
+            start.elapsed() < PATIENCE,
+            "job {long_id} never ran\n{}",
+            logs_near(&base)
+        );
         tokio::time::sleep(Duration::from_millis(20)).await;
     }
     first.0.kill().unwrap();
@@ -294,7 +296,7 @@ async fn saved_analyses_outlive_a_restart_of_the_embedded_database() {
         finished(&http, &base, &read_id).await["status"],
         "succeeded"
     );
-    assert_eq!(terminate(&mut second, Duration::from_secs(5)), Some(0));
+    assert_eq!(terminate(&mut second, PATIENCE), Some(0));
     let (_third, base) = single(&http, &database, &[]).await;
     let view = get_json(&http, format!("{base}/v1/jobs/{read_id}")).await;
     assert_eq!(view["status"], "succeeded", "{view}");
@@ -305,11 +307,16 @@ async fn the_embedded_history_forgets_jobs_past_its_retention() {
     let dir = TempDir::new("retention");
     let database = dir.database();
     let http = Client::new();
-    let flags = ["--history-retention", "2s", "--job-retention", "1s"];
+    // A history long beside a stall of a loaded machine between two requests: the job is
+    // read from it once out of memory, however late that read comes.
+    let history = Duration::from_secs(10);
+    let flags = ["--history-retention", "10s", "--job-retention", "1s"];
     let (_service, base) = single(&http, &database, &flags).await;
+    let submitted = Instant::now();
     let view = submit(&http, &base, &rolling("35 nm"), Some(OWNER)).await;
     let id = view["id"].as_str().unwrap();
     assert_eq!(finished(&http, &base, id).await["status"], "succeeded");
+    let ended = Instant::now();
     // Out of memory after a second, still in the database.
     tokio::time::sleep(Duration::from_millis(1300)).await;
     assert_eq!(
@@ -318,8 +325,15 @@ async fn the_embedded_history_forgets_jobs_past_its_retention() {
     );
     let (_, page) = list(&http, &base, "/v1/jobs", Some(OWNER)).await;
     assert_eq!(page["total"], 1);
-    // Past the history's retention: forgotten.
-    tokio::time::sleep(Duration::from_millis(1000)).await;
+    assert!(
+        submitted.elapsed() < history,
+        "the reads came {:?} after the submission, past the history's retention",
+        submitted.elapsed()
+    );
+    // Past the history's retention (counted from the job's end, before `ended`): forgotten.
+    let past =
+        (ended + history + Duration::from_millis(300)).saturating_duration_since(Instant::now());
+    tokio::time::sleep(past).await;
     let (_, page) = list(&http, &base, "/v1/jobs", Some(OWNER)).await;
     assert_eq!(page["total"], 0, "{page}");
     let gone = body(&http, format!("{base}/v1/jobs/{id}"), "application/json").await;

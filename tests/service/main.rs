@@ -16,6 +16,7 @@ mod honest_answers;
 mod jobs;
 mod kinds;
 mod pictures;
+mod processes;
 mod storage;
 mod three_body;
 mod tls;

@@ -11,7 +11,8 @@ use std::time::{Duration, Instant};
 use reqwest::{Client, StatusCode};
 use serde_json::{json, Value};
 
-use crate::fleet::{answering, free_port, Process};
+use crate::fleet::{answering, free_port};
+use crate::processes::{thirdbody, Process};
 
 /// A tmpfs of `size` mounted at a directory of the test's own; unmounted when dropped.
 struct SmallDisk(PathBuf);
@@ -55,7 +56,7 @@ impl Drop for SmallDisk {
 /// `thirdbody serve` alone on the database `database`; its base URL.
 async fn serve(http: &Client, database: &Path) -> (Process, String) {
     let port = free_port();
-    let child = Command::new(env!("CARGO_BIN_EXE_thirdbody"))
+    let child = thirdbody()
         .args(["serve", "--bind", &format!("127.0.0.1:{port}")])
         .arg("--database")
         .arg(database)
@@ -215,7 +216,7 @@ fn a_damaged_database_is_refused_at_start_saying_how_to_go_on() {
         .map(|i| (i.wrapping_mul(2654435761) >> 13) as u8)
         .collect();
     std::fs::write(&database, noise).unwrap();
-    let out = Command::new(env!("CARGO_BIN_EXE_thirdbody"))
+    let out = thirdbody()
         .args(["serve", "--bind", &format!("127.0.0.1:{}", free_port())])
         .arg("--database")
         .arg(&database)
@@ -237,7 +238,7 @@ async fn the_drain_does_not_wait_for_unread_jobs_the_database_keeps() {
     let database = dir.join("analyses.db");
     let http = Client::new();
     let port = free_port();
-    let child = Command::new(env!("CARGO_BIN_EXE_thirdbody"))
+    let child = thirdbody()
         .args(["serve", "--bind", &format!("127.0.0.1:{port}")])
         .arg("--database")
         .arg(&database)

@@ -13,6 +13,7 @@ use serde_json::json;
 use crate::fleet::{
     answering, finished, free_port, get_json, redis_server_available, redis_with, submit, Process,
 };
+use crate::processes::{thirdbody, PATIENCE};
 
 const PASSWORD: &str = "s3cret-over-tls";
 
@@ -88,7 +89,7 @@ fn certificates(dir: &Path) {
 /// log in `log`.
 fn serve(port: u16, url: &str, trusted: &Path, log: &Path) -> Process {
     Process(
-        Command::new(env!("CARGO_BIN_EXE_thirdbody"))
+        thirdbody()
             .args(["serve", "--bind", &format!("127.0.0.1:{port}")])
             .args(["--redis-url", url, "--log-format", "text"])
             .env("SSL_CERT_FILE", trusted)
@@ -162,7 +163,11 @@ async fn a_fleet_works_on_a_redis_over_tls_whose_certificate_it_checks() {
             assert_eq!(ready["status"], "degraded", "{ready}");
             break;
         }
-        assert!(start.elapsed() < Duration::from_secs(10), "{ready}");
+        assert!(
+            start.elapsed() < PATIENCE,
+            "{ready}\n{}",
+            std::fs::read_to_string(&log).unwrap_or_default()
+        );
         tokio::time::sleep(Duration::from_millis(50)).await;
     }
     let job = json!({"kind": "rolling", "input": {}});
