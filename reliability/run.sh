@@ -30,6 +30,7 @@ python3 reliability/checks_memory.py | tee -a "$out"
 python3 reliability/queue_cost.py | tee -a "$out"
 python3 reliability/sigterm.py | tee -a "$out"
 python3 reliability/sigkill.py | tee -a "$out"
+python3 reliability/continuum.py | tee -a "$out"
 if $bounded; then
   broken=0
   if grep -q "server alive at the end: False" "$out"; then echo "BROKEN: the server died"; broken=1; fi
@@ -57,6 +58,12 @@ if $bounded; then
     || { echo "BROKEN: a poller of a job the shutdown interrupted was not told"; broken=1; }
   grep -q "answers 410 tag:thirdbody,2026:problems/interrupted" "$out" \
     || { echo "BROKEN: a restarted server does not say interrupted"; broken=1; }
+  # The continuum's extremes are refused (422) before any work, and a long continuum solve
+  # stops at its deadline (2 s; 3 s allows a loaded machine, the solve itself takes 30 s).
+  [ "$(grep -cE '^continuum extreme .*: 422 ' "$out")" -eq 6 ] \
+    || { echo "BROKEN: a continuum extreme was not refused with 422"; broken=1; }
+  grep -qE "^continuum past a 2 s deadline: 504 deadline-exceeded after (2\.[0-9]+|1\.[0-9]+) s; the next solve 200" "$out" \
+    || { echo "BROKEN: a continuum solve went on past its deadline"; broken=1; }
   # 503 results-full is a refusal the service owes (no room to keep a job's result for its
   # retention), not a fault.
   if grep -oE "(solve|hostile|distinct|cached) 5[0-9][0-9][^:,]*" "$out" | grep -v "results-full"; then
