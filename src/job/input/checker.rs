@@ -8,7 +8,7 @@ use serde_json::{json, Value};
 
 use super::units::{is_bare_number, parse_quantity, Dimension, UnitError};
 use super::{Field, Quantity};
-use crate::job::{FieldError, InputWarning, JobError, Validated};
+use crate::job::{echoed, FieldError, InputWarning, JobError, Validated};
 use crate::model::{OptionError, Parameter, ParameterError, SolveOption};
 use crate::render::format_number;
 
@@ -225,11 +225,10 @@ impl Checker {
         if let (true, Ok(x)) = (bare, &parsed) {
             if let Some(message) = implausible(parameter, *x) {
                 let path = at.path();
-                let message = format!("{path}: {message}");
                 self.warnings.push(InputWarning {
+                    message: format!("{path}: {message}"),
                     field: path,
                     value: quantity.sent(),
-                    message,
                 });
             }
         }
@@ -248,6 +247,28 @@ impl Checker {
             self.unreadable(at.path(), quantity.sent(), dimension(parameter), &e);
             f64::NAN
         })
+    }
+
+    /// Warns of a bare number `x` (SI, as it has no unit) far from the scale of `parameter`,
+    /// read from `cell` at `place` of `field` (in the object being read) — a field holding
+    /// several values, such as a CSV's rows: `layer.prony_csv (row 3, E_j): 6 is 6 Pa; did you
+    /// mean "6 GPa"?`. The same warning as a bare number sent in a field of its own.
+    pub fn bare_cell(
+        &mut self,
+        field: &str,
+        place: &str,
+        cell: &str,
+        parameter: Parameter,
+        x: f64,
+    ) {
+        if let Some(message) = implausible(parameter, x) {
+            let path = self.path(field);
+            self.warnings.push(InputWarning {
+                message: format!("{path} ({place}): {message}"),
+                field: path,
+                value: Value::from(echoed(cell)),
+            });
+        }
     }
 
     fn unreadable(&mut self, field: String, value: Value, expected: Dimension, e: &UnitError) {

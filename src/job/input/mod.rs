@@ -77,16 +77,12 @@ impl Quantity {
         Some(Quantity::Number(si(x)))
     }
 
-    /// The value as sent, for error reports (a long text cut to its first 100 characters,
-    /// so that an error never echoes a huge input back).
+    /// The value as sent, for error reports and warnings (a long text cut, so that they
+    /// never echo a huge input back).
     fn sent(&self) -> Value {
-        const ECHOED: usize = 100;
         match self {
             Quantity::Number(x) => Value::from(*x),
-            Quantity::Text(s) if s.chars().count() > ECHOED => {
-                Value::from(format!("{}…", s.chars().take(ECHOED).collect::<String>()))
-            }
-            Quantity::Text(s) => Value::from(s.as_str()),
+            Quantity::Text(s) => Value::from(super::echoed(s)),
         }
     }
 }
