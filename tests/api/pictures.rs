@@ -96,8 +96,8 @@ async fn the_dashboard_is_served_with_its_assets_under_a_strict_policy() {
         let headers = response.headers();
         assert_eq!(headers["content-type"], content_type, "{path}");
         assert_eq!(
-            headers["content-security-policy"], "default-src 'self'",
-            "{path}"
+            headers["content-security-policy"], "default-src 'self'; frame-ancestors 'self'",
+            "{path}: no other site frames it"
         );
     }
     let page = app.get("/").await.text().await.unwrap();
