@@ -1,6 +1,7 @@
 //! Reading the fields of an input: quantities with units, counts and lists, each checked
 //! against its range, every bad field recorded with its path and its value as sent.
 
+use std::cell::RefCell;
 use std::collections::{HashMap, HashSet};
 use std::rc::Rc;
 
@@ -71,6 +72,20 @@ pub struct Checker {
 
 /// Errors listed at most; the rest are counted.
 const MAX_ERRORS: usize = 100;
+
+thread_local! {
+    /// The parameters the checkers of this thread read, while [`parameters_read`] asks.
+    static READ: RefCell<Option<Vec<(String, Parameter)>>> = const { RefCell::new(None) };
+}
+
+/// The model parameter each quantity field is read as, by path (`layer.thickness`), by the
+/// checkers that `read` runs to their end: so the OpenAPI description gives a field the
+/// range of the code that reads it (each parameter at the first place it is read).
+pub fn parameters_read(read: impl FnOnce()) -> Vec<(String, Parameter)> {
+    READ.with(|recorded| recorded.replace(Some(Vec::new())));
+    read();
+    READ.with(|recorded| recorded.take()).unwrap_or_default()
+}
 
 impl Checker {
     pub fn new() -> Self {
@@ -369,8 +384,21 @@ impl Checker {
         });
     }
 
+    /// Hands the parameters read to [`parameters_read`], if it asks.
+    fn record(&self) {
+        READ.with(|recorded| {
+            if let Some(recorded) = recorded.borrow_mut().as_mut() {
+                recorded.extend(self.paths.iter().filter_map(|(source, at)| match source {
+                    Source::Parameter(parameter) => Some((at.path(), *parameter)),
+                    Source::Option(_) => None,
+                }));
+            }
+        });
+    }
+
     /// The recorded errors, as the job's error (the last one counting those not listed).
     pub fn into_error(mut self) -> JobError {
+        self.record();
         if self.omitted > 0 {
             let n = self.omitted;
             self.errors.push(FieldError {
@@ -386,6 +414,7 @@ impl Checker {
     /// The job read, with the input's warnings, if no field was bad; else every error.
     pub fn finish<T>(self, job: T) -> Result<Validated<T>, JobError> {
         if self.errors.is_empty() {
+            self.record();
             Ok(Validated {
                 job,
                 warnings: self.warnings,
