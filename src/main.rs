@@ -196,6 +196,7 @@ fn main() -> ExitCode {
     match result {
         Ok(text) => print(&text),
         Err(e) => {
+            let e = e.cut();
             eprintln!("thirdbody: {e}");
             match e {
                 JobError::Syntax(_)

@@ -232,7 +232,9 @@ pub struct FleetArgs {
     pub part_points: usize,
 
     /// When one Redis holds both the cache and the jobs: the bytes the cached answers may
-    /// take there at most (the oldest go first), so that answers never crowd out jobs.
+    /// take there at most (the oldest go first), so that answers never crowd out jobs; and
+    /// never more than half of the server's maxmemory (read when connected, and every
+    /// minute; the bound chosen is logged).
     #[arg(long, env = "THIRDBODY_REDIS_CACHE_BYTES", default_value_t = 64 << 20)]
     pub redis_cache_bytes: u64,
 }
@@ -259,11 +261,6 @@ impl FleetArgs {
                  running part)",
                 humantime::format_duration(self.claim_idle)
             )));
-        }
-        if self.max_deliveries == 0 || self.part_points == 0 {
-            return Err(ConfigError(
-                "--max-deliveries and --part-points: allowed at least 1".to_string(),
-            ));
         }
         Ok(Some(FleetConfig {
             cache_url,
@@ -328,19 +325,88 @@ impl fmt::Display for ConfigError {
 impl std::error::Error for ConfigError {}
 
 /// Most solver threads a pool may have: beyond this a number is a typo, not a machine.
-const MAX_POOL_SIZE: usize = 1024;
+const MAX_POOL_SIZE: u64 = 1024;
 /// Smallest body limit that still fits a sweep of a few lists.
-const MIN_BODY_LIMIT: usize = 1024;
+const MIN_BODY_LIMIT: u64 = 1024;
 /// Largest body limit: a body is held in memory whole, and parsed at ~40 times its size.
-const MAX_BODY_LIMIT: usize = 1 << 30;
+const MAX_BODY_LIMIT: u64 = 1 << 30;
 /// Most connections: far above any process's limit on open files.
-const MAX_CONNECTIONS: usize = 1 << 20;
+const MAX_CONNECTIONS: u64 = 1 << 20;
 /// Most of any other count (points, jobs): beyond this a number is a typo.
-const MAX_COUNT: usize = 100_000_000;
+const MAX_COUNT: u64 = 100_000_000;
 /// Largest minimum body rate: 1 GB/s.
-const MAX_BODY_MIN_RATE: usize = 1_000_000_000;
+const MAX_BODY_MIN_RATE: u64 = 1_000_000_000;
+/// Most of any amount of bytes kept (memory, disk, Redis): 1 TiB, beyond any machine this
+/// service runs on; 2⁶⁴ − 1 is a typo (and sums of such amounts would wrap).
+const MAX_BYTES: u64 = 1 << 40;
+/// Least memory budget, and least share of Redis for answers: 64 KiB, a few answers.
+const MIN_BYTES_KEPT: u64 = 1 << 16;
+/// Most deliveries of a part of a job: a part whose processes died a hundred times will
+/// not finish on the hundred-and-first.
+const MAX_DELIVERIES: u64 = 100;
 /// Longest of any duration: a year (times are added to clocks, which must not overflow).
 const MAX_DURATION: Duration = Duration::from_secs(365 * 24 * 3600);
+
+/// A numeric flag as given, and the values it allows.
+struct Bounded {
+    flag: &'static str,
+    value: u64,
+    least: u64,
+    most: u64,
+    /// What the least value means, where it is 0 and special ("no limit").
+    zero: &'static str,
+    /// The unit, after the most ("bytes (1 TiB)"), if any.
+    unit: &'static str,
+}
+
+impl Bounded {
+    fn count(flag: &'static str, value: impl TryInto<u64>, least: u64, most: u64) -> Bounded {
+        Bounded {
+            flag,
+            value: value.try_into().unwrap_or(u64::MAX),
+            least,
+            most,
+            zero: "",
+            unit: "",
+        }
+    }
+
+    /// A count whose 0 means `zero` ("no limit").
+    fn or_zero(
+        flag: &'static str,
+        value: impl TryInto<u64>,
+        most: u64,
+        zero: &'static str,
+    ) -> Bounded {
+        Bounded {
+            zero,
+            ..Bounded::count(flag, value, 0, most)
+        }
+    }
+
+    fn in_unit(self, unit: &'static str) -> Bounded {
+        Bounded { unit, ..self }
+    }
+
+    /// `--spill-bytes 18446744073709551615: allowed 0 (none) to 1099511627776 bytes (1 TiB)`.
+    fn check(&self) -> Result<(), ConfigError> {
+        if (self.least..=self.most).contains(&self.value) {
+            return Ok(());
+        }
+        let zero = match self.zero {
+            "" => String::new(),
+            zero => format!(" ({zero})"),
+        };
+        let unit = match self.unit {
+            "" => String::new(),
+            unit => format!(" {unit}"),
+        };
+        Err(ConfigError(format!(
+            "{} {}: allowed {}{zero} to {}{unit}",
+            self.flag, self.value, self.least, self.most
+        )))
+    }
+}
 
 fn duration(text: &str) -> Result<Duration, String> {
     humantime::parse_duration(text).map_err(|e| format!("{e} (write e.g. 30s, 500ms, 10m)"))
@@ -355,36 +421,70 @@ impl ServeArgs {
         let max_event_streams = self
             .max_event_streams
             .unwrap_or((self.max_connections / 8).max(1));
-        let body_min_rate = usize::try_from(self.body_min_rate).unwrap_or(usize::MAX);
-        for (flag, value, allowed) in [
-            ("--pool-size", pool_size, 1..=MAX_POOL_SIZE),
-            (
+        let fleet = &self.fleet;
+        let bytes = "bytes (1 TiB)";
+        let no_limit = "no limit";
+        for bounded in [
+            Bounded::count("--pool-size", pool_size, 1, MAX_POOL_SIZE),
+            Bounded::count(
                 "--body-limit",
                 self.body_limit,
-                MIN_BODY_LIMIT..=MAX_BODY_LIMIT,
-            ),
-            ("--body-min-rate", body_min_rate, 0..=MAX_BODY_MIN_RATE),
-            ("--max-sweep-points", self.max_sweep_points, 1..=MAX_COUNT),
-            ("--max-queued-jobs", self.max_queued_jobs, 0..=MAX_COUNT),
-            ("--max-jobs", self.max_jobs, 1..=MAX_COUNT),
-            (
+                MIN_BODY_LIMIT,
+                MAX_BODY_LIMIT,
+            )
+            .in_unit("bytes (1 GiB)"),
+            Bounded::count("--body-min-rate", self.body_min_rate, 0, MAX_BODY_MIN_RATE)
+                .in_unit("bytes/s"),
+            Bounded::count("--max-sweep-points", self.max_sweep_points, 1, MAX_COUNT),
+            // 0 would refuse every job: a job waits in the queue before it runs.
+            Bounded::count("--max-queued-jobs", self.max_queued_jobs, 1, MAX_COUNT),
+            Bounded::count("--max-jobs", self.max_jobs, 1, MAX_COUNT),
+            Bounded::count(
                 "--max-connections",
                 self.max_connections,
-                1..=MAX_CONNECTIONS,
+                1,
+                MAX_CONNECTIONS,
             ),
-            (
+            Bounded::count(
                 "--max-event-streams",
                 max_event_streams,
-                1..=self.max_connections,
+                1,
+                u64::try_from(self.max_connections).unwrap_or(u64::MAX),
             ),
+            Bounded::count(
+                "--memory-budget",
+                self.memory_budget,
+                MIN_BYTES_KEPT,
+                MAX_BYTES,
+            )
+            .in_unit(bytes),
+            Bounded::or_zero("--spill-bytes", self.spill_bytes, MAX_BYTES, "none").in_unit(bytes),
+            Bounded::or_zero("--quota-points", self.quota_points, MAX_COUNT, no_limit),
+            Bounded::or_zero("--quota-jobs", self.quota_jobs, MAX_COUNT, no_limit),
+            Bounded::or_zero(
+                "--quota-result-bytes",
+                self.quota_result_bytes,
+                MAX_BYTES,
+                no_limit,
+            )
+            .in_unit(bytes),
+            Bounded::or_zero(
+                "--anonymous-quota-points",
+                self.anonymous_quota_points,
+                MAX_COUNT,
+                no_limit,
+            ),
+            Bounded::count("--max-deliveries", fleet.max_deliveries, 1, MAX_DELIVERIES),
+            Bounded::count("--part-points", fleet.part_points, 1, MAX_COUNT),
+            Bounded::count(
+                "--redis-cache-bytes",
+                fleet.redis_cache_bytes,
+                MIN_BYTES_KEPT,
+                MAX_BYTES,
+            )
+            .in_unit(bytes),
         ] {
-            if !allowed.contains(&value) {
-                return fail(format!(
-                    "{flag} {value}: allowed {} to {}",
-                    allowed.start(),
-                    allowed.end()
-                ));
-            }
+            bounded.check()?;
         }
         // (flag, value, whether 0 is allowed)
         for (flag, value, zero) in [
@@ -400,13 +500,15 @@ impl ServeArgs {
             ("--history-retention", self.history_retention, false),
             ("--shutdown-timeout", self.shutdown_timeout, false),
             ("--drain-delay", self.drain_delay, true),
+            ("--claim-idle", self.fleet.claim_idle, false),
         ] {
             if (value.is_zero() && !zero) || value > MAX_DURATION {
                 let least = if zero { "0s" } else { "more than 0s" };
+                // In days: not humantime's "11months 30days 3h 50m 24s" (30.44-day months).
+                let days = MAX_DURATION.as_secs() / (24 * 3600);
                 return fail(format!(
-                    "{flag} {}: allowed {least} and at most {}",
+                    "{flag} {}: allowed {least} and at most {days}days",
                     humantime::format_duration(value),
-                    humantime::format_duration(MAX_DURATION)
                 ));
             }
         }
@@ -622,6 +724,72 @@ mod tests {
         ] {
             let error = config(args).unwrap_err();
             assert!(error.contains(needle), "{args:?}: {error}");
+        }
+    }
+
+    /// Every numeric flag has a range, named with the flag and the value when it is left
+    /// (2⁶⁴ − 1 was taken for bytes and quotas, 0 queued jobs for a service refusing every
+    /// job); 0 is allowed where it means something (none, no limit).
+    #[test]
+    fn every_numeric_flag_is_bounded() {
+        let most = "18446744073709551615";
+        for (args, expected) in [
+            (
+                ["--memory-budget", most],
+                "--memory-budget 18446744073709551615: allowed 65536 to 1099511627776 bytes (1 TiB)",
+            ),
+            (
+                ["--memory-budget", "0"],
+                "--memory-budget 0: allowed 65536 to 1099511627776 bytes (1 TiB)",
+            ),
+            (
+                ["--spill-bytes", most],
+                "--spill-bytes 18446744073709551615: allowed 0 (none) to 1099511627776 bytes (1 TiB)",
+            ),
+            (
+                ["--quota-points", most],
+                "--quota-points 18446744073709551615: allowed 0 (no limit) to 100000000",
+            ),
+            (
+                ["--quota-jobs", most],
+                "--quota-jobs 18446744073709551615: allowed 0 (no limit) to 100000000",
+            ),
+            (
+                ["--quota-result-bytes", most],
+                "--quota-result-bytes 18446744073709551615: allowed 0 (no limit) to 1099511627776 bytes (1 TiB)",
+            ),
+            (
+                ["--anonymous-quota-points", most],
+                "--anonymous-quota-points 18446744073709551615: allowed 0 (no limit) to 100000000",
+            ),
+            (
+                ["--max-queued-jobs", "0"],
+                "--max-queued-jobs 0: allowed 1 to 100000000",
+            ),
+            (
+                ["--max-deliveries", "4294967295"],
+                "--max-deliveries 4294967295: allowed 1 to 100",
+            ),
+            (["--part-points", "0"], "--part-points 0: allowed 1 to 100000000"),
+            (
+                ["--body-limit", most],
+                "--body-limit 18446744073709551615: allowed 1024 to 1073741824 bytes (1 GiB)",
+            ),
+            (
+                ["--claim-idle", "2y"],
+                "--claim-idle 2years: allowed more than 0s and at most 365days",
+            ),
+        ] {
+            assert_eq!(config(&args).unwrap_err(), expected);
+        }
+        for args in [
+            ["--spill-bytes", "0"],
+            ["--quota-points", "0"],
+            ["--memory-budget", "65536"],
+            ["--memory-budget", "1099511627776"],
+            ["--max-queued-jobs", "1"],
+        ] {
+            assert!(config(&args).is_ok(), "{args:?}");
         }
     }
 

@@ -350,6 +350,7 @@ impl ApiError {
 
 impl From<JobError> for ApiError {
     fn from(e: JobError) -> Self {
+        let e = e.cut();
         let detail = e.to_string();
         match e {
             JobError::Syntax(_) => ApiError::new(Kind::MalformedJson, detail),

@@ -4,17 +4,22 @@
 use std::collections::{BTreeMap, BTreeSet};
 
 use axum::Router;
-use serde_json::Value;
+use serde_json::{json, Value};
 use utoipa::openapi::extensions::Extensions;
 use utoipa::openapi::header::HeaderBuilder;
-use utoipa::openapi::schema::{AdditionalProperties, ArrayItems, Schema};
-use utoipa::openapi::{OpenApi as Spec, RefOr};
-use utoipa::OpenApi;
+use utoipa::openapi::path::{self, ParameterIn};
+use utoipa::openapi::schema::{AdditionalProperties, ArrayItems, Object, Schema, SchemaType, Type};
+use utoipa::openapi::{OpenApi as Spec, RefOr, Required};
+use utoipa::{OpenApi, PartialSchema};
 use utoipa_axum::router::OpenApiRouter;
 
 use super::error::Problem;
 use super::{routes, AppState};
+use crate::job::input::parameters_read;
 use crate::job::registry::{self, Registered};
+use crate::job::Limits;
+use crate::job::Quantity;
+use crate::model::Parameter;
 
 #[derive(OpenApi)]
 #[openapi(
@@ -42,6 +47,7 @@ pub fn router_and_spec() -> (Router<AppState>, Spec) {
         .split_for_parts();
     document_validators(&mut spec);
     document_units(&mut spec);
+    document_ranges(&mut spec);
     document_access(&mut spec);
     (router, spec)
 }
@@ -122,6 +128,14 @@ fn document_access(spec: &mut Spec) {
             .into_iter()
             .flatten()
         {
+            // An API key names its caller: the owner's token is never required, even where
+            // a caller without a key must send it (listing jobs).
+            let owner = |p: &&mut path::Parameter| {
+                p.name == routes::history::OWNER_HEADER && p.parameter_in == ParameterIn::Header
+            };
+            for parameter in operation.parameters.iter_mut().flatten().filter(owner) {
+                parameter.required = Required::False;
+            }
             let probe = ["healthz", "readyz"];
             if probe.contains(&operation.operation_id.as_deref().unwrap_or_default()) {
                 continue;
@@ -165,6 +179,95 @@ fn document_units(spec: &mut Spec) {
         };
         let extensions = extensions.get_or_insert_with(Extensions::default);
         extensions.insert("x-unit".to_string(), Value::from(*unit));
+    }
+}
+
+/// Gives each quantity field of each kind's input the range of the model parameter it is
+/// read as (`exclusiveMinimum: 0` for a radius, `minimum: 0` for a speed), from the code that
+/// reads it ([`parameters_read`] of each kind's defaults): its numbers are in SI, so the
+/// range holds for them (not for text with a unit, which only the service reads), and a
+/// client generated from the spec does not send `"radius": 0`. A schema reached for two
+/// parameters of different ranges is left as it is.
+fn document_ranges(spec: &mut Spec) {
+    let json = serde_json::to_value(&*spec).expect("an OpenAPI document serializes");
+    let mut ranges: BTreeMap<String, Vec<Range>> = BTreeMap::new();
+    for kind in registry::all() {
+        let read = parameters_read(|| {
+            // Read for the paths of its fields, not for a job.
+            let _ = kind.validate(json!({}), &Limits::default());
+        });
+        let root = format!("/components/schemas/{}", kind.input_name());
+        for (path, parameter) in read {
+            for leaf in reach(&json, root.clone(), &segments(&path)) {
+                let found = ranges.entry(leaf).or_default();
+                let range = Range::of(parameter);
+                if !found.contains(&range) {
+                    found.push(range);
+                }
+            }
+        }
+    }
+    let RefOr::T(Schema::OneOf(quantity)) = Quantity::schema() else {
+        unreachable!("a quantity is a number or a text");
+    };
+    for (leaf, ranges) in ranges {
+        let [range] = &ranges[..] else {
+            continue;
+        };
+        // A field that may be absent, `oneOf` null or a quantity (a field reached through a
+        // reference is the quantity's own schema: left), becomes `oneOf` null, a number in
+        // its range or a text.
+        let Some(Schema::OneOf(field)) = schema_at(spec, &leaf) else {
+            continue;
+        };
+        let Some(at) = field.items.iter().position(
+            |item| matches!(item, RefOr::Ref(r) if r.ref_location.ends_with("/Quantity")),
+        ) else {
+            continue;
+        };
+        if let RefOr::Ref(reference) = field.items.remove(at) {
+            field.description = Some(reference.description).filter(|d| !d.is_empty());
+        }
+        for form in &quantity.items {
+            let mut form = form.clone();
+            if let RefOr::T(Schema::Object(number)) = &mut form {
+                if number.schema_type == SchemaType::Type(Type::Number) {
+                    range.bound(number);
+                }
+            }
+            field.items.push(form);
+        }
+    }
+}
+
+/// The numbers a parameter allows, as JSON Schema says it: from 0 or above it, and below ½
+/// for a Poisson ratio.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Range {
+    zero: bool,
+    below_half: bool,
+}
+
+impl Range {
+    /// The range of `parameter`, found by asking its own check.
+    fn of(parameter: Parameter) -> Range {
+        let allows = |x: f64| parameter.check(x).is_ok();
+        Range {
+            zero: allows(0.0),
+            below_half: !allows(0.5) && allows(0.25),
+        }
+    }
+
+    /// Bounds the numbers of `number` to this range.
+    fn bound(self, number: &mut Object) {
+        if self.zero {
+            number.minimum = Some(0.into());
+        } else {
+            number.exclusive_minimum = Some(0.into());
+        }
+        if self.below_half {
+            number.exclusive_maximum = Some(0.5.into());
+        }
     }
 }
 
@@ -274,6 +377,58 @@ fn reach(spec: &Value, at: String, segments: &[&str]) -> Vec<String> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// An API key replaces the owner's token: the header is never required, and a string
+    /// of its pattern where sent (schemathesis sent `null`, and none where a key named the
+    /// caller).
+    #[test]
+    fn the_owners_token_is_an_optional_string_of_its_pattern() {
+        let spec = serde_json::to_value(router_and_spec().1).unwrap();
+        let mut found = 0;
+        for (path, item) in spec["paths"].as_object().unwrap() {
+            for (method, operation) in item.as_object().unwrap() {
+                let parameters = operation["parameters"].as_array().into_iter().flatten();
+                for parameter in parameters.filter(|p| p["name"] == "thirdbody-owner") {
+                    let schema = json!({"type": "string", "pattern": "^[A-Za-z0-9._~-]{16,128}$"});
+                    assert_eq!(parameter["required"], false, "{method} {path}");
+                    assert_eq!(parameter["schema"], schema, "{method} {path}");
+                    found += 1;
+                }
+            }
+        }
+        assert_eq!(found, 4, "listed, submitted, cancelled, deleted");
+    }
+
+    /// The range the spec gives each parameter read is the model's check, at its ends and
+    /// beyond: a number the spec allows is one the check allows.
+    #[test]
+    fn every_range_is_its_parameters_check() {
+        let mut read = Vec::new();
+        for kind in registry::all() {
+            read.extend(parameters_read(|| {
+                let _ = kind.validate(json!({}), &Limits::default());
+            }));
+        }
+        assert!(read.len() > 20, "{read:?}");
+        for (path, parameter) in read {
+            let mut number = Object::new();
+            Range::of(parameter).bound(&mut number);
+            let bound = |b: &Option<utoipa::Number>| {
+                b.as_ref()
+                    .map(|b| serde_json::to_value(b).unwrap().as_f64().unwrap())
+            };
+            let allows = |x: f64| {
+                bound(&number.minimum).is_none_or(|m| x >= m)
+                    && bound(&number.exclusive_minimum).is_none_or(|m| x > m)
+                    && bound(&number.exclusive_maximum).is_none_or(|m| x < m)
+            };
+            for x in [
+                -1.0, -1e-300, 0.0, 1e-300, 0.25, 0.4999, 0.5, 0.6, 1.0, 1e300,
+            ] {
+                assert_eq!(allows(x), parameter.check(x).is_ok(), "{path}: {x}");
+            }
+        }
+    }
 
     /// Every numeric field of every kind's answer is a field of its schema, with its unit
     /// (but for fields whose schema serves several units); so a field's unit, its place

@@ -1,6 +1,7 @@
 //! What is wrong with a job, in terms a client can act on. The model's errors are sorted
 //! here, so that the layers above see only the job's.
 
+use std::borrow::Cow;
 use std::fmt;
 
 use serde::{Deserialize, Serialize};
@@ -27,6 +28,76 @@ impl fmt::Display for FieldError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(&self.message)
     }
+}
+
+/// Characters of a value sent that an error echoes at most (RELIABILITY.md): the answer to
+/// a huge bad input stays small.
+const ECHOED: usize = 100;
+
+/// `text` as an error echoes it: its first [`ECHOED`] characters, then "…" if it was longer.
+pub fn echoed(text: &str) -> Cow<'_, str> {
+    match text.char_indices().nth(ECHOED) {
+        Some((end, _)) => Cow::Owned(format!("{}…", &text[..end])),
+        None => Cow::Borrowed(text),
+    }
+}
+
+/// `text` with every quoted part longer than [`ECHOED`] characters cut to that many: the
+/// parts of a message that echo a value sent, which every message here quotes ("…" as JSON
+/// and Rust write strings, with their backslash escapes, or `…` as serde names a field).
+fn cut_quoted(text: &str) -> Cow<'_, str> {
+    if text.len() <= ECHOED {
+        return Cow::Borrowed(text);
+    }
+    let mut cut = String::with_capacity(text.len().min(4 * ECHOED));
+    // The quote open, the characters inside it so far, whether the last one was a `\`.
+    let (mut open, mut inside, mut escaped) = (None, 0, false);
+    for c in text.chars() {
+        match open {
+            Some(quote) if c == quote && !escaped => open = None,
+            Some(quote) => {
+                escaped = quote == '"' && c == '\\' && !escaped;
+                inside += 1;
+                if inside > ECHOED {
+                    if inside == ECHOED + 1 {
+                        cut.push('…');
+                    }
+                    continue;
+                }
+            }
+            None if c == '"' || c == '`' => (open, inside, escaped) = (Some(c), 0, false),
+            None => {}
+        }
+        cut.push(c);
+    }
+    Cow::Owned(cut)
+}
+
+impl FieldError {
+    /// The error with every value sent it echoes cut to [`ECHOED`] characters: the value
+    /// itself, and its quoted echoes in the path (a key sent), the allowed values and the
+    /// message.
+    fn cut(self) -> FieldError {
+        let value = match self.value {
+            Value::String(s) if s.chars().nth(ECHOED).is_some() => Value::from(echoed(&s)),
+            value => value,
+        };
+        FieldError {
+            field: cut_path(&self.field),
+            value,
+            allowed: cut_quoted(&self.allowed).into_owned(),
+            message: cut_quoted(&self.message).into_owned(),
+        }
+    }
+}
+
+/// A field's path with each of its names cut to [`ECHOED`] characters (a key sent in a map
+/// is a name of the path).
+fn cut_path(path: &str) -> String {
+    if path.len() <= ECHOED {
+        return path.to_string();
+    }
+    path.split('.').map(echoed).collect::<Vec<_>>().join(".")
 }
 
 /// Why a job was not answered. Serializable, so that a job failed in one process reads
@@ -89,6 +160,24 @@ impl fmt::Display for JobError {
 
 impl std::error::Error for JobError {}
 
+impl JobError {
+    /// The error as it is shown, every value sent it echoes cut to [`ECHOED`] characters
+    /// (RELIABILITY.md): one place for every problem and every message of the command
+    /// line, whichever part of the service wrote the error.
+    pub fn cut(self) -> JobError {
+        match self {
+            JobError::Schema { field, message } => JobError::Schema {
+                field: cut_path(&field),
+                message: cut_quoted(&message).into_owned(),
+            },
+            JobError::Invalid(errors) => {
+                JobError::Invalid(errors.into_iter().map(FieldError::cut).collect())
+            }
+            other => other,
+        }
+    }
+}
+
 impl From<ModelError> for JobError {
     /// Validation checks every range before the model runs, so a range error from the model
     /// is still the input's; it names the parameter rather than a field path.
@@ -113,5 +202,31 @@ impl From<ModelError> for JobError {
             // Only a job's control stops a solve, and it says why ([`super::Control::failed`]).
             ModelError::Stopped => JobError::Cancelled,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Quoted parts past 100 characters are cut, escapes and all, the rest of the message
+    /// kept whole; a short text is left as it is.
+    #[test]
+    fn only_long_quoted_parts_are_cut() {
+        let long = "y".repeat(150);
+        let head = format!("{}…", "y".repeat(100));
+        let text =
+            format!("a: \"{long}\" and `{long}`; \"short \\\" quote\" then a long tail {long}");
+        assert_eq!(
+            cut_quoted(&text),
+            format!("a: \"{head}\" and `{head}`; \"short \\\" quote\" then a long tail {long}")
+        );
+        // An escaped quote does not close the part; an escaped backslash does not escape.
+        let escaped = format!("\"{}\\\"{long}\" end \"\\\\\" {long}", "z".repeat(10));
+        let cut = cut_quoted(&escaped);
+        assert!(cut.ends_with(&format!("…\" end \"\\\\\" {long}")), "{cut}");
+        assert_eq!(cut_quoted("\"short\""), "\"short\"");
+        assert_eq!(echoed("ünï"), "ünï");
+        assert_eq!(echoed(&"é".repeat(101)), format!("{}…", "é".repeat(100)));
     }
 }

@@ -26,7 +26,7 @@ pub mod validity;
 mod wire;
 
 pub use control::{Control, Kept, Later, Memo, OnRefusal, Swept};
-pub use error::{FieldError, JobError};
+pub use error::{echoed, FieldError, JobError};
 pub use figure::FigureJob;
 pub use fit::FitJob;
 pub use input::Quantity;

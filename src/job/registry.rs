@@ -54,6 +54,11 @@ impl Registered {
         }
     }
 
+    /// The name of the OpenAPI schema of the kind's input.
+    pub fn input_name(&self) -> Cow<'static, str> {
+        (self.input_schema)()
+    }
+
     /// The name of the OpenAPI schema of the kind's answer.
     pub fn output_name(&self) -> Cow<'static, str> {
         (self.output_name)()
@@ -254,7 +259,7 @@ pub struct Envelope {
 fn any_input() -> Object {
     let names: Vec<String> = KINDS
         .iter()
-        .map(|k| format!("`{}`", (k.input_schema)()))
+        .map(|k| format!("`{}`", k.input_name()))
         .collect();
     let (last, rest) = names.split_last().expect("there are kinds");
     ObjectBuilder::new()

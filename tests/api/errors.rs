@@ -1,6 +1,6 @@
 //! Every error status from a real bad request, each an RFC 9457 problem.
 
-use serde_json::json;
+use serde_json::{json, Value};
 
 use crate::helpers::{long_sweep, problem, problem_type, spawn_app, within};
 
@@ -72,6 +72,47 @@ async fn invalid_values_are_422_naming_each_field_its_value_and_range() {
         .await;
     let too_big = problem(too_big, 422).await;
     assert_eq!(too_big["errors"][0]["field"], "vary");
+}
+
+/// Every echo of a huge value sent is cut to 100 characters (RELIABILITY.md): a key no
+/// input has, a text where one of two series is given, a misspelt temperature difference,
+/// a query's value; each problem a few kB, naming its field.
+#[tokio::test]
+async fn a_huge_value_is_never_echoed_whole() {
+    let app = spawn_app(&[]).await;
+    let huge = "x".repeat(300_000);
+    let head = format!("{}…", "x".repeat(100));
+    let wlf = json!({"reference_temperature": "25 °C", "c1": 17.44, "c2": format!("{huge} °C")});
+    for (body, field) in [
+        // The key is the path of its error.
+        (json!({&huge: 1}), head.clone()),
+        (
+            json!({"layer": {"prony": [{"time": 1, "modulus": 1e9}], "prony_csv": &huge}}),
+            "layer.prony_csv".to_string(),
+        ),
+        (
+            json!({"layer": {"wlf": wlf, "temperature": "30 °C"}}),
+            "layer.wlf.c2".to_string(),
+        ),
+    ] {
+        let response = app.post("/v1/rolling", &body).await;
+        let text = response.text().await.unwrap();
+        assert!(text.len() < 4000, "{field}: {} bytes", text.len());
+        let problem: Value = serde_json::from_str(&text).unwrap();
+        let error = &problem["errors"][0];
+        assert_eq!(error["field"], field.as_str(), "{problem}");
+        assert!(
+            error["message"].as_str().unwrap().contains(&head),
+            "{problem}"
+        );
+    }
+    // A query's value, echoed by the history's own checks.
+    let path = format!("/v1/jobs?tenant={}", &huge[..60_000]);
+    let text = app.get(&path).await.text().await.unwrap();
+    assert!(text.len() < 4000, "tenant: {} bytes", text.len());
+    let problem: Value = serde_json::from_str(&text).unwrap();
+    assert_eq!(problem["errors"][0]["field"], "tenant", "{problem}");
+    assert_eq!(problem["errors"][0]["value"], head.as_str(), "{problem}");
 }
 
 #[tokio::test]

@@ -2,7 +2,7 @@
 //! that answers, finished jobs included; an unknown form is 406; the dashboard at `/`.
 
 use reqwest::Method;
-use serde_json::json;
+use serde_json::{json, Value};
 
 use crate::helpers::{problem, problem_type, spawn_app};
 
@@ -96,8 +96,8 @@ async fn the_dashboard_is_served_with_its_assets_under_a_strict_policy() {
         let headers = response.headers();
         assert_eq!(headers["content-type"], content_type, "{path}");
         assert_eq!(
-            headers["content-security-policy"], "default-src 'self'",
-            "{path}"
+            headers["content-security-policy"], "default-src 'self'; frame-ancestors 'self'",
+            "{path}: no other site frames it"
         );
     }
     let page = app.get("/").await.text().await.unwrap();
@@ -142,4 +142,57 @@ async fn every_request_body_example_in_the_spec_is_accepted() {
         }
     }
     assert_eq!(tried, 6);
+}
+
+/// The spec says what the service accepts of a quantity sent as a number: each range it
+/// gives a field (`exclusiveMinimum` 0 for a radius, `minimum` 0 for a speed, below ½ for a
+/// Poisson ratio) is the service's own at its ends, and a text not starting with a number
+/// (`""`, `"twelve"`) is outside the spec as the service refuses it. Schemathesis sent
+/// `"radius": 0`, which the spec allowed and the service refused.
+#[tokio::test]
+async fn the_spec_s_ranges_of_quantities_are_the_service_s() {
+    let app = spawn_app(&[]).await;
+    let spec: Value = serde_json::from_str(&thirdbody::http::openapi::spec_json()).unwrap();
+    let schemas = &spec["components"]["schemas"];
+    let field = |schema: &str, name: &str| schemas[schema]["properties"][name].clone();
+    // The field's number: `oneOf` null, a number in its range, or a text.
+    let ranged = |schema: &str, name: &str| {
+        let field = field(schema, name);
+        let number = field["oneOf"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|form| form["type"] == "number")
+            .unwrap()
+            .clone();
+        ["minimum", "exclusiveMinimum", "exclusiveMaximum"]
+            .map(|keyword| number.get(keyword).and_then(Value::as_f64))
+    };
+    assert_eq!(ranged("RollingInput", "radius"), [None, Some(0.0), None]);
+    assert_eq!(ranged("RollingInput", "velocity"), [Some(0.0), None, None]);
+    assert_eq!(
+        ranged("LayerInput", "poisson_ratio"),
+        [Some(0.0), None, Some(0.5)]
+    );
+    assert_eq!(
+        ranged("OperatingInput", "separation"),
+        [Some(0.0), None, None]
+    );
+    let pattern = schemas["Quantity"]["oneOf"][1]["pattern"].as_str().unwrap();
+    assert_eq!(pattern, r"^\s*[+-]?(\d|\.\d)");
+    // At the ends of the ranges, the service agrees with the spec.
+    for (input, accepted) in [
+        (json!({"radius": 0}), false),
+        (json!({"radius": 2.5e-8}), true),
+        (json!({"velocity": 0}), true),
+        (json!({"velocity": -1e-9}), false),
+        (json!({"layer": {"poisson_ratio": 0}}), true),
+        (json!({"layer": {"poisson_ratio": 0.5}}), false),
+        (json!({"layer": {"thickness": 0}}), false),
+        (json!({"radius": ""}), false),
+        (json!({"radius": "twelve nm"}), false),
+    ] {
+        let status = app.post("/v1/rolling", &input).await.status().as_u16();
+        assert_eq!(status == 200, accepted, "{input}: {status}");
+    }
 }

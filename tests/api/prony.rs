@@ -215,3 +215,163 @@ async fn a_fit_finds_the_modulus_scale_and_shift_factor_of_a_series() {
         "{body}"
     );
 }
+
+/// The README's layer (its μ 0.0497 at 20 °C) with its series as CSV text `csv`.
+fn readme_layer(csv: &str) -> Value {
+    json!({"elastic_modulus": "3 GPa", "prony_csv": csv,
+           "wlf": {"reference_temperature": "25 °C", "c1": 17.44, "c2": 51.6},
+           "temperature": "20 °C"})
+}
+
+/// A header's units are its columns' units, in each of its spellings: the same answer as
+/// the rows in SI, to the bit (a header `tau [ms]` was read as seconds: μ 0.1137 for
+/// 0.0497). A cell with a unit of its own keeps it.
+#[tokio::test]
+async fn a_header_s_units_are_the_units_of_its_columns() {
+    let app = spawn_app(&[]).await;
+    let si = rolling(
+        &app,
+        readme_layer("tau_s,E_Pa\n0.01,6e9\n0.1,4.5e9\n1,3e9\n10,1.5e9"),
+    )
+    .await;
+    let mu = si["friction_coefficient"].as_f64().unwrap();
+    assert_eq!(format!("{mu:.4}"), "0.0497", "the README's example");
+    for csv in [
+        "tau [ms],E [GPa]\n10,6\n100,4.5\n1000,3\n10000,1.5",
+        "tau (ms); E (GPa)\n10; 6\n100; 4.5\n1000; 3\n10000; 1.5",
+        "tau_ms\tE_MPa\n10\t6000\n100\t4500\n1000\t3000\n10000\t1500",
+        "τ/ms,E/GPa\n10,6\n100,4.5\n1 s,3 GPa\n10000,1.5",
+    ] {
+        let answer = rolling(&app, readme_layer(csv)).await;
+        assert_same(&answer, &si, 0.0);
+        assert_eq!(answer["meta"]["warnings"], json!([]), "{csv}");
+    }
+}
+
+/// A header whose unit cannot be read refuses the series, naming the cell and what a
+/// header may be: never read as SI.
+#[tokio::test]
+async fn a_header_s_unit_that_cannot_be_read_is_422_naming_it() {
+    let app = spawn_app(&[]).await;
+    let forms = "expected a header naming each column's unit as \"tau [ms]\", \"tau (ms)\", \
+        \"tau/ms\" or \"tau_ms\" (an SI unit with an SI prefix: a time, then a pressure such \
+        as \"E [GPa]\"), or no unit for numbers in s and Pa";
+    for (csv, value, whats) in [
+        (
+            "tau [min],E [GPa]\n10,6",
+            "tau [min],E [GPa]",
+            &[
+                "the header's \"tau [min]\" has an unknown unit \"min\" (SI symbols m, g, s, N, \
+               Pa, K with SI prefixes, or °C)",
+            ][..],
+        ),
+        (
+            "tau [ms],E_psi\n10,6",
+            "tau [ms],E_psi",
+            &[
+                "the header's \"E_psi\" has an unknown unit \"psi\" (SI symbols m, g, s, N, Pa, \
+               K with SI prefixes, or °C)",
+            ],
+        ),
+        (
+            "E [GPa],tau [ms]\n6,10",
+            "E [GPa],tau [ms]",
+            &[
+                "the header's \"E [GPa]\" names a pressure, and its column holds τ_j, a time",
+                "the header's \"tau [ms]\" names a time, and its column holds E_j, a pressure",
+            ],
+        ),
+    ] {
+        let input = json!({"layer": {"prony_csv": csv}});
+        let body = problem(app.post("/v1/rolling", &input).await, 422).await;
+        let expected: Vec<Value> = whats
+            .iter()
+            .map(|what| {
+                let allowed = format!("row 1: {what}; {forms}");
+                let message = format!(
+                    "layer.prony_csv: \"{value}\" is not a valid value; expected {allowed}"
+                );
+                json!({"field": "layer.prony_csv", "value": value, "allowed": allowed,
+                       "message": message})
+            })
+            .collect();
+        // The header alone: its rows are not read under it.
+        assert_eq!(body["errors"], json!(expected), "{csv}");
+    }
+}
+
+/// Bare numbers in the rows are warned of as a bare number in a field of its own is (a
+/// modulus below 1 kPa, a time above 1e6 s), each naming its row and column; under a
+/// header's unit they are not bare.
+#[tokio::test]
+async fn implausible_bare_numbers_in_the_rows_are_warned_of() {
+    let app = spawn_app(&[]).await;
+    let answer = rolling(&app, json!({"prony_csv": "tau,E\n0.1,6\n2e6,3e9"})).await;
+    assert_eq!(
+        answer["meta"]["warnings"],
+        json!([
+            {"field": "layer.prony_csv", "value": "6",
+             "message": "layer.prony_csv (row 2, E_j): 6 is 6 Pa; did you mean \"6 GPa\"?"},
+            {"field": "layer.prony_csv", "value": "2e6",
+             "message": "layer.prony_csv (row 3, τ_j): 2e6 is 2e6 s; did you mean \"2e6 ms\"?"},
+        ])
+    );
+    // As the same numbers given as JSON terms are.
+    let json_terms = rolling(
+        &app,
+        json!({"prony": [{"time": 0.1, "modulus": 6}, {"time": 2e6, "modulus": 3e9}]}),
+    )
+    .await;
+    let messages = |answer: &Value| -> Vec<String> {
+        let warnings = answer["meta"]["warnings"].as_array().unwrap();
+        warnings
+            .iter()
+            .map(|w| {
+                w["message"]
+                    .as_str()
+                    .unwrap()
+                    .split(": ")
+                    .nth(1)
+                    .unwrap()
+                    .to_string()
+            })
+            .collect()
+    };
+    assert_eq!(messages(&answer), messages(&json_terms));
+    let under_units = rolling(&app, json!({"prony_csv": "tau [s],E [GPa]\n0.1,6"})).await;
+    assert_eq!(under_units["meta"]["warnings"], json!([]));
+}
+
+/// A 900 kB cell is echoed cut to 100 characters, in the error's value, its allowed values,
+/// its message and the detail: a problem of a few kB naming the field (it was 5.4 MB).
+#[tokio::test]
+async fn a_huge_bad_cell_is_echoed_cut() {
+    let app = spawn_app(&[]).await;
+    let huge = "x".repeat(900_000);
+    let input = json!({"layer": {"prony_csv": format!("tau_s,E_Pa\n0.1,{huge}")}});
+    let response = app.post("/v1/rolling", &input).await;
+    assert_eq!(response.status(), 422);
+    let text = response.text().await.unwrap();
+    assert!(text.len() < 4000, "{} bytes: {}", text.len(), &text[..2000]);
+    let body: Value = serde_json::from_str(&text).unwrap();
+    let error = &body["errors"][0];
+    assert_eq!(error["field"], "layer.prony_csv");
+    let cut = format!("0.1,{}…", "x".repeat(96));
+    assert_eq!(error["value"], cut.as_str());
+    let head = format!("\"{}…\"", "x".repeat(100));
+    assert_eq!(
+        error["allowed"],
+        format!(
+            "row 2: {head} does not start with a number; expected rows \"τ_j, E_j\" such as \
+             \"0.1, 12e9\" or \"100 ms, 12 GPa\""
+        )
+    );
+    assert_eq!(
+        error["message"],
+        format!(
+            "layer.prony_csv: \"{cut}\" is not a valid value; expected {}",
+            error["allowed"].as_str().unwrap()
+        )
+    );
+    assert_eq!(body["detail"], error["message"]);
+}

@@ -88,7 +88,7 @@ try {
   // The default rolling contact: a table and its picture.
   await page.goto(`${base}/`);
   const csp = (await page.request.get(`${base}/`)).headers()["content-security-policy"];
-  if (csp !== "default-src 'self'") fail(`Content-Security-Policy is ${csp}`);
+  if (csp !== "default-src 'self'; frame-ancestors 'self'") fail(`Content-Security-Policy is ${csp}`);
   await page.locator("#form-rolling").getByRole("button", { name: "Solve" }).click();
   await page.waitForSelector(`${area("rolling", "picture")} svg .series`);
   const mu = await page.locator(`${area("rolling", "table")} tr`, { hasText: "friction_coefficient" }).first().textContent();

@@ -203,6 +203,58 @@ fn serve_refuses_a_bad_setting_at_start_up_with_status_2() {
     );
 }
 
+/// A number out of its flag's range stops `serve` and `worker` (whose flags are `serve`'s)
+/// with status 2, naming the flag, the value and the range; so does its variable.
+#[test]
+fn every_numeric_flag_out_of_range_is_status_2_naming_flag_value_and_range() {
+    let fleet = ["worker", "--redis-url", "redis://127.0.0.1:1"];
+    for (command, flag, value, expected) in [
+        (
+            &["serve"][..],
+            "--memory-budget",
+            "18446744073709551615",
+            "thirdbody serve: invalid setting: --memory-budget 18446744073709551615: allowed \
+             65536 to 1099511627776 bytes (1 TiB)",
+        ),
+        (
+            &["serve"],
+            "--max-queued-jobs",
+            "0",
+            "thirdbody serve: invalid setting: --max-queued-jobs 0: allowed 1 to 100000000",
+        ),
+        (
+            &fleet,
+            "--spill-bytes",
+            "18446744073709551615",
+            "thirdbody worker: invalid setting: --spill-bytes 18446744073709551615: allowed 0 \
+             (none) to 1099511627776 bytes (1 TiB)",
+        ),
+        (
+            &fleet,
+            "--redis-cache-bytes",
+            "0",
+            "thirdbody worker: invalid setting: --redis-cache-bytes 0: allowed 65536 to \
+             1099511627776 bytes (1 TiB)",
+        ),
+    ] {
+        let args: Vec<&str> = command.iter().copied().chain([flag, value]).collect();
+        let output = thirdbody(&args, None);
+        assert_eq!(output.status.code(), Some(2), "{args:?}");
+        assert_eq!(String::from_utf8_lossy(&output.stderr).trim(), expected);
+    }
+    let output = Command::new(env!("CARGO_BIN_EXE_thirdbody"))
+        .args(["serve", "--database", ":memory:"])
+        .env("THIRDBODY_QUOTA_POINTS", "18446744073709551615")
+        .output()
+        .unwrap();
+    assert_eq!(output.status.code(), Some(2));
+    assert_eq!(
+        String::from_utf8_lossy(&output.stderr).trim(),
+        "thirdbody serve: invalid setting: --quota-points 18446744073709551615: allowed 0 (no \
+         limit) to 100000000"
+    );
+}
+
 /// `ENV` settings of the Dockerfile's run stage, as (name, value) pairs.
 fn dockerfile_env() -> Vec<(String, String)> {
     let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/Dockerfile")).unwrap();

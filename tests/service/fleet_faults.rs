@@ -10,7 +10,8 @@ use serde_json::{json, Value};
 
 use super::fleet::{
     answering, finished, free_port, fresh_redis, one_service, post, readyz_until, redis_cli,
-    redis_server_available, result, serve, start, start_redis, submit, taken_by, Process,
+    redis_server_available, redis_with, result, serve, start, start_redis, submit, taken_by,
+    Process,
 };
 use crate::processes::{logs_near, spawn_logged, thirdbody, PATIENCE};
 
@@ -82,6 +83,96 @@ async fn a_full_cache_never_fails_a_job_and_a_full_job_store_is_told_truly() {
     )
     .await;
     assert_eq!(finished(&http, &a.base, &id).await["status"], "succeeded");
+}
+
+/// On a 32 MB server holding both roles, the answers take at most half of it whatever
+/// `--redis-cache-bytes` says (64 MiB by default): after 40 MB of distinct answers the jobs
+/// are still accepted (before, every submission was 503 "Redis (jobs) is full"), and the
+/// bound chosen is logged. So on a server that refuses CONFIG, as managed ones do: its
+/// limit is read from INFO.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn answers_leave_half_of_a_small_servers_maxmemory_to_the_jobs() {
+    if !redis_server_available() {
+        eprintln!("SKIPPED: redis-server is not on PATH (`.ci/run` installs it)");
+        return;
+    }
+    for managed in [false, true] {
+        let port = free_port();
+        let mut args = vec!["--port".to_string(), port.to_string()];
+        args.extend(["--maxmemory", "32mb"].map(String::from));
+        if managed {
+            args.extend(["--rename-command", "CONFIG", ""].map(String::from));
+        }
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        let _redis = redis_with(port, &args);
+        fill_a_small_server(port, managed).await;
+    }
+}
+
+/// 41 MB of distinct answers on the 32 MB server on `port`, a job submitted after each
+/// 0.7 MB: see [`answers_leave_half_of_a_small_servers_maxmemory_to_the_jobs`].
+async fn fill_a_small_server(port: u16, managed: bool) {
+    let http = reqwest::Client::new();
+    let web = free_port();
+    let (_serve, logs) = start("serve", port, Some(web), &[]);
+    let base = answering(&http, web).await;
+    let chosen = "cached answers take at most half of Redis's maxmemory";
+    let started = Instant::now();
+    while !logs
+        .lock()
+        .unwrap()
+        .iter()
+        .any(|line| line.contains(chosen))
+    {
+        assert!(
+            started.elapsed() < Duration::from_secs(20),
+            "no bound logged"
+        );
+        tokio::time::sleep(Duration::from_millis(50)).await;
+    }
+    let logged = logs.lock().unwrap().join("\n");
+    assert!(
+        logged.contains("maxmemory=33554432") && logged.contains("cache_bytes=16777216"),
+        "{logged}"
+    );
+    // 60 distinct sweeps of 1,000 points: 0.68 MB of JSON each (0.92 MB in Redis, with
+    // their CSV), 41 MB in all; a job submitted after each.
+    let (mut shared, mut jobs) = (0, Vec::new());
+    for k in 0..60 {
+        let loads: Vec<String> = (0..50)
+            .map(|j| format!("{} nN", 1.0 + 0.01 * f64::from(j) + 0.7 * f64::from(k)))
+            .collect();
+        let radii: Vec<String> = (0..20).map(|i| format!("{} nm", 20 + i)).collect();
+        let body = json!({"vary": {"radius": radii, "load": loads}});
+        let solved = post(&http, format!("{base}/v1/sweeps"), &body).await;
+        assert_eq!(solved.status(), 200);
+        shared += solved.bytes().await.unwrap().len();
+        let load = format!("{} nN", 2.0 + 0.01 * f64::from(k));
+        let job = json!({"kind": "rolling", "input": {"load": load}});
+        jobs.push(submit(&http, &base, job).await);
+    }
+    assert!(shared > 32 << 20, "{shared} bytes of answers");
+    let total: u64 = redis_cli(port, &["HGET", "thirdbody:answers:sizes", "total"])
+        .trim()
+        .parse()
+        .unwrap();
+    assert!(total <= 16 << 20, "the answers take {total} bytes");
+    // Room to spare: no write was refused (before: 31 MB of 32 used, the server full).
+    let memory = redis_cli(port, &["INFO", "memory"]);
+    let used: u64 = memory
+        .lines()
+        .find_map(|line| line.strip_prefix("used_memory:"))
+        .and_then(|bytes| bytes.trim().parse().ok())
+        .unwrap();
+    assert!(
+        used < 24 << 20,
+        "Redis uses {used} bytes of 32 MB (CONFIG refused: {managed})"
+    );
+    let logged = logs.lock().unwrap().join("\n");
+    assert!(!logged.contains("Redis is full"), "{logged}");
+    for id in jobs {
+        assert_eq!(finished(&http, &base, &id).await["status"], "succeeded");
+    }
 }
 
 /// A Redis server on `port` keeping its data in an append-only file in `dir`.

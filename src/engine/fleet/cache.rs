@@ -148,7 +148,7 @@ impl ResultCache for TieredCache {
         if self.fleet.one_server() {
             let bytes = (solved.json().len() + csv.len() + key.len()).to_string();
             let now = super::store::unix_millis(std::time::SystemTime::now()).to_string();
-            let bound = self.fleet.config.shared_cache_bytes.to_string();
+            let bound = self.fleet.cache_bytes().to_string();
             let ttl = self.ttl_millis().to_string();
             pipe.add_command(super::store::eval(
                 BOUND,

@@ -15,6 +15,8 @@ pub mod placement;
 mod store;
 pub mod worker;
 
+use std::collections::HashMap;
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
 use std::time::Duration;
 
@@ -40,8 +42,35 @@ pub struct FleetConfig {
     pub max_deliveries: u32,
     /// Points per part of a sweep whose cost per point is not measured yet.
     pub part_points: usize,
-    /// Bytes the cached answers may take when the cache shares the jobs' server.
+    /// Bytes the cached answers may take when the cache shares the jobs' server, at most
+    /// (lowered to half the server's maxmemory where that is less: [`cache_share`]).
     pub shared_cache_bytes: u64,
+}
+
+/// How often the server's maxmemory is read again (it may be changed while running, or
+/// the server replaced by one of another size).
+const MAXMEMORY_EVERY: Duration = Duration::from_secs(60);
+
+/// What a Redis server says of its memory limit.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Maxmemory {
+    /// `maxmemory`, in bytes.
+    Limit(u64),
+    /// `maxmemory 0`: the server takes what the machine has.
+    Unlimited,
+    /// Neither `CONFIG GET` nor `INFO memory` says (managed servers may refuse both).
+    Unknown,
+}
+
+/// The bytes the cached answers may take on a server shared with the jobs: `given`
+/// (`--redis-cache-bytes`), but at most half of the server's maxmemory, so that answers
+/// never fill a small server and leave the jobs no room (a 32 MB server under the 64 MiB
+/// default refused every submission once anonymous solves had filled it).
+pub fn cache_share(given: u64, maxmemory: Maxmemory) -> u64 {
+    match maxmemory {
+        Maxmemory::Limit(limit) => given.min(limit / 2),
+        Maxmemory::Unlimited | Maxmemory::Unknown => given,
+    }
 }
 
 /// The Redis keys, all under `thirdbody:`.
@@ -119,6 +148,9 @@ pub struct Fleet {
     pub jobs: Link,
     /// Unique to this process: host name, process id and random bits.
     pub consumer: String,
+    /// The bytes the cached answers may take on a server shared with the jobs, as last
+    /// decided from the configuration and the server ([`Fleet::size_cache`]).
+    cache_bytes: AtomicU64,
 }
 
 impl Fleet {
@@ -130,11 +162,17 @@ impl Fleet {
         let tag = uuid::Uuid::new_v4().simple().to_string();
         let consumer = format!("{host}-{}-{}", std::process::id(), &tag[..8]);
         Ok(Fleet {
+            cache_bytes: AtomicU64::new(config.shared_cache_bytes),
             config,
             cache,
             jobs,
             consumer,
         })
+    }
+
+    /// The bytes the cached answers may take on a server shared with the jobs.
+    pub fn cache_bytes(&self) -> u64 {
+        self.cache_bytes.load(Ordering::Relaxed)
     }
 
     /// Whether the cache and the jobs are on one server.
@@ -166,7 +204,63 @@ impl Fleet {
                 tokio::time::sleep(link::RETRY_EVERY).await;
             }
         };
-        tokio::join!(self.cache.watch(), self.jobs.watch(), epoch);
+        tokio::join!(
+            self.cache.watch(),
+            self.jobs.watch(),
+            epoch,
+            self.size_cache()
+        );
+    }
+
+    /// On a server shared with the jobs, bounds the cached answers by its maxmemory
+    /// ([`cache_share`]), read at once and every minute, and logs the bound chosen whenever it
+    /// changes (with the reason, and what to do where the server does not say its limit).
+    async fn size_cache(&self) {
+        if !self.one_server() {
+            return;
+        }
+        let given = self.config.shared_cache_bytes;
+        let mut known = None;
+        loop {
+            let maxmemory = match maxmemory(&self.cache).await {
+                Some(said) => said,
+                None => {
+                    // Unreachable: try again soon.
+                    tokio::time::sleep(link::RETRY_EVERY).await;
+                    continue;
+                }
+            };
+            if known != Some(maxmemory) {
+                let bytes = cache_share(given, maxmemory);
+                self.cache_bytes.store(bytes, Ordering::Relaxed);
+                match maxmemory {
+                    Maxmemory::Limit(limit) if bytes < given => tracing::warn!(
+                        maxmemory = limit,
+                        redis_cache_bytes = given,
+                        cache_bytes = bytes,
+                        "cached answers take at most half of Redis's maxmemory, less than \
+                         --redis-cache-bytes, so that jobs keep room on the server they share"
+                    ),
+                    Maxmemory::Limit(limit) => tracing::info!(
+                        maxmemory = limit,
+                        cache_bytes = bytes,
+                        "cached answers take at most --redis-cache-bytes of Redis"
+                    ),
+                    Maxmemory::Unlimited => tracing::info!(
+                        cache_bytes = bytes,
+                        "Redis has no maxmemory: cached answers take at most --redis-cache-bytes"
+                    ),
+                    Maxmemory::Unknown => tracing::warn!(
+                        cache_bytes = bytes,
+                        "Redis does not say its maxmemory (CONFIG GET and INFO refused): cached \
+                         answers take at most --redis-cache-bytes; keep it under half of the \
+                         server's memory"
+                    ),
+                }
+                known = Some(maxmemory);
+            }
+            tokio::time::sleep(MAXMEMORY_EVERY).await;
+        }
     }
 
     /// When the job store's data began (Unix ms), if known.
@@ -176,6 +270,33 @@ impl Fleet {
             .await
             .ok()
             .flatten()
+    }
+}
+
+/// What the server of `link` says of its memory limit: `CONFIG GET maxmemory`, or where
+/// that is refused (managed servers often forbid CONFIG) the `maxmemory` of `INFO memory`;
+/// `None` if the server cannot be reached.
+async fn maxmemory(link: &Link) -> Option<Maxmemory> {
+    let said = |bytes: u64| match bytes {
+        0 => Maxmemory::Unlimited,
+        limit => Maxmemory::Limit(limit),
+    };
+    let config = redis::cmd("CONFIG").arg("GET").arg("maxmemory").clone();
+    if let Ok(values) = link.query::<HashMap<String, u64>>(&config).await {
+        if let Some(&bytes) = values.get("maxmemory") {
+            return Some(said(bytes));
+        }
+    }
+    let info = redis::cmd("INFO").arg("memory").clone();
+    match link.query::<String>(&info).await {
+        Ok(text) => Some(
+            text.lines()
+                .find_map(|line| line.strip_prefix("maxmemory:")?.trim().parse().ok())
+                .map_or(Maxmemory::Unknown, said),
+        ),
+        // Reached, and refused both: the server does not say.
+        Err(_) if link.is_up() => Some(Maxmemory::Unknown),
+        Err(_) => None,
     }
 }
 
@@ -195,4 +316,18 @@ pub fn storage(config: &EngineConfig, fleet: FleetConfig) -> Result<Storage, Str
         jobs: store.clone(),
         fleet: Some(Arc::new(Shared::new(fleet, store))),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn answers_take_at_most_half_of_a_servers_maxmemory() {
+        let flag = 64 << 20;
+        assert_eq!(cache_share(flag, Maxmemory::Limit(32 << 20)), 16 << 20);
+        assert_eq!(cache_share(flag, Maxmemory::Limit(1 << 30)), flag);
+        assert_eq!(cache_share(flag, Maxmemory::Unlimited), flag);
+        assert_eq!(cache_share(flag, Maxmemory::Unknown), flag);
+    }
 }

@@ -1,6 +1,7 @@
 //! The dashboard at `/`: one page, a script and a style sheet, embedded in the binary (no
 //! CDN, no build step). The page only talks to this server, which its
-//! `Content-Security-Policy` enforces; pictures are inlined SVG.
+//! `Content-Security-Policy` enforces, and only its own pages may frame it; pictures are
+//! inlined SVG.
 
 use axum::http::{header, HeaderValue};
 use axum::response::IntoResponse;
@@ -15,8 +16,10 @@ const PLOT: &str = include_str!("plot.js");
 const STYLE: &str = include_str!("app.css");
 const ICON: &str = include_str!("icon.svg");
 
-/// Nothing but this server, no inline script or style.
-const POLICY: &str = "default-src 'self'";
+/// Nothing but this server, no inline script or style; and framed by no other site's page
+/// (`frame-ancestors` has no fallback to `default-src`): a page that frames the dashboard
+/// could lure a click onto its Solve, Cancel or Delete buttons.
+const POLICY: &str = "default-src 'self'; frame-ancestors 'self'";
 
 /// The dashboard's routes (outside the API and its OpenAPI description).
 pub fn router() -> Router<AppState> {

@@ -295,7 +295,13 @@ fn changeable(record: &JobRecord, caller: &Caller, token: Option<Owner>) -> Resu
 pub struct OwnerParam {
     /// A token of 16 to 128 characters the client keeps: a job submitted with it is listed
     /// to its holder (`GET /v1/jobs`), and only a request with it cancels or deletes the job.
-    #[param(rename = "thirdbody-owner", pattern = r"^[A-Za-z0-9._~-]{16,128}$")]
+    // A string when sent (not `null`: a client generated from the spec sent "null").
+    #[param(
+        rename = "thirdbody-owner",
+        value_type = String,
+        required = false,
+        pattern = r"^[A-Za-z0-9._~-]{16,128}$"
+    )]
     #[allow(dead_code)]
     owner: Option<String>,
 }

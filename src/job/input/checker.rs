@@ -1,6 +1,7 @@
 //! Reading the fields of an input: quantities with units, counts and lists, each checked
 //! against its range, every bad field recorded with its path and its value as sent.
 
+use std::cell::RefCell;
 use std::collections::{HashMap, HashSet};
 use std::rc::Rc;
 
@@ -8,7 +9,7 @@ use serde_json::{json, Value};
 
 use super::units::{is_bare_number, parse_quantity, Dimension, UnitError};
 use super::{Field, Quantity};
-use crate::job::{FieldError, InputWarning, JobError, Validated};
+use crate::job::{echoed, FieldError, InputWarning, JobError, Validated};
 use crate::model::{OptionError, Parameter, ParameterError, SolveOption};
 use crate::render::format_number;
 
@@ -71,6 +72,20 @@ pub struct Checker {
 
 /// Errors listed at most; the rest are counted.
 const MAX_ERRORS: usize = 100;
+
+thread_local! {
+    /// The parameters the checkers of this thread read, while [`parameters_read`] asks.
+    static READ: RefCell<Option<Vec<(String, Parameter)>>> = const { RefCell::new(None) };
+}
+
+/// The model parameter each quantity field is read as, by path (`layer.thickness`), by the
+/// checkers that `read` runs to their end: so the OpenAPI description gives a field the
+/// range of the code that reads it (each parameter at the first place it is read).
+pub fn parameters_read(read: impl FnOnce()) -> Vec<(String, Parameter)> {
+    READ.with(|recorded| recorded.replace(Some(Vec::new())));
+    read();
+    READ.with(|recorded| recorded.take()).unwrap_or_default()
+}
 
 impl Checker {
     pub fn new() -> Self {
@@ -225,11 +240,10 @@ impl Checker {
         if let (true, Ok(x)) = (bare, &parsed) {
             if let Some(message) = implausible(parameter, *x) {
                 let path = at.path();
-                let message = format!("{path}: {message}");
                 self.warnings.push(InputWarning {
+                    message: format!("{path}: {message}"),
                     field: path,
                     value: quantity.sent(),
-                    message,
                 });
             }
         }
@@ -248,6 +262,28 @@ impl Checker {
             self.unreadable(at.path(), quantity.sent(), dimension(parameter), &e);
             f64::NAN
         })
+    }
+
+    /// Warns of a bare number `x` (SI, as it has no unit) far from the scale of `parameter`,
+    /// read from `cell` at `place` of `field` (in the object being read) — a field holding
+    /// several values, such as a CSV's rows: `layer.prony_csv (row 3, E_j): 6 is 6 Pa; did you
+    /// mean "6 GPa"?`. The same warning as a bare number sent in a field of its own.
+    pub fn bare_cell(
+        &mut self,
+        field: &str,
+        place: &str,
+        cell: &str,
+        parameter: Parameter,
+        x: f64,
+    ) {
+        if let Some(message) = implausible(parameter, x) {
+            let path = self.path(field);
+            self.warnings.push(InputWarning {
+                message: format!("{path} ({place}): {message}"),
+                field: path,
+                value: Value::from(echoed(cell)),
+            });
+        }
     }
 
     fn unreadable(&mut self, field: String, value: Value, expected: Dimension, e: &UnitError) {
@@ -348,8 +384,21 @@ impl Checker {
         });
     }
 
+    /// Hands the parameters read to [`parameters_read`], if it asks.
+    fn record(&self) {
+        READ.with(|recorded| {
+            if let Some(recorded) = recorded.borrow_mut().as_mut() {
+                recorded.extend(self.paths.iter().filter_map(|(source, at)| match source {
+                    Source::Parameter(parameter) => Some((at.path(), *parameter)),
+                    Source::Option(_) => None,
+                }));
+            }
+        });
+    }
+
     /// The recorded errors, as the job's error (the last one counting those not listed).
     pub fn into_error(mut self) -> JobError {
+        self.record();
         if self.omitted > 0 {
             let n = self.omitted;
             self.errors.push(FieldError {
@@ -365,6 +414,7 @@ impl Checker {
     /// The job read, with the input's warnings, if no field was bad; else every error.
     pub fn finish<T>(self, job: T) -> Result<Validated<T>, JobError> {
         if self.errors.is_empty() {
+            self.record();
             Ok(Validated {
                 job,
                 warnings: self.warnings,

@@ -5,8 +5,9 @@ use utoipa::ToSchema;
 
 use serde_json::json;
 
-use super::units::{names_celsius, parse_quantity, Dimension};
+use super::units::{is_bare_number, names_celsius, parse_quantity, Dimension, UnitError};
 use super::{field, Checker, Quantity};
+use crate::job::echoed;
 use crate::model::spectrum::{wlf_decades, Terms, MAX_TERMS};
 use crate::model::{Layer, Parameter};
 use crate::render::format_number;
@@ -69,8 +70,10 @@ pub struct LayerInput {
     /// `elastic_modulus` (docs/model.md §9). 1 to 24 terms.
     pub prony: Option<Vec<PronyTerm>>,
     /// The same series as CSV text, a row (τ_j, E_j) per term: numbers in s and Pa, or
-    /// quantities with units ("100 ms", "12 GPa"); comma, semicolon or tab separated; a
-    /// first row that is not numbers is a header.
+    /// quantities with units ("100 ms", "12 GPa"); comma, semicolon or tab separated. A
+    /// first row with no cell starting with a number is a header, which may name its
+    /// columns' units as "tau [ms]", "tau (ms)", "tau/ms" or "tau_ms": the units of their
+    /// bare numbers (a unit it names that cannot be read is refused).
     pub prony_csv: Option<String>,
     /// Shift the times from `wlf.reference_temperature` to `temperature` (WLF).
     pub wlf: Option<WlfInput>,
@@ -295,57 +298,140 @@ impl LayerInput {
     }
 }
 
+/// The columns of a Prony series' CSV, in their order: each term's name, parameter and
+/// dimension.
+const COLUMNS: [(&str, Parameter, Dimension); 2] = [
+    ("τ_j", Parameter::PronyTime, Dimension::TIME),
+    ("E_j", Parameter::PronyModulus, Dimension::PRESSURE),
+];
+
+/// What the rows of a Prony series' CSV may be.
+const ROWS: &str = "rows \"τ_j, E_j\" such as \"0.1, 12e9\" or \"100 ms, 12 GPa\"";
+
+/// How a header may name its columns' units (README, "A layer from material data").
+const HEADER: &str = "a header naming each column's unit as \"tau [ms]\", \"tau (ms)\", \
+    \"tau/ms\" or \"tau_ms\" (an SI unit with an SI prefix: a time, then a pressure such as \
+    \"E [GPa]\"), or no unit for numbers in s and Pa";
+
 /// The rows (τ_j, E_j) of a Prony series as CSV text, as (E_j, τ_j); each bad cell is
 /// reported once, naming its row, and the series is then `None`.
+///
+/// A first row of which no cell starts with a number is a header. A unit it names is the
+/// unit of its column's bare numbers (a cell with a unit of its own keeps it), and a unit it
+/// names that cannot be read refuses the series: a header `tau [min]` or `E_psi` ignored would
+/// read its rows as seconds and pascals, a silently wrong answer. Bare numbers under no unit
+/// are SI, warned of where far from their column's scale as a bare number in a field is.
 fn read_csv(csv: &str, checker: &mut Checker) -> Option<Vec<(f64, f64)>> {
-    let rows: Vec<(usize, Vec<&str>)> = csv
+    let mut rows = csv
         .lines()
         .enumerate()
         .filter(|(_, line)| !line.trim().is_empty())
         .map(|(i, line)| (i + 1, line.split([',', ';', '\t']).map(str::trim).collect()))
-        .collect();
-    let numeric = |cell: &str, dimension| parse_quantity(cell, dimension).is_ok();
-    let header = rows.first().is_some_and(|(_, cells)| {
-        !cells
+        .peekable();
+    let is_header = |cells: &Vec<&str>| {
+        cells
             .iter()
-            .zip([Dimension::TIME, Dimension::PRESSURE])
-            .all(|(cell, d)| numeric(cell, d))
-    });
+            .all(|cell| parse_quantity(cell, Dimension::NONE) == Err(UnitError::NoNumber))
+    };
+    let units = match rows.next_if(|(_, cells)| is_header(cells)) {
+        Some((line, cells)) => header_units(checker, line, &cells)?,
+        None => [None; 2],
+    };
     let mut terms = Vec::new();
     let mut bad = false;
-    for (line, cells) in rows.iter().skip(usize::from(header)) {
-        let mut complain = |what: String| {
-            let allowed = format!(
-                "row {line}: {what}; expected rows \"τ_j, E_j\" such as \"0.1, 12e9\" or \"100 ms, 12 GPa\""
-            );
-            checker.invalid("prony_csv", json!(cells.join(",")), &allowed);
-            bad = true;
-        };
-        if cells.len() != 2 {
-            complain(format!("{} cells", cells.len()));
+    let mut refuse = |checker: &mut Checker, line, cells: &[&str], what| {
+        complain(checker, line, cells, what, ROWS);
+        bad = true;
+    };
+    for (line, cells) in rows {
+        if cells.len() != COLUMNS.len() {
+            refuse(checker, line, &cells, format!("{} cells", cells.len()));
             continue;
         }
-        let mut read =
-            |cell: &str, parameter: Parameter, dimension| match parse_quantity(cell, dimension) {
-                Ok(x) if parameter.check(x).is_ok() => Some(x),
-                Ok(x) => {
-                    let allowed = parameter.allowed();
-                    complain(format!(
-                        "{parameter} {} is out of range ({allowed})",
-                        format_number(x)
-                    ));
-                    None
-                }
-                Err(e) => {
-                    complain(format!("\"{cell}\" {e}"));
-                    None
-                }
+        let mut term = [f64::NAN; 2];
+        for ((x, (cell, unit)), (name, parameter, dimension)) in
+            term.iter_mut().zip(cells.iter().zip(units)).zip(COLUMNS)
+        {
+            let bare = is_bare_number(cell);
+            let read = match unit {
+                Some(unit) if bare => parse_quantity(&format!("{cell} {unit}"), dimension),
+                _ => parse_quantity(cell, dimension),
             };
-        let time = read(cells[0], Parameter::PronyTime, Dimension::TIME);
-        let modulus = read(cells[1], Parameter::PronyModulus, Dimension::PRESSURE);
-        if let (Some(time), Some(modulus)) = (time, modulus) {
-            terms.push((modulus, time));
+            match read {
+                Ok(value) if parameter.check(value).is_ok() => {
+                    if bare && unit.is_none() {
+                        let place = format!("row {line}, {name}");
+                        checker.bare_cell("prony_csv", &place, cell, parameter, value);
+                    }
+                    *x = value;
+                }
+                Ok(value) => {
+                    let what = format!(
+                        "{parameter} {} is out of range ({})",
+                        format_number(value),
+                        parameter.allowed()
+                    );
+                    refuse(checker, line, &cells, what);
+                }
+                Err(e) => refuse(checker, line, &cells, format!("\"{}\" {e}", echoed(cell))),
+            }
+        }
+        if term.iter().all(|x| x.is_finite()) {
+            terms.push((term[1], term[0]));
         }
     }
     (!bad).then_some(terms)
+}
+
+/// The unit of each column a CSV's header names (`None`: no unit, SI); `None` after
+/// reporting a header that cannot be read, whose rows then cannot be either.
+fn header_units<'a>(
+    checker: &mut Checker,
+    line: usize,
+    cells: &[&'a str],
+) -> Option<[Option<&'a str>; 2]> {
+    let mut bad = cells.len() != COLUMNS.len();
+    if bad {
+        let what = format!("a header of {} cells", cells.len());
+        complain(checker, line, cells, what, HEADER);
+    }
+    let mut units = [None; 2];
+    for ((unit, cell), (name, _, dimension)) in units.iter_mut().zip(cells).zip(COLUMNS) {
+        *unit = header_unit(cell);
+        let Some(named) = unit else { continue };
+        if let Err(e) = parse_quantity(&format!("1 {named}"), dimension) {
+            let e = match e {
+                UnitError::WrongDimension { found, .. } => {
+                    format!("names {found}, and its column holds {name}, {dimension}")
+                }
+                e => e.to_string(),
+            };
+            let what = format!("the header's \"{}\" {e}", echoed(cell));
+            complain(checker, line, cells, what, HEADER);
+            bad = true;
+        }
+    }
+    (!bad).then_some(units)
+}
+
+/// Reports row `line` of `prony_csv` (its `cells`): `what` is wrong with it, `expected` is
+/// what it may be.
+fn complain(checker: &mut Checker, line: usize, cells: &[&str], what: String, expected: &str) {
+    let allowed = format!("row {line}: {what}; expected {expected}");
+    checker.invalid("prony_csv", json!(cells.join(",")), &allowed);
+}
+
+/// The unit a header cell names: `tau [ms]`, `tau (ms)`, `tau/ms` (a quantity over its unit,
+/// as the SI brochure labels a table's column) or `tau_ms`; `None` for a name alone (`tau`).
+fn header_unit(cell: &str) -> Option<&str> {
+    let bracketed = [('[', ']'), ('(', ')')]
+        .into_iter()
+        .find_map(|(open, close)| {
+            let (_, unit) = cell.strip_suffix(close)?.rsplit_once(open)?;
+            Some(unit)
+        });
+    bracketed
+        .or_else(|| cell.rsplit_once(['/', '_']).map(|(_, unit)| unit))
+        .map(str::trim)
+        .filter(|unit| !unit.is_empty())
 }

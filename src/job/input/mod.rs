@@ -19,24 +19,54 @@ use std::fmt;
 use serde::de::{self, DeserializeOwned, Visitor};
 use serde::{Deserialize, Deserializer, Serialize};
 use serde_json::Value;
-use utoipa::ToSchema;
+use utoipa::openapi::schema::{
+    KnownFormat, ObjectBuilder, OneOfBuilder, Schema, SchemaFormat, Type,
+};
+use utoipa::openapi::RefOr;
+use utoipa::{PartialSchema, ToSchema};
 
 pub use canonical::{canonical, canonical_text};
-pub use checker::Checker;
+pub use checker::{parameters_read, Checker};
 pub use json::parse;
 pub use layer::{LayerInput, LayerModel};
 pub use quadrature::QuadratureKind;
 
 use super::JobError;
 
-/// A quantity as sent: an SI number, or a string with a unit such as `"25 nm"`, `"1.2 nN"`,
-/// `"4 nm/s"`, `"3 GPa"` or `"100 ms"` (its dimension must be the field's).
-#[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
+/// A quantity as sent, before [`units`] reads it in SI: a number (SI already), or text with
+/// a unit (its schema, below, says so to clients).
+#[derive(Clone, Debug, PartialEq, Serialize)]
 #[serde(untagged)]
 pub enum Quantity {
     Number(f64),
     Text(String),
 }
+
+/// The schema says what it can of a quantity: a number, or a string starting with one (what
+/// follows is the unit, whose dimension only the service checks), so that a client
+/// generated from the spec does not send `""` or `"twelve"` (written by hand: a variant's
+/// text cannot carry a pattern in the derive).
+impl PartialSchema for Quantity {
+    fn schema() -> RefOr<Schema> {
+        let number = ObjectBuilder::new()
+            .schema_type(Type::Number)
+            .format(Some(SchemaFormat::KnownFormat(KnownFormat::Double)));
+        let text = ObjectBuilder::new()
+            .schema_type(Type::String)
+            .pattern(Some(r"^\s*[+-]?(\d|\.\d)"));
+        OneOfBuilder::new()
+            .item(number)
+            .item(text)
+            .description(Some(
+                "A quantity as sent: an SI number, or a string with a unit such as `\"25 nm\"`, \
+                 `\"1.2 nN\"`, `\"4 nm/s\"`, `\"3 GPa\"` or `\"100 ms\"` (its dimension must be \
+                 the field's).",
+            ))
+            .into()
+    }
+}
+
+impl ToSchema for Quantity {}
 
 impl<'de> Deserialize<'de> for Quantity {
     fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
@@ -77,16 +107,12 @@ impl Quantity {
         Some(Quantity::Number(si(x)))
     }
 
-    /// The value as sent, for error reports (a long text cut to its first 100 characters,
-    /// so that an error never echoes a huge input back).
+    /// The value as sent, for error reports and warnings (a long text cut, so that they
+    /// never echo a huge input back).
     fn sent(&self) -> Value {
-        const ECHOED: usize = 100;
         match self {
             Quantity::Number(x) => Value::from(*x),
-            Quantity::Text(s) if s.chars().count() > ECHOED => {
-                Value::from(format!("{}…", s.chars().take(ECHOED).collect::<String>()))
-            }
-            Quantity::Text(s) => Value::from(s.as_str()),
+            Quantity::Text(s) => Value::from(super::echoed(s)),
         }
     }
 }
