@@ -474,6 +474,12 @@ impl ServeArgs {
                 MAX_COUNT,
                 no_limit,
             ),
+            Bounded::or_zero(
+                "--anonymous-quota-jobs",
+                self.anonymous_quota_jobs,
+                MAX_COUNT,
+                no_limit,
+            ),
             Bounded::count("--max-deliveries", fleet.max_deliveries, 1, MAX_DELIVERIES),
             Bounded::count("--part-points", fleet.part_points, 1, MAX_COUNT),
             Bounded::count(
@@ -761,6 +767,10 @@ mod tests {
             (
                 ["--anonymous-quota-points", most],
                 "--anonymous-quota-points 18446744073709551615: allowed 0 (no limit) to 100000000",
+            ),
+            (
+                ["--anonymous-quota-jobs", most],
+                "--anonymous-quota-jobs 18446744073709551615: allowed 0 (no limit) to 100000000",
             ),
             (
                 ["--max-queued-jobs", "0"],
