@@ -33,11 +33,16 @@ pub struct Exceeded {
     pub retry_after: Option<Duration>,
 }
 
-/// Points charged to a tenant before its work, to true up after it ([`PointCounts::true_up`]).
+/// Points charged to a tenant before its work, to true up after it ([`PointCounts::true_up`])
+/// if they were a guess at its iterations.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Charge {
     pub tenant: String,
     pub points: u64,
+    /// Whether the points guessed at an iterative job's work (a fit's), which its time then
+    /// settles; else they are the work's own measure (a point a local answer, a continuum
+    /// answer's grid), the same whatever the machine.
+    pub guessed: bool,
 }
 
 /// The points charged to each tenant in the current window.
@@ -90,8 +95,11 @@ impl PointCounts {
     }
 
     /// Trues up `charge`, made before the work, by what the work really `took` on a solver
-    /// thread ([`crate::job::Cost::of_time`]).
+    /// thread ([`crate::job::Cost::of_time`]), if it was a guess.
     pub async fn true_up(&self, charge: &Charge, took: Duration) {
+        if !charge.guessed {
+            return;
+        }
         let took = i64::try_from(Cost::of_time(took)).unwrap_or(i64::MAX);
         let charged = i64::try_from(charge.points).unwrap_or(i64::MAX);
         self.adjust(&charge.tenant, took - charged, SystemTime::now())

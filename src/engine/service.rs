@@ -314,7 +314,8 @@ impl Engine {
     /// queue is full, the service is draining, or there is no room to keep the job's
     /// result.
     /// `charged`: the points a quota charged for it, trued up by what it really took when it
-    /// ends (in this process; a fleet's workers run jobs elsewhere, and the estimate stands).
+    /// ends if they were a guess (in this process; a fleet's workers run jobs elsewhere, and
+    /// the guess stands).
     pub async fn submit(
         &self,
         keyed: Keyed,
@@ -323,7 +324,7 @@ impl Engine {
     ) -> Result<JobRecord, EngineError> {
         self.admit()?;
         let points = self.points.clone();
-        let on_end = charged.map(|charge| -> OnEnd {
+        let on_end = charged.filter(|c| c.guessed).map(|charge| -> OnEnd {
             Box::new(move |took| {
                 tokio::spawn(async move { points.true_up(&charge, took).await });
             })

@@ -45,8 +45,8 @@ impl Work {
 /// A point is about ten microseconds of a solver thread, a local-law answer's work: a local
 /// sweep costs a point a point, as it always has, and a continuum answer what its grids
 /// cost ([`Cost::continuum`]: 7,000 points on the default grid, up to about 800,000 on the
-/// largest). An iterative job estimates its iterations; what it really took is charged
-/// after it ran ([`Cost::of_time`]).
+/// largest), the same on every machine. An iterative job guesses at its iterations; what it
+/// really took is charged after it ran ([`Cost::of_time`]).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Cost {
     pub points: u64,

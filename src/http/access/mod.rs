@@ -28,7 +28,7 @@ use super::AppState;
 use crate::engine::admission::Turn;
 use crate::engine::quota::{Charge, Exceeded};
 use crate::engine::store::Owner;
-use crate::job::Keyed;
+use crate::job::{Keyed, Work};
 
 /// The header that carries an API key (`Authorization: Bearer` does too).
 pub const API_KEY_HEADER: &str = "x-api-key";
@@ -255,10 +255,11 @@ pub async fn charge_all(
         return Ok(None);
     }
     // What each job is estimated to cost (`Cost`: a point a local answer).
-    let mut points = 0;
+    let (mut points, mut guessed) = (0, false);
     for keyed in jobs {
         if state.engine().cached(keyed.key()).await.is_none() {
             points += keyed.job().cost().points;
+            guessed |= keyed.job().work() == Work::Unknown;
         }
     }
     if points == 0 {
@@ -266,7 +267,11 @@ pub async fn charge_all(
     }
     let Err(Exceeded { used, retry_after }) = state.engine().charge(&tenant, points, limit).await
     else {
-        return Ok(Some(Charge { tenant, points }));
+        return Ok(Some(Charge {
+            tenant,
+            points,
+            guessed,
+        }));
     };
     let whose = caller.describe();
     let detail = match retry_after {

@@ -109,6 +109,7 @@ pub struct ListQuery {
     #[param(value_type = Option<usize>)]
     offset: Option<String>,
     /// The jobs of the API keys of this name instead of the caller's (an admin key only).
+    #[param(pattern = r"^[A-Za-z0-9._-]{1,64}$")]
     tenant: Option<String>,
 }
 

@@ -132,6 +132,7 @@ pub struct PointInput {
 /// `shift_factor` and `modulus_scale` (its shape held), not by its single times.
 #[derive(Clone, Debug, Default, PartialEq, Deserialize, Serialize, ToSchema)]
 #[serde(deny_unknown_fields)]
+#[schema(min_properties = 1)]
 pub struct ParametersInput {
     /// T_σ (s).
     pub relaxation_time: Option<BoundsInput>,
