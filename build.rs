@@ -40,7 +40,10 @@ fn main() {
     ) {
         // Only the files there are: cargo takes a file missing (a clone without packed
         // refs, as CI's fresh one) for one changed, and built the crate again every time.
-        for file in [format!("{common}/{branch}"), format!("{common}/packed-refs")] {
+        for file in [
+            format!("{common}/{branch}"),
+            format!("{common}/packed-refs"),
+        ] {
             if std::path::Path::new(&file).exists() {
                 println!("cargo:rerun-if-changed={file}");
             }

@@ -38,9 +38,17 @@ if $bounded; then
   if grep "failed (5 s timeout)" "$out" | grep -v ", 0 failed (5 s timeout)"; then
     echo "BROKEN: /healthz went unanswered"; broken=1
   fi
-  # A checks suite near the body limit stays within the default memory budget (256 MiB).
-  if ! grep -qE "checks suite: .*status 200 .* -> ([0-9]|[0-9][0-9]|1[0-9][0-9]|2[0-4][0-9]|25[0-5]) MiB" "$out"; then
-    echo "BROKEN: a large checks suite was not answered within the memory budget"; broken=1
+  # A checks suite near the body limit is answered within the default memory budget (256
+  # MiB); one of 332 10,000-point sweeps peaks at 300 MiB at most and, its answers judged and
+  # let go, leaves the process under 100 MiB when idle (issue 45).
+  if ! awk '/^checks (suite|of sweeps): /{
+          seen++; peak = $0; sub(/.* peak /, "", peak); idle = $0; sub(/.* idle /, "", idle)
+          sweeps = /^checks of sweeps/
+          if (!/ status 200 / || peak + 0 > (sweeps ? 300 : 255) || (sweeps && idle + 0 >= 100)) {
+            print "  " $0; bad = 1
+          }
+        } END { exit bad || seen != 2 }' "$out"; then
+    echo "BROKEN: a large checks suite went past its memory bound, or kept its memory"; broken=1
   fi
   # Under 511 hostile connections, a well-behaved client is served (RELIABILITY.md).
   if grep -E "well-behaved solves: .*\((9[0-8]|[0-8]?[0-9])\.[0-9] %\)" "$out"; then

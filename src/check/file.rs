@@ -30,24 +30,26 @@ pub fn run_file(path: &Path, update: bool) -> Result<Report, JobError> {
     }
     let suite = Suite::from_value(value, &Limits::default())?;
     let mut reports = Vec::new();
+    // Each answer is judged, then dropped before the next job runs: a file of large sweeps
+    // holds one answer at a time.
     for mut spec in suite.checks {
-        let answer = spec
+        let json = spec
             .job
             .run(spec.job.meta(), &Control::default())
             .and_then(|answer| {
-                let json = answer
+                answer
                     .render(Format::Json)
-                    .map_err(|e| JobError::Internal(e.to_string()))?;
-                serde_json::from_slice::<Value>(&json)
                     .map_err(|e| JobError::Internal(e.to_string()))
             });
-        if let (true, Ok(answer), Some(golden)) = (update, &answer, &mut spec.golden) {
+        if let (true, Ok(json), Some(golden)) = (update, &json, &mut spec.golden) {
+            let answer = serde_json::from_slice::<Value>(json)
+                .map_err(|e| JobError::Internal(e.to_string()))?;
             if let Some(file) = &golden.file {
-                write_golden(&dir.join(file), answer)?;
+                write_golden(&dir.join(file), &answer)?;
             }
-            golden.answer = Some(answer.clone());
+            golden.answer = Some(answer);
         }
-        reports.push(spec.judge(answer));
+        reports.push(spec.judge(json.as_deref()));
     }
     Ok(Report::new(reports))
 }

@@ -4,11 +4,14 @@
 //!
 //! This module reads a checks document ([`Suite`]) and judges answers ([`CheckSpec::judge`]);
 //! the command line runs a file of checks in process ([`run_file`]), the service runs a
-//! document through its engine and cache.
+//! document through its engine. Either way each answer is judged as it comes and let go: a
+//! suite holds its verdicts, never its answers, and an answer is read only as far as its
+//! checks need ([`read`]).
 
 mod expect;
 mod file;
 mod path;
+mod read;
 mod report;
 
 use std::collections::BTreeMap;
@@ -156,20 +159,37 @@ impl Suite {
 }
 
 impl CheckSpec {
-    /// Judges the job's answer (its JSON as clients see it), or the error it failed with.
-    pub fn judge(&self, answer: Result<Value, JobError>) -> CheckReport {
+    /// Judges the job's answer (its JSON text, as clients see it), or the error it failed
+    /// with. Only what the expectations read is parsed, unless a golden answer is matched
+    /// (the whole answer) or a path reaches nothing (the whole answer again, to name the
+    /// nearest paths).
+    pub fn judge(&self, answer: Result<&[u8], &JobError>) -> CheckReport {
         let mut report = CheckReport::new(&self.name, self.job.kind().name());
-        match answer {
-            Err(e) => report.fail_with(e.to_string()),
+        let json = match answer {
+            Ok(json) => json,
+            Err(e) => {
+                report.fail_with(e.to_string());
+                report.settle();
+                return report;
+            }
+        };
+        let whole = || serde_json::from_slice::<Value>(json);
+        let read = match &self.golden {
+            Some(_) => whole(),
+            None => read::parts(json, self.expectations.iter().map(Expectation::path)),
+        };
+        match read {
+            Err(e) => report.fail_with(format!("the answer could not be read: {e}")),
             Ok(answer) => {
                 report.input_hash = answer["meta"]["input_hash"].as_str().map(str::to_string);
                 for expectation in &self.expectations {
-                    report.outcomes.extend(expectation.judge(&answer));
+                    // The text was read a moment ago: it parses again.
+                    let outcomes = expectation.judge(&answer, || whole().unwrap_or_default());
+                    report.outcomes.extend(outcomes);
                 }
                 if let Some(golden) = &self.golden {
                     report.outcomes.push(golden.judge(&answer));
                 }
-                report.answer = Some(answer);
             }
         }
         report.settle();

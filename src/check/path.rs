@@ -1,10 +1,10 @@
 //! Field paths of an answer, as checks name them (`static.friction_coefficient`,
-//! `points[2].load`, `points[].contact_area`): reading one, finding what it reaches
-//! ([`FieldPath::resolve`]), and saying what is there instead when it reaches nothing
+//! `points[2].load`, `points[].contact_area`): reading one, visiting what it reaches
+//! ([`FieldPath::visit`]), and saying what is there instead when it reaches nothing
 //! ([`FieldPath::miss`]).
 
 use std::collections::BTreeSet;
-use std::fmt;
+use std::fmt::{self, Write};
 
 use serde_json::Value;
 
@@ -14,7 +14,7 @@ const NEAREST: usize = 3;
 
 /// A step of a field path.
 #[derive(Clone, Debug, PartialEq)]
-enum Step {
+pub(super) enum Step {
     Key(String),
     Index(usize),
     /// `[]`: every element.
@@ -60,12 +60,21 @@ impl FieldPath {
         &self.text
     }
 
-    /// The values the path reaches in `answer`, each with its concrete path (`[]` may reach
-    /// several, a miss none).
-    pub fn resolve<'a>(&self, answer: &'a Value) -> Vec<(String, &'a Value)> {
-        let mut found = Vec::new();
-        resolve(answer, &self.steps, String::new(), &mut found);
-        found
+    /// The steps, for what reads only the parts of an answer that paths reach.
+    pub(super) fn steps(&self) -> &[Step] {
+        &self.steps
+    }
+
+    /// Whether the path may reach several values: it has a `[]`.
+    pub fn reaches_many(&self) -> bool {
+        self.steps.contains(&Step::Each)
+    }
+
+    /// Calls `visit` with each value the path reaches in `answer` and its concrete path (`[]`
+    /// may reach several, a miss none), one at a time: a path over every point of a sweep
+    /// is judged without a list of its thousands of values.
+    pub fn visit<'a>(&self, answer: &'a Value, mut visit: impl FnMut(&str, &'a Value)) {
+        visit_at(answer, &self.steps, &mut String::new(), &mut visit);
     }
 
     /// Why the path reaches nothing in `answer`, naming the path and the existing paths
@@ -111,28 +120,48 @@ fn child(at: &str, name: &str) -> String {
     }
 }
 
-/// Puts the values at `steps` below `value` into `out`, each with its concrete path.
-fn resolve<'a>(value: &'a Value, steps: &[Step], at: String, out: &mut Vec<(String, &'a Value)>) {
+/// Calls `visit` with the values at `steps` below `value`, each with its concrete path: `at`
+/// followed by the steps taken (one buffer, grown and cut back as the walk goes).
+fn visit_at<'a>(
+    value: &'a Value,
+    steps: &[Step],
+    at: &mut String,
+    visit: &mut impl FnMut(&str, &'a Value),
+) {
     let Some((step, rest)) = steps.split_first() else {
-        out.push((at, value));
+        visit(at, value);
         return;
     };
+    let len = at.len();
+    let mut below = |at: &mut String, child: &'a Value, rest: &[Step]| {
+        visit_at(child, rest, at, visit);
+        at.truncate(len);
+    };
     match (step, value) {
-        (Step::Key(k), Value::Object(map)) => match map.get(k) {
-            Some(v) => resolve(v, rest, child(&at, k), out),
-            // A row of a sweep without numbers (refused, or not solved) is reached as itself,
-            // so that an expectation on it fails saying why rather than passing it over.
-            None if unanswered(value).is_some() => out.push((child(&at, k), value)),
-            None => {}
-        },
+        (Step::Key(k), Value::Object(map)) => {
+            if !at.is_empty() {
+                at.push('.');
+            }
+            at.push_str(k);
+            match map.get(k) {
+                Some(v) => below(at, v, rest),
+                // A row of a sweep without numbers (refused, or not solved) is reached as
+                // itself, so that an expectation on it fails saying why rather than passing
+                // it over.
+                None if unanswered(value).is_some() => below(at, value, &[]),
+                None => at.truncate(len),
+            }
+        }
         (Step::Index(i), Value::Array(items)) => {
             if let Some(v) = items.get(*i) {
-                resolve(v, rest, format!("{at}[{i}]"), out);
+                let _ = write!(at, "[{i}]");
+                below(at, v, rest);
             }
         }
         (Step::Each, Value::Array(items)) => {
             for (i, v) in items.iter().enumerate() {
-                resolve(v, rest, format!("{at}[{i}]"), out);
+                let _ = write!(at, "[{i}]");
+                below(at, v, rest);
             }
         }
         _ => {}
@@ -232,8 +261,9 @@ mod tests {
         }
         let answer = json!({"points": [{"mu": 0.05}, {"mu": 0.2}], "static": {"mu": 0.3}});
         let reached = |text: &str| {
-            let found = path(text).resolve(&answer);
-            found.into_iter().map(|(at, _)| at).collect::<Vec<_>>()
+            let mut found = Vec::new();
+            path(text).visit(&answer, |at, _| found.push(at.to_string()));
+            found
         };
         assert_eq!(reached("points[].mu"), ["points[0].mu", "points[1].mu"]);
         assert_eq!(reached("points[1].mu"), ["points[1].mu"]);

@@ -3,7 +3,6 @@
 use std::fmt::Write;
 
 use serde::Serialize;
-use serde_json::Value;
 use utoipa::ToSchema;
 
 /// One judgement of one number (or of a golden answer).
@@ -32,7 +31,8 @@ impl Outcome {
         }
     }
 
-    /// A judgement with no single number that held (a golden answer matched).
+    /// A judgement with no single number that held: a golden answer matched, or every
+    /// number at a path with `[]`.
     pub fn matched(path: &str, expected: &str) -> Outcome {
         Outcome {
             path: path.to_string(),
@@ -68,9 +68,6 @@ pub struct CheckReport {
     /// Why the job itself gave no answer.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub error: Option<String>,
-    /// The answer judged (for `--update`; not reported).
-    #[serde(skip)]
-    pub answer: Option<Value>,
 }
 
 impl CheckReport {
@@ -82,7 +79,6 @@ impl CheckReport {
             input_hash: None,
             outcomes: Vec::new(),
             error: None,
-            answer: None,
         }
     }
 

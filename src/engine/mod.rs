@@ -33,7 +33,7 @@ pub mod store;
 pub use backlog::Backlogged;
 pub use ids::Unknown;
 pub use service::{Engine, EngineConfig, EngineError, Held, Storage};
-pub use solver::{CacheStatus, Solver};
+pub use solver::{CacheStatus, CacheUse, Solver};
 
 use crate::job::{Control, Job, JobError};
 use crate::render::Answer;

@@ -22,7 +22,7 @@ use super::lifecycle::{Lifecycle, OnEnd};
 use super::local::LocalJobStore;
 use super::metrics::{self as names, Metrics};
 use super::quota::{Charge, Exceeded, PointCounts};
-use super::solver::{CacheStatus, Solver};
+use super::solver::{CacheStatus, CacheUse, Solver};
 use super::spill::SpillDir;
 use super::store::{JobRecord, JobStatus, JobStore, Listing, MemoryJobStore, Owner, Page, Refusal};
 use crate::job::{JobError, Keyed};
@@ -293,20 +293,22 @@ impl Engine {
         self: &Arc<Self>,
         keyed: Keyed,
     ) -> Result<(Arc<Solved>, CacheStatus), EngineError> {
-        self.solve_by(keyed, Instant::now() + self.solve_deadline)
-            .await
+        let deadline = Instant::now() + self.solve_deadline;
+        self.solve_by(keyed, deadline, CacheUse::Keep).await
     }
 
     /// [`Engine::solve`] with a deadline of the caller's (shared by several solves, as a
-    /// checks suite's), never later than the solve deadline from now.
+    /// checks suite's), never later than the solve deadline from now, and its own use of
+    /// the cache (a check's answer is not kept).
     pub async fn solve_by(
         self: &Arc<Self>,
         keyed: Keyed,
         deadline: Instant,
+        cache: CacheUse,
     ) -> Result<(Arc<Solved>, CacheStatus), EngineError> {
         self.admit()?;
         let deadline = deadline.min(Instant::now() + self.solve_deadline);
-        let solved = self.solver.solve_by(keyed, deadline).await;
+        let solved = self.solver.solve_by(keyed, deadline, cache).await;
         solved.map_err(|e| self.refused(e))
     }
 

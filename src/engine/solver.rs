@@ -37,6 +37,17 @@ impl CacheStatus {
     }
 }
 
+/// What a solve does with the cache besides reading it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CacheUse {
+    /// Keeps the answer for the next caller (a client's solve).
+    Keep,
+    /// Lets the answer go once the caller has it (a large answer solved for a check, which
+    /// nobody else asks for). Identical concurrent solves share this one, so theirs is not
+    /// kept either.
+    ReadOnly,
+}
+
 /// A solve that did not answer: why, and the partial answer of a job that keeps what it
 /// finished ([`crate::job::Unfinished`]).
 pub(super) struct Stopped {
@@ -150,13 +161,14 @@ impl Solver {
         self.cache.insert_result_of(solved, job).await;
     }
 
-    /// Solves `keyed` by `deadline`, or takes its answer from the cache. Identical
-    /// concurrent calls share one solve (in a fleet, one across processes). With no solver
-    /// thread free the call is refused at once.
+    /// Solves `keyed` by `deadline` (keeping the answer as `cache` says), or takes its
+    /// answer from the cache. Identical concurrent calls share one solve (in a fleet, one
+    /// across processes). With no solver thread free the call is refused at once.
     pub async fn solve_by(
         self: &Arc<Self>,
         keyed: Keyed,
         deadline: Instant,
+        cache: CacheUse,
     ) -> Result<(Arc<Solved>, CacheStatus), EngineError> {
         let key = keyed.key().to_string();
         if let Some(solved) = self.cached(&key).await {
@@ -169,7 +181,7 @@ impl Solver {
                 if let Claim::Solved(solved) = solver.cache.claim(&key_claimed, deadline).await? {
                     return Ok(solved);
                 }
-                let solved = solver.solve_claimed(keyed, deadline).await;
+                let solved = solver.solve_claimed(keyed, deadline, cache).await;
                 solver.cache.release(&key_claimed).await;
                 solved
             }
@@ -186,11 +198,12 @@ impl Solver {
     }
 
     /// Solves `keyed` now, this process holding the fleet's claim on it, and keeps the
-    /// answer.
+    /// answer if `cache` says so.
     async fn solve_claimed(
         &self,
         keyed: Keyed,
         deadline: Instant,
+        cache: CacheUse,
     ) -> Result<Arc<Solved>, EngineError> {
         let bytes = keyed.job().cost().bytes;
         let permit = self
@@ -202,7 +215,9 @@ impl Solver {
             .execute(permit, keyed, control, false)
             .await
             .map_err(|stopped| stopped.into_parts().0)?;
-        self.keep(solved.clone()).await;
+        if cache == CacheUse::Keep {
+            self.keep(solved.clone()).await;
+        }
         Ok(solved)
     }
 

@@ -241,8 +241,8 @@ fn domain(a0: f64, pixel: f64, wake: f64, cause: Fineness) -> Result<Domain, Too
     let (front, back) = (side, side + wake);
     let even = |length: f64| 2.0 * (0.5 * length / pixel).ceil();
     let (nx, ny) = (even(front + back + pixel), even(2.0 * side));
-    // Written so that a NaN is refused too.
-    if !(nx * ny <= MAX_PIXELS as f64) {
+    let pixels = nx * ny;
+    if pixels.is_nan() || pixels > MAX_PIXELS as f64 {
         return Err(TooFine { nx, ny, cause });
     }
     Ok(Domain {
@@ -373,7 +373,7 @@ mod tests {
                     }
                 }
                 Ok(Plan { route: Route::Thin { ratio }, .. }) => prop_assert!(ratio >= THIN),
-                Err(e) => prop_assert!(!(e.nx * e.ny <= MAX_PIXELS as f64)),
+                Err(e) => prop_assert!(e.nx * e.ny > MAX_PIXELS as f64 || (e.nx * e.ny).is_nan()),
             }
         }
     }

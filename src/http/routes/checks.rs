@@ -5,17 +5,16 @@ use std::time::Instant;
 use axum::extract::State;
 use axum::http::{header, HeaderMap};
 use axum::response::{IntoResponse, Response};
-use serde_json::Value;
 
 use crate::check::{CheckReport, ChecksInput, Report, Suite};
-use crate::engine::EngineError;
+use crate::engine::{CacheUse, EngineError};
 use crate::http::accept::Accept;
 use crate::http::access::{self, Caller};
-use crate::http::body::JsonBody;
+use crate::http::body::{offload, JsonBody};
 use crate::http::error::ApiError;
 use crate::http::responses::{BadBody, Busy, ChecksFailed, NotAcceptable};
 use crate::http::AppState;
-use crate::job::{JobError, Keyed};
+use crate::job::{Job, JobError, Keyed};
 
 /// The forms of a report: JSON, or JUnit XML for CI systems.
 const FORMS: [&str; 2] = ["application/json", "application/xml"];
@@ -78,11 +77,12 @@ pub async fn run(
         .collect();
     let charged = access::charge_all(&state, &caller, &jobs).await?;
     // One deadline for the whole suite, so that its cost is that of one solve at most,
-    // however many checks it holds; each answer is judged and let go before the next.
+    // however many checks it holds; each answer is judged and let go before the next, so
+    // that the suite holds its verdicts and one answer at a time.
     let started = Instant::now();
     let deadline = started + state.config().engine.solve_deadline;
     let mut reports = Vec::with_capacity(suite.checks.len());
-    for (spec, keyed) in suite.checks.iter().zip(jobs) {
+    for (spec, keyed) in suite.checks.into_iter().zip(jobs) {
         if Instant::now() >= deadline {
             let mut report = CheckReport::new(&spec.name, spec.job.kind().name());
             report.fail_with(format!(
@@ -94,16 +94,20 @@ pub async fn run(
             reports.push(report);
             continue;
         }
-        let answer = match state.engine().solve_by(keyed, deadline).await {
-            Ok((solved, _)) => serde_json::from_slice::<Value>(solved.json())
-                .map_err(|e| JobError::Internal(e.to_string())),
+        let cache = cache_use(&spec.job, state.config().engine.memory_budget);
+        let answer = match state.engine().solve_by(keyed, deadline, cache).await {
+            Ok((solved, _)) => Ok(solved),
             Err(EngineError::Job(e)) => Err(e),
             Err(refusal) => return Err(refusal.into()),
         };
-        let mut report = spec.judge(answer);
-        // The answer is kept for `thirdbody check --update` only.
-        report.answer = None;
-        reports.push(report);
+        // A large answer (a sweep's is megabytes) is read as a large body is: off the async
+        // threads.
+        let size = answer.as_ref().map_or(0, |solved| solved.json().len());
+        let judge = move || {
+            let json = answer.as_ref().map(|solved| solved.json().as_ref());
+            Ok(spec.judge(json))
+        };
+        reports.push(offload(&state, size, judge).await?);
     }
     if let Some(charge) = charged {
         state.engine().true_up(&charge, started.elapsed()).await;
@@ -116,4 +120,20 @@ pub async fn run(
         (Some(failed), false) => failed.into_response(),
         (Some(failed), true) => failed.respond_as(FORMS[1], report.to_junit()),
     })
+}
+
+/// Whether a check keeps the answer it solves in the cache: when the answer takes at most a
+/// thousandth of the memory budget (256 KiB of the default 256 MiB), as a rolling contact's
+/// few kB do, so that the suite run again is answered from the cache and costs its caller no
+/// points. A larger answer (a sweep of more than about 150 points, up to megabytes) is judged
+/// and let go: nobody but the same check asks for it, and a suite of them kept would push out
+/// every client's answers and stay resident (332 10,000-point sweeps left the cache holding
+/// ~100 MiB after the suite), while the suite run again would not find them anyway, each
+/// having pushed out the ones before.
+fn cache_use(job: &Job, memory_budget: u64) -> CacheUse {
+    if job.result_bytes() <= memory_budget / 1024 {
+        CacheUse::Keep
+    } else {
+        CacheUse::ReadOnly
+    }
 }
