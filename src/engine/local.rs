@@ -50,11 +50,12 @@ impl LocalJobStore {
     ) -> Result<(), String> {
         let outcome = match self.db(what, call).await {
             Some(()) => None,
-            None => Some(format!(
+            None => Some(
                 "the database of saved analyses cannot be written now (the log says why: a \
                  full disk?), so the job is not accepted, that none is lost; it is retried with \
                  every submission"
-            )),
+                    .to_string(),
+            ),
         };
         let mut failing = self.failing.lock().unwrap_or_else(|p| p.into_inner());
         *failing = outcome.clone();
