@@ -31,6 +31,7 @@ python3 reliability/queue_cost.py | tee -a "$out"
 python3 reliability/sigterm.py | tee -a "$out"
 python3 reliability/sigkill.py | tee -a "$out"
 python3 reliability/continuum.py | tee -a "$out"
+python3 reliability/full_disk.py | tee -a "$out"
 if $bounded; then
   broken=0
   if grep -q "server alive at the end: False" "$out"; then echo "BROKEN: the server died"; broken=1; fi
@@ -66,6 +67,9 @@ if $bounded; then
     || { echo "BROKEN: a poller of a job the shutdown interrupted was not told"; broken=1; }
   grep -q "answers 410 tag:thirdbody,2026:problems/interrupted" "$out" \
     || { echo "BROKEN: a restarted server does not say interrupted"; broken=1; }
+  # On a full disk jobs are refused, never accepted and lost (a machine that cannot mount a
+  # tmpfs says it skipped it).
+  if grep -E "^full disk: .*lost [1-9]" "$out"; then echo "BROKEN: a job accepted on a full disk was lost"; broken=1; fi
   # The continuum's extremes are refused (422) before any work, and a long continuum solve
   # stops at its deadline (2 s; 3 s allows a loaded machine, the solve itself takes 30 s).
   [ "$(grep -cE '^continuum extreme .*: 422 ' "$out")" -eq 6 ] \

@@ -10,6 +10,10 @@ use thirdbody::render::Format;
 /// Jobs larger than this are validated but not solved: the fuzzer hunts panics, not time.
 const MAX_SOLVES: usize = 64;
 
+/// Nor are jobs that cost more than this (points of about 10 µs: a continuum answer on a
+/// fine grid takes seconds; its plan and refusal are what is fuzzed).
+const MAX_POINTS: u64 = 20_000;
+
 fuzz_target!(|bytes: &[u8]| {
     let limits = Limits {
         max_sweep_points: MAX_SOLVES,
@@ -18,7 +22,8 @@ fuzz_target!(|bytes: &[u8]| {
         return;
     };
     let _ = job.canonical();
-    let small = matches!(job.work(), Work::Known(n) if n <= MAX_SOLVES);
+    let small =
+        matches!(job.work(), Work::Known(n) if n <= MAX_SOLVES) && job.cost().points <= MAX_POINTS;
     if !small || job.kind() == "figure" {
         return;
     }
