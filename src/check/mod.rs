@@ -44,7 +44,7 @@ pub struct CheckInput {
     /// The check's name in reports.
     pub name: String,
     /// The job, as `thirdbody solve` takes it: `{"kind": ..., "input": {...}}`.
-    #[schema(value_type = Object)]
+    #[schema(value_type = crate::job::registry::Envelope)]
     pub job: Value,
     /// Expectations on fields of the answer, by dotted path: `friction_coefficient`,
     /// `static.friction_coefficient`, `points[2].load`, or `points[].contact_area` for every

@@ -242,7 +242,7 @@ fn every_numeric_flag_out_of_range_is_status_2_naming_flag_value_and_range() {
         assert_eq!(output.status.code(), Some(2), "{args:?}");
         assert_eq!(String::from_utf8_lossy(&output.stderr).trim(), expected);
     }
-    let output = Command::new(env!("CARGO_BIN_EXE_thirdbody"))
+    let output = crate::processes::thirdbody()
         .args(["serve", "--database", ":memory:"])
         .env("THIRDBODY_QUOTA_POINTS", "18446744073709551615")
         .output()
