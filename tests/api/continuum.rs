@@ -186,3 +186,72 @@ async fn a_rolling_fit_on_the_continuum_is_sent_to_the_jobs_and_one_at_rest_answ
     assert_eq!(answer["meta"]["input"]["layer"]["model"], "continuum");
     assert!(answer["parameters"]["thickness"]["value"].as_f64().unwrap() > 0.0);
 }
+
+/// The requests that took the process down (issue 45) are refused before any work: a 422
+/// naming the field, and for a grid past its cap the range of the field that is answered
+/// with the other inputs as given; a layer thinner than any grid is the local law's answer
+/// (or its refusal); a three-body system's layer curves are planned too.
+#[tokio::test]
+async fn a_continuum_job_beyond_its_grid_is_refused_naming_the_field_and_its_range() {
+    let app = spawn_app(&[]).await;
+    let refusal = |layer: Value| {
+        let app = &app;
+        async move {
+            let mut layer = layer;
+            layer["model"] = "continuum".into();
+            problem(app.post("/v1/rolling", &json!({"layer": layer})).await, 422).await
+        }
+    };
+    let fast = refusal(json!({"relaxation_time": 1e-30})).await;
+    assert_eq!(
+        fast["errors"][0]["field"], "layer.relaxation_time",
+        "{fast}"
+    );
+    let allowed = fast["errors"][0]["allowed"].as_str().unwrap();
+    assert!(
+        allowed.starts_with("at least 2.59 ms with the other inputs as given (T_ε/T_σ at most 19"),
+        "{allowed}"
+    );
+    let slow = refusal(json!({"retardation_time": 1e30})).await;
+    assert_eq!(
+        slow["errors"][0]["field"], "layer.retardation_time",
+        "{slow}"
+    );
+    assert!(slow["errors"][0]["allowed"]
+        .as_str()
+        .unwrap()
+        .starts_with("at most 9.7"));
+    let squeezed = refusal(json!({"thickness": "1 pm", "poisson_ratio": 0.49})).await;
+    assert_eq!(
+        squeezed["errors"][0]["field"], "layer.thickness",
+        "{squeezed}"
+    );
+    let allowed = squeezed["errors"][0]["allowed"].as_str().unwrap();
+    assert!(
+        allowed.contains("or ν at most 0.4 (the thin-layer path)"),
+        "{allowed}"
+    );
+    for thin in [
+        json!({"thickness": 1e-12}),
+        json!({"thickness": 1e-14}),
+        json!({"elastic_modulus": 1e-3}),
+    ] {
+        let pierced = refusal(thin.clone()).await;
+        assert!(
+            pierced["detail"]
+                .as_str()
+                .unwrap()
+                .contains("reaches the layer's thickness"),
+            "{thin}: {pierced}"
+        );
+    }
+    let thinnest = refusal(json!({"thickness": 1e-300})).await;
+    assert!(thinnest["detail"].as_str().is_some(), "{thinnest}");
+    let system = json!({"layer": {"relaxation_time": "1 ms"}, "layer_contact": "continuum",
+        "operating": {"total_load": "1 mN"}});
+    let refused = problem(app.post("/v1/three-body", &system).await, 422).await;
+    assert_eq!(
+        refused["errors"][0]["field"], "layer.relaxation_time",
+        "{refused}"
+    );
+}

@@ -61,53 +61,22 @@ pub fn check(layer: &Layer, problems: Problems, checker: &mut Checker) {
 fn slower(layer: &Layer, problems: Problems) -> Option<ParameterError> {
     let default = Layer::default();
     let off = |value: f64, default: f64| (value / default).ln().abs();
-    let by_relaxation = off(layer.relaxation_time, default.relaxation_time)
-        >= off(layer.retardation_time, default.retardation_time);
-    let ratio = |l: &Layer| l.retardation_time / l.relaxation_time;
-    let (parameter, value, bound, side) = if by_relaxation {
-        let set = |l: &mut Layer, t: f64| l.relaxation_time = t;
-        let t = boundary(
-            layer,
-            problems,
-            layer.relaxation_time,
-            layer.retardation_time,
-            set,
-        )?;
-        (
-            Parameter::RelaxationTime,
-            layer.relaxation_time,
-            t,
-            "at least",
-        )
-    } else {
-        let set = |l: &mut Layer, t: f64| l.retardation_time = t;
-        let t = boundary(
-            layer,
-            problems,
-            layer.retardation_time,
-            layer.relaxation_time,
-            set,
-        )?;
-        (
-            Parameter::RetardationTime,
-            layer.retardation_time,
-            t,
-            "at most",
-        )
-    };
-    let answered = Layer {
-        relaxation_time: if by_relaxation {
-            bound
+    type Set = fn(&mut Layer, f64);
+    let (parameter, value, good, side, set): (_, _, _, _, Set) =
+        if off(layer.relaxation_time, default.relaxation_time)
+            >= off(layer.retardation_time, default.retardation_time)
+        {
+            let set: Set = |l, t| l.relaxation_time = t;
+            let (value, good) = (layer.relaxation_time, layer.retardation_time);
+            (Parameter::RelaxationTime, value, good, "at least", set)
         } else {
-            layer.relaxation_time
-        },
-        retardation_time: if by_relaxation {
-            layer.retardation_time
-        } else {
-            bound
-        },
-        ..*layer
-    };
+            let set: Set = |l, t| l.retardation_time = t;
+            let (value, good) = (layer.retardation_time, layer.relaxation_time);
+            (Parameter::RetardationTime, value, good, "at most", set)
+        };
+    let bound = boundary(layer, problems, value, good, set)?;
+    let mut answered = *layer;
+    set(&mut answered, bound);
     Some(ParameterError {
         parameter,
         value,
@@ -116,7 +85,7 @@ fn slower(layer: &Layer, problems: Problems) -> Option<ParameterError> {
              layer as a continuum would need a grid of more than {} to resolve the contact \
              at high speed, which is that many times stiffer than at rest",
             quantity(bound, "s"),
-            quantity(ratio(&answered), ""),
+            quantity(answered.retardation_time / answered.relaxation_time, ""),
             count(continuum::MAX_PIXELS as f64, "pixel", "pixels"),
         ),
     })
