@@ -28,4 +28,4 @@ pub use rolling::{solve, Rolling, RollingSolution, SolveOptions};
 pub use stop::Stop;
 
 /// Version of the model's numbers: part of every cache key, bumped whenever a result changes.
-pub const MODEL_VERSION: &str = "1.5.0";
+pub const MODEL_VERSION: &str = "1.5.1";

@@ -38,8 +38,12 @@ pub struct Turn {
 
 impl Drop for Turn {
     fn drop(&mut self) {
+        // Outside a runtime (none to free it on) the lease runs out by itself.
+        let Ok(runtime) = tokio::runtime::Handle::try_current() else {
+            return;
+        };
         if let Some((fleet, key, token)) = self.fleet.take() {
-            tokio::spawn(async move {
+            runtime.spawn(async move {
                 let script = redis::Script::new(RELEASE);
                 let released = fleet
                     .jobs

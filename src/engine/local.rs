@@ -112,9 +112,13 @@ impl LocalJobStore {
     }
 
     /// Saves the ends not saved before (a disk that was full has room again) of the jobs
-    /// memory still holds: after this they are not lost at a restart.
+    /// memory still holds: after this they are not lost at a restart. Tried after every
+    /// write that succeeds, and at every purge.
     async fn save_unsaved(&self) {
         let pending = std::mem::take(&mut *self.unsaved());
+        if pending.is_empty() {
+            return;
+        }
         for id in pending {
             let Some(record) = self.memory.get(id).await else {
                 continue;
@@ -142,9 +146,7 @@ impl JobStore for LocalJobStore {
             self.memory.remove(id).await;
             return Err(Refusal::Unwritable { why });
         }
-        if !self.unsaved().is_empty() {
-            self.save_unsaved().await;
-        }
+        self.save_unsaved().await;
         Ok(())
     }
 
@@ -168,9 +170,12 @@ impl JobStore for LocalJobStore {
                 .await;
             return;
         };
-        if self.save_end(id, kept, done, finished).await.is_err() {
-            self.memory.mark_unsaved(id, true);
-            self.unsaved().push(id);
+        match self.save_end(id, kept, done, finished).await {
+            Ok(()) => self.save_unsaved().await,
+            Err(_) => {
+                self.memory.mark_unsaved(id, true);
+                self.unsaved().push(id);
+            }
         }
     }
 
@@ -180,6 +185,7 @@ impl JobStore for LocalJobStore {
     }
 
     async fn purge_expired(&self) -> usize {
+        self.save_unsaved().await;
         let purged = self.db("forget expired jobs", |db| db.purge()).await;
         self.memory.purge_expired().await + purged.unwrap_or(0)
     }
@@ -204,6 +210,18 @@ impl JobStore for LocalJobStore {
 
     fn problem(&self) -> Option<String> {
         let failing = self.failing.lock().unwrap_or_else(|p| p.into_inner());
-        self.archive.moved().or_else(|| failing.clone())
+        let unsaved = self.unsaved().len();
+        self.archive
+            .moved()
+            .or_else(|| failing.clone())
+            .or_else(|| {
+                (unsaved > 0).then(|| {
+                    format!(
+                        "{unsaved} finished jobs could not be saved in the database of saved \
+                         analyses (the log says why): they are kept in memory until a write \
+                         succeeds"
+                    )
+                })
+            })
     }
 }

@@ -34,11 +34,13 @@ pub struct Exceeded {
 }
 
 /// Points charged to a tenant before its work, to true up after it ([`PointCounts::true_up`])
-/// if they were a guess at its iterations.
+/// if they were a guess at its iterations, or to give back if the work is refused after all.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Charge {
     pub tenant: String,
     pub points: u64,
+    /// The window they were charged in.
+    pub window: u64,
     /// Whether the points guessed at an iterative job's work (a fit's), which its time then
     /// settles; else they are the work's own measure (a point a local answer, a continuum
     /// answer's grid), the same whatever the machine.
@@ -61,14 +63,14 @@ impl PointCounts {
     }
 
     /// Charges `points` to `tenant` in the window of `now`, unless its points there would
-    /// pass `limit`.
+    /// pass `limit`; the window charged.
     pub async fn charge(
         &self,
         tenant: &str,
         points: u64,
         limit: u64,
         now: SystemTime,
-    ) -> Result<(), Exceeded> {
+    ) -> Result<u64, Exceeded> {
         let since = seconds(now);
         let window = window_of(now);
         let retry_after = Duration::from_secs(WINDOW.as_secs() - since % WINDOW.as_secs());
@@ -86,7 +88,7 @@ impl PointCounts {
             None => None,
         };
         match shared.unwrap_or_else(|| self.charge_here(tenant, window, points, limit)) {
-            Ok(()) => Ok(()),
+            Ok(()) => Ok(window),
             Err(used) => Err(Exceeded {
                 used,
                 retry_after: Some(retry_after),
@@ -102,17 +104,23 @@ impl PointCounts {
         }
         let took = i64::try_from(Cost::of_time(took)).unwrap_or(i64::MAX);
         let charged = i64::try_from(charge.points).unwrap_or(i64::MAX);
-        self.adjust(&charge.tenant, took - charged, SystemTime::now())
+        self.adjust(&charge.tenant, took - charged, charge.window)
             .await;
     }
 
+    /// Gives back `charge`: the work it was for was refused after all.
+    pub async fn refund(&self, charge: &Charge) {
+        let charged = i64::try_from(charge.points).unwrap_or(i64::MAX);
+        self.adjust(&charge.tenant, -charged, charge.window).await;
+    }
+
     /// Trues up a charge made before the work: `delta` more points (fewer, if negative) for
-    /// `tenant` in the window of `now`, whatever its limit (the work is done).
-    pub async fn adjust(&self, tenant: &str, delta: i64, now: SystemTime) {
+    /// `tenant` in the window it was charged in, `window`, whatever its limit (the work is
+    /// done); never below nought.
+    pub async fn adjust(&self, tenant: &str, delta: i64, window: u64) {
         if delta == 0 {
             return;
         }
-        let window = window_of(now);
         if let Some(fleet) = &self.fleet {
             let key = format!("thirdbody:quota:{tenant}:{window}");
             let mut pipe = redis::pipe();
@@ -126,11 +134,10 @@ impl PointCounts {
             }
         }
         let mut counts = self.local.lock().unwrap_or_else(|p| p.into_inner());
-        let count = counts.entry(tenant.to_string()).or_insert((window, 0));
-        if count.0 != window {
-            *count = (window, 0);
+        // A window gone by is not counted any more: nothing to true up there.
+        if let Some(count) = counts.get_mut(tenant).filter(|c| c.0 == window) {
+            count.1 = count.1.saturating_add_signed(delta);
         }
-        count.1 = count.1.saturating_add_signed(delta);
     }
 
     /// In this process: the points used before, if the charge is refused.
@@ -163,7 +170,9 @@ impl PointCounts {
             .incr(&key, points)
             .expire(&key, 2 * WINDOW.as_secs() as i64)
             .ignore();
-        let (used,): (u64,) = fleet.jobs.pipe(&pipe).await.ok()?;
+        // A count trued up below nought (a refund that passed a later charge) is nought.
+        let (used,): (i64,) = fleet.jobs.pipe(&pipe).await.ok()?;
+        let used = u64::try_from(used).unwrap_or(0);
         if used <= limit {
             return Some(Ok(()));
         }
@@ -184,8 +193,8 @@ mod tests {
         let counts = PointCounts::new(None);
         let at = |s: u64| std::time::UNIX_EPOCH + Duration::from_secs(s);
         // 60 000 s is the start of a window; 10 points a window.
-        assert_eq!(counts.charge("a", 6, 10, at(60_000)).await, Ok(()));
-        assert_eq!(counts.charge("a", 4, 10, at(60_010)).await, Ok(()));
+        assert_eq!(counts.charge("a", 6, 10, at(60_000)).await, Ok(1000));
+        assert_eq!(counts.charge("a", 4, 10, at(60_010)).await, Ok(1000));
         assert_eq!(
             counts.charge("a", 1, 10, at(60_015)).await,
             Err(Exceeded {
@@ -194,26 +203,36 @@ mod tests {
             })
         );
         // Another tenant counts apart; the next window starts afresh.
-        assert_eq!(counts.charge("b", 10, 10, at(60_015)).await, Ok(()));
-        assert_eq!(counts.charge("a", 10, 10, at(60_060)).await, Ok(()));
+        assert_eq!(counts.charge("b", 10, 10, at(60_015)).await, Ok(1000));
+        assert_eq!(counts.charge("a", 10, 10, at(60_060)).await, Ok(1001));
         // More than the limit at once: waiting cannot help.
         let alone = counts.charge("c", 11, 10, at(60_000)).await;
         assert_eq!(alone.unwrap_err().retry_after, None);
     }
 
-    /// A charge is trued up by what the work took: a refund makes room, work beyond the
-    /// estimate takes it (past the limit, even: the work is done).
+    /// A charge is trued up in the window it was charged in: a refund makes room, work beyond
+    /// the estimate takes it (past the limit, even: the work is done); a window gone by is
+    /// not counted any more.
     #[tokio::test]
-    async fn a_charge_is_trued_up_after_the_work() {
+    async fn a_charge_is_trued_up_in_its_window() {
         let counts = PointCounts::new(None);
         let at = |s: u64| std::time::UNIX_EPOCH + Duration::from_secs(s);
-        assert_eq!(counts.charge("a", 8, 10, at(60_000)).await, Ok(()));
-        counts.adjust("a", -6, at(60_001)).await;
-        assert_eq!(counts.charge("a", 8, 10, at(60_002)).await, Ok(()));
-        counts.adjust("a", 5, at(60_003)).await;
+        let window = counts.charge("a", 8, 10, at(60_000)).await.unwrap();
+        counts.adjust("a", -6, window).await;
+        assert_eq!(counts.charge("a", 8, 10, at(60_002)).await, Ok(window));
+        counts.adjust("a", 5, window).await;
         let over = counts.charge("a", 1, 10, at(60_004)).await.unwrap_err();
         assert_eq!(over.used, 15);
-        counts.adjust("b", -5, at(60_005)).await;
-        assert_eq!(counts.charge("b", 10, 10, at(60_006)).await, Ok(()));
+        counts.adjust("a", -100, window - 1).await;
+        assert_eq!(
+            counts
+                .charge("a", 1, 10, at(60_005))
+                .await
+                .unwrap_err()
+                .used,
+            15
+        );
+        counts.adjust("b", -5, window).await;
+        assert_eq!(counts.charge("b", 10, 10, at(60_006)).await, Ok(window));
     }
 }

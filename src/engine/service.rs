@@ -211,7 +211,8 @@ impl Engine {
 
     /// Charges `points` of work to `tenant`, unless its points this minute would pass
     /// `limit` (counted fleet-wide in a fleet).
-    pub async fn charge(&self, tenant: &str, points: u64, limit: u64) -> Result<(), Exceeded> {
+    /// The window charged, for a later true-up or refund ([`Charge`]).
+    pub async fn charge(&self, tenant: &str, points: u64, limit: u64) -> Result<u64, Exceeded> {
         self.points
             .charge(tenant, points, limit, std::time::SystemTime::now())
             .await
@@ -326,18 +327,29 @@ impl Engine {
     ) -> Result<JobRecord, EngineError> {
         self.admit()?;
         let points = self.points.clone();
-        let on_end = charged.filter(|c| c.guessed).map(|charge| -> OnEnd {
-            Box::new(move |took| {
-                tokio::spawn(async move { points.true_up(&charge, took).await });
-            })
-        });
+        let on_end = charged
+            .clone()
+            .filter(|c| c.guessed)
+            .map(|charge| -> OnEnd {
+                Box::new(move |took| {
+                    tokio::spawn(async move { points.true_up(&charge, took).await });
+                })
+            });
         let record = self.jobs.submit(keyed, owner, on_end).await;
+        if let (Err(_), Some(charge)) = (&record, &charged) {
+            self.points.refund(charge).await;
+        }
         record.map_err(|e| self.refused(e))
     }
 
     /// Trues up `charge` by what its work really `took` on a solver thread.
     pub async fn true_up(&self, charge: &Charge, took: Duration) {
         self.points.true_up(charge, took).await;
+    }
+
+    /// Gives back `charge`: its work was refused after all (no thread, no room).
+    pub async fn refund(&self, charge: &Charge) {
+        self.points.refund(charge).await;
     }
 
     /// Starts `loops` workers on the fleet's stream (none without a fleet). With

@@ -482,6 +482,21 @@ pub struct Keyed {
 /// in a hash (hexadecimal) or a tenant's name.
 const SCOPE: char = '@';
 
+/// The cache key of the input whose hash is `input_hash` among `tenant`'s answers (none:
+/// among those of callers without an API key). `None` if `input_hash` is no input's hash (64
+/// lowercase hexadecimal digits): a key is never taken from a client whole, or it could name
+/// another tenant's.
+pub fn scoped_key(input_hash: &str, tenant: Option<&str>) -> Option<String> {
+    let hex = |b: u8| b.is_ascii_digit() || (b'a'..=b'f').contains(&b);
+    if input_hash.len() != 64 || !input_hash.bytes().all(hex) {
+        return None;
+    }
+    Some(match tenant {
+        Some(tenant) => format!("{input_hash}{SCOPE}{tenant}"),
+        None => input_hash.to_string(),
+    })
+}
+
 /// The input's hash of a cache key, without its tenant ([`Keyed::scoped`]): what a client
 /// reads as `input_hash` and `X-Input-Hash`.
 pub fn input_hash_of(key: &str) -> &str {
@@ -513,7 +528,7 @@ impl Keyed {
     /// it is cached tells that somebody asked for it: a tenant learns from the cache (its
     /// `X-Cache`, its input's link) only what it asked itself.
     pub fn scoped(self, tenant: Option<&str>) -> Keyed {
-        let scoped = tenant.map(|t| format!("{}{SCOPE}{t}", self.meta.input_hash));
+        let scoped = tenant.and_then(|t| scoped_key(&self.meta.input_hash, Some(t)));
         Keyed { scoped, ..self }
     }
 

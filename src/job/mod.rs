@@ -30,7 +30,9 @@ pub use error::{echoed, FieldError, JobError};
 pub use figure::FigureJob;
 pub use fit::FitJob;
 pub use input::Quantity;
-pub use kind::{input_hash_of, tenant_of, Cost, Job, Keyed, Kind, Unfinished, Validated, Work};
+pub use kind::{
+    input_hash_of, scoped_key, tenant_of, Cost, Job, Keyed, Kind, Unfinished, Validated, Work,
+};
 pub use meta::{
     InputWarning, Meta, Reference, References, Software, REFERENCES, ROLLING_REFERENCES, SOFTWARE,
 };

@@ -359,6 +359,11 @@ async fn a_tenant_learns_nothing_of_what_another_asked() {
     assert_eq!(read(Some(LAB_A)).await, StatusCode::OK);
     assert_eq!(read(Some(LAB_B)).await, StatusCode::NOT_FOUND);
     assert_eq!(read(None).await, StatusCode::NOT_FOUND);
+    // Nor by naming the tenant in the link: a link is an input's hash, nothing else.
+    for forged in [format!("{link}@lab-a"), format!("{link}%40lab-a")] {
+        let response = send(&app, Method::GET, &forged, None, None).await;
+        assert_eq!(response.status(), StatusCode::NOT_FOUND, "{forged}");
+    }
     assert_eq!(cache(&solve_with(&app, LAB_B).await), "miss");
     assert_eq!(cache(&solve_with(&app, LAB_B).await), "hit");
     assert_eq!(read(Some(LAB_B)).await, StatusCode::OK);

@@ -314,6 +314,7 @@ pub fn expected_evaluations(problem: &Problem) -> (u64, u64) {
 pub fn fit<E>(
     problem: &Problem,
     check: &(dyn Fn() -> Result<(), E> + Sync),
+    stop: Stop,
 ) -> Result<(Fitted, Option<E>), FitError<E>> {
     let ln = |f: fn(&Bounds) -> f64| {
         DVector::from_iterator(
@@ -322,7 +323,11 @@ pub fn fit<E>(
         )
     };
     let (start, lower, upper) = (ln(|b| b.start), ln(|b| b.min), ln(|b| b.max));
-    let mut residuals = Residuals { problem, check };
+    let mut residuals = Residuals {
+        problem,
+        check,
+        stop,
+    };
     // Screen the start and the corners of the box's middle half by their cost alone.
     let mut candidates = vec![start.clone()];
     for corner in 0..1usize << start.len() {
@@ -366,8 +371,7 @@ pub fn fit<E>(
         }
     }
     let Some(best) = best else {
-        let asked = || check().is_err();
-        let failure = problem.failure_at_start(Stop::when(&asked));
+        let failure = problem.failure_at_start(stop);
         return Err(match check() {
             Err(e) if failure == ModelError::Stopped => FitError::Stopped(e),
             _ => FitError::Model(failure),
@@ -406,6 +410,9 @@ pub fn fit<E>(
 struct Residuals<'a, E> {
     problem: &'a Problem,
     check: &'a (dyn Fn() -> Result<(), E> + Sync),
+    /// Asked inside each solve (a continuum answer takes up to half a minute); `check`,
+    /// which may count its calls, is asked between them.
+    stop: Stop<'a>,
 }
 
 impl<E> Residuals<'_, E> {
@@ -422,11 +429,10 @@ impl<E> Residuals<'_, E> {
             return Ok(None);
         };
         let mut cost = 0.0;
-        let asked = || (self.check)().is_err();
         for d in &self.problem.data {
             (self.check)()?;
             let law = self.problem.parameterization.law;
-            let Ok(y) = d.point.value(&layer, law, Stop::when(&asked)) else {
+            let Ok(y) = d.point.value(&layer, law, self.stop) else {
                 // A solve the check stopped is the check's error, not a point outside.
                 (self.check)()?;
                 return Ok(None);
@@ -447,14 +453,10 @@ impl<E> LeastSquares for Residuals<'_, E> {
         let (n, m) = (self.problem.data.len(), x.len());
         let mut residuals = DVector::zeros(n);
         let mut jacobian = DMatrix::zeros(n, m);
-        let asked = || (self.check)().is_err();
         for (i, d) in self.problem.data.iter().enumerate() {
             (self.check)()?;
             let law = self.problem.parameterization.law;
-            let Ok((y, s)) = d
-                .point
-                .value_and_sensitivity(&layer, law, Stop::when(&asked))
-            else {
+            let Ok((y, s)) = d.point.value_and_sensitivity(&layer, law, self.stop) else {
                 // A solve the check stopped is the check's error, not a point outside.
                 (self.check)()?;
                 return Ok(None);
@@ -575,7 +577,7 @@ mod tests {
             calls.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
             Ok::<(), ()>(())
         };
-        let (whole, stop) = fit(&problem, &counting).unwrap();
+        let (whole, stop) = fit(&problem, &counting, Stop::NEVER).unwrap();
         assert!(stop.is_none() && whole.finished == whole.starts && whole.starts >= 2);
         // Stopped at its last evaluation: every run but the last finished.
         let last = calls.load(std::sync::atomic::Ordering::Relaxed);
@@ -588,13 +590,13 @@ mod tests {
                 Ok(())
             }
         };
-        let (partial, stop) = fit(&problem, &stopping).unwrap();
+        let (partial, stop) = fit(&problem, &stopping, Stop::NEVER).unwrap();
         assert_eq!(stop, Some("stopped"));
         assert_eq!(partial.finished, whole.starts - 1);
         assert!(partial.chi_squared.is_finite() && partial.values.len() == 2);
         // Stopped before any run finished, it has nothing to answer with.
         assert!(matches!(
-            fit(&problem, &|| Err::<(), _>("at once")),
+            fit(&problem, &|| Err::<(), _>("at once"), Stop::NEVER),
             Err(FitError::Stopped("at once"))
         ));
     }
@@ -603,7 +605,7 @@ mod tests {
     fn noiseless_data_give_back_the_layer_they_came_from() {
         let truth = Layer::default();
         let problem = two_times(&truth);
-        let (fitted, _) = fit(&problem, &|| Ok::<(), ()>(())).unwrap();
+        let (fitted, _) = fit(&problem, &|| Ok::<(), ()>(()), Stop::NEVER).unwrap();
         assert!(
             (fitted.values[0] / 0.1 - 1.0).abs() < 1e-6,
             "{:?}",

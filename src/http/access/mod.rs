@@ -265,13 +265,16 @@ pub async fn charge_all(
     if points == 0 {
         return Ok(None);
     }
-    let Err(Exceeded { used, retry_after }) = state.engine().charge(&tenant, points, limit).await
-    else {
-        return Ok(Some(Charge {
-            tenant,
-            points,
-            guessed,
-        }));
+    let (used, retry_after) = match state.engine().charge(&tenant, points, limit).await {
+        Ok(window) => {
+            return Ok(Some(Charge {
+                tenant,
+                points,
+                window,
+                guessed,
+            }))
+        }
+        Err(Exceeded { used, retry_after }) => (used, retry_after),
     };
     let whose = caller.describe();
     let detail = match retry_after {

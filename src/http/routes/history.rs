@@ -30,7 +30,7 @@ use crate::http::responses::{
 };
 use crate::http::AppState;
 use crate::job::registry::KindName;
-use crate::job::{FieldError, JobError};
+use crate::job::{scoped_key, FieldError, JobError};
 
 /// The header naming who submits and lists jobs.
 pub const OWNER_HEADER: &str = "thirdbody-owner";
@@ -342,24 +342,29 @@ pub async fn by_input(
         }
         None => caller.tenant(),
     };
-    let key = match tenant {
-        Some(tenant) => format!("{input_hash}@{tenant}"),
-        None => input_hash.clone(),
+    let missing = || {
+        let shown: String = input_hash.chars().take(64).collect();
+        ApiError::not_found(format!(
+            "no answer to the input {shown}: it is not cached, and no job on it succeeded \
+             within the history's retention"
+        ))
     };
+    let key = scoped_key(&input_hash, tenant).ok_or_else(missing)?;
     let engine = state.engine();
     if let Some(solved) = engine.cached(&key).await {
         return answering.respond(&solved, None);
     }
-    let record = engine
-        .with_input(&key)
-        .await
-        .map_err(unreadable)?
-        .filter(|record| caller.may_read(record.owner.as_ref()));
+    let mut record = engine.with_input(&key).await.map_err(unreadable)?;
+    if record.is_none() && tenant.is_some() {
+        // A tenant's job saved before answers were kept by tenant: under the bare hash.
+        record = engine.with_input(&input_hash).await.map_err(unreadable)?;
+    }
+    let record = record.filter(|r| match tenant {
+        Some(name) => r.owner == Some(Owner::of_tenant(name)),
+        None => caller.may_read(r.owner.as_ref()),
+    });
     match record.as_ref().and_then(|r| r.state.result()) {
         Some(result) => answering.respond_result(result).await,
-        None => Err(ApiError::not_found(format!(
-            "no answer to the input {input_hash}: it is not cached, and no job on it \
-             succeeded within the history's retention"
-        ))),
+        None => Err(missing()),
     }
 }

@@ -351,17 +351,35 @@ impl SolveRequest {
             Ok::<_, ApiError>(keyed)
         };
         let started = std::time::Instant::now();
-        let (solved, cache) = state.engine().answer(text, validate).await?;
-        // The estimate charged, trued up: what the solve took, nothing for an answer another
-        // request's solve gave.
+        let answered = state.engine().answer(text, validate).await;
         let charged = charged.into_inner().unwrap_or_else(|p| p.into_inner());
-        if let Some(charge) = charged {
-            let took = match cache {
-                CacheStatus::Miss => started.elapsed(),
-                CacheStatus::Hit => std::time::Duration::ZERO,
-            };
-            state.engine().true_up(&charge, took).await;
-        }
+        // What was charged is given back if the solve was refused before any work (no
+        // thread, no room: 429, 503), and a guess is trued up by what the solve took
+        // (nothing, for another request's solve).
+        let refused_before_work = |e: &ApiError| {
+            [
+                StatusCode::TOO_MANY_REQUESTS,
+                StatusCode::SERVICE_UNAVAILABLE,
+            ]
+            .contains(&e.status())
+        };
+        let (solved, cache) = match (answered, charged) {
+            (Err(refused), Some(charge)) if refused_before_work(&refused) => {
+                state.engine().refund(&charge).await;
+                return Err(refused);
+            }
+            (answered, charge) => {
+                let (solved, cache) = answered?;
+                if let Some(charge) = charge {
+                    let took = match cache {
+                        CacheStatus::Miss => started.elapsed(),
+                        CacheStatus::Hit => std::time::Duration::ZERO,
+                    };
+                    state.engine().true_up(&charge, took).await;
+                }
+                (solved, cache)
+            }
+        };
         self.answering.respond(&solved, Some(cache))
     }
 }

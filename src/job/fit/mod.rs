@@ -13,6 +13,7 @@ mod input;
 mod output;
 
 use std::collections::BTreeMap;
+use std::time::{Duration, Instant};
 
 use nalgebra::DVector;
 use serde_json::{json, Value};
@@ -34,7 +35,10 @@ use crate::model::continuum;
 use crate::model::fit::stats;
 use crate::model::fit::{self, Datum, FitError, Fitted, Law, Point, Problem, Setting};
 use crate::model::three_body::{LayerContact, ThreeBody};
-use crate::model::{Layer, Rolling};
+use crate::model::{Layer, Rolling, Stop};
+
+/// How long a stopped fit may go on drawing its curves.
+const DRAWING_GRACE: Duration = Duration::from_secs(2);
 
 /// What one solve of `point` on `layer` costs under the fit's `law`: a grid's answer for a
 /// rolling particle on the continuum, a system's continuum curves, a point otherwise (a
@@ -187,16 +191,24 @@ impl Kind for FitJob {
             control.advance(1);
             Ok(())
         };
-        let (fitted, stop) = fit::fit(&self.problem, &check).map_err(|e| self.refused(e))?;
+        let asked = || control.must_stop();
+        let (fitted, stop) =
+            fit::fit(&self.problem, &check, Stop::when(&asked)).map_err(|e| self.refused(e))?;
         let layer = self.problem.parameterization.layer(&fitted.values);
         // A stopped fit answers with the minimisations it finished; its curves (a few dozen
-        // solves a series) are still drawn, under a control of their own that is not stopped.
-        let drawing = Control::new(None, 1);
+        // solves a series) are still drawn, under a control of their own with a short grace
+        // of its own: on the continuum they may take minutes, and a job past its deadline
+        // or cancelled must end. The curves not drawn by then are left out.
+        let drawing = Control::new(Some(Instant::now() + DRAWING_GRACE), 1);
         let curves_control = if stop.is_none() { control } else { &drawing };
         let mut curves = Vec::new();
         for (index, points) in self.series_data().enumerate() {
             let law = self.problem.parameterization.law;
-            curves.push(curve(index, points, &layer, law, curves_control)?);
+            match curve(index, points, &layer, law, curves_control) {
+                Ok(drawn) => curves.push(drawn),
+                Err(JobError::DeadlineExceeded) if stop.is_some() => break,
+                Err(e) => return Err(e),
+            }
         }
         Ok(FitOutput {
             parameter_names: self.names(),
