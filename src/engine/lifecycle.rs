@@ -509,17 +509,18 @@ impl Lifecycle {
     /// Waits (after `begin_drain`) for the jobs to finish until `end`; what is still running
     /// then is interrupted ([`Lifecycle::interrupt_unfinished_jobs`]) and given a second to stop.
     /// Returns whether every job finished in time.
+    /// Whatever the store could not save before is saved then, if it now can.
     pub(super) async fn finish_jobs(&self, end: tokio::time::Instant) -> bool {
-        if tokio::time::timeout_at(end, self.jobs_finished())
+        let finished = tokio::time::timeout_at(end, self.jobs_finished())
             .await
-            .is_ok()
-        {
-            return true;
+            .is_ok();
+        if !finished {
+            self.interrupt_unfinished_jobs();
+            // They stop at their next check, microseconds to milliseconds away.
+            let _ = tokio::time::timeout(Duration::from_secs(1), self.jobs_finished()).await;
         }
-        self.interrupt_unfinished_jobs();
-        // They stop at their next check, microseconds to milliseconds away.
-        let _ = tokio::time::timeout(Duration::from_secs(1), self.jobs_finished()).await;
-        false
+        self.jobs.settle().await;
+        finished
     }
 
     /// Stops every job not finished yet (the drain ran out of time): they end

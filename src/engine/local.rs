@@ -208,6 +208,11 @@ impl JobStore for LocalJobStore {
         self.archive.durable()
     }
 
+    /// The ends not saved, saved now if the disk has room again.
+    async fn settle(&self) {
+        self.save_unsaved().await;
+    }
+
     fn problem(&self) -> Option<String> {
         let failing = self.failing.lock().unwrap_or_else(|p| p.into_inner());
         let unsaved = self.unsaved().len();

@@ -392,6 +392,9 @@ pub trait JobStore: Send + Sync {
     fn problem(&self) -> Option<String> {
         None
     }
+
+    /// Saves for good what it could not save before (the process is about to end).
+    async fn settle(&self) {}
 }
 
 /// Where a job's result will be kept.
