@@ -277,10 +277,14 @@ pub async fn charge_all(
         Err(Exceeded { used, retry_after }) => (used, retry_after),
     };
     let whose = caller.describe();
+    let flag = match caller.owner(None) {
+        Some(_) => "--quota-points",
+        None => "--anonymous-quota-points",
+    };
     let detail = match retry_after {
         None => format!(
             "this asks for {points} points, more than the {limit} a minute {whose} may ask \
-             for (--quota-points): split it"
+             for ({flag}): split it"
         ),
         Some(wait) => format!(
             "{whose} asked for {used} points this minute, of the {limit} it may; this asks for \

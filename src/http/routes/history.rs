@@ -316,7 +316,15 @@ pub struct LinkQuery {
     operation_id = "get_result_by_input",
     tag = "jobs",
     params(InputHash, FormatQuery, LinkQuery),
-    responses(ReadBack, NotModified, NotFound, NotAcceptable, HistoryUnreadable)
+    responses(
+        ReadBack,
+        NotModified,
+        NotFound,
+        InvalidParameters,
+        NotAnAdmin,
+        NotAcceptable,
+        HistoryUnreadable
+    )
 )]
 pub async fn by_input(
     State(state): State<AppState>,
