@@ -1,7 +1,7 @@
-//! Answers as JSON text: serde_json's compact form, or [`Rows`] for people, with numbers
-//! written through a memo ([`Numbers`]) and a non-finite number refused as it is met.
+//! Answers as JSON text: serde_json's compact form, or [`Rows`] for people, with a
+//! non-finite number refused as it is met.
 
-use std::cell::RefCell;
+use std::cell::Cell;
 use std::io::{self, Write};
 use std::sync::LazyLock;
 
@@ -9,7 +9,6 @@ use memchr::memmem;
 use serde::Serialize;
 use serde_json::ser::Formatter;
 
-use super::compact::{self, Style, Writer};
 use super::RenderError;
 
 /// `value` as JSON: compact, or with `pretty` one field or list element a line ([`Rows`]).
@@ -19,272 +18,66 @@ pub(super) fn write<T: Serialize + ?Sized>(
     value: &T,
     pretty: bool,
 ) -> Result<Vec<u8>, RenderError> {
-    let written = SCRATCH.with(|cell| match cell.try_borrow_mut() {
-        Ok(mut scratch) => scratch.write(value, pretty),
-        // An answer written while another is (one holding the other).
-        Err(_) => Scratch::new().write(value, pretty),
-    });
+    let written = match pretty {
+        true => {
+            let mut json = Vec::with_capacity(PRETTY_ROOM);
+            value
+                .serialize(&mut serde_json::Serializer::with_formatter(
+                    &mut json,
+                    Rows::default(),
+                ))
+                .map(|()| json)
+        }
+        false => compact(value),
+    };
     written.map_err(|e| match e.is_io() {
-        // The writer is a vector, which never fails: the error is the style's (or the
-        // pretty formatter's) refusal of a null.
+        // The writer is a vector, which never fails: the error is the formatter's refusal
+        // of a null.
         true => RenderError::non_finite(),
         false => RenderError(format!("cannot write the result: {e}")),
     })
 }
 
 thread_local! {
-    /// What each thread keeps between the answers it writes.
-    pub(super) static SCRATCH: RefCell<Scratch> = const { RefCell::new(Scratch::new()) };
+    /// The size of the last compact answer this thread wrote.
+    static LAST: Cell<usize> = const { Cell::new(0) };
 }
 
 /// The room a pretty answer (for a terminal, written once) starts with.
 const PRETTY_ROOM: usize = 64 << 10;
 
-/// What a thread keeps between the answers it writes: the size of its last answer and the
-/// memos of numbers and field names. Written into a fresh vector, a 7 kB rolling answer
-/// grew through seven reallocations and their copies (BENCHMARKS.md, issue 12), and written
-/// into a buffer kept here, it was copied out once more; the next answer is most often of
-/// the same kind and size, so it is written into a vector of that room. The memos are kept
-/// too: made anew for each answer, the numbers' 10 kB cost more than they saved.
-pub(super) struct Scratch {
-    last: usize,
-    numbers: Numbers,
-    fields: Fields,
+/// `value` as compact JSON, in a vector of the room of the thread's last answer: written
+/// into a fresh vector, a 7 kB rolling answer grew through seven reallocations and their
+/// copies (BENCHMARKS.md, issue 12), and the next answer is most often of the same kind and
+/// size.
+fn compact<T: Serialize + ?Sized>(value: &T) -> serde_json::Result<Vec<u8>> {
+    let last = LAST.get();
+    let mut json = Vec::with_capacity(last + last / 16 + 64);
+    value.serialize(&mut serde_json::Serializer::with_formatter(
+        &mut json, Strict,
+    ))?;
+    LAST.set(json.len());
+    // A small answer after a large one does not keep the large one's room.
+    if json.capacity() > json.len() + json.len() / 8 + 64 {
+        json.shrink_to_fit();
+    }
+    Ok(json)
 }
 
-impl Scratch {
-    const fn new() -> Scratch {
-        Scratch {
-            last: 0,
-            numbers: Numbers::new(),
-            fields: Fields::new(),
-        }
+/// serde_json's compact text, with `null` refused (written or embedded).
+struct Strict;
+
+impl Formatter for Strict {
+    fn write_null<W: ?Sized + Write>(&mut self, _: &mut W) -> io::Result<()> {
+        refuse_null()
     }
 
-    /// `value` as JSON, in a vector of its size or little more (compact) or of room to
-    /// spare (pretty).
-    fn write<T: Serialize + ?Sized>(
+    fn write_raw_fragment<W: ?Sized + Write>(
         &mut self,
-        value: &T,
-        pretty: bool,
-    ) -> serde_json::Result<Vec<u8>> {
-        let Scratch {
-            last,
-            numbers,
-            fields,
-        } = self;
-        if pretty {
-            let mut json = Vec::with_capacity(PRETTY_ROOM);
-            value.serialize(&mut serde_json::Serializer::with_formatter(
-                &mut json,
-                Rows::new(numbers),
-            ))?;
-            return Ok(json);
-        }
-        let mut json = Vec::with_capacity(*last + *last / 16 + 64);
-        value.serialize(Writer::new(&mut json, &mut Answer { numbers, fields }))?;
-        *last = json.len();
-        // A small answer after a large one does not keep the large one's room.
-        if json.capacity() > json.len() + json.len() / 8 + 64 {
-            json.shrink_to_fit();
-        }
-        Ok(json)
-    }
-}
-
-/// An answer's compact text: serde_json's, its numbers through [`Numbers`], `null` refused,
-/// embedded JSON searched for `null` as it is copied.
-struct Answer<'a> {
-    numbers: &'a mut Numbers,
-    fields: &'a mut Fields,
-}
-
-impl Style for Answer<'_> {
-    const SORTED: bool = false;
-
-    #[inline]
-    fn number(&mut self, out: &mut Vec<u8>, x: f64) {
-        self.numbers.push(out, x);
-    }
-
-    fn float(&mut self, out: &mut Vec<u8>, x: f32) {
-        out.extend_from_slice(zmij::Buffer::new().format_finite(x).as_bytes());
-    }
-
-    fn null(&mut self, _: &mut Vec<u8>) -> Result<(), compact::Error> {
-        refuse_null().map_err(compact::Error::io)
-    }
-
-    fn raw(&mut self, json: &[u8]) -> Result<(), compact::Error> {
-        match has_null(json) {
-            true => self.null(&mut Vec::new()),
-            false => Ok(()),
-        }
-    }
-
-    #[inline]
-    fn field(&mut self, out: &mut Vec<u8>, key: &'static str) {
-        self.fields.push(out, key);
-    }
-}
-
-/// Places in the memo of [`Fields`] (a power of two): a rolling answer has about 60 field
-/// names.
-const FIELD_SLOTS: usize = 512;
-
-/// The longest `"name":` [`Fields`] keeps.
-const FIELD_TEXT: usize = 32;
-
-/// The names of answers' fields as written, `"name":`, copied rather than checked for
-/// characters to escape again: a rolling answer writes 180 of them (a third of its
-/// rendering time went to them, BENCHMARKS.md, issue 25). A field's name is a `&'static
-/// str`, so its address and length name its text for good. Direct-mapped by the address.
-pub(super) struct Fields {
-    slots: [Field; FIELD_SLOTS],
-}
-
-/// A field name's address and length (0 and 0: an empty place) and its text as written.
-#[derive(Clone, Copy)]
-struct Field {
-    name: (usize, usize),
-    len: u8,
-    text: [u8; FIELD_TEXT],
-}
-
-impl Fields {
-    const fn new() -> Fields {
-        const EMPTY: Field = Field {
-            name: (0, 0),
-            len: 0,
-            text: [0; FIELD_TEXT],
-        };
-        Fields {
-            slots: [EMPTY; FIELD_SLOTS],
-        }
-    }
-
-    /// Writes `"name":`.
-    #[inline]
-    fn push(&mut self, out: &mut Vec<u8>, name: &'static str) {
-        let address = name.as_ptr() as usize;
-        let hash = (address as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15);
-        let slot = &mut self.slots[(hash >> (64 - FIELD_SLOTS.trailing_zeros())) as usize];
-        match slot.name == (address, name.len()) {
-            true => push_prefix(out, &slot.text, slot.len),
-            false => slot.keep(out, name),
-        }
-    }
-}
-
-impl Field {
-    /// Writes `"name":` and keeps it here, unless it is longer than a place holds (such a
-    /// name is written each time). Out of line: the writing of a name already kept is the
-    /// loop of every answer.
-    #[cold]
-    #[inline(never)]
-    fn keep(&mut self, out: &mut Vec<u8>, name: &'static str) {
-        let from = out.len();
-        compact::write_field(out, name);
-        let text = &out[from..];
-        if text.len() <= FIELD_TEXT {
-            self.text[..text.len()].copy_from_slice(text);
-            self.len = text.len() as u8;
-            self.name = (name.as_ptr() as usize, name.len());
-        }
-    }
-}
-
-/// Pushes the first `len` bytes of `text`: the whole array copied (a copy of a known size,
-/// without a call to `memcpy`), then the rest cut off again.
-#[inline]
-fn push_prefix<const N: usize>(out: &mut Vec<u8>, text: &[u8; N], len: u8) {
-    let end = out.len() + usize::from(len);
-    out.extend_from_slice(text);
-    out.truncate(end);
-}
-
-/// Places in the memo of [`Numbers`] (a power of two): enough that a rolling answer's
-/// boundary finds the first half's numbers still there when it writes the second half
-/// (with 64 places, fewer than half of them were).
-const SLOTS: usize = 256;
-
-/// The numbers of answers, each written as serde_json writes it (the shortest text that
-/// reads back as the same double, from `zmij`), but a magnitude met lately copied from a
-/// table of texts rather than formatted again: a rolling answer's boundary is symmetric in
-/// y, so half its 123 numbers repeat the other half's, and a sweep repeats its axes' values
-/// down its points. The table is direct-mapped by a hash of the magnitude's bits.
-pub(super) struct Numbers {
-    slots: [Slot; SLOTS],
-}
-
-/// A magnitude and its text, after a minus sign that a negative number's copy starts from.
-#[derive(Clone, Copy)]
-struct Slot {
-    /// The magnitude's bits, inverted: a magnitude's sign bit is clear, so its inverted bits
-    /// are never those of an empty place (all zero).
-    inverted: u64,
-    /// The text is `text[1..=len]`.
-    len: u8,
-    text: [u8; 25],
-}
-
-impl Numbers {
-    const fn new() -> Numbers {
-        const EMPTY: Slot = Slot {
-            inverted: 0,
-            len: 0,
-            text: [0; 25],
-        };
-        Numbers {
-            slots: [EMPTY; SLOTS],
-        }
-    }
-
-    /// Pushes the text of `x`, finite ([`Numbers::text`]).
-    #[inline]
-    fn push(&mut self, out: &mut Vec<u8>, x: f64) {
-        let negative = x.is_sign_negative();
-        let slot = self.slot(x);
-        match negative {
-            true => push_prefix(out, &slot.text, slot.len + 1),
-            false => {
-                let text: &[u8; 24] = slot.text[1..].try_into().expect("24 bytes");
-                push_prefix(out, text, slot.len)
-            }
-        }
-    }
-
-    /// The text of `x`, finite (serde_json sends non-finite numbers to `write_null`).
-    fn text(&mut self, x: f64) -> &[u8] {
-        let start = usize::from(!x.is_sign_negative());
-        let slot = self.slot(x);
-        &slot.text[start..=usize::from(slot.len)]
-    }
-
-    /// The place of `|x|`, its text written there if it was not.
-    #[inline]
-    fn slot(&mut self, x: f64) -> &Slot {
-        let magnitude = x.abs();
-        let bits = magnitude.to_bits();
-        let place = bits.wrapping_mul(0x9E37_79B9_7F4A_7C15) >> (64 - SLOTS.trailing_zeros());
-        let slot = &mut self.slots[place as usize];
-        if slot.inverted != !bits {
-            slot.keep(magnitude);
-        }
-        slot
-    }
-}
-
-impl Slot {
-    /// Keeps `magnitude` and its text here. Out of line, as [`Field::keep`].
-    #[inline(never)]
-    fn keep(&mut self, magnitude: f64) {
-        let mut shortest = zmij::Buffer::new();
-        let text = shortest.format_finite(magnitude).as_bytes();
-        self.text[0] = b'-';
-        self.text[1..=text.len()].copy_from_slice(text);
-        self.len = text.len() as u8;
-        self.inverted = !magnitude.to_bits();
+        w: &mut W,
+        fragment: &str,
+    ) -> io::Result<()> {
+        write_raw(w, fragment)
     }
 }
 
@@ -337,7 +130,8 @@ fn has_null(json: &[u8]) -> bool {
 /// JSON for people: objects indented a field a line, as `serde_json`'s pretty form, but each
 /// element of a list on one line of its own. A sweep then reads a point a line (a table, as
 /// in its CSV) rather than twenty lines a point, and is written in a quarter less time.
-struct Rows<'a> {
+#[derive(Default)]
+struct Rows {
     /// Indentation of the innermost indented container.
     level: usize,
     /// Containers opened inside a one-line list element, still open (0: indenting).
@@ -346,20 +140,9 @@ struct Rows<'a> {
     lists: Vec<bool>,
     /// Whether the innermost indented container has a value yet.
     has_value: bool,
-    numbers: &'a mut Numbers,
 }
 
-impl<'a> Rows<'a> {
-    fn new(numbers: &'a mut Numbers) -> Rows<'a> {
-        Rows {
-            level: 0,
-            inline: 0,
-            lists: Vec::new(),
-            has_value: false,
-            numbers,
-        }
-    }
-
+impl Rows {
     fn open<W: ?Sized + Write>(&mut self, w: &mut W, list: bool) -> io::Result<()> {
         if self.inline > 0 || self.lists.last() == Some(&true) {
             self.inline += 1;
@@ -411,11 +194,7 @@ impl<'a> Rows<'a> {
     }
 }
 
-impl Formatter for Rows<'_> {
-    fn write_f64<W: ?Sized + Write>(&mut self, w: &mut W, value: f64) -> io::Result<()> {
-        w.write_all(self.numbers.text(value))
-    }
-
+impl Formatter for Rows {
     fn write_null<W: ?Sized + Write>(&mut self, _: &mut W) -> io::Result<()> {
         refuse_null()
     }
@@ -468,7 +247,7 @@ impl Formatter for Rows<'_> {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use std::collections::BTreeMap;
 
     use proptest::prelude::*;
@@ -476,7 +255,57 @@ mod tests {
     use serde_json::Value;
 
     use super::*;
-    use crate::render::compact::tests::{json, Flat, Shapes, Tagged};
+
+    /// An internally tagged enum, as a layer's model is.
+    #[derive(Serialize)]
+    #[serde(tag = "model", rename_all = "snake_case")]
+    pub(crate) enum Tagged {
+        Local {
+            thickness: f64,
+            #[serde(skip_serializing_if = "Option::is_none")]
+            spare: Option<f64>,
+        },
+        Continuum,
+    }
+
+    /// Every form of an externally tagged enum's variants.
+    #[derive(Serialize)]
+    pub(crate) enum Shapes {
+        Unit,
+        Newtype(Option<u8>),
+        Tuple(i32, f32),
+        Struct { z: char, a: Vec<u8> },
+    }
+
+    /// Fields to flatten into another struct, one of them skipped when absent.
+    #[derive(Serialize)]
+    pub(crate) struct Flat {
+        pub(crate) zeta: u8,
+        #[serde(skip_serializing_if = "Option::is_none")]
+        pub(crate) skipped: Option<u8>,
+    }
+
+    /// Any JSON: nulls among members and in lists, keys needing escapes, every kind of
+    /// number.
+    pub(crate) fn json() -> impl Strategy<Value = Value> {
+        let leaf = prop_oneof![
+            Just(Value::Null),
+            any::<bool>().prop_map(Value::from),
+            any::<i64>().prop_map(Value::from),
+            any::<u64>().prop_map(Value::from),
+            any::<f64>().prop_map(Value::from),
+            "(?s).{0,40}".prop_map(Value::from),
+            prop::sample::select(vec!["\"", "\\", "\u{0}", "\u{1f}", "\u{7f}", "\n\t", "é €"])
+                .prop_map(Value::from),
+        ];
+        leaf.prop_recursive(4, 48, 6, |inner| {
+            prop_oneof![
+                prop::collection::vec(inner.clone(), 0..6).prop_map(Value::Array),
+                prop::collection::btree_map("[a-c_\"é]{0,3}", inner, 0..6)
+                    .prop_map(|map| Value::Object(map.into_iter().collect())),
+            ]
+        })
+    }
 
     /// Numbers drawn so that many repeat, in either sign, among every kind of double.
     fn numbers() -> impl Strategy<Value = Vec<f64>> {
@@ -568,7 +397,7 @@ mod tests {
         bytes: &'static [u8],
         input: Box<RawValue>,
         pair: (i64, bool),
-        /// Names to escape, one longer than [`Fields`] keeps.
+        /// Names to escape, one of them long.
         #[serde(rename = "tab\tname")]
         tab: u8,
         #[serde(rename = "a \"quoted\" name longer than 32 bytes")]
@@ -614,7 +443,7 @@ mod tests {
         assert!(compact.contains(r#""input":{"b": [1, 2.5e-9], "a": "x"},"#));
         assert!(compact.contains(r#""by_some":{"1":2},"#));
         assert!(compact.ends_with(r#""tab\tname":1,"a \"quoted\" name longer than 32 bytes":2}"#));
-        // A second time, its names from the memo.
+        // A second time, into the room the first left.
         assert_eq!(write(&typed, false).unwrap(), compact.as_bytes());
         // Rows lays out the same text.
         let pretty = String::from_utf8(write(&typed, true).unwrap()).unwrap();

@@ -3,10 +3,9 @@
 //! and the command line choose a [`Format`] ([`negotiate`] for HTTP) and render an
 //! [`Answer`] into bytes.
 
-pub(crate) mod compact;
 pub mod fields;
 pub mod fixed;
-mod json;
+pub(crate) mod json;
 mod negotiate;
 mod number;
 pub mod svg;
