@@ -36,7 +36,9 @@ ENV THIRDBODY_BIND=0.0.0.0:8080 \
     THIRDBODY_SHUTDOWN_TIMEOUT=25s \
     THIRDBODY_DRAIN_DELAY=2s
 EXPOSE 8080
-# Alive when /healthz answers (`thirdbody worker` has no HTTP: its compose service disables it).
+# Alive when /healthz answers on THIRDBODY_BIND. `thirdbody worker` serves no API: it answers
+# /healthz, /readyz and /metrics only on THIRDBODY_METRICS_BIND (--metrics-bind), so its
+# compose service sets 0.0.0.0:9100 and checks `thirdbody healthcheck --bind 127.0.0.1:9100`.
 HEALTHCHECK --interval=10s --timeout=3s --start-period=5s --retries=3 CMD ["thirdbody", "healthcheck"]
 # SIGTERM drains: /readyz turns 503, in-flight requests and running jobs finish, then exit.
 STOPSIGNAL SIGTERM
