@@ -284,9 +284,108 @@ fn ramp(stops: &[[u8; 3]], t: f64) -> String {
     format!("#{:02x}{:02x}{:02x}", mix(0), mix(1), mix(2))
 }
 
+/// Where a chart's data land on the page: each axis's scale, and the factor and prefixed unit
+/// its values are shown in (nm for 1e-9 m).
+struct Frame {
+    sx: Scale,
+    sy: Scale,
+    factors: (f64, f64),
+    units: (String, String),
+}
+
+impl Frame {
+    /// The page position of the data point `(x, y)`.
+    fn px(&self, &(x, y): &(f64, f64)) -> (f64, f64) {
+        (
+            self.sx.at(x * self.factors.0),
+            self.sy.at(y * self.factors.1),
+        )
+    }
+}
+
+/// How successive layers take their colours: lines of one group share one, and the other
+/// layers go on through the palette past the groups met so far.
+struct Palette<'a> {
+    colours: Colours,
+    groups: Vec<&'a str>,
+    next: usize,
+}
+
+impl<'a> Palette<'a> {
+    /// The colour of `layer`, the palette moved on past it.
+    fn take(&mut self, layer: &'a Layer) -> String {
+        match layer {
+            Layer::Line { group, .. } => {
+                let i = match self.groups.iter().position(|g| g == group) {
+                    Some(i) => i,
+                    None => {
+                        self.groups.push(group);
+                        self.groups.len() - 1
+                    }
+                };
+                self.next = self.next.max(self.groups.len());
+                self.colours.line(i)
+            }
+            // A heat map has its own colour bar.
+            Layer::Heatmap { .. } => String::new(),
+            _ => {
+                self.next += 1;
+                self.colours.other(self.next - 1)
+            }
+        }
+    }
+}
+
+/// A legend's entry: the layer's name, its colour and its mark (`line`, `dashed`,
+/// `marker`, `hollow`, `area`).
+type Entry<'a> = (&'a str, String, &'static str);
+
 impl Chart {
     /// The chart as an SVG document.
     pub fn to_svg(&self) -> String {
+        let frame = self.frame();
+        let (sx, sy) = (&frame.sx, &frame.sy);
+        let mut svg = String::new();
+        let _ = write!(
+            svg,
+            r##"<svg xmlns="http://www.w3.org/2000/svg" width="{WIDTH}" height="{HEIGHT}" viewBox="0 0 {WIDTH} {HEIGHT}" font-family="sans-serif" font-size="13"><title>{}</title><rect width="100%" height="100%" fill="#ffffff"/>"##,
+            escape(&self.title)
+        );
+        let _ = write!(
+            svg,
+            r##"<text class="title" x="20" y="28" font-size="15" font-weight="bold">{}</text>"##,
+            escape(&self.title)
+        );
+        self.write_axes(&mut svg, sx, sy, (&frame.units.0, &frame.units.1));
+        let _ = write!(
+            svg,
+            r#"<defs><clipPath id="plot"><rect x="{}" y="{}" width="{}" height="{}"/></clipPath></defs><g clip-path="url(#plot)">"#,
+            sx.from,
+            sy.to,
+            sx.to - sx.from,
+            sy.from - sy.to
+        );
+        let mut legend = Vec::new();
+        let mut notes = self.notes.clone();
+        let mut palette = Palette {
+            colours: self.colours(),
+            groups: Vec::new(),
+            next: 0,
+        };
+        for layer in &self.layers {
+            let colour = palette.take(layer);
+            legend.extend(self.write_layer(&mut svg, &frame, layer, colour, &mut notes));
+        }
+        svg.push_str("</g>");
+        let shown = write_legend(&mut svg, &legend);
+        write_notes(&mut svg, &notes, shown);
+        svg.push_str("</svg>");
+        svg
+    }
+
+    /// The axes' scales and units: ranges from the layers' extents, the plot a square
+    /// when the chart keeps its aspect.
+    fn frame(&self) -> Frame {
         let points: Vec<(f64, f64)> = self.layers.iter().flat_map(Layer::extent).collect();
         let largest =
             |f: fn(&(f64, f64)) -> f64| points.iter().map(f).map(f64::abs).fold(0.0, f64::max);
@@ -310,170 +409,133 @@ impl Chart {
             y_lo = yc - width / 2.0;
             y_hi = yc + width / 2.0;
         }
-        let sx = Scale {
-            lo: x_lo,
-            hi: x_hi,
-            from: left,
-            to: right,
-            log: self.x.log,
-        };
-        let sy = Scale {
-            lo: y_lo,
-            hi: y_hi,
-            from: bottom,
-            to: top,
-            log: self.y.log,
-        };
-        let mut svg = String::new();
-        let _ = write!(
-            svg,
-            r##"<svg xmlns="http://www.w3.org/2000/svg" width="{WIDTH}" height="{HEIGHT}" viewBox="0 0 {WIDTH} {HEIGHT}" font-family="sans-serif" font-size="13"><title>{}</title><rect width="100%" height="100%" fill="#ffffff"/>"##,
-            escape(&self.title)
-        );
-        let _ = write!(
-            svg,
-            r##"<text class="title" x="20" y="28" font-size="15" font-weight="bold">{}</text>"##,
-            escape(&self.title)
-        );
-        self.write_axes(&mut svg, &sx, &sy, (&x_unit, &y_unit));
-        let _ = write!(
-            svg,
-            r#"<defs><clipPath id="plot"><rect x="{left}" y="{top}" width="{}" height="{}"/></clipPath></defs><g clip-path="url(#plot)">"#,
-            right - left,
-            bottom - top
-        );
-        let mut legend = Vec::new();
-        let mut colour = 0;
-        let mut groups: Vec<&str> = Vec::new();
-        let mut notes = self.notes.clone();
-        let colours = self.colours();
-        for layer in &self.layers {
-            let mut c = colours.other(colour);
-            if let Layer::Line { group, .. } = layer {
-                match groups.iter().position(|g| g == group) {
-                    Some(i) => c = colours.line(i),
-                    None => {
-                        groups.push(group);
-                        c = colours.line(groups.len() - 1);
-                    }
+        Frame {
+            sx: Scale {
+                lo: x_lo,
+                hi: x_hi,
+                from: left,
+                to: right,
+                log: self.x.log,
+            },
+            sy: Scale {
+                lo: y_lo,
+                hi: y_hi,
+                from: bottom,
+                to: top,
+                log: self.y.log,
+            },
+            factors: (x_factor, y_factor),
+            units: (x_unit, y_unit),
+        }
+    }
+
+    /// Draws one layer in `colour`; returns its legend entry (a heat map has none: it adds
+    /// to `notes` when drawn coarser than the answer's grid).
+    fn write_layer<'a>(
+        &self,
+        svg: &mut String,
+        frame: &Frame,
+        layer: &'a Layer,
+        c: String,
+        notes: &mut Vec<String>,
+    ) -> Option<Entry<'a>> {
+        let px = |p: &(f64, f64)| frame.px(p);
+        let mark = match layer {
+            Layer::Line { points, dashed, .. } => {
+                let dash = if *dashed {
+                    r#" stroke-dasharray="6 4""#
+                } else {
+                    ""
+                };
+                let _ = write!(
+                    svg,
+                    r#"<path class="series" data-name="{}" d="{}" fill="none" stroke="{c}" stroke-width="2"{dash}/>"#,
+                    escape(layer.name()),
+                    path(points.iter().map(px), false)
+                );
+                // A line of one point (a one-point sweep) has no length: its point shows.
+                if let [only] = points.as_slice() {
+                    let (x, y) = px(only);
+                    let _ = write!(
+                        svg,
+                        r#"<circle class="lone" cx="{x:.1}" cy="{y:.1}" r="4" fill="{c}"/>"#
+                    );
+                }
+                if *dashed {
+                    "dashed"
+                } else {
+                    "line"
                 }
             }
-            let px = |&(x, y): &(f64, f64)| (sx.at(x * x_factor), sy.at(y * y_factor));
-            match layer {
-                Layer::Line { points, dashed, .. } => {
-                    let dash = if *dashed {
-                        r#" stroke-dasharray="6 4""#
-                    } else {
-                        ""
-                    };
+            Layer::Markers { points, hollow, .. } => {
+                let fill = if *hollow { "#ffffff" } else { &c };
+                let _ = write!(
+                    svg,
+                    r#"<g class="series" data-name="{}">"#,
+                    escape(layer.name())
+                );
+                for (x, y) in points.iter().map(px) {
                     let _ = write!(
                         svg,
-                        r#"<path class="series" data-name="{}" d="{}" fill="none" stroke="{c}" stroke-width="2"{dash}/>"#,
-                        escape(layer.name()),
-                        path(points.iter().map(px), false)
+                        r#"<circle cx="{x:.1}" cy="{y:.1}" r="4" fill="{fill}" stroke="{c}" stroke-width="1.5"/>"#
                     );
-                    // A line of one point (a one-point sweep) has no length: its point shows.
-                    if let [only] = points.as_slice() {
-                        let (x, y) = px(only);
-                        let _ = write!(
-                            svg,
-                            r#"<circle class="lone" cx="{x:.1}" cy="{y:.1}" r="4" fill="{c}"/>"#
-                        );
-                    }
-                    legend.push((layer.name(), c, if *dashed { "dashed" } else { "line" }));
-                    colour = colour.max(groups.len());
                 }
-                Layer::Markers { points, hollow, .. } => {
-                    let fill = if *hollow { "#ffffff" } else { &c };
-                    let _ = write!(
-                        svg,
-                        r#"<g class="series" data-name="{}">"#,
-                        escape(layer.name())
-                    );
-                    for (x, y) in points.iter().map(px) {
-                        let _ = write!(
-                            svg,
-                            r#"<circle cx="{x:.1}" cy="{y:.1}" r="4" fill="{fill}" stroke="{c}" stroke-width="1.5"/>"#
-                        );
-                    }
-                    svg.push_str("</g>");
-                    legend.push((layer.name(), c, if *hollow { "hollow" } else { "marker" }));
-                    colour += 1;
+                svg.push_str("</g>");
+                if *hollow {
+                    "hollow"
+                } else {
+                    "marker"
                 }
-                Layer::Area { outline, .. } => {
-                    let _ = write!(
-                        svg,
-                        r#"<path class="series area" data-name="{}" d="{}" fill="{c}" fill-opacity="0.25" stroke="{c}" stroke-width="2"/>"#,
-                        escape(layer.name()),
-                        path(outline.iter().map(px), true)
-                    );
-                    legend.push((layer.name(), c, "area"));
-                    colour += 1;
-                }
-                Layer::Circle { centre, radius, .. } => {
-                    let (cx, cy) = px(centre);
-                    let r = (sx.at((centre.0 + radius) * x_factor) - cx).abs();
-                    let _ = write!(
-                        svg,
-                        r#"<circle class="series" data-name="{}" cx="{cx:.1}" cy="{cy:.1}" r="{r:.1}" fill="none" stroke="{c}" stroke-width="2" stroke-dasharray="6 4"/>"#,
-                        escape(layer.name())
-                    );
-                    legend.push((layer.name(), c, "dashed"));
-                    colour += 1;
-                }
-                Layer::Heatmap {
-                    name,
-                    x,
-                    y,
-                    values,
+            }
+            Layer::Area { outline, .. } => {
+                let _ = write!(
+                    svg,
+                    r#"<path class="series area" data-name="{}" d="{}" fill="{c}" fill-opacity="0.25" stroke="{c}" stroke-width="2"/>"#,
+                    escape(layer.name()),
+                    path(outline.iter().map(px), true)
+                );
+                "area"
+            }
+            Layer::Circle { centre, radius, .. } => {
+                let (cx, cy) = px(centre);
+                let r = (frame.sx.at((centre.0 + radius) * frame.factors.0) - cx).abs();
+                let _ = write!(
+                    svg,
+                    r#"<circle class="series" data-name="{}" cx="{cx:.1}" cy="{cy:.1}" r="{r:.1}" fill="none" stroke="{c}" stroke-width="2" stroke-dasharray="6 4"/>"#,
+                    escape(layer.name())
+                );
+                "dashed"
+            }
+            Layer::Heatmap {
+                name,
+                x,
+                y,
+                values,
+                unit,
+                clip,
+            } => {
+                // An outline of fewer than three points encloses nothing: no clip then.
+                let clip = if clip.len() >= 3 {
+                    path(clip.iter().map(px), true)
+                } else {
+                    String::new()
+                };
+                let drawn = self.write_heatmap(
+                    svg,
+                    (&frame.sx, &frame.sy),
+                    frame.factors,
+                    (x, y, values),
                     unit,
-                    clip,
-                } => {
-                    // An outline of fewer than three points encloses nothing: no clip then.
-                    let clip = if clip.len() >= 3 {
-                        path(clip.iter().map(px), true)
-                    } else {
-                        String::new()
-                    };
-                    let drawn = self.write_heatmap(
-                        &mut svg,
-                        (&sx, &sy),
-                        (x_factor, y_factor),
-                        (x, y, values),
-                        unit,
-                        &clip,
-                    );
-                    if drawn != (x.len(), y.len()) {
-                        notes.push(format!("{name} drawn on {} × {} cells", drawn.0, drawn.1));
-                        notes.push(format!("(the answer has {} × {})", x.len(), y.len()));
-                    }
+                    &clip,
+                );
+                if drawn != (x.len(), y.len()) {
+                    notes.push(format!("{name} drawn on {} × {} cells", drawn.0, drawn.1));
+                    notes.push(format!("(the answer has {} × {})", x.len(), y.len()));
                 }
+                return None;
             }
-        }
-        svg.push_str("</g>");
-        let shown = write_legend(&mut svg, &legend);
-        let mut y = TOP + 10.0 + 22.0 * shown as f64 + 10.0;
-        svg.push_str(r#"<g class="notes">"#);
-        // As many as fit under the legend; the last line then says that more are in the answer.
-        let room = ((HEIGHT - 8.0 - y) / 18.0).floor().max(0.0) as usize + 1;
-        let cut = notes.len() > room;
-        let kept = if cut {
-            room.saturating_sub(1)
-        } else {
-            notes.len()
         };
-        let more = cut.then(|| format!("… {} more in the answer", notes.len() - kept));
-        for note in notes[..kept].iter().chain(&more) {
-            let _ = write!(
-                svg,
-                r#"<text x="{}" y="{y}" font-size="11">{}</text>"#,
-                WIDTH - RIGHT + 20.0,
-                escape(note)
-            );
-            y += 18.0;
-        }
-        svg.push_str("</g></svg>");
-        svg
+        Some((layer.name(), c, mark))
     }
 
     /// The chart's colours: sequential when its groups of lines outnumber the palette.
@@ -704,7 +766,7 @@ fn path(points: impl Iterator<Item = (f64, f64)>, closed: bool) -> String {
 
 /// The legend, right of the plot: at most [`LEGEND_ROWS`] rows (the rest counted on the
 /// last). Returns the rows written.
-fn write_legend(svg: &mut String, entries: &[(&str, String, &str)]) -> usize {
+fn write_legend(svg: &mut String, entries: &[Entry]) -> usize {
     let x = WIDTH - RIGHT + 20.0;
     let entries: Vec<_> = entries.iter().filter(|e| !e.0.is_empty()).collect();
     let _ = write!(svg, r#"<g class="legend">"#);
@@ -757,6 +819,31 @@ fn write_legend(svg: &mut String, entries: &[(&str, String, &str)]) -> usize {
     }
     svg.push_str("</g>");
     shown.len() + usize::from(more > 0)
+}
+
+/// The notes under a legend of `shown` rows: as many as fit above the picture's foot, the
+/// last line then saying that more are in the answer.
+fn write_notes(svg: &mut String, notes: &[String], shown: usize) {
+    let mut y = TOP + 10.0 + 22.0 * shown as f64 + 10.0;
+    svg.push_str(r#"<g class="notes">"#);
+    let room = ((HEIGHT - 8.0 - y) / 18.0).floor().max(0.0) as usize + 1;
+    let cut = notes.len() > room;
+    let kept = if cut {
+        room.saturating_sub(1)
+    } else {
+        notes.len()
+    };
+    let more = cut.then(|| format!("… {} more in the answer", notes.len() - kept));
+    for note in notes[..kept].iter().chain(&more) {
+        let _ = write!(
+            svg,
+            r#"<text x="{}" y="{y}" font-size="11">{}</text>"#,
+            WIDTH - RIGHT + 20.0,
+            escape(note)
+        );
+        y += 18.0;
+    }
+    svg.push_str("</g>");
 }
 
 /// Rows of a legend.
