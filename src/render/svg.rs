@@ -442,50 +442,10 @@ impl Chart {
         let px = |p: &(f64, f64)| frame.px(p);
         let mark = match layer {
             Layer::Line { points, dashed, .. } => {
-                let dash = if *dashed {
-                    r#" stroke-dasharray="6 4""#
-                } else {
-                    ""
-                };
-                let _ = write!(
-                    svg,
-                    r#"<path class="series" data-name="{}" d="{}" fill="none" stroke="{c}" stroke-width="2"{dash}/>"#,
-                    escape(layer.name()),
-                    path(points.iter().map(px), false)
-                );
-                // A line of one point (a one-point sweep) has no length: its point shows.
-                if let [only] = points.as_slice() {
-                    let (x, y) = px(only);
-                    let _ = write!(
-                        svg,
-                        r#"<circle class="lone" cx="{x:.1}" cy="{y:.1}" r="4" fill="{c}"/>"#
-                    );
-                }
-                if *dashed {
-                    "dashed"
-                } else {
-                    "line"
-                }
+                write_line(svg, layer.name(), points.iter().map(px), *dashed, &c)
             }
             Layer::Markers { points, hollow, .. } => {
-                let fill = if *hollow { "#ffffff" } else { &c };
-                let _ = write!(
-                    svg,
-                    r#"<g class="series" data-name="{}">"#,
-                    escape(layer.name())
-                );
-                for (x, y) in points.iter().map(px) {
-                    let _ = write!(
-                        svg,
-                        r#"<circle cx="{x:.1}" cy="{y:.1}" r="4" fill="{fill}" stroke="{c}" stroke-width="1.5"/>"#
-                    );
-                }
-                svg.push_str("</g>");
-                if *hollow {
-                    "hollow"
-                } else {
-                    "marker"
-                }
+                write_markers(svg, layer.name(), points.iter().map(px), *hollow, &c)
             }
             Layer::Area { outline, .. } => {
                 let _ = write!(
@@ -819,6 +779,64 @@ fn write_legend(svg: &mut String, entries: &[Entry]) -> usize {
     }
     svg.push_str("</g>");
     shown.len() + usize::from(more > 0)
+}
+
+/// A polyline in `colour` through page points; returns its legend mark.
+fn write_line(
+    svg: &mut String,
+    name: &str,
+    points: impl Iterator<Item = (f64, f64)>,
+    dashed: bool,
+    c: &str,
+) -> &'static str {
+    let points: Vec<_> = points.collect();
+    let dash = if dashed {
+        r#" stroke-dasharray="6 4""#
+    } else {
+        ""
+    };
+    let _ = write!(
+        svg,
+        r#"<path class="series" data-name="{}" d="{}" fill="none" stroke="{c}" stroke-width="2"{dash}/>"#,
+        escape(name),
+        path(points.iter().copied(), false)
+    );
+    // A line of one point (a one-point sweep) has no length: its point shows.
+    if let [(x, y)] = points.as_slice() {
+        let _ = write!(
+            svg,
+            r#"<circle class="lone" cx="{x:.1}" cy="{y:.1}" r="4" fill="{c}"/>"#
+        );
+    }
+    if dashed {
+        "dashed"
+    } else {
+        "line"
+    }
+}
+
+/// A marker in `colour` at each page point, filled or hollow; returns its legend mark.
+fn write_markers(
+    svg: &mut String,
+    name: &str,
+    points: impl Iterator<Item = (f64, f64)>,
+    hollow: bool,
+    c: &str,
+) -> &'static str {
+    let fill = if hollow { "#ffffff" } else { c };
+    let _ = write!(svg, r#"<g class="series" data-name="{}">"#, escape(name));
+    for (x, y) in points {
+        let _ = write!(
+            svg,
+            r#"<circle cx="{x:.1}" cy="{y:.1}" r="4" fill="{fill}" stroke="{c}" stroke-width="1.5"/>"#
+        );
+    }
+    svg.push_str("</g>");
+    if hollow {
+        "hollow"
+    } else {
+        "marker"
+    }
 }
 
 /// The notes under a legend of `shown` rows: as many as fit above the picture's foot, the
