@@ -223,7 +223,7 @@ fn cors(origins: &CorsOrigins) -> Option<CorsLayer> {
                 header::IF_NONE_MATCH,
                 header::AUTHORIZATION,
                 HeaderName::from_static(access::API_KEY_HEADER),
-                HeaderName::from_static(routes::history::OWNER_HEADER),
+                HeaderName::from_static(routes::shared::OWNER_HEADER),
                 X_REQUEST_ID,
             ])
             .expose_headers(
