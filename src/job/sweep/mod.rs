@@ -278,7 +278,12 @@ impl Kind for SweepJob {
                     control.map_each(&contacts, on_refusal, |p| SweepPoint::new(p, &solve(p)?))
                 } else {
                     let kept = control.kept(
-                        |p| format!("{MODEL_VERSION} rolling {law:?} {p:?} {options:?}"),
+                        |p| {
+                            point_key(&RollingJob {
+                                rolling: *p,
+                                ..*base
+                            })
+                        },
                         |_| std::mem::size_of::<Solved>(),
                         solve,
                     );
@@ -291,9 +296,15 @@ impl Kind for SweepJob {
             }
             SweepOfPoints::ThreeBody(s) => {
                 let systems = part(s.points(), range)?;
-                let options = &s.base.options;
+                let base = &s.base;
+                let options = &base.options;
                 let kept = control.kept(
-                    |p| format!("{MODEL_VERSION} three_body {p:?} {options:?}"),
+                    |p| {
+                        point_key(&ThreeBodyJob {
+                            system: *p,
+                            ..*base
+                        })
+                    },
                     |_| std::mem::size_of::<ThreeBodySolution>(),
                     |p| solve_kept(p, options, control),
                 );
@@ -316,6 +327,17 @@ impl Kind for SweepJob {
     fn unfinished(output: &SweepOutput) -> Option<JobError> {
         output.stop.clone()
     }
+}
+
+/// The memo key of a sweep's point: the model's version, its kind, and its canonical text
+/// as a job of its own, so that equal points share one solve (a retry, a sweep that
+/// overlaps another).
+fn point_key<K: Kind>(point: &K) -> String {
+    format!(
+        "{MODEL_VERSION} {} {}",
+        K::NAME,
+        point.canonical_text().get()
+    )
 }
 
 /// A sweep that stopped at a refusal (`on_refusal: fail`) fails with it, the point named by
