@@ -3,7 +3,9 @@
 //! diameter).
 
 mod picture;
+mod rows;
 pub use picture::SweepPicture;
+pub use rows::{PointCounts, SweepSummary, SweepVerification};
 
 use std::ops::Range;
 
@@ -14,7 +16,6 @@ use utoipa::ToSchema;
 use super::input::LayerModel;
 use super::input::{self, field, Checker, Field, Quantity};
 use super::kind::SMALL_ANSWER;
-use super::points::{self, SweepSummary};
 use super::rolling::{RollingInput, RollingJob, Solved};
 use super::three_body::{
     operating_fields, references as three_body_references, slot, solve_kept, system_cost, Nodes,
@@ -291,7 +292,7 @@ impl Kind for SweepJob {
                 };
                 let swept = refused_at(swept, first, on_refusal)?;
                 let stop = swept.stopped.clone();
-                let (rows, summary) = points::rows(&contacts, swept, first, Subject::Particle);
+                let (rows, summary) = rows::rows(&contacts, swept, first, Subject::Particle);
                 (SweepPoints::Rolling(rows), summary, stop)
             }
             SweepOfPoints::ThreeBody(s) => {
@@ -313,7 +314,7 @@ impl Kind for SweepJob {
                 });
                 let swept = refused_at(swept, first, on_refusal)?;
                 let stop = swept.stopped.clone();
-                let (rows, summary) = points::rows(&systems, swept, first, Subject::System);
+                let (rows, summary) = rows::rows(&systems, swept, first, Subject::System);
                 (SweepPoints::ThreeBody(rows), summary, stop)
             }
         };

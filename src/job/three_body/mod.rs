@@ -14,7 +14,7 @@ use utoipa::ToSchema;
 use super::input::units::Dimension;
 use super::input::{self, field, Checker, LayerInput, LayerModel, QuadratureKind, Quantity};
 use super::meta::{Canonical, REFERENCES, THREE_BODY_CONTINUUM_REFERENCES};
-use super::points::{self, PointNotes, PointNotesFields, PointStatus, Row, SweepVerification};
+use super::points::{self, PointNotes, PointNotesFields, PointStatus, Row};
 use super::rolling::RollingJob;
 use super::validity::{self, PointValidity, Subject, ValidityOutput};
 use super::{rolling, Control, Cost, JobError, Kind, Limits, Meta, References, Validated, Work};
@@ -946,6 +946,7 @@ impl ThreeBodySweepPoint {
 
 impl Row for ThreeBodySweepPoint {
     type Point = ThreeBody;
+    type Verification = ThreeBodyVerificationOutput;
 
     fn unanswered(system: &ThreeBody, notes: PointNotes) -> Self {
         ThreeBodySweepPoint {
@@ -964,7 +965,7 @@ impl Row for ThreeBodySweepPoint {
         &self.notes
     }
 
-    fn verification(&self) -> Option<SweepVerification> {
-        self.verification.clone().map(SweepVerification::ThreeBody)
+    fn verification(&self) -> Option<ThreeBodyVerificationOutput> {
+        self.verification.clone()
     }
 }
