@@ -61,6 +61,9 @@ fn group_name(curve: &Curve, along: &str) -> String {
     held.unwrap_or_else(|| format!("series {}", curve.series))
 }
 
+/// A series' measured points, and the segments from them to the curve and their bars.
+type Residuals = (Vec<(f64, f64)>, Vec<Layer>);
+
 /// Where a point is along the curves, and the unit there.
 type Along<'a> = dyn Fn(&Conditions) -> Result<(f64, &'static str), PictureError> + 'a;
 
@@ -73,7 +76,7 @@ impl FitPicture {
         quantity: MeasuredQuantity,
         group: &str,
         x: &Along<'_>,
-    ) -> Result<(Vec<(f64, f64)>, Vec<Layer>), PictureError> {
+    ) -> Result<Residuals, PictureError> {
         let mut measured = Vec::new();
         let mut segments = Vec::new();
         for r in self.residuals.iter().filter(|r| r.series == series) {
