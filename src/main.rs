@@ -320,7 +320,7 @@ fn worker(args: WorkerArgs) -> ExitCode {
     let worked = runtime.block_on(async {
         let timeout = config.shutdown_timeout;
         let pool_size = config.engine.pool_size;
-        let state = AppState::new(config)?;
+        let state = AppState::new(config).map_err(|e| e.to_string())?;
         let operations = match args.metrics_bind {
             Some(bind) => Some(
                 tokio::net::TcpListener::bind(bind)
@@ -361,7 +361,7 @@ fn serve(args: ServeArgs) -> ExitCode {
         let signals = Signals::new();
         let (bind, timeout) = (config.bind, config.shutdown_timeout);
         // The service first (its database may be another process's): then the port.
-        let state = AppState::new(config)?;
+        let state = AppState::new(config).map_err(|e| e.to_string())?;
         let listener = tokio::net::TcpListener::bind(bind)
             .await
             .map_err(|e| format!("cannot listen on {bind}: {e}"))?;

@@ -2,7 +2,7 @@
 
 use serde_json::Value;
 
-use super::path::{unanswered, FieldPath};
+use super::path::{unanswered, FieldPath, NotAPath};
 use super::report::Outcome;
 use super::{ExpectInput, GoldenInput};
 use crate::render::format_number;
@@ -34,23 +34,44 @@ pub struct Expectation {
     bound: Bound,
 }
 
-fn finite(name: &str, x: Option<f64>) -> Result<Option<f64>, String> {
+/// Why an expectation or a golden answer cannot be one: the message a 422 names it with.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum BadExpectation {
+    #[error(transparent)]
+    Path(#[from] NotAPath),
+    #[error("{0} must be a finite number")]
+    NotFinite(&'static str),
+    #[error("{0} must be ≥ 0")]
+    Negative(&'static str),
+    #[error("{0}: one of min, max, or equals (with rtol, atol)")]
+    NoBound(FieldPath),
+    #[error("{0}: equals, or min and max, not both")]
+    EqualsAndRange(FieldPath),
+    #[error("{0}: rtol and atol go with equals")]
+    ToleranceWithoutEquals(FieldPath),
+    #[error("{path}: min {min} is above max {max}")]
+    Inverted { path: FieldPath, min: f64, max: f64 },
+    #[error("a golden answer needs `file` or `answer`")]
+    NoGolden,
+}
+
+fn finite(name: &'static str, x: Option<f64>) -> Result<Option<f64>, BadExpectation> {
     match x {
-        Some(x) if !x.is_finite() => Err(format!("{name} must be a finite number")),
+        Some(x) if !x.is_finite() => Err(BadExpectation::NotFinite(name)),
         _ => Ok(x),
     }
 }
 
-fn tolerance(name: &str, x: Option<f64>, default: f64) -> Result<f64, String> {
+fn tolerance(name: &'static str, x: Option<f64>, default: f64) -> Result<f64, BadExpectation> {
     match finite(name, x)? {
-        Some(t) if t < 0.0 => Err(format!("{name} must be ≥ 0")),
+        Some(t) if t < 0.0 => Err(BadExpectation::Negative(name)),
         t => Ok(t.unwrap_or(default)),
     }
 }
 
 impl Expectation {
     /// The expectation `input` on the field at `path`, or why it cannot be one.
-    pub fn new(path: String, input: ExpectInput) -> Result<Expectation, String> {
+    pub fn new(path: String, input: ExpectInput) -> Result<Expectation, BadExpectation> {
         let path = FieldPath::parse(path)?;
         let (min, max) = (finite("min", input.min)?, finite("max", input.max)?);
         let equals = finite("equals", input.equals)?;
@@ -60,17 +81,13 @@ impl Expectation {
                 rtol: tolerance("rtol", input.rtol, DEFAULT_RTOL)?,
                 atol: tolerance("atol", input.atol, 0.0)?,
             },
-            (None, None, None) => {
-                return Err(format!(
-                    "{path}: one of min, max, or equals (with rtol, atol)"
-                ))
-            }
-            (Some(_), ..) => return Err(format!("{path}: equals, or min and max, not both")),
+            (None, None, None) => return Err(BadExpectation::NoBound(path)),
+            (Some(_), ..) => return Err(BadExpectation::EqualsAndRange(path)),
             (None, ..) if input.rtol.is_some() || input.atol.is_some() => {
-                return Err(format!("{path}: rtol and atol go with equals"))
+                return Err(BadExpectation::ToleranceWithoutEquals(path))
             }
-            (None, Some(lo), Some(hi)) if lo > hi => {
-                return Err(format!("{path}: min {lo} is above max {hi}"))
+            (None, Some(min), Some(max)) if min > max => {
+                return Err(BadExpectation::Inverted { path, min, max })
             }
             (None, min, max) => Bound::Range { min, max },
         };
@@ -177,9 +194,9 @@ pub struct Golden {
 }
 
 impl Golden {
-    pub fn new(input: GoldenInput) -> Result<Golden, String> {
+    pub fn new(input: GoldenInput) -> Result<Golden, BadExpectation> {
         if input.file.is_none() && input.answer.is_none() {
-            return Err("a golden answer needs `file` or `answer`".to_string());
+            return Err(BadExpectation::NoGolden);
         }
         Ok(Golden {
             file: input.file,

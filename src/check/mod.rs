@@ -20,8 +20,9 @@ use serde::Deserialize;
 use serde_json::Value;
 use utoipa::ToSchema;
 
-pub use expect::{Expectation, Golden};
+pub use expect::{BadExpectation, Expectation, Golden};
 pub use file::run_file;
+pub use path::NotAPath;
 pub use report::{CheckReport, Outcome, Report, Summary};
 
 use crate::job::input::{deserialize, Checker};
@@ -129,13 +130,17 @@ impl Suite {
                 .into_iter()
                 .filter_map(|(path, e)| {
                     Expectation::new(path, e)
-                        .map_err(|why| checker.invalid(&format!("{at}.expect"), Value::Null, &why))
+                        .map_err(|why| {
+                            checker.invalid(&format!("{at}.expect"), Value::Null, &why.to_string())
+                        })
                         .ok()
                 })
                 .collect();
             let golden = check.golden.and_then(|g| {
                 Golden::new(g)
-                    .map_err(|why| checker.invalid(&format!("{at}.golden"), Value::Null, &why))
+                    .map_err(|why| {
+                        checker.invalid(&format!("{at}.golden"), Value::Null, &why.to_string())
+                    })
                     .ok()
             });
             if expectations.is_empty() && golden.is_none() {

@@ -21,6 +21,11 @@ pub(super) enum Step {
     Each,
 }
 
+/// Text that is no field path, as written.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error("\"{0}\" is not a field path (write e.g. static.friction_coefficient or points[].load)")]
+pub struct NotAPath(String);
+
 /// A field path, as written and as steps.
 #[derive(Clone, Debug, PartialEq)]
 pub struct FieldPath {
@@ -30,10 +35,8 @@ pub struct FieldPath {
 
 impl FieldPath {
     /// Reads `a.b[2].c` or `points[].contact_area`.
-    pub fn parse(text: String) -> Result<FieldPath, String> {
-        let bad = || {
-            format!("\"{text}\" is not a field path (write e.g. static.friction_coefficient or points[].load)")
-        };
+    pub fn parse(text: String) -> Result<FieldPath, NotAPath> {
+        let bad = || NotAPath(text.clone());
         let mut steps = Vec::new();
         for part in text.split('.') {
             let (key, mut rest) = part.split_at(part.find('[').unwrap_or(part.len()));

@@ -379,6 +379,69 @@ impl From<JobError> for ApiError {
     }
 }
 
+impl ApiError {
+    /// A job refused because the queue ahead of it, or the job alone, would take it past
+    /// its deadline.
+    fn backlogged(backlogged: Backlogged) -> ApiError {
+        let Backlogged {
+            ahead,
+            needs,
+            deadline,
+        } = backlogged;
+        if needs > deadline {
+            return ApiError::new(
+                Kind::Overloaded,
+                format!(
+                    "the job was not accepted: it alone needs about {} (estimated from the \
+                     jobs of its kind solved here), more than its deadline of {} \
+                     (--job-deadline), and other work is queued ahead of it: split it",
+                    quantity(needs.as_secs_f64(), "s"),
+                    quantity(deadline.as_secs_f64(), "s"),
+                ),
+            );
+        }
+        let ahead_s = ahead.as_secs_f64().ceil().max(1.0);
+        ApiError::new(
+            Kind::Overloaded,
+            format!(
+                "the job was not accepted: the jobs accepted before it hold the \
+                 job threads for about {} and it needs about {} more (estimated \
+                 from the jobs of its kind solved here), past its deadline of {} \
+                 (--job-deadline). Retry in about {}, or split it",
+                quantity(ahead.as_secs_f64(), "s"),
+                quantity(needs.as_secs_f64(), "s"),
+                quantity(deadline.as_secs_f64(), "s"),
+                quantity(ahead_s, "s"),
+            ),
+        )
+        .retrying_in(ahead_s)
+    }
+
+    /// A job refused because the results kept have no room for its result now.
+    fn results_full(what: &str, retry_after: Duration) -> ApiError {
+        // Rounded up, and at least a second: room is made no sooner.
+        let seconds = retry_after.as_secs_f64().ceil().max(1.0);
+        ApiError::new(
+            Kind::ResultsFull,
+            format!(
+                "the job was not accepted, so that its result is not lost after \
+                 the work: {what}. Room is made as finished jobs expire (the next \
+                 in {seconds} s) or are deleted (DELETE /v1/jobs/{{id}}); a \
+                 smaller job may fit now"
+            ),
+        )
+        .retrying_in(seconds)
+    }
+
+    /// The same error, saying to retry in `seconds` (whole, and at least one).
+    fn retrying_in(self, seconds: f64) -> ApiError {
+        ApiError {
+            retry_after: Some(seconds.min(f64::from(u32::MAX)) as u32),
+            ..self
+        }
+    }
+}
+
 impl From<EngineError> for ApiError {
     fn from(e: EngineError) -> Self {
         match e {
@@ -388,43 +451,7 @@ impl From<EngineError> for ApiError {
                 "every solver thread is busy and the job queue is full or not used: \
                  retry shortly, or submit big work to /v1/jobs",
             ),
-            EngineError::Backlogged(Backlogged {
-                ahead: _,
-                needs,
-                deadline,
-            }) if needs > deadline => ApiError::new(
-                Kind::Overloaded,
-                format!(
-                    "the job was not accepted: it alone needs about {} (estimated from the \
-                     jobs of its kind solved here), more than its deadline of {} \
-                     (--job-deadline), and other work is queued ahead of it: split it",
-                    quantity(needs.as_secs_f64(), "s"),
-                    quantity(deadline.as_secs_f64(), "s"),
-                ),
-            ),
-            EngineError::Backlogged(Backlogged {
-                ahead,
-                needs,
-                deadline,
-            }) => {
-                let ahead_s = ahead.as_secs_f64().ceil().max(1.0);
-                ApiError {
-                    retry_after: Some(ahead_s.min(f64::from(u32::MAX)) as u32),
-                    ..ApiError::new(
-                        Kind::Overloaded,
-                        format!(
-                            "the job was not accepted: the jobs accepted before it hold the \
-                             job threads for about {} and it needs about {} more (estimated \
-                             from the jobs of its kind solved here), past its deadline of {} \
-                             (--job-deadline). Retry in about {}, or split it",
-                            quantity(ahead.as_secs_f64(), "s"),
-                            quantity(needs.as_secs_f64(), "s"),
-                            quantity(deadline.as_secs_f64(), "s"),
-                            quantity(ahead_s, "s"),
-                        ),
-                    )
-                }
-            }
+            EngineError::Backlogged(backlogged) => ApiError::backlogged(backlogged),
             EngineError::Draining => ApiError::new(
                 Kind::Draining,
                 "the service is shutting down and takes no new work",
@@ -437,20 +464,7 @@ impl From<EngineError> for ApiError {
                 ),
             ),
             EngineError::ResultsFull { what, retry_after } => {
-                // Rounded up, and at least a second: room is made no sooner.
-                let seconds = retry_after.as_secs_f64().ceil().max(1.0);
-                ApiError {
-                    retry_after: Some(seconds.min(f64::from(u32::MAX)) as u32),
-                    ..ApiError::new(
-                        Kind::ResultsFull,
-                        format!(
-                            "the job was not accepted, so that its result is not lost after \
-                             the work: {what}. Room is made as finished jobs expire (the next \
-                             in {seconds} s) or are deleted (DELETE /v1/jobs/{{id}}); a \
-                             smaller job may fit now"
-                        ),
-                    )
-                }
+                ApiError::results_full(&what, retry_after)
             }
             EngineError::ResultTooLarge { needed, limit } => ApiError::new(
                 Kind::ResultTooLarge,

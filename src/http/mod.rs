@@ -67,15 +67,22 @@ struct Inner {
     streams: Arc<tokio::sync::Semaphore>,
 }
 
+/// Why the service cannot start: its storage cannot be opened (the database, the spill
+/// directory, the fleet's Redis), in words for the operator.
+#[derive(Debug, thiserror::Error)]
+#[error("{0}")]
+pub struct CannotStart(pub String);
+
 impl AppState {
     /// A service with its own engine, its answers and jobs in its own memory (and spill
     /// directory and database) or its fleet's Redis, and its own metrics registry; or why it
     /// cannot start.
-    pub fn new(config: Config) -> Result<Self, String> {
+    pub fn new(config: Config) -> Result<Self, CannotStart> {
         let storage = match &config.fleet {
-            Some(fleet) => crate::engine::fleet::storage(&config.engine, fleet.clone())?,
-            None => Storage::in_process(&config.engine)?,
-        };
+            Some(fleet) => crate::engine::fleet::storage(&config.engine, fleet.clone()),
+            None => Storage::in_process(&config.engine),
+        }
+        .map_err(CannotStart)?;
         Ok(AppState::with_storage(config, storage))
     }
 
@@ -223,7 +230,7 @@ fn cors(origins: &CorsOrigins) -> Option<CorsLayer> {
                 header::IF_NONE_MATCH,
                 header::AUTHORIZATION,
                 HeaderName::from_static(access::API_KEY_HEADER),
-                HeaderName::from_static(routes::history::OWNER_HEADER),
+                HeaderName::from_static(routes::shared::OWNER_HEADER),
                 X_REQUEST_ID,
             ])
             .expose_headers(

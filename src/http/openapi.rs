@@ -131,7 +131,7 @@ fn document_access(spec: &mut Spec) {
             // An API key names its caller: the owner's token is never required, even where
             // a caller without a key must send it (listing jobs).
             let owner = |p: &&mut path::Parameter| {
-                p.name == routes::history::OWNER_HEADER && p.parameter_in == ParameterIn::Header
+                p.name == routes::shared::OWNER_HEADER && p.parameter_in == ParameterIn::Header
             };
             for parameter in operation.parameters.iter_mut().flatten().filter(owner) {
                 parameter.required = Required::False;

@@ -11,7 +11,8 @@ use utoipa::ToSchema;
 use crate::model::ModelError;
 
 /// One invalid field: where, what was sent, and what is allowed.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, ToSchema)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, ToSchema, thiserror::Error)]
+#[error("{message}")]
 pub struct FieldError {
     /// Path of the field in the input, e.g. `layer.thickness` or `vary.radius[2]`.
     pub field: String,
@@ -22,12 +23,6 @@ pub struct FieldError {
     pub allowed: String,
     /// A sentence saying all of it.
     pub message: String,
-}
-
-impl fmt::Display for FieldError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(&self.message)
-    }
 }
 
 /// Characters of a value sent that an error echoes at most (RELIABILITY.md): the answer to
@@ -102,63 +97,72 @@ fn cut_path(path: &str) -> String {
 
 /// Why a job was not answered. Serializable, so that a job failed in one process reads
 /// the same from another (`engine::fleet`).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, thiserror::Error)]
 pub enum JobError {
     /// The body is not JSON.
+    #[error("malformed JSON: {0}")]
     Syntax(String),
     /// JSON of the wrong shape: an unknown field or kind, a wrong type.
+    #[error("{}", Located(.field, .message))]
     Schema { field: String, message: String },
     /// Values out of their ranges (all of them).
+    #[error("{}", Sentence(.0))]
     Invalid(Vec<FieldError>),
     /// Valid values the model cannot solve (a root finder that does not converge, a scale
     /// double precision cannot hold, a load the system cannot carry): the same input always
     /// fails, so only a changed input can help.
+    #[error("{0}")]
     Unsolvable(String),
     /// Valid values for which an assumption of the model fails (docs/model.md §7): the answer
     /// would be a number the model cannot vouch for.
+    #[error("{0}")]
     OutOfDomain(String),
     /// The job was cancelled before it finished.
+    #[error("the job was cancelled")]
     Cancelled,
     /// The job ran past its deadline.
+    #[error("the job ran past its deadline")]
     DeadlineExceeded,
     /// The service gave the job up (every worker that took a part of it stopped): its fate,
     /// in words for the client.
+    #[error("{0}")]
     Abandoned(String),
     /// A fault of the service, not of the job: logged, not shown to clients.
+    #[error("internal error: {0}")]
     Internal(String),
 }
 
-impl fmt::Display for JobError {
+/// A schema error's message, after its field when it has one.
+struct Located<'a>(&'a String, &'a String);
+
+impl fmt::Display for Located<'_> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            JobError::Syntax(m) => write!(f, "malformed JSON: {m}"),
-            JobError::Schema { field, message } if field.is_empty() => f.write_str(message),
-            JobError::Schema { field, message } => write!(f, "{field}: {message}"),
-            JobError::Invalid(errors) => {
-                // A sentence, not a listing: `errors` of the problem has every field.
-                const SHOWN: usize = 10;
-                let messages: Vec<&str> = errors
-                    .iter()
-                    .take(SHOWN)
-                    .map(|e| e.message.as_str())
-                    .collect();
-                f.write_str(&messages.join("; "))?;
-                match errors.len().saturating_sub(SHOWN) {
-                    0 => Ok(()),
-                    more => write!(f, "; and {more} more (see `errors`)"),
-                }
-            }
-            JobError::Unsolvable(m) | JobError::OutOfDomain(m) | JobError::Abandoned(m) => {
-                f.write_str(m)
-            }
-            JobError::Cancelled => f.write_str("the job was cancelled"),
-            JobError::DeadlineExceeded => f.write_str("the job ran past its deadline"),
-            JobError::Internal(m) => write!(f, "internal error: {m}"),
+            Located(field, message) if field.is_empty() => f.write_str(message),
+            Located(field, message) => write!(f, "{field}: {message}"),
         }
     }
 }
 
-impl std::error::Error for JobError {}
+/// Invalid fields as a sentence, not a listing: `errors` of the problem has every field.
+struct Sentence<'a>(&'a [FieldError]);
+
+impl fmt::Display for Sentence<'_> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        const SHOWN: usize = 10;
+        let messages: Vec<&str> = self
+            .0
+            .iter()
+            .take(SHOWN)
+            .map(|e| e.message.as_str())
+            .collect();
+        f.write_str(&messages.join("; "))?;
+        match self.0.len().saturating_sub(SHOWN) {
+            0 => Ok(()),
+            more => write!(f, "; and {more} more (see `errors`)"),
+        }
+    }
+}
 
 impl JobError {
     /// The error as it is shown, every value sent it echoes cut to [`ECHOED`] characters

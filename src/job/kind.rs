@@ -1,22 +1,28 @@
 //! A job kind is one type behind one trait ([`Kind`]): it validates its input, gives its
 //! canonical form (and so its cache key), says how much work it takes, and runs under a
 //! [`Control`] to an answer the render layer can write in every format. [`Job`] holds any
-//! validated job, whatever its kind; the registry ([`super::registry`]) finds a kind by its
-//! name on the wire and reads a job from JSON.
+//! validated job, whatever its kind, and [`KindName`] names its kind as answers and records
+//! carry it; the registry ([`super::registry`]) lists the kinds, finds one by its name on
+//! the wire and reads a job from JSON.
 
 use std::any::Any;
+use std::borrow::Cow;
 use std::fmt;
 use std::ops::Range;
 use std::sync::Arc;
 
+use serde::{Serialize, Serializer};
 use serde_json::Value;
-use utoipa::ToSchema;
+use utoipa::openapi::{Ref, RefOr, Schema};
+use utoipa::{PartialSchema, ToSchema};
 
 use super::meta::{Canonical, InputWarning, Meta, References};
 use super::picture::{draw, Picture};
-use super::registry::KindName;
 use super::{Control, JobError, Limits};
-use crate::render::{Answer, Output};
+use crate::render::{Answer, Draw, Output, UnitTable};
+
+/// Schemas as utoipa collects them: (name, schema).
+pub(super) type Schemas = Vec<(String, RefOr<Schema>)>;
 
 /// How much work a job takes, in the units its [`Control`] counts (rolling solves for the
 /// kinds that solve contacts); `Unknown` for a job that cannot tell in advance (an
@@ -115,7 +121,7 @@ impl<K> From<K> for Validated<K> {
 }
 
 /// A kind of job.
-pub trait Kind: fmt::Debug + PartialEq + Send + Sync + Sized + 'static {
+pub trait Kind: fmt::Debug + Send + Sync + Sized + 'static {
     /// The kind's name on the wire: the `kind` of a job envelope and of a job's status.
     const NAME: &'static str;
     /// The input as the wire has it (its OpenAPI schema).
@@ -214,6 +220,123 @@ pub trait Kind: fmt::Debug + PartialEq + Send + Sync + Sized + 'static {
     }
 }
 
+/// A registered kind: its name and what the rest of the crate needs of it without knowing
+/// its type.
+pub struct Registered {
+    pub(super) name: &'static str,
+    validate: fn(Value, &Limits) -> Result<Job, JobError>,
+    picture: Draw,
+    input_schema: fn() -> Cow<'static, str>,
+    pub(super) output_schema: fn(&mut Schemas) -> RefOr<Schema>,
+    output_name: fn() -> Cow<'static, str>,
+    units: &'static UnitTable,
+}
+
+impl Registered {
+    /// The kind's name on the wire.
+    pub fn name(&self) -> &'static str {
+        self.name
+    }
+
+    pub(super) const fn of<K: Kind>() -> Registered {
+        Registered {
+            name: K::NAME,
+            validate: validate::<K>,
+            picture: draw::<K::Picture>,
+            input_schema: <K::Input as ToSchema>::name,
+            output_schema: output_schema::<K>,
+            output_name: <K::Output as ToSchema>::name,
+            units: K::Output::UNITS,
+        }
+    }
+
+    /// The name of the OpenAPI schema of the kind's input.
+    pub fn input_name(&self) -> Cow<'static, str> {
+        (self.input_schema)()
+    }
+
+    /// The name of the OpenAPI schema of the kind's answer.
+    pub fn output_name(&self) -> Cow<'static, str> {
+        (self.output_name)()
+    }
+
+    /// The unit of every numeric field of the kind's answer, by path.
+    pub fn units(&self) -> &'static UnitTable {
+        self.units
+    }
+
+    /// Reads and validates an input of this kind.
+    pub fn validate(&self, input: Value, limits: &Limits) -> Result<Job, JobError> {
+        (self.validate)(input, limits)
+    }
+}
+
+fn validate<K: Kind>(input: Value, limits: &Limits) -> Result<Job, JobError> {
+    K::validate(input, limits).map(Job::validated)
+}
+
+/// Adds the schema of `K`'s output (and those it refers to) to `schemas`; returns a
+/// reference to it.
+fn output_schema<K: Kind>(schemas: &mut Schemas) -> RefOr<Schema> {
+    let name = K::Output::name();
+    schemas.push((name.to_string(), K::Output::schema()));
+    K::Output::schemas(schemas);
+    Ref::from_schema_name(name).into()
+}
+
+/// A registered kind, as answers, records and pictures carry it: its name on the wire and
+/// what the registry knows of it, without a look-up by name.
+#[derive(Clone, Copy)]
+pub struct KindName(pub(super) &'static Registered);
+
+impl KindName {
+    /// Kind `K`.
+    pub const fn of<K: Kind>() -> KindName {
+        KindName(const { &Registered::of::<K>() })
+    }
+
+    pub fn name(self) -> &'static str {
+        self.0.name
+    }
+
+    /// How an answer of this kind is drawn ([`Kind::Picture`], drawn by [`super::picture::draw`]).
+    pub fn picture(self) -> Draw {
+        self.0.picture
+    }
+}
+
+impl PartialEq for KindName {
+    fn eq(&self, other: &KindName) -> bool {
+        self.name() == other.name()
+    }
+}
+
+impl Eq for KindName {}
+
+impl PartialEq<&str> for KindName {
+    fn eq(&self, other: &&str) -> bool {
+        self.name() == *other
+    }
+}
+
+impl fmt::Debug for KindName {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl fmt::Display for KindName {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl Serialize for KindName {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(self.name())
+    }
+}
+
 /// A job that stopped before its end: why, and the answer with what it finished, for a kind
 /// that keeps partial work ([`Kind::unfinished`]).
 #[derive(Debug)]
@@ -267,7 +390,6 @@ trait Dispatch: fmt::Debug + Send + Sync {
     ) -> Result<Answer, Unfinished>;
     fn units(&self) -> &'static crate::render::UnitTable;
     fn as_any(&self) -> &dyn Any;
-    fn same(&self, other: &dyn Any) -> bool;
 }
 
 impl<K: Kind> Dispatch for K {
@@ -330,10 +452,6 @@ impl<K: Kind> Dispatch for K {
 
     fn as_any(&self) -> &dyn Any {
         self
-    }
-
-    fn same(&self, other: &dyn Any) -> bool {
-        other.downcast_ref::<K>() == Some(self)
     }
 }
 
@@ -551,9 +669,13 @@ impl Job {
     }
 }
 
+/// Jobs of one kind whose canonical texts are equal are the same job: equal canonical
+/// inputs have equal answers ([`Kind::canonical`]).
 impl PartialEq for Job {
     fn eq(&self, other: &Job) -> bool {
-        self.kind.same(other.kind.as_any()) && self.warnings == other.warnings
+        self.kind() == other.kind()
+            && self.kind.canonical_text() == other.kind.canonical_text()
+            && self.warnings == other.warnings
     }
 }
 

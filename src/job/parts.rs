@@ -9,8 +9,7 @@ use std::ops::Range;
 use serde::{Deserialize, Serialize};
 use serde_json::value::RawValue;
 
-use super::points::SweepSummary;
-use super::sweep::SweepMeta;
+use super::sweep::{SweepMeta, SweepSummary};
 use super::{JobError, Meta};
 use crate::render::{Answer, Format};
 

@@ -3,90 +3,21 @@
 //! `JobKind` and `Output` follow from here.
 
 use std::borrow::Cow;
-use std::fmt;
 
-use serde::{Deserialize, Deserializer, Serialize, Serializer};
+use serde::{Deserialize, Deserializer};
 use serde_json::Value;
 use utoipa::openapi::schema::{Object, ObjectBuilder, OneOfBuilder, Schema, SchemaType, Type};
-use utoipa::openapi::{Ref, RefOr};
+use utoipa::openapi::RefOr;
 use utoipa::{PartialSchema, ToSchema};
 
 use super::figure::FigureJob;
 use super::fit::FitJob;
-use super::kind::{Job, Kind};
-use super::picture::draw;
+use super::kind::{Job, Schemas};
+pub use super::kind::{KindName, Registered};
 use super::rolling::RollingJob;
 use super::sweep::SweepJob;
 use super::three_body::ThreeBodyJob;
 use super::{JobError, Limits};
-use crate::render::{Draw, Output, UnitTable};
-
-/// Schemas as utoipa collects them: (name, schema).
-type Schemas = Vec<(String, RefOr<Schema>)>;
-
-/// A registered kind: its name and what the rest of the crate needs of it without knowing
-/// its type.
-pub struct Registered {
-    name: &'static str,
-    validate: fn(Value, &Limits) -> Result<Job, JobError>,
-    picture: Draw,
-    input_schema: fn() -> Cow<'static, str>,
-    output_schema: fn(&mut Schemas) -> RefOr<Schema>,
-    output_name: fn() -> Cow<'static, str>,
-    units: &'static UnitTable,
-}
-
-impl Registered {
-    /// The kind's name on the wire.
-    pub fn name(&self) -> &'static str {
-        self.name
-    }
-
-    const fn of<K: Kind>() -> Registered {
-        Registered {
-            name: K::NAME,
-            validate: validate::<K>,
-            picture: draw::<K::Picture>,
-            input_schema: <K::Input as ToSchema>::name,
-            output_schema: output_schema::<K>,
-            output_name: <K::Output as ToSchema>::name,
-            units: K::Output::UNITS,
-        }
-    }
-
-    /// The name of the OpenAPI schema of the kind's input.
-    pub fn input_name(&self) -> Cow<'static, str> {
-        (self.input_schema)()
-    }
-
-    /// The name of the OpenAPI schema of the kind's answer.
-    pub fn output_name(&self) -> Cow<'static, str> {
-        (self.output_name)()
-    }
-
-    /// The unit of every numeric field of the kind's answer, by path.
-    pub fn units(&self) -> &'static UnitTable {
-        self.units
-    }
-
-    /// Reads and validates an input of this kind.
-    pub fn validate(&self, input: Value, limits: &Limits) -> Result<Job, JobError> {
-        (self.validate)(input, limits)
-    }
-}
-
-fn validate<K: Kind>(input: Value, limits: &Limits) -> Result<Job, JobError> {
-    K::validate(input, limits).map(Job::validated)
-}
-
-/// Adds the schema of `K`'s output (and those it refers to) to `schemas`; returns a
-/// reference to it.
-fn output_schema<K: Kind>(schemas: &mut Schemas) -> RefOr<Schema> {
-    let name = K::Output::name();
-    schemas.push((name.to_string(), K::Output::schema()));
-    K::Output::schemas(schemas);
-    Ref::from_schema_name(name).into()
-}
 
 /// Every job kind, one line each.
 const LIST: &[Registered] = &[
@@ -162,61 +93,10 @@ impl Job {
     }
 }
 
-/// A registered kind, as answers, records and pictures carry it: its name on the wire and
-/// what the registry knows of it, without a look-up by name.
-#[derive(Clone, Copy)]
-pub struct KindName(&'static Registered);
-
 impl KindName {
-    /// Kind `K`.
-    pub const fn of<K: Kind>() -> KindName {
-        KindName(const { &Registered::of::<K>() })
-    }
-
     /// The kind named `name`, or the error naming the known ones.
     pub fn find(name: &str) -> Result<KindName, JobError> {
         find(name).map(KindName)
-    }
-
-    pub fn name(self) -> &'static str {
-        self.0.name
-    }
-
-    /// How an answer of this kind is drawn ([`Kind::Picture`], drawn by [`super::picture::draw`]).
-    pub fn picture(self) -> Draw {
-        self.0.picture
-    }
-}
-
-impl PartialEq for KindName {
-    fn eq(&self, other: &KindName) -> bool {
-        self.name() == other.name()
-    }
-}
-
-impl Eq for KindName {}
-
-impl PartialEq<&str> for KindName {
-    fn eq(&self, other: &&str) -> bool {
-        self.name() == *other
-    }
-}
-
-impl fmt::Debug for KindName {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-impl fmt::Display for KindName {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-impl Serialize for KindName {
-    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
-        s.serialize_str(self.name())
     }
 }
 

@@ -6,7 +6,7 @@ use axum::extract::State;
 use axum::http::{header, HeaderMap};
 use axum::response::{IntoResponse, Response};
 
-use crate::check::{CheckReport, ChecksInput, Report, Suite};
+use crate::check::{CheckReport, CheckSpec, ChecksInput, Report, Suite};
 use crate::engine::{CacheUse, EngineError};
 use crate::http::accept::Accept;
 use crate::http::access::{self, Caller};
@@ -54,21 +54,7 @@ pub async fn run(
             Ok(Suite::from_value(checks, &limits)?)
         })
         .await?;
-    if let Some(spec) = suite
-        .checks
-        .iter()
-        .find(|c| c.golden.as_ref().is_some_and(|g| g.answer.is_none()))
-    {
-        return Err(JobError::Schema {
-            field: "golden".to_string(),
-            message: format!(
-                "check \"{}\": a golden file is for `thirdbody check`; send the answer inline \
-                 as golden.answer",
-                spec.name
-            ),
-        }
-        .into());
-    }
+    refuse_golden_files(&suite)?;
     // Its points are the caller's, charged at once: the suite runs whole or not at all.
     let jobs: Vec<Keyed> = suite
         .checks
@@ -84,14 +70,7 @@ pub async fn run(
     let mut reports = Vec::with_capacity(suite.checks.len());
     for (spec, keyed) in suite.checks.into_iter().zip(jobs) {
         if Instant::now() >= deadline {
-            let mut report = CheckReport::new(&spec.name, spec.job.kind().name());
-            report.fail_with(format!(
-                "not run: the suite ran past its deadline of {} (--solve-deadline, one for \
-                 the whole suite); split the suite, or run it with `thirdbody check`",
-                humantime::format_duration(state.config().engine.solve_deadline)
-            ));
-            report.settle();
-            reports.push(report);
+            reports.push(not_run(&spec, &state));
             continue;
         }
         let cache = cache_use(&spec.job, state.config().engine.memory_budget);
@@ -112,14 +91,51 @@ pub async fn run(
     if let Some(charge) = charged {
         state.engine().true_up(&charge, started.elapsed()).await;
     }
-    let report = Report::new(reports);
+    Ok(respond(Report::new(reports), xml))
+}
+
+/// A golden answer kept in a file is read by the command line, not by the service: a suite
+/// that names one is refused whole.
+fn refuse_golden_files(suite: &Suite) -> Result<(), ApiError> {
+    let Some(spec) = suite
+        .checks
+        .iter()
+        .find(|c| c.golden.as_ref().is_some_and(|g| g.answer.is_none()))
+    else {
+        return Ok(());
+    };
+    Err(JobError::Schema {
+        field: "golden".to_string(),
+        message: format!(
+            "check \"{}\": a golden file is for `thirdbody check`; send the answer inline \
+             as golden.answer",
+            spec.name
+        ),
+    }
+    .into())
+}
+
+/// The report of a check the suite's deadline came before.
+fn not_run(spec: &CheckSpec, state: &AppState) -> CheckReport {
+    let mut report = CheckReport::new(&spec.name, spec.job.kind().name());
+    report.fail_with(format!(
+        "not run: the suite ran past its deadline of {} (--solve-deadline, one for \
+         the whole suite); split the suite, or run it with `thirdbody check`",
+        humantime::format_duration(state.config().engine.solve_deadline)
+    ));
+    report.settle();
+    report
+}
+
+/// The suite's report, as JSON or JUnit XML: 200 if every check passed, else the problem.
+fn respond(report: Report, xml: bool) -> Response {
     let failed = (!report.passed).then(|| ApiError::checks_failed(&report));
-    Ok(match (failed, xml) {
+    match (failed, xml) {
         (None, false) => axum::Json(report).into_response(),
         (None, true) => ([(header::CONTENT_TYPE, FORMS[1])], report.to_junit()).into_response(),
         (Some(failed), false) => failed.into_response(),
         (Some(failed), true) => failed.respond_as(FORMS[1], report.to_junit()),
-    })
+    }
 }
 
 /// Whether a check keeps the answer it solves in the cache: when the answer takes at most a

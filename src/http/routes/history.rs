@@ -7,8 +7,7 @@
 //! random one in the browser's storage, so that a browser lists its own jobs and nobody
 //! else's. An admin key lists any tenant's jobs (`?tenant=`).
 
-use axum::extract::{FromRequestParts, Path, RawQuery, State};
-use axum::http::request::Parts;
+use axum::extract::{Path, RawQuery, State};
 use axum::http::StatusCode;
 use axum::response::Response;
 use axum::Json;
@@ -16,7 +15,7 @@ use serde::{Deserialize, Serialize};
 use serde_json::Value;
 use utoipa::{IntoParams, ToSchema};
 
-use super::jobs::JobView;
+use super::shared::{invalid, JobView, OwnerHeader, OWNER_HEADER};
 use super::{Answering, FormatQuery};
 use crate::engine::store::{JobStatus, Listing, Owner};
 use crate::engine::EngineError;
@@ -30,40 +29,11 @@ use crate::http::responses::{
 };
 use crate::http::AppState;
 use crate::job::registry::KindName;
-use crate::job::{scoped_key, FieldError, JobError};
-
-/// The header naming who submits and lists jobs.
-pub const OWNER_HEADER: &str = "thirdbody-owner";
+use crate::job::scoped_key;
 
 /// Jobs on a page unless `limit` says, and at most.
 const PAGE: usize = 20;
 const MAX_PAGE: usize = 100;
-
-/// The owner named by the request's `Thirdbody-Owner` header, if any: a token of 16 to 128
-/// characters that the client keeps (stored only as its hash).
-pub struct OwnerHeader(pub Option<Owner>);
-
-impl<S: Send + Sync> FromRequestParts<S> for OwnerHeader {
-    type Rejection = ApiError;
-
-    async fn from_request_parts(parts: &mut Parts, _: &S) -> Result<Self, ApiError> {
-        let Some(value) = parts.headers.get(OWNER_HEADER) else {
-            return Ok(OwnerHeader(None));
-        };
-        let token = String::from_utf8_lossy(value.as_bytes());
-        let allowed = |b: u8| b.is_ascii_alphanumeric() || b"-_.~".contains(&b);
-        if (16..=128).contains(&token.len()) && token.bytes().all(allowed) {
-            return Ok(OwnerHeader(Some(Owner::of_token(&token))));
-        }
-        // Not echoed: it may be a secret mistyped.
-        Err(invalid(
-            &format!("header {OWNER_HEADER}"),
-            Value::String(format!("({} characters)", token.chars().count())),
-            "16 to 128 characters of A-Z, a-z, 0-9, '-', '_', '.' and '~' (a random token \
-             the client keeps, e.g. a UUID)",
-        ))
-    }
-}
 
 /// The history's store failing a read: 503, saying why (not a submission's refusal).
 fn unreadable(error: EngineError) -> ApiError {
@@ -74,21 +44,6 @@ fn unreadable(error: EngineError) -> ApiError {
         ),
         other => other.into(),
     }
-}
-
-/// A 422 `invalid-input` problem naming `field`, its `value` and what is `allowed`.
-fn invalid(field: &str, value: Value, allowed: &str) -> ApiError {
-    let shown = match &value {
-        Value::Null => "missing".to_string(),
-        other => other.to_string(),
-    };
-    JobError::Invalid(vec![FieldError {
-        field: field.to_string(),
-        message: format!("{field} = {shown}: allowed {allowed}"),
-        value,
-        allowed: allowed.to_string(),
-    }])
-    .into()
 }
 
 /// `GET /v1/jobs`'s query: filters and the page. Read by hand, so that every bad query

@@ -11,107 +11,29 @@ use axum::response::sse::{Event, KeepAlive, Sse};
 use axum::response::{IntoResponse, Response};
 use axum::Json;
 use futures_util::stream::{self, Stream};
-use serde::{Deserialize, Serialize};
+use serde::Deserialize;
 use tokio::sync::watch;
 use utoipa::{IntoParams, ToSchema};
 use uuid::Uuid;
 
-use super::history::{OwnerHeader, OWNER_HEADER};
+use super::shared::{JobView, OwnerHeader, OWNER_HEADER};
 use super::{Answering, FormatQuery};
 use crate::engine::store::{JobRecord, JobState, JobStatus, Owner};
 use crate::engine::{Engine, Unknown};
 use crate::http::accept::{Accept, AcceptsJson};
 use crate::http::access::{self, Caller};
 use crate::http::body::JsonBody;
-use crate::http::error::{ApiError, Problem};
+use crate::http::error::ApiError;
 use crate::http::responses::{
     BadBody, Busy, Gone, InvalidParameters, JobFailure, NotAcceptable, NotFound, NotModified,
     NotTheOwner, ReadBack, TooManyStreams, Unfinished,
 };
 use crate::http::AppState;
-use crate::job::registry::{Envelope, KindName};
-use crate::job::{input_hash_of, Job, JobError, Work};
+use crate::job::registry::Envelope;
+use crate::job::{Job, JobError};
 
 /// How often a progress stream looks at a running job's count of solves.
 const PROGRESS_INTERVAL: Duration = Duration::from_millis(100);
-
-/// Work done out of the job's total.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, ToSchema)]
-pub struct Progress {
-    /// Units of work done (count): rolling solves, or for a fit the points evaluated.
-    pub done: usize,
-    /// Units of work the job takes (count; 0 for a job that cannot tell in advance, a fit).
-    pub total: usize,
-}
-
-/// An asynchronous job as clients see it: small, whatever the size of its answer, which is
-/// at `result_url`.
-#[derive(Debug, Serialize, ToSchema)]
-pub struct JobView {
-    /// The job's id (a UUID); its URL is `/v1/jobs/{id}`.
-    pub id: Uuid,
-    pub kind: KindName,
-    pub status: JobStatus,
-    pub progress: Progress,
-    /// Where the job's answer is, once it has one: `/v1/jobs/{id}/result` (JSON, CSV or its
-    /// picture). A succeeded job's answer is whole; a cancelled or failed sweep's holds the
-    /// points it finished (see `partial`).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub result_url: Option<String>,
-    /// Whether the answer at `result_url` is partial: what a cancelled or failed job
-    /// finished, its unsolved points `missing` (present only when true).
-    #[serde(skip_serializing_if = "std::ops::Not::not")]
-    pub partial: bool,
-    /// Why it failed, once `failed`.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub problem: Option<Problem>,
-    /// The hash of the job's canonical input: its answer's stable link is
-    /// `/v1/results/{input_hash}`.
-    pub input_hash: String,
-    /// When the job was accepted (RFC 3339, UTC).
-    #[schema(format = DateTime)]
-    pub submitted_at: String,
-    /// When it finished, once it has (RFC 3339, UTC).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    #[schema(format = DateTime)]
-    pub finished_at: Option<String>,
-    /// `true` (present only then) when the job's end could not be saved in the database of
-    /// saved analyses (a full disk): it is kept in memory only, for `--job-retention`, and
-    /// not across a restart.
-    #[serde(skip_serializing_if = "std::ops::Not::not")]
-    #[schema(value_type = Option<bool>)]
-    pub unsaved: bool,
-}
-
-impl JobView {
-    /// The job as recorded.
-    pub fn of(record: &JobRecord) -> JobView {
-        let time = |t| humantime::format_rfc3339_millis(t).to_string();
-        let result = record.state.result();
-        JobView {
-            id: record.id,
-            kind: record.kind,
-            status: record.state.status(),
-            progress: Progress {
-                done: record.done,
-                total: match record.work {
-                    Work::Known(total) => total,
-                    Work::Unknown => 0,
-                },
-            },
-            result_url: result.map(|_| format!("/v1/jobs/{}/result", record.id)),
-            partial: result.is_some_and(|r| !r.complete()),
-            problem: match &record.state {
-                JobState::Failed { error, .. } => Some(ApiError::from(error.clone()).problem()),
-                _ => None,
-            },
-            input_hash: input_hash_of(&record.input_hash).to_string(),
-            submitted_at: time(record.submitted_at),
-            finished_at: record.finished_at.map(time),
-            unsaved: record.unsaved,
-        }
-    }
-}
 
 /// The job named in the path; 404 when the id is unknown, expired or not a UUID.
 #[derive(Deserialize, IntoParams)]

@@ -10,6 +10,7 @@ pub mod history;
 pub mod jobs;
 pub mod ops;
 pub mod rolling;
+pub mod shared;
 pub mod sweeps;
 pub mod three_body;
 

@@ -3,7 +3,6 @@
 //! rate after a grace period, as Kestrel's `MinRequestBodyDataRate`), and an answer's body
 //! carries the guard that ends its request when hyper has taken all of it.
 
-use std::fmt;
 use std::future::Future;
 use std::pin::Pin;
 use std::sync::Arc;
@@ -28,29 +27,20 @@ pub struct BodyPace {
 }
 
 /// A request body that arrived too slowly; the JSON body extractor answers it with 408.
-#[derive(Debug)]
+#[derive(Debug, thiserror::Error)]
+#[error(
+    "the request body arrived too slowly: {received} bytes in {secs:.1} s; this service waits at \
+     most {wait} s for each piece of a body (--body-timeout) and, after that long, takes \
+     at least {rate} bytes/s on average (--body-min-rate)",
+    secs = .after.as_secs_f64(),
+    wait = .pace.timeout.as_secs_f64(),
+    rate = .pace.min_rate
+)]
 pub struct TooSlow {
     pub received: u64,
     pub after: Duration,
     pub pace: BodyPace,
 }
-
-impl fmt::Display for TooSlow {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(
-            f,
-            "the request body arrived too slowly: {} bytes in {:.1} s; this service waits at \
-             most {} s for each piece of a body (--body-timeout) and, after that long, takes \
-             at least {} bytes/s on average (--body-min-rate)",
-            self.received,
-            self.after.as_secs_f64(),
-            self.pace.timeout.as_secs_f64(),
-            self.pace.min_rate
-        )
-    }
-}
-
-impl std::error::Error for TooSlow {}
 
 /// A request body held to its pace.
 pub struct Paced {

@@ -23,7 +23,7 @@ use hyper::body::Incoming;
 use hyper_util::rt::{TokioIo, TokioTimer};
 use hyper_util::server::graceful::GracefulShutdown;
 use tokio::net::TcpListener;
-use tokio::sync::Semaphore;
+use tokio::sync::{OwnedSemaphorePermit, Semaphore};
 use tokio_util::sync::CancellationToken;
 use tower::ServiceExt;
 
@@ -49,6 +49,29 @@ pub struct ConnectionLimits {
     pub send_timeout: Duration,
     /// How a request body must arrive.
     pub body: BodyPace,
+}
+
+/// A slot for a newcomer. At the cap, it takes the slot of the most dispensable connection,
+/// closed for it, or (when every connection is serving a request) waits for the first to
+/// end; `None` once `stop` is cancelled.
+async fn take_slot(
+    slots: &Arc<Semaphore>,
+    connections: &Connections,
+    stop: &CancellationToken,
+) -> Option<OwnedSemaphorePermit> {
+    loop {
+        if let Ok(slot) = slots.clone().try_acquire_owned() {
+            return Some(slot);
+        }
+        if let Some(slot) = connections.evict() {
+            return Some(slot);
+        }
+        tokio::select! {
+            () = stop.cancelled() => return None,
+            slot = slots.clone().acquire_owned() => return slot.ok(),
+            () = tokio::time::sleep(EVICT_RETRY) => {}
+        }
+    }
 }
 
 /// Serves `app` on `listener` until `stop` is cancelled, then lets the open connections
@@ -88,22 +111,9 @@ pub async fn serve(
                 }
             },
         };
-        // At the cap, the newcomer takes the slot of the most dispensable connection, closed
-        // for it, or (when every connection is serving a request) waits for the first to end.
-        let slot = loop {
-            if let Ok(slot) = slots.clone().try_acquire_owned() {
-                break Some(slot);
-            }
-            if let Some(slot) = connections.evict() {
-                break Some(slot);
-            }
-            tokio::select! {
-                () = stop.cancelled() => break None,
-                slot = slots.clone().acquire_owned() => break slot.ok(),
-                () = tokio::time::sleep(EVICT_RETRY) => {}
-            }
+        let Some(slot) = take_slot(&slots, &connections, &stop).await else {
+            break;
         };
-        let Some(slot) = slot else { break };
         let _ = stream.set_nodelay(true);
         let activity = Arc::new(Activity::new(clock));
         let service = hyper::service::service_fn({

@@ -317,25 +317,7 @@ fn read_parameters(
     checker: &mut Checker,
 ) -> (Vec<FitParameter>, Vec<Bounds>) {
     let given = input.given();
-    let named = |p: FitParameter| given.iter().any(|(q, _)| *q == p);
-    for (a, b) in [
-        (FitParameter::RetardationTime, FitParameter::Kappa),
-        (FitParameter::Thickness, FitParameter::Stiffness),
-        (FitParameter::RelaxationTime, FitParameter::ShiftFactor),
-        (FitParameter::ElasticModulus, FitParameter::ModulusScale),
-    ] {
-        if named(a) && named(b) {
-            let allowed = format!("at most one of {} and {}", a.name(), b.name());
-            checker.invalid(b.name(), json!({}), &allowed);
-        }
-    }
-    if !base.arms.is_empty() {
-        for (parameter, _) in given.iter().filter(|(p, _)| p.is_kelvin_time()) {
-            let allowed = "absent for a layer given as a Prony series of more than one term: \
-                           fit shift_factor (all its times) and modulus_scale (all its moduli)";
-            checker.invalid(parameter.name(), json!({}), allowed);
-        }
-    }
+    refuse_conflicts(&given, base, checker);
     let mut free = Vec::new();
     let mut all = Vec::new();
     for (parameter, field) in given {
@@ -383,12 +365,42 @@ fn read_parameters(
         free.push(parameter);
         all.push(b);
     }
-    // The starts must make a valid layer (T_ε ≥ T_σ above all).
+    check_starts(base, &free, &all, checker);
+    (free, all)
+}
+
+/// Parameters that name one quantity twice (a time and the factor over it), and Kelvin
+/// times for a layer of several Prony terms: each refused, naming the parameter.
+fn refuse_conflicts<F>(given: &[(FitParameter, F)], base: &Layer, checker: &mut Checker) {
+    let named = |p: FitParameter| given.iter().any(|(q, _)| *q == p);
+    for (a, b) in [
+        (FitParameter::RetardationTime, FitParameter::Kappa),
+        (FitParameter::Thickness, FitParameter::Stiffness),
+        (FitParameter::RelaxationTime, FitParameter::ShiftFactor),
+        (FitParameter::ElasticModulus, FitParameter::ModulusScale),
+    ] {
+        if named(a) && named(b) {
+            let allowed = format!("at most one of {} and {}", a.name(), b.name());
+            checker.invalid(b.name(), json!({}), &allowed);
+        }
+    }
+    if !base.arms.is_empty() {
+        for (parameter, _) in given.iter().filter(|(p, _)| p.is_kelvin_time()) {
+            let allowed = "absent for a layer given as a Prony series of more than one term: \
+                           fit shift_factor (all its times) and modulus_scale (all its moduli)";
+            checker.invalid(parameter.name(), json!({}), allowed);
+        }
+    }
+}
+
+/// The starts must make a valid layer (T_ε ≥ T_σ above all): each violation is refused,
+/// showing the starts.
+fn check_starts(base: &Layer, free: &[FitParameter], all: &[Bounds], checker: &mut Checker) {
     let starts: Vec<f64> = all.iter().map(|b| b.start).collect();
     // Only its layers are read here, which the law does not change.
     let parameterization = Parameterization {
         base: *base,
-        free: free.clone(),
+        free: free.to_vec(),
         law: Law::Local,
     };
     if starts.iter().all(|x| x.is_finite()) && base.violations().is_empty() {
@@ -408,7 +420,6 @@ fn read_parameters(
             checker.invalid("", serde_json::Value::Object(shown.clone()), &allowed);
         }
     }
-    (free, all)
 }
 
 fn read_series(

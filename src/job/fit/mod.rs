@@ -488,54 +488,42 @@ fn by_quantity<T>(measured: fit::Measured, x: T) -> (Option<T>, Option<T>) {
 /// Points along a curve.
 const CURVE_POINTS: usize = 41;
 
-/// The fitted model along the series `points`: dense over the one condition they vary,
-/// through the points themselves when they vary several or none.
-fn curve(
-    series: usize,
-    points: &[Datum],
-    layer: &Layer,
-    law: Law,
-    control: &Control,
-) -> Result<Curve, JobError> {
-    let first = points.first().map_or_else(
-        || Err(JobError::Internal("a series without points".to_string())),
-        |d| Ok(d.point),
-    )?;
-    let conditions: [Condition; 4] = [
-        ("velocity", |p| Some(p.velocity), |p, x| p.velocity = x),
-        (
-            "load",
-            |p| where_measured(p).load,
-            |p, x| {
-                if let Setting::Particle { load, .. } = &mut p.setting {
-                    *load = x;
-                }
-            },
-        ),
-        (
-            "radius",
-            |p| where_measured(p).radius,
-            |p, x| {
-                if let Setting::Particle { radius, .. } = &mut p.setting {
-                    *radius = x;
-                }
-            },
-        ),
-        (
-            "total_load",
-            |p| where_measured(p).total_load,
-            |p, x| {
-                if let Setting::System { total_load, .. } = &mut p.setting {
-                    *total_load = x;
-                }
-            },
-        ),
-    ];
-    let varied: Vec<&Condition> = conditions
-        .iter()
-        .filter(|(_, of, _)| points.iter().any(|d| of(&d.point) != of(&first)))
-        .collect();
-    let along = varied.first().map_or("velocity", |c| c.0);
+/// The conditions a series may vary, in the order a curve is drawn along the first varied.
+const CONDITIONS: [Condition; 4] = [
+    ("velocity", |p| Some(p.velocity), |p, x| p.velocity = x),
+    (
+        "load",
+        |p| where_measured(p).load,
+        |p, x| {
+            if let Setting::Particle { load, .. } = &mut p.setting {
+                *load = x;
+            }
+        },
+    ),
+    (
+        "radius",
+        |p| where_measured(p).radius,
+        |p, x| {
+            if let Setting::Particle { radius, .. } = &mut p.setting {
+                *radius = x;
+            }
+        },
+    ),
+    (
+        "total_load",
+        |p| where_measured(p).total_load,
+        |p, x| {
+            if let Setting::System { total_load, .. } = &mut p.setting {
+                *total_load = x;
+            }
+        },
+    ),
+];
+
+/// Where a series' curve is evaluated: dense over the one condition its points vary (on a
+/// log scale when it spans more than a factor of 20), else at the points themselves, sorted
+/// along the first condition they vary.
+fn grid(points: &[Datum], first: Point, varied: &[&Condition]) -> Vec<Point> {
     let mut grid: Vec<Point> = points.iter().map(|d| d.point).collect();
     if let [(_, of, set)] = varied[..] {
         let (lo, hi) = grid
@@ -567,6 +555,28 @@ fn curve(
                 .unwrap_or(std::cmp::Ordering::Equal)
         });
     }
+    grid
+}
+
+/// The fitted model along the series `points`: dense over the one condition they vary,
+/// through the points themselves when they vary several or none.
+fn curve(
+    series: usize,
+    points: &[Datum],
+    layer: &Layer,
+    law: Law,
+    control: &Control,
+) -> Result<Curve, JobError> {
+    let first = points.first().map_or_else(
+        || Err(JobError::Internal("a series without points".to_string())),
+        |d| Ok(d.point),
+    )?;
+    let varied: Vec<&Condition> = CONDITIONS
+        .iter()
+        .filter(|(_, of, _)| points.iter().any(|d| of(&d.point) != of(&first)))
+        .collect();
+    let along = varied.first().map_or("velocity", |c| c.0);
+    let grid = grid(points, first, &varied);
     let mut curve_points = Vec::with_capacity(grid.len());
     for p in grid {
         let y = control.solve(|stop| p.value(layer, law, stop))?;

@@ -8,6 +8,7 @@ use std::collections::BTreeMap;
 
 use serde::Deserialize;
 
+use super::input::MeasuredQuantity;
 use super::output::{Conditions, Curve, Residual};
 use crate::job::picture::{shown, symbol, Picture, PictureError};
 use crate::model::fit::FitParameter;
@@ -49,6 +50,81 @@ impl Fitted {
     }
 }
 
+/// A curve's name: the conditions it holds, `R = 25 nm, P = 1 nN`, or its series' number.
+fn group_name(curve: &Curve, along: &str) -> String {
+    let held = curve.points.first().map(|p| {
+        let held = p.at.given().into_iter().filter(|c| c.0 != along);
+        let named =
+            held.map(|(name, unit, value)| format!("{} = {}", symbol(&name), shown(value, unit)));
+        named.collect::<Vec<_>>().join(", ")
+    });
+    held.unwrap_or_else(|| format!("series {}", curve.series))
+}
+
+/// A series' measured points, and the segments from them to the curve and their bars.
+type Residuals = (Vec<(f64, f64)>, Vec<Layer>);
+
+/// Where a point is along the curves, and the unit there.
+type Along<'a> = dyn Fn(&Conditions) -> Result<(f64, &'static str), PictureError> + 'a;
+
+impl FitPicture {
+    /// The measured points of `series` and the segments to their fitted values (dashed),
+    /// with their uncertainty bars.
+    fn residuals(
+        &self,
+        series: usize,
+        quantity: MeasuredQuantity,
+        group: &str,
+        x: &Along<'_>,
+    ) -> Result<Residuals, PictureError> {
+        let mut measured = Vec::new();
+        let mut segments = Vec::new();
+        for r in self.residuals.iter().filter(|r| r.series == series) {
+            let compared = r
+                .comparison(quantity)
+                .ok_or("a residual has no comparison")?;
+            let (x, _) = x(&r.at)?;
+            measured.push((x, compared.measured));
+            segments.push(Layer::Line {
+                name: String::new(),
+                group: group.to_string(),
+                points: vec![(x, compared.measured), (x, compared.fitted)],
+                dashed: true,
+            });
+            if let Some(u) = compared.uncertainty {
+                segments.push(Layer::Line {
+                    name: String::new(),
+                    group: group.to_string(),
+                    points: vec![(x, compared.measured - u), (x, compared.measured + u)],
+                    dashed: false,
+                });
+            }
+        }
+        Ok((measured, segments))
+    }
+
+    /// The notes under the chart: each parameter fitted, χ², how to read it, and the series
+    /// `left_out`.
+    fn notes(&self, left_out: usize) -> Vec<String> {
+        let mut notes: Vec<String> = self
+            .parameters
+            .iter()
+            .flat_map(|(name, fitted)| fitted.note(name))
+            .collect();
+        notes.push(format!(
+            "χ² = {} for {} dof",
+            shown(self.chi_squared, ""),
+            self.dof
+        ));
+        notes.push("bars: ± the uncertainty given".to_string());
+        notes.push("dashed: residuals".to_string());
+        if left_out > 0 {
+            notes.push(format!("{left_out} series of the other quantity not drawn"));
+        }
+        notes
+    }
+}
+
 impl Picture for FitPicture {
     fn chart(self) -> Result<Chart, PictureError> {
         let first = self.curves.first().ok_or("the fit has no curve")?;
@@ -69,15 +145,7 @@ impl Picture for FitPicture {
                 left_out += 1;
                 continue;
             }
-            // Named by the conditions the curve holds: `R = 25 nm, P = 1 nN`.
-            let held = curve.points.first().map(|p| {
-                let held = p.at.given().into_iter().filter(|c| c.0 != along);
-                let named = held.map(|(name, unit, value)| {
-                    format!("{} = {}", symbol(&name), shown(value, unit))
-                });
-                named.collect::<Vec<_>>().join(", ")
-            });
-            let group = held.unwrap_or_else(|| format!("series {}", curve.series));
+            let group = group_name(curve, &along);
             let line = curve
                 .points
                 .iter()
@@ -88,29 +156,7 @@ impl Picture for FitPicture {
                     Ok((x, y))
                 })
                 .collect::<Result<Vec<_>, PictureError>>()?;
-            let mut measured = Vec::new();
-            let mut segments = Vec::new();
-            for r in self.residuals.iter().filter(|r| r.series == curve.series) {
-                let compared = r
-                    .comparison(quantity)
-                    .ok_or("a residual has no comparison")?;
-                let (x, _) = x(&r.at)?;
-                measured.push((x, compared.measured));
-                segments.push(Layer::Line {
-                    name: String::new(),
-                    group: group.clone(),
-                    points: vec![(x, compared.measured), (x, compared.fitted)],
-                    dashed: true,
-                });
-                if let Some(u) = compared.uncertainty {
-                    segments.push(Layer::Line {
-                        name: String::new(),
-                        group: group.clone(),
-                        points: vec![(x, compared.measured - u), (x, compared.measured + u)],
-                        dashed: false,
-                    });
-                }
-            }
+            let (measured, segments) = self.residuals(curve.series, quantity, &group, &x)?;
             all_x.extend(measured.iter().map(|p| p.0));
             // Markers first: they take the colour the series' lines then share.
             layers.push(Layer::Markers {
@@ -133,21 +179,7 @@ impl Picture for FitPicture {
         if lo > 0.0 && hi / lo > 20.0 {
             x = x.log();
         }
-        let mut notes: Vec<String> = self
-            .parameters
-            .iter()
-            .flat_map(|(name, fitted)| fitted.note(name))
-            .collect();
-        notes.push(format!(
-            "χ² = {} for {} dof",
-            shown(self.chi_squared, ""),
-            self.dof
-        ));
-        notes.push("bars: ± the uncertainty given".to_string());
-        notes.push("dashed: residuals".to_string());
-        if left_out > 0 {
-            notes.push(format!("{left_out} series of the other quantity not drawn"));
-        }
+        let notes = self.notes(left_out);
         let name = quantity.name();
         Ok(Chart {
             title: format!("Fit: {} against {along}", name.replace('_', " ")),

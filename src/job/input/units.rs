@@ -107,37 +107,28 @@ impl fmt::Display for Dimension {
 }
 
 /// Why a quantity string could not be read.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum UnitError {
     /// No number at the start.
+    #[error("does not start with a number")]
     NoNumber,
     /// A unit symbol that is not an SI symbol with an SI prefix.
+    #[error("has an unknown unit \"{0}\" (SI symbols m, g, s, N, Pa, K with SI prefixes, or °C)")]
     UnknownUnit(String),
     /// A unit power out of range (`m^127`).
+    #[error(
+        "has a unit power out of range in \"{0}\" (allowed: −{max} to {max} per symbol, at \
+         most {all} in all)",
+        max = MAX_POWER,
+        all = MAX_DIMENSION
+    )]
     Power(String),
     /// A valid unit of another dimension than the field's.
+    #[error("is {found}")]
     WrongDimension {
         found: Dimension,
         expected: Dimension,
     },
-}
-
-impl fmt::Display for UnitError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            UnitError::NoNumber => f.write_str("does not start with a number"),
-            UnitError::UnknownUnit(u) => write!(
-                f,
-                "has an unknown unit \"{u}\" (SI symbols m, g, s, N, Pa, K with SI prefixes, or °C)"
-            ),
-            UnitError::Power(u) => write!(
-                f,
-                "has a unit power out of range in \"{u}\" (allowed: −{MAX_POWER} to {MAX_POWER} \
-                 per symbol, at most {MAX_DIMENSION} in all)"
-            ),
-            UnitError::WrongDimension { found, .. } => write!(f, "is {found}"),
-        }
-    }
 }
 
 /// Largest power of one symbol in a unit (`m^4`): beyond it a unit is a typo, not a unit.

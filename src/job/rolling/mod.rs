@@ -13,7 +13,7 @@ use utoipa::ToSchema;
 use super::input::{self, field, Checker, LayerInput, LayerModel, QuadratureKind, Quantity};
 use super::kind::SMALL_ANSWER;
 use super::meta::{Canonical, CONTINUUM_REFERENCES, ROLLING_REFERENCES};
-use super::points::{self, PointNotes, PointNotesFields, PointStatus, Row, SweepVerification};
+use super::points::{self, PointNotes, PointNotesFields, PointStatus, Row};
 use super::validity::{self, PointValidity, Subject, ValidityOutput};
 use super::{Control, Cost, JobError, Kind, Limits, Meta, References, Validated, Work};
 use crate::model::continuum::ContinuumVerification;
@@ -630,6 +630,7 @@ impl SweepPoint {
 
 impl Row for SweepPoint {
     type Point = Rolling;
+    type Verification = ContactVerification;
 
     fn unanswered(rolling: &Rolling, notes: PointNotes) -> Self {
         SweepPoint {
@@ -647,8 +648,8 @@ impl Row for SweepPoint {
         &self.notes
     }
 
-    fn verification(&self) -> Option<SweepVerification> {
-        self.verification.clone().map(SweepVerification::Rolling)
+    fn verification(&self) -> Option<ContactVerification> {
+        self.verification.clone()
     }
 }
 

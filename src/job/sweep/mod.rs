@@ -3,7 +3,9 @@
 //! diameter).
 
 mod picture;
+mod rows;
 pub use picture::SweepPicture;
+pub use rows::{PointCounts, SweepSummary, SweepVerification};
 
 use std::ops::Range;
 
@@ -14,7 +16,6 @@ use utoipa::ToSchema;
 use super::input::LayerModel;
 use super::input::{self, field, Checker, Field, Quantity};
 use super::kind::SMALL_ANSWER;
-use super::points::{self, SweepSummary};
 use super::rolling::{RollingInput, RollingJob, Solved};
 use super::three_body::{
     operating_fields, references as three_body_references, slot, solve_kept, system_cost, Nodes,
@@ -278,7 +279,12 @@ impl Kind for SweepJob {
                     control.map_each(&contacts, on_refusal, |p| SweepPoint::new(p, &solve(p)?))
                 } else {
                     let kept = control.kept(
-                        |p| format!("{MODEL_VERSION} rolling {law:?} {p:?} {options:?}"),
+                        |p| {
+                            point_key(&RollingJob {
+                                rolling: *p,
+                                ..*base
+                            })
+                        },
                         |_| std::mem::size_of::<Solved>(),
                         solve,
                     );
@@ -286,14 +292,20 @@ impl Kind for SweepJob {
                 };
                 let swept = refused_at(swept, first, on_refusal)?;
                 let stop = swept.stopped.clone();
-                let (rows, summary) = points::rows(&contacts, swept, first, Subject::Particle);
+                let (rows, summary) = rows::rows(&contacts, swept, first, Subject::Particle);
                 (SweepPoints::Rolling(rows), summary, stop)
             }
             SweepOfPoints::ThreeBody(s) => {
                 let systems = part(s.points(), range)?;
-                let options = &s.base.options;
+                let base = &s.base;
+                let options = &base.options;
                 let kept = control.kept(
-                    |p| format!("{MODEL_VERSION} three_body {p:?} {options:?}"),
+                    |p| {
+                        point_key(&ThreeBodyJob {
+                            system: *p,
+                            ..*base
+                        })
+                    },
                     |_| std::mem::size_of::<ThreeBodySolution>(),
                     |p| solve_kept(p, options, control),
                 );
@@ -302,7 +314,7 @@ impl Kind for SweepJob {
                 });
                 let swept = refused_at(swept, first, on_refusal)?;
                 let stop = swept.stopped.clone();
-                let (rows, summary) = points::rows(&systems, swept, first, Subject::System);
+                let (rows, summary) = rows::rows(&systems, swept, first, Subject::System);
                 (SweepPoints::ThreeBody(rows), summary, stop)
             }
         };
@@ -316,6 +328,17 @@ impl Kind for SweepJob {
     fn unfinished(output: &SweepOutput) -> Option<JobError> {
         output.stop.clone()
     }
+}
+
+/// The memo key of a sweep's point: the model's version, its kind, and its canonical text
+/// as a job of its own, so that equal points share one solve (a retry, a sweep that
+/// overlaps another).
+fn point_key<K: Kind>(point: &K) -> String {
+    format!(
+        "{MODEL_VERSION} {} {}",
+        K::NAME,
+        point.canonical_text().get()
+    )
 }
 
 /// A sweep that stopped at a refusal (`on_refusal: fail`) fails with it, the point named by

@@ -108,21 +108,66 @@ fn condition(name: &str, parameter: Parameter, value: f64) -> Condition {
     (name.to_string(), parameter.unit(), value)
 }
 
+/// The conditions that vary over `rows`, each with its number of distinct values.
+fn varied(rows: &[Drawn], first: &Drawn) -> Vec<(usize, usize)> {
+    let values =
+        |i: usize| -> Vec<u64> { rows.iter().map(|r| r.conditions[i].2.to_bits()).collect() };
+    (0..first.conditions.len())
+        .filter_map(|i| {
+            let mut seen = values(i);
+            seen.sort_unstable();
+            seen.dedup();
+            (seen.len() > 1).then_some((i, seen.len()))
+        })
+        .collect()
+}
+
+/// The label of `row`'s curve: the values of the `varied` conditions other than the one
+/// drawn `along`, or `sweep` when there are none.
+fn label(row: &Drawn, varied: &[(usize, usize)], along: usize) -> String {
+    let label: Vec<String> = varied
+        .iter()
+        .filter(|v| v.0 != along)
+        .map(|v| {
+            let (name, unit, value) = &row.conditions[v.0];
+            format!("{} = {}", symbol(name), shown(*value, unit))
+        })
+        .collect();
+    if label.is_empty() {
+        "sweep".to_string()
+    } else {
+        label.join(", ")
+    }
+}
+
+/// A line for each curve, then the points at rest of them all as hollow markers.
+fn layers(curves: Vec<Curve>) -> Vec<Layer> {
+    let mut layers = Vec::new();
+    let mut rest = Vec::new();
+    for (name, line, at_rest) in curves {
+        layers.push(Layer::Line {
+            group: name.clone(),
+            name,
+            points: line,
+            dashed: false,
+        });
+        rest.extend(at_rest);
+    }
+    if !rest.is_empty() {
+        layers.push(Layer::Markers {
+            name: "at rest, V = 0".to_string(),
+            points: rest,
+            hollow: true,
+        });
+    }
+    layers
+}
+
 impl Picture for SweepPicture {
     fn chart(self) -> Result<Chart, PictureError> {
         let (rows, y_name) = self.points.drawn();
         let first = rows.first().ok_or("the sweep has no point")?;
-        let values =
-            |i: usize| -> Vec<u64> { rows.iter().map(|r| r.conditions[i].2.to_bits()).collect() };
-        // The conditions that vary, each with its number of distinct values.
-        let varied: Vec<(usize, usize)> = (0..first.conditions.len())
-            .filter_map(|i| {
-                let mut seen = values(i);
-                seen.sort_unstable();
-                seen.dedup();
-                (seen.len() > 1).then_some((i, seen.len()))
-            })
-            .collect();
+        let varied = varied(&rows, first);
         // The longest list; of equal ones, the first (`max_by_key` keeps the last).
         let along = varied.iter().rev().max_by_key(|v| v.1).map_or(0, |v| v.0);
         let (along_name, along_unit, _) = &first.conditions[along];
@@ -134,19 +179,7 @@ impl Picture for SweepPicture {
                 unanswered += 1;
                 continue;
             };
-            let label: Vec<String> = varied
-                .iter()
-                .filter(|v| v.0 != along)
-                .map(|v| {
-                    let (name, unit, value) = &row.conditions[v.0];
-                    format!("{} = {}", symbol(name), shown(*value, unit))
-                })
-                .collect();
-            let label = if label.is_empty() {
-                "sweep".to_string()
-            } else {
-                label.join(", ")
-            };
+            let label = label(row, &varied, along);
             let point = (row.conditions[along].2, mu);
             let index = match curves.iter().position(|c| c.0 == label) {
                 Some(i) => i,
@@ -160,24 +193,7 @@ impl Picture for SweepPicture {
                 curves[index].2.push(point);
             }
         }
-        let mut layers = Vec::new();
-        let mut rest = Vec::new();
-        for (name, line, at_rest) in curves {
-            layers.push(Layer::Line {
-                group: name.clone(),
-                name,
-                points: line,
-                dashed: false,
-            });
-            rest.extend(at_rest);
-        }
-        if !rest.is_empty() {
-            layers.push(Layer::Markers {
-                name: "at rest, V = 0".to_string(),
-                points: rest,
-                hollow: true,
-            });
-        }
+        let layers = layers(curves);
         // Short lines: they stand under the legend.
         let notes = match unanswered {
             0 => Vec::new(),

@@ -12,9 +12,10 @@ use serde_json::Value;
 use utoipa::ToSchema;
 
 use super::input::units::Dimension;
-use super::input::{self, field, Checker, LayerInput, QuadratureKind, Quantity};
+use super::input::{self, field, Checker, LayerInput, LayerModel, QuadratureKind, Quantity};
 use super::meta::{Canonical, REFERENCES, THREE_BODY_CONTINUUM_REFERENCES};
-use super::points::{self, PointNotes, PointNotesFields, PointStatus, Row, SweepVerification};
+use super::points::{self, PointNotes, PointNotesFields, PointStatus, Row};
+use super::rolling::RollingJob;
 use super::validity::{self, PointValidity, Subject, ValidityOutput};
 use super::{rolling, Control, Cost, JobError, Kind, Limits, Meta, References, Validated, Work};
 use crate::model::continuum::{self, ContinuumVerification, PenetrationCurve};
@@ -24,7 +25,8 @@ use crate::model::three_body::{
     DEFAULT_DIAMETER_NODES,
 };
 use crate::model::{
-    Layer, ModelError, Parameter, Rolling, RollingSolution, SolveOption, Stop, MODEL_VERSION,
+    Layer, ModelError, Parameter, Rolling, RollingSolution, SolveOption, SolveOptions, Stop,
+    MODEL_VERSION,
 };
 use crate::render::{fields, Column, Output, Table, UnitTable};
 use crate::{described, unit_table};
@@ -562,7 +564,16 @@ pub fn kept_node(
     control: &Control,
 ) -> impl Fn(&Rolling) -> Result<RollingSolution<ContinuumVerification>, ModelError> + Sync + '_ {
     control.kept(
-        |p: &Rolling| format!("{MODEL_VERSION} continuum curve node {p:?}"),
+        |p: &Rolling| {
+            // The node as a rolling contact on the continuum: its canonical text.
+            let node = RollingJob {
+                rolling: *p,
+                options: SolveOptions::default(),
+                law: LayerModel::Continuum,
+            };
+            let text = Kind::canonical_text(&node);
+            format!("{MODEL_VERSION} continuum curve node {}", text.get())
+        },
         |_| std::mem::size_of::<RollingSolution<ContinuumVerification>>(),
         move |p: &Rolling| {
             let asked = || control.must_stop();
@@ -935,6 +946,7 @@ impl ThreeBodySweepPoint {
 
 impl Row for ThreeBodySweepPoint {
     type Point = ThreeBody;
+    type Verification = ThreeBodyVerificationOutput;
 
     fn unanswered(system: &ThreeBody, notes: PointNotes) -> Self {
         ThreeBodySweepPoint {
@@ -953,7 +965,7 @@ impl Row for ThreeBodySweepPoint {
         &self.notes
     }
 
-    fn verification(&self) -> Option<SweepVerification> {
-        self.verification.clone().map(SweepVerification::ThreeBody)
+    fn verification(&self) -> Option<ThreeBodyVerificationOutput> {
+        self.verification.clone()
     }
 }
