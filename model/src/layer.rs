@@ -285,23 +285,16 @@ impl fmt::Display for Parameter {
     }
 }
 
-/// A parameter outside its physical range.
-#[derive(Clone, Debug, PartialEq)]
+/// A parameter outside its physical range. The message names the parameter, its value with
+/// its unit, and the range allowed, so a caller can mend the input from it alone.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error(
+    "{parameter} = {} is out of range; expected {allowed}",
+    quantity(*.value, .parameter.unit())
+)]
 pub struct ParameterError {
     pub parameter: Parameter,
     pub value: f64,
     /// The allowed range, as text.
     pub allowed: String,
-}
-
-impl fmt::Display for ParameterError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(
-            f,
-            "{} = {} is out of range; expected {}",
-            self.parameter,
-            quantity(self.value, self.parameter.unit()),
-            self.allowed
-        )
-    }
 }
