@@ -60,3 +60,18 @@ pub enum ModelError {
     #[error("the solve was stopped by its caller")]
     Stopped,
 }
+
+impl ModelError {
+    /// The first of a solve's invalid inputs, parameters before options, as its refusal: a
+    /// solve checks every input before it does any work, and answers the first problem.
+    pub(crate) fn check_inputs(
+        parameters: Vec<ParameterError>,
+        options: Vec<OptionError>,
+    ) -> Result<(), ModelError> {
+        match (parameters.into_iter().next(), options.into_iter().next()) {
+            (Some(parameter), _) => Err(parameter.into()),
+            (None, Some(option)) => Err(ModelError::InvalidOption(option)),
+            (None, None) => Ok(()),
+        }
+    }
+}

@@ -69,16 +69,13 @@ impl Layer {
 
     /// Every parameter outside its physical range.
     pub fn violations(&self) -> Vec<ParameterError> {
-        let mut errors: Vec<ParameterError> = [
+        let mut errors = Parameter::check_all([
             (Parameter::ElasticModulus, self.elastic_modulus),
             (Parameter::Thickness, self.thickness),
             (Parameter::PoissonRatio, self.poisson_ratio),
             (Parameter::RelaxationTime, self.relaxation_time),
             (Parameter::RetardationTime, self.retardation_time),
-        ]
-        .into_iter()
-        .filter_map(|(parameter, value)| parameter.check(value).err())
-        .collect();
+        ]);
         let times_valid = errors.iter().all(|e| {
             !matches!(
                 e.parameter,
@@ -215,6 +212,17 @@ impl Parameter {
         } else {
             format!("finite and > 0 {unit}").trim_end().to_string()
         }
+    }
+
+    /// Each of `values` outside its parameter's own range, in order: every input struct
+    /// checks its fields this way, then adds its own cross-checks.
+    pub(crate) fn check_all(
+        values: impl IntoIterator<Item = (Parameter, f64)>,
+    ) -> Vec<ParameterError> {
+        values
+            .into_iter()
+            .filter_map(|(parameter, value)| parameter.check(value).err())
+            .collect()
     }
 
     /// Checks one value against the parameter's own range (not the cross-checks, such as

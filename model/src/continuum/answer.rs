@@ -129,12 +129,7 @@ pub fn solve_at(
     per_radius: usize,
     stop: Stop,
 ) -> Result<RollingSolution<ContinuumVerification>, ModelError> {
-    if let Some(error) = rolling.violations().into_iter().next() {
-        return Err(error.into());
-    }
-    if let Some(error) = options.violations().into_iter().next() {
-        return Err(ModelError::InvalidOption(error));
-    }
+    ModelError::check_inputs(rolling.violations(), options.violations())?;
     let solution = match plan(rolling, per_radius)?.route {
         Route::Thin { ratio } => thin_layer(rolling, ratio, crate::solve(rolling, options)?),
         Route::Grid(marches) => on_grid(rolling, options, &marches, stop)?,
@@ -324,16 +319,11 @@ fn fine_answer(
     errors: QuantityErrors,
     domain_error: f64,
 ) -> RollingSolution<ContinuumVerification> {
-    let Rolling {
-        radius,
-        load,
-        velocity,
-        layer,
-    } = *rolling;
+    let (radius, load, velocity) = (rolling.radius, rolling.load, rolling.velocity);
     let contact = &fine.rolled.contact;
     let rest = fine.rest.as_ref().expect("solved at rest");
     let pixel = contact.grid.pixel;
-    let shear = layer.interfacial_shear_strength();
+    let shear = rolling.layer.interfacial_shear_strength();
     let half_width = lateral_half_width(contact);
     let pressure_centre_shift = shift(velocity, fine.rolled.pressure_centre_shift);
     let (contact_area, static_area) = (contact.contact_area, rest.contact_area);

@@ -32,12 +32,7 @@ pub(crate) fn solve_with(
     options: &SolveOptions,
     table: Option<&SimilarityTable>,
 ) -> Result<RollingSolution, ModelError> {
-    if let Some(error) = rolling.violations().into_iter().next() {
-        return Err(error.into());
-    }
-    if let Some(error) = options.violations().into_iter().next() {
-        return Err(ModelError::InvalidOption(error));
-    }
+    ModelError::check_inputs(rolling.violations(), options.violations())?;
     let layer = &rolling.layer;
     let reference = relaxed(rolling.radius, rolling.load, layer);
     let r0 = reference.half_width;

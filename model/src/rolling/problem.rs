@@ -35,14 +35,11 @@ impl Default for Rolling {
 impl Rolling {
     /// Every parameter outside its physical range.
     pub fn violations(&self) -> Vec<ParameterError> {
-        let mut errors: Vec<_> = [
+        let mut errors = Parameter::check_all([
             (Parameter::Radius, self.radius),
             (Parameter::Load, self.load),
             (Parameter::Velocity, self.velocity),
-        ]
-        .into_iter()
-        .filter_map(|(parameter, value)| parameter.check(value).err())
-        .collect();
+        ]);
         errors.extend(self.layer.violations());
         errors
     }

@@ -43,12 +43,7 @@ pub fn solve_with(
     options: &ThreeBodyOptions,
     curves: Option<&LayerCurves>,
 ) -> Result<ThreeBodySolution, ModelError> {
-    if let Some(e) = system.violations().into_iter().next() {
-        return Err(e.into());
-    }
-    if let Some(e) = options.violations().into_iter().next() {
-        return Err(ModelError::InvalidOption(e));
-    }
+    ModelError::check_inputs(system.violations(), options.violations())?;
     let table = kelvin_table(system, options)?;
     let layer_table_error = table.as_ref().map(|t| t.error());
     let (rolling_law, resting_law) = layer_laws(system, table, curves)?;

@@ -164,11 +164,7 @@ impl ThreeBody {
     /// Every parameter outside its physical range, and every inconsistency between them.
     pub fn violations(&self) -> Vec<ParameterError> {
         use Parameter::*;
-        let mut errors: Vec<ParameterError> = self
-            .ranged()
-            .into_iter()
-            .filter_map(|(p, v)| p.check(v).err())
-            .collect();
+        let mut errors = Parameter::check_all(self.ranged());
         errors.extend(self.layer.violations());
         let diameters_valid = !errors.iter().any(|e| {
             matches!(
