@@ -36,49 +36,42 @@ pub struct OptionError {
 }
 
 /// A failure of the model: bad parameters, an unrepresentable scale, or a root finder that
-/// did not converge within its bound.
-#[derive(Clone, Debug, PartialEq)]
+/// did not converge within its bound. The messages reach callers word for word (the service's
+/// 422 problems), so each is part of the interface.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum ModelError {
     /// A parameter outside its physical range.
-    InvalidParameter(ParameterError),
+    #[error(transparent)]
+    InvalidParameter(#[from] ParameterError),
     /// A solver option (strips, boundary points, pressure grid) outside what is offered.
+    #[error("{} = {} is out of range; expected {}", .0.option, .0.value, .0.allowed)]
     InvalidOption(OptionError),
     /// Valid parameters whose combination over- or underflows double precision.
+    #[error("{what} is not representable in double precision")]
     NotRepresentable { what: String },
     /// Valid parameters that ask for something the model cannot do: a load the system cannot
     /// carry, no particle in contact, a layer pierced through.
+    #[error("{0}")]
     OutOfModel(String),
     /// A bracketed root finder ran out of iterations.
+    #[error("the {what} did not converge in {iterations} iterations")]
     NoConvergence { what: &'static str, iterations: u32 },
     /// The caller asked the solve to stop ([`crate::Stop`]): past its deadline, cancelled.
+    #[error("the solve was stopped by its caller")]
     Stopped,
 }
 
-impl fmt::Display for ModelError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            ModelError::InvalidParameter(e) => e.fmt(f),
-            ModelError::InvalidOption(e) => write!(
-                f,
-                "{} = {} is out of range; expected {}",
-                e.option, e.value, e.allowed
-            ),
-            ModelError::NotRepresentable { what } => {
-                write!(f, "{what} is not representable in double precision")
-            }
-            ModelError::OutOfModel(why) => f.write_str(why),
-            ModelError::NoConvergence { what, iterations } => {
-                write!(f, "the {what} did not converge in {iterations} iterations")
-            }
-            ModelError::Stopped => f.write_str("the solve was stopped by its caller"),
+impl ModelError {
+    /// The first of a solve's invalid inputs, parameters before options, as its refusal: a
+    /// solve checks every input before it does any work, and answers the first problem.
+    pub(crate) fn check_inputs(
+        parameters: Vec<ParameterError>,
+        options: Vec<OptionError>,
+    ) -> Result<(), ModelError> {
+        match (parameters.into_iter().next(), options.into_iter().next()) {
+            (Some(parameter), _) => Err(parameter.into()),
+            (None, Some(option)) => Err(ModelError::InvalidOption(option)),
+            (None, None) => Ok(()),
         }
-    }
-}
-
-impl std::error::Error for ModelError {}
-
-impl From<ParameterError> for ModelError {
-    fn from(e: ParameterError) -> Self {
-        ModelError::InvalidParameter(e)
     }
 }

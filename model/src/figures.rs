@@ -97,41 +97,76 @@ struct Curve {
     contacts: Vec<Rolling>,
 }
 
-impl Layout {
-    fn new(number: u8) -> Option<Layout> {
-        let at = |radius: f64, load: f64, velocity: f64| Rolling {
-            radius,
-            load,
-            velocity,
-            layer: Layer::default(),
-        };
-        let along_load = |radius: f64, velocity: f64| Curve {
+/// One contact of the figures: on the paper's default layer (docs/model.md §5).
+fn at(radius: f64, load: f64, velocity: f64) -> Rolling {
+    Rolling {
+        radius,
+        load,
+        velocity,
+        layer: Layer::default(),
+    }
+}
+
+impl Curve {
+    /// Along the loads of Figs. 4–7, at a fixed radius.
+    fn along_load(radius: f64, velocity: f64) -> Curve {
+        Curve {
             radius: Some(radius),
             load: None,
             velocity,
             contacts: LOADS.iter().map(|&p| at(radius, p, velocity)).collect(),
-        };
-        let along_radius = |load: f64, velocity: f64| Curve {
+        }
+    }
+
+    /// Along the radii of Figs. 8–9 (25 … 350 nm), at a fixed load.
+    fn along_radius(load: f64, velocity: f64) -> Curve {
+        Curve {
             radius: None,
             load: Some(load),
             velocity,
             contacts: (1..=14)
                 .map(|i| at(25e-9 * f64::from(i), load, velocity))
                 .collect(),
-        };
-        let by_radius = || {
-            RADII
-                .iter()
-                .flat_map(|&r| STATIC_AND_ROLLING.map(|v| along_load(r, v)))
-                .collect()
-        };
-        let by_speed = || SPEEDS.iter().map(|&v| along_load(25e-9, v)).collect();
-        let by_load = || {
-            LOADS
-                .iter()
-                .flat_map(|&p| STATIC_AND_ROLLING.map(|v| along_radius(p, v)))
-                .collect()
-        };
+        }
+    }
+
+    /// Fig. 3's one contact at speed `velocity`, whose boundary is the curve.
+    fn contour(velocity: f64) -> Curve {
+        Curve {
+            radius: Some(25e-9),
+            load: Some(1e-9),
+            velocity,
+            contacts: vec![at(25e-9, 1e-9, velocity)],
+        }
+    }
+
+    /// Along the load, static and rolling for each radius (Figs. 4 and 6).
+    fn by_radius() -> Vec<Curve> {
+        RADII
+            .iter()
+            .flat_map(|&r| STATIC_AND_ROLLING.map(|v| Curve::along_load(r, v)))
+            .collect()
+    }
+
+    /// Along the load, R = 25 nm, one series a speed (Figs. 5 and 7).
+    fn by_speed() -> Vec<Curve> {
+        SPEEDS
+            .iter()
+            .map(|&v| Curve::along_load(25e-9, v))
+            .collect()
+    }
+
+    /// Along the radius, static and rolling for each load (Figs. 8 and 9).
+    fn by_load() -> Vec<Curve> {
+        LOADS
+            .iter()
+            .flat_map(|&p| STATIC_AND_ROLLING.map(|v| Curve::along_radius(p, v)))
+            .collect()
+    }
+}
+
+impl Layout {
+    fn new(number: u8) -> Option<Layout> {
         let (title, x, y, series) = match number {
             3 => (
                 "Contact region a(y) ≤ x ≤ b(y), R = 25 nm, P = 1 nN, V = 0, 2, 3, 4 nm/s",
@@ -143,51 +178,43 @@ impl Layout {
                     quantity: "y",
                     unit: "m",
                 },
-                CONTOUR_SPEEDS
-                    .iter()
-                    .map(|&v| Curve {
-                        radius: Some(25e-9),
-                        load: Some(1e-9),
-                        velocity: v,
-                        contacts: vec![at(25e-9, 1e-9, v)],
-                    })
-                    .collect(),
+                CONTOUR_SPEEDS.iter().map(|&v| Curve::contour(v)).collect(),
             ),
             4 => (
                 "Contact area vs load, R = 25–350 nm, V = 0 and 4 nm/s",
                 LOAD_AXIS,
                 AREA_AXIS,
-                by_radius(),
+                Curve::by_radius(),
             ),
             5 => (
                 "Contact area vs load, R = 25 nm, V = 0–10 nm/s",
                 LOAD_AXIS,
                 AREA_AXIS,
-                by_speed(),
+                Curve::by_speed(),
             ),
             6 => (
                 "Friction coefficient vs load, R = 25–350 nm, V = 0 and 4 nm/s",
                 LOAD_AXIS,
                 FRICTION_AXIS,
-                by_radius(),
+                Curve::by_radius(),
             ),
             7 => (
                 "Friction coefficient vs load, R = 25 nm, V = 0–10 nm/s",
                 LOAD_AXIS,
                 FRICTION_AXIS,
-                by_speed(),
+                Curve::by_speed(),
             ),
             8 => (
                 "Contact area vs radius, P = 1–1.4 nN, V = 0 and 4 nm/s",
                 RADIUS_AXIS,
                 AREA_AXIS,
-                by_load(),
+                Curve::by_load(),
             ),
             9 => (
                 "Friction coefficient vs radius, P = 1–1.4 nN, V = 0 and 4 nm/s",
                 RADIUS_AXIS,
                 FRICTION_AXIS,
-                by_load(),
+                Curve::by_load(),
             ),
             _ => return None,
         };

@@ -69,16 +69,13 @@ impl Layer {
 
     /// Every parameter outside its physical range.
     pub fn violations(&self) -> Vec<ParameterError> {
-        let mut errors: Vec<ParameterError> = [
+        let mut errors = Parameter::check_all([
             (Parameter::ElasticModulus, self.elastic_modulus),
             (Parameter::Thickness, self.thickness),
             (Parameter::PoissonRatio, self.poisson_ratio),
             (Parameter::RelaxationTime, self.relaxation_time),
             (Parameter::RetardationTime, self.retardation_time),
-        ]
-        .into_iter()
-        .filter_map(|(parameter, value)| parameter.check(value).err())
-        .collect();
+        ]);
         let times_valid = errors.iter().all(|e| {
             !matches!(
                 e.parameter,
@@ -217,6 +214,17 @@ impl Parameter {
         }
     }
 
+    /// Each of `values` outside its parameter's own range, in order: every input struct
+    /// checks its fields this way, then adds its own cross-checks.
+    pub(crate) fn check_all(
+        values: impl IntoIterator<Item = (Parameter, f64)>,
+    ) -> Vec<ParameterError> {
+        values
+            .into_iter()
+            .filter_map(|(parameter, value)| parameter.check(value).err())
+            .collect()
+    }
+
     /// Checks one value against the parameter's own range (not the cross-checks, such as
     /// T_ε ≥ T_σ, that [`Layer::violations`] adds).
     pub fn check(self, value: f64) -> Result<(), ParameterError> {
@@ -285,23 +293,16 @@ impl fmt::Display for Parameter {
     }
 }
 
-/// A parameter outside its physical range.
-#[derive(Clone, Debug, PartialEq)]
+/// A parameter outside its physical range. The message names the parameter, its value with
+/// its unit, and the range allowed, so a caller can mend the input from it alone.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error(
+    "{parameter} = {} is out of range; expected {allowed}",
+    quantity(*.value, .parameter.unit())
+)]
 pub struct ParameterError {
     pub parameter: Parameter,
     pub value: f64,
     /// The allowed range, as text.
     pub allowed: String,
-}
-
-impl fmt::Display for ParameterError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(
-            f,
-            "{} = {} is out of range; expected {}",
-            self.parameter,
-            quantity(self.value, self.parameter.unit()),
-            self.allowed
-        )
-    }
 }

@@ -62,35 +62,7 @@ pub fn brent(
         if m.abs() <= tol || fb == 0.0 {
             return Ok(Root { x: b, iterations });
         }
-        if e.abs() >= tol && fa.abs() > fb.abs() {
-            // Inverse quadratic interpolation, or secant when only two points differ.
-            let s = fb / fa;
-            let (mut p, mut q) = if a == c {
-                (2.0 * m * s, 1.0 - s)
-            } else {
-                let q = fa / fc;
-                let r = fb / fc;
-                (
-                    s * (2.0 * m * q * (q - r) - (b - a) * (r - 1.0)),
-                    (q - 1.0) * (r - 1.0) * (s - 1.0),
-                )
-            };
-            if p > 0.0 {
-                q = -q;
-            } else {
-                p = -p;
-            }
-            if 2.0 * p < (3.0 * m * q - (tol * q).abs()).min((e * q).abs()) {
-                e = d;
-                d = p / q;
-            } else {
-                d = m;
-                e = m;
-            }
-        } else {
-            d = m;
-            e = m;
-        }
+        (d, e) = next_step((a, fa), (b, fb), (c, fc), (m, tol), (d, e));
         (a, fa) = (b, fb);
         b += if d.abs() > tol { d } else { tol.copysign(m) };
         fb = f(b);
@@ -102,6 +74,45 @@ pub fn brent(
         what,
         iterations: MAX_ITERATIONS,
     })
+}
+
+/// Brent's next step from b, and the step before it, as (d, e): inverse quadratic
+/// interpolation through a, b and c (a secant when a = c) while the steps shrink fast enough
+/// and it lands well inside the bracket, else bisection by m, half the bracket; `tol` is the
+/// smallest step that counts. Apart from [`brent`] so the bracket's bookkeeping reads alone.
+fn next_step(
+    (a, fa): (f64, f64),
+    (b, fb): (f64, f64),
+    (c, fc): (f64, f64),
+    (m, tol): (f64, f64),
+    (d, e): (f64, f64),
+) -> (f64, f64) {
+    if e.abs() >= tol && fa.abs() > fb.abs() {
+        // Inverse quadratic interpolation, or secant when only two points differ.
+        let s = fb / fa;
+        let (mut p, mut q) = if a == c {
+            (2.0 * m * s, 1.0 - s)
+        } else {
+            let q = fa / fc;
+            let r = fb / fc;
+            (
+                s * (2.0 * m * q * (q - r) - (b - a) * (r - 1.0)),
+                (q - 1.0) * (r - 1.0) * (s - 1.0),
+            )
+        };
+        if p > 0.0 {
+            q = -q;
+        } else {
+            p = -p;
+        }
+        if 2.0 * p < (3.0 * m * q - (tol * q).abs()).min((e * q).abs()) {
+            (p / q, d)
+        } else {
+            (m, m)
+        }
+    } else {
+        (m, m)
+    }
 }
 
 #[cfg(test)]

@@ -129,12 +129,7 @@ pub fn solve_at(
     per_radius: usize,
     stop: Stop,
 ) -> Result<RollingSolution<ContinuumVerification>, ModelError> {
-    if let Some(error) = rolling.violations().into_iter().next() {
-        return Err(error.into());
-    }
-    if let Some(error) = options.violations().into_iter().next() {
-        return Err(ModelError::InvalidOption(error));
-    }
+    ModelError::check_inputs(rolling.violations(), options.violations())?;
     let solution = match plan(rolling, per_radius)?.route {
         Route::Thin { ratio } => thin_layer(rolling, ratio, crate::solve(rolling, options)?),
         Route::Grid(marches) => on_grid(rolling, options, &marches, stop)?,
@@ -201,73 +196,94 @@ fn on_grid(
     marches: &Marches,
     stop: Stop,
 ) -> Result<RollingSolution<ContinuumVerification>, ModelError> {
+    // The coarse march first, from rest: the others start from its steady contact.
+    let coarse = march(rolling, &marches.coarse, None, None, stop)?;
+    let coarse_rest = coarse.rest.as_ref();
+    let far = match &marches.far {
+        Some(far) => march(rolling, far, Some(&coarse.rolled.contact), None, stop)?,
+        None => coarse.clone(),
+    };
+    let fine = march(
+        rolling,
+        &marches.fine,
+        Some(&coarse.rolled.contact),
+        coarse_rest,
+        stop,
+    )?;
+    let (errors, domain_error) = grid_errors(rolling, &coarse, &far, &fine);
+    Ok(fine_answer(rolling, options, &fine, errors, domain_error))
+}
+
+/// A march on `domain`, from `start` (a contact on another grid, resampled; else the contact
+/// at rest on this grid, solved here, from `rest_from` resampled if given): its steady
+/// contact, and its contact at rest.
+fn march(
+    rolling: &Rolling,
+    domain: &Domain,
+    start: Option<&GridContact>,
+    rest_from: Option<&GridContact>,
+    stop: Stop,
+) -> Result<Solved, ModelError> {
     let Rolling {
         radius,
         load,
         velocity,
         layer,
     } = *rolling;
-    // A march on `domain`, from `start` (a contact on another grid, resampled; else the
-    // contact at rest on this grid, solved here, from `rest_from` resampled if given): its
-    // steady contact, and its contact at rest.
-    let march = |domain: &Domain,
-                 start: Option<&GridContact>,
-                 rest_from: Option<&GridContact>|
-     -> Result<Solved, ModelError> {
-        let Domain { grid, middle } = *domain;
-        let influence = Influence::new(&layer, grid, stop)?;
-        let rolled = Rolled {
-            radius,
-            load,
-            velocity,
-            layer: &layer,
-            surface: &influence,
-            middle,
-            stop,
-        };
-        let resample = |contact: &GridContact| resampled(contact, &grid, middle);
-        let rest = match start {
-            Some(_) if rest_from.is_none() => None,
-            _ => Some(at_rest(&rolled, rest_from.map(resample), 0.1 * TOLERANCE)?),
-        };
-        let from = match (start, &rest) {
-            (Some(contact), _) => resample(contact),
-            (None, Some(rest)) => rest.pressure.clone(),
-            (None, None) => unreachable!("a march starts from a contact or from rest"),
-        };
-        let rolled = roll(&rolled, from, TOLERANCE)?;
-        if touches_border(&rolled.contact) {
-            return Err(ModelError::OutOfModel(
-                "the continuum contact reached the border of its grid".to_string(),
-            ));
-        }
-        Ok(Solved { rolled, rest })
+    let Domain { grid, middle } = *domain;
+    let influence = Influence::new(&layer, grid, stop)?;
+    let rolled = Rolled {
+        radius,
+        load,
+        velocity,
+        layer: &layer,
+        surface: &influence,
+        middle,
+        stop,
     };
-    // The coarse march first, from rest: the others start from its steady contact.
-    let coarse = march(&marches.coarse, None, None)?;
-    let coarse_rest = coarse.rest.as_ref();
-    let far = match &marches.far {
-        Some(far) => march(far, Some(&coarse.rolled.contact), None)?,
-        None => coarse.clone(),
+    let resample = |contact: &GridContact| resampled(contact, &grid, middle);
+    let rest = match start {
+        Some(_) if rest_from.is_none() => None,
+        _ => Some(at_rest(&rolled, rest_from.map(resample), 0.1 * TOLERANCE)?),
     };
-    let fine = march(&marches.fine, Some(&coarse.rolled.contact), coarse_rest)?;
-    // Each quantity's change to the fine grid and to the far domain, from the coarse grid
-    // (at rest the far domain is the same problem: no change).
+    let from = match (start, &rest) {
+        (Some(contact), _) => resample(contact),
+        (None, Some(rest)) => rest.pressure.clone(),
+        (None, None) => unreachable!("a march starts from a contact or from rest"),
+    };
+    let rolled = roll(&rolled, from, TOLERANCE)?;
+    if touches_border(&rolled.contact) {
+        return Err(ModelError::OutOfModel(
+            "the continuum contact reached the border of its grid".to_string(),
+        ));
+    }
+    Ok(Solved { rolled, rest })
+}
+
+/// Each quantity's error on the fine grid, from its change to the fine grid and to the far
+/// domain against the coarse grid (at rest the far domain is the same problem: no change),
+/// and the domain's share of the worst.
+fn grid_errors(
+    rolling: &Rolling,
+    coarse: &Solved,
+    far: &Solved,
+    fine: &Solved,
+) -> (QuantityErrors, f64) {
+    let velocity = rolling.velocity;
     let changes = |f: fn(&Solved) -> f64| {
-        let change = |a: &Solved| (f(a) / f(&coarse) - 1.0).abs();
-        (change(&fine), change(&far))
+        let change = |a: &Solved| (f(a) / f(coarse) - 1.0).abs();
+        (change(fine), change(far))
     };
     let rest_changes = |f: fn(&GridContact) -> f64| {
         let rest = |s: &Solved| f(s.rest.as_ref().expect("solved at rest"));
-        ((rest(&fine) / rest(&coarse) - 1.0).abs(), 0.0)
+        ((rest(fine) / rest(coarse) - 1.0).abs(), 0.0)
     };
-    let absolute =
-        |f: fn(&Solved) -> f64| (f(&fine) - f(&coarse)).abs() + (f(&far) - f(&coarse)).abs();
+    let absolute = |f: fn(&Solved) -> f64| (f(fine) - f(coarse)).abs() + (f(far) - f(coarse)).abs();
     let contact = &fine.rolled.contact;
     let rest = fine.rest.as_ref().expect("solved at rest");
     let pixel = contact.grid.pixel;
     let area_error = |(grid, domain): (f64, f64), area: f64| {
-        (2.0 * grid + domain).max(area_floor(area, pixel, layer.thickness))
+        (2.0 * grid + domain).max(area_floor(area, pixel, rolling.layer.thickness))
     };
     let (d, a, d0, a0_) = (
         changes(|s| s.rolled.contact.penetration),
@@ -275,19 +291,41 @@ fn on_grid(
         rest_changes(|c| c.penetration),
         rest_changes(|c| c.contact_area),
     );
-    // At rest the contact is symmetric in x: its shifts are nought, not the grid's rounding.
-    let shift = |x: f64| if velocity > 0.0 { x } else { 0.0 };
     let errors = QuantityErrors {
         penetration: d.0 + d.1,
         contact_area: area_error(a, contact.contact_area),
-        centroid_shift: shift(absolute(|s| s.rolled.centroid_shift)),
-        pressure_centre_shift: shift(absolute(|s| s.rolled.pressure_centre_shift)),
+        centroid_shift: shift(velocity, absolute(|s| s.rolled.centroid_shift)),
+        pressure_centre_shift: shift(velocity, absolute(|s| s.rolled.pressure_centre_shift)),
         static_penetration: d0.0 + d0.1,
         static_contact_area: area_error(a0_, rest.contact_area),
     };
-    let shear = layer.interfacial_shear_strength();
+    (errors, d.1.max(a.1))
+}
+
+/// At rest the contact is symmetric in x: its shifts are nought, not the grid's rounding.
+fn shift(velocity: f64, x: f64) -> f64 {
+    if velocity > 0.0 {
+        x
+    } else {
+        0.0
+    }
+}
+
+/// The answer in SI units from the fine grid's march, with its `errors`.
+fn fine_answer(
+    rolling: &Rolling,
+    options: &SolveOptions,
+    fine: &Solved,
+    errors: QuantityErrors,
+    domain_error: f64,
+) -> RollingSolution<ContinuumVerification> {
+    let (radius, load, velocity) = (rolling.radius, rolling.load, rolling.velocity);
+    let contact = &fine.rolled.contact;
+    let rest = fine.rest.as_ref().expect("solved at rest");
+    let pixel = contact.grid.pixel;
+    let shear = rolling.layer.interfacial_shear_strength();
     let half_width = lateral_half_width(contact);
-    let pressure_centre_shift = shift(fine.rolled.pressure_centre_shift);
+    let pressure_centre_shift = shift(velocity, fine.rolled.pressure_centre_shift);
     let (contact_area, static_area) = (contact.contact_area, rest.contact_area);
     let across = |area: f64| 2.0 * (area / PI).sqrt() / pixel;
     // The contact's largest extent from the centre: the lateral half-width, or an edge
@@ -297,11 +335,11 @@ fn on_grid(
         .fold(half_width, |m, (_, exit, entry)| {
             m.max(exit.abs()).max(entry.abs())
         });
-    Ok(RollingSolution {
+    RollingSolution {
         penetration: contact.penetration,
         contact_area,
         half_width,
-        centroid_shift: shift(fine.rolled.centroid_shift),
+        centroid_shift: shift(velocity, fine.rolled.centroid_shift),
         pressure_centre_shift,
         rolling_resistance_coefficient: pressure_centre_shift / radius,
         friction_coefficient: shear * contact_area / load,
@@ -317,7 +355,7 @@ fn on_grid(
             .map(|n| pressure_grid(contact, extent, n)),
         verification: ContinuumVerification {
             errors,
-            domain_error: d.1.max(a.1),
+            domain_error,
             extent,
             grid: Some(GridUsed {
                 nx: contact.grid.nx,
@@ -328,7 +366,7 @@ fn on_grid(
                 steps: fine.rolled.steps,
             }),
         },
-    })
+    }
 }
 
 /// A march's steady contact, and the contact at rest on its grid (where it was solved).

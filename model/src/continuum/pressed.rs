@@ -111,9 +111,9 @@ pub fn press(
         stop,
     } = *pressing;
     let grid = surface.grid();
-    let (ny, count) = (grid.ny, grid.pixels());
+    let ny = grid.ny;
     let area = grid.pixel * grid.pixel;
-    let mut profile: Vec<f64> = (0..count)
+    let mut profile: Vec<f64> = (0..grid.pixels())
         .map(|k| {
             let (x, y) = (middle + grid.x(k / ny), grid.y(k % ny));
             (x * x + y * y) / (2.0 * radius)
@@ -122,138 +122,212 @@ pub fn press(
     if let Some(memory) = memory {
         profile.iter_mut().zip(memory).for_each(|(f, m)| *f += m);
     }
-    let deflect = |p: &[f64]| -> Vec<f64> {
-        let mut w = surface.deflect(p);
-        w.iter_mut().for_each(|w| *w *= instant);
-        w
-    };
     let mut pressure = start.unwrap_or_else(|| {
         let reach = grid.pixel * grid.nx.min(grid.ny) as f64 / 6.0;
-        (0..count)
+        (0..grid.pixels())
             .map(|k| f64::from(u8::from(grid.x(k / ny).hypot(grid.y(k % ny)) < reach)))
             .collect()
     });
     normalise(&mut pressure, load / area);
-    let own = instant * surface.deflect_scale();
-    let done = |pressure: Vec<f64>, penetration: f64, iterations: u32| {
-        let edges = row_edges(&pressure, &grid);
-        GridContact {
-            grid,
-            middle,
-            contact_area: area_between(&edges, grid.pixel),
-            edges,
-            pressure,
-            penetration,
-            iterations,
-        }
+    let descent = Descent {
+        surface,
+        instant,
+        profile,
+        total: load / area,
+        tolerance,
     };
-    let mut direction = vec![0.0; count];
-    let (mut g_old, mut conjugate) = (1.0, false);
-    // The deflection of `pressure`, carried along by the steps while they are linear (no
-    // pixel clipped or joined): one convolution an iteration rather than two. `exact` says
-    // whether it was just convolved (it is before an answer is returned).
-    let mut deflection = deflect(&pressure);
-    let mut exact = true;
-    for iteration in 1..=MAX_ITERATIONS {
-        stop.check()?;
-        let mut gap: Vec<f64> = deflection
-            .iter()
-            .zip(&profile)
-            .map(|(u, f)| u + f)
-            .collect();
-        let in_contact: Vec<bool> = pressure.iter().map(|p| *p > 0.0).collect();
-        let mean_gap = mean_over(&gap, &in_contact);
-        gap.iter_mut().for_each(|g| *g -= mean_gap);
-        // Solved when the gap is flat over the contact and nowhere negative outside it, to
-        // `tolerance` of the penetration.
-        let slack = tolerance * mean_gap.abs();
-        let flat = masked(&gap, &in_contact).all(|g| g.abs() <= slack);
-        let apart = gap.iter().zip(&in_contact).all(|(g, c)| *c || *g >= -slack);
-        if flat && apart {
-            if exact {
-                return Ok(done(pressure, mean_gap, iteration));
+    let (pressure, penetration, iterations) = descent.run(pressure, stop)?;
+    let edges = row_edges(&pressure, &grid);
+    Ok(GridContact {
+        grid,
+        middle,
+        contact_area: area_between(&edges, grid.pixel),
+        edges,
+        pressure,
+        penetration,
+        iterations,
+    })
+}
+
+/// Polonsky & Keer's constrained conjugate gradient on one pressed contact: kept apart from
+/// [`press`], which only sets the problem up and reads the answer, so the iteration reads
+/// as the method does.
+struct Descent<'a> {
+    surface: &'a dyn Surface,
+    /// The share of the surface's response that acts at once ([`Pressing::instant`]).
+    instant: f64,
+    /// The undeformed gap at each pixel: the sphere's profile plus the layer's memory.
+    profile: Vec<f64>,
+    /// The sum of the pixel pressures that carries the load: P over a pixel's area.
+    total: f64,
+    tolerance: f64,
+}
+
+impl Descent<'_> {
+    /// The deflection that acts at once under `pressure`.
+    fn deflect(&self, pressure: &[f64]) -> Vec<f64> {
+        let mut w = self.surface.deflect(pressure);
+        w.iter_mut().for_each(|w| *w *= self.instant);
+        w
+    }
+
+    /// Descends from `pressure` (normalised to the load) to the converged pressure, its
+    /// penetration and the iterations taken.
+    fn run(&self, mut pressure: Vec<f64>, stop: Stop) -> Result<(Vec<f64>, f64, u32), ModelError> {
+        let own = self.instant * self.surface.deflect_scale();
+        let mut direction = vec![0.0; pressure.len()];
+        let (mut g_old, mut conjugate) = (1.0, false);
+        // The deflection of `pressure`, carried along by the steps while they are linear (no
+        // pixel clipped or joined): one convolution an iteration rather than two. `exact`
+        // says whether it was just convolved (it is before an answer is returned).
+        let mut deflection = self.deflect(&pressure);
+        let mut exact = true;
+        for iteration in 1..=MAX_ITERATIONS {
+            stop.check()?;
+            let gap = Gap::new(&deflection, &self.profile, &pressure, self.tolerance);
+            if gap.flat && gap.apart {
+                if exact {
+                    return Ok((pressure, gap.mean, iteration));
+                }
+                deflection = self.deflect(&pressure);
+                exact = true;
+                continue;
             }
-            deflection = deflect(&pressure);
-            exact = true;
-            continue;
+            let g_norm: f64 = masked(&gap.values, &gap.in_contact).map(|g| g * g).sum();
+            let beta = if conjugate { g_norm / g_old } else { 0.0 };
+            gap.conjugate(&mut direction, beta);
+            g_old = g_norm;
+            let response = self.deflect(&direction);
+            let (along, curvature) = gap.along_and_curvature(&direction, &response);
+            // A direction the load constraint cancels (constant over the contact) has no
+            // curvature: start the conjugation again from the gap itself. The gap has none
+            // only where it is flat over the contact to rounding: solved, if nothing outside
+            // penetrates (else the method is stuck: say so rather than answer).
+            let scale: f64 = masked(&direction, &gap.in_contact).map(|d| d * d).sum();
+            let curved = curvature > 1e-12 * scale * own;
+            if !curved {
+                if conjugate {
+                    conjugate = false;
+                    continue;
+                }
+                if gap.apart && exact {
+                    return Ok((pressure, gap.mean, iteration));
+                }
+                if !exact {
+                    deflection = self.deflect(&pressure);
+                    exact = true;
+                    continue;
+                }
+                break;
+            }
+            let step = along / curvature;
+            let before = pressure.clone();
+            let (overlap, clipped) = gap.step(&mut pressure, &direction, step);
+            conjugate = !overlap;
+            if pressure.iter().all(|p| *p == 0.0) {
+                // The step emptied the contact: take it back, and go down the gap alone.
+                pressure = before;
+                conjugate = false;
+                continue;
+            }
+            let scale = normalise(&mut pressure, self.total);
+            if overlap || clipped {
+                deflection = self.deflect(&pressure);
+                exact = true;
+            } else {
+                for (u, r) in deflection.iter_mut().zip(&response) {
+                    *u = scale * (*u - step * r);
+                }
+                exact = false;
+            }
         }
-        let g_norm: f64 = masked(&gap, &in_contact).map(|g| g * g).sum();
-        let beta = if conjugate { g_norm / g_old } else { 0.0 };
-        for k in 0..count {
-            direction[k] = if in_contact[k] {
-                gap[k] + beta * direction[k]
+        Err(ModelError::NoConvergence {
+            what: "continuum contact pressure (conjugate gradients)",
+            iterations: MAX_ITERATIONS,
+        })
+    }
+}
+
+/// The gap at one iterate, less its mean over the contact (the penetration), and whether the
+/// iterate is solved there.
+struct Gap {
+    values: Vec<f64>,
+    /// Which pixels carry pressure.
+    in_contact: Vec<bool>,
+    /// The mean gap over the contact: the penetration.
+    mean: f64,
+    /// Flat over the contact to `tolerance` of the penetration.
+    flat: bool,
+    /// Nowhere negative outside the contact, to the same.
+    apart: bool,
+}
+
+impl Gap {
+    fn new(deflection: &[f64], profile: &[f64], pressure: &[f64], tolerance: f64) -> Gap {
+        let mut values: Vec<f64> = deflection.iter().zip(profile).map(|(u, f)| u + f).collect();
+        let in_contact: Vec<bool> = pressure.iter().map(|p| *p > 0.0).collect();
+        let mean = mean_over(&values, &in_contact);
+        values.iter_mut().for_each(|g| *g -= mean);
+        let slack = tolerance * mean.abs();
+        let flat = masked(&values, &in_contact).all(|g| g.abs() <= slack);
+        let apart = values
+            .iter()
+            .zip(&in_contact)
+            .all(|(g, c)| *c || *g >= -slack);
+        Gap {
+            values,
+            in_contact,
+            mean,
+            flat,
+            apart,
+        }
+    }
+
+    /// The next search direction: the gap over the contact plus `beta` times the last
+    /// direction (conjugation), zero outside it.
+    fn conjugate(&self, direction: &mut [f64], beta: f64) {
+        for (k, d) in direction.iter_mut().enumerate() {
+            *d = if self.in_contact[k] {
+                self.values[k] + beta * *d
             } else {
                 0.0
             };
         }
-        g_old = g_norm;
-        let response = deflect(&direction);
-        let mean_response = mean_over(&response, &in_contact);
+    }
+
+    /// Over the contact, the gap along `direction` and the curvature of the surface's
+    /// `response` to it, with the load constraint's mean taken out.
+    fn along_and_curvature(&self, direction: &[f64], response: &[f64]) -> (f64, f64) {
+        let count = direction.len();
+        let mean_response = mean_over(response, &self.in_contact);
         let along: f64 = (0..count)
-            .filter(|k| in_contact[*k])
-            .map(|k| gap[k] * direction[k])
+            .filter(|k| self.in_contact[*k])
+            .map(|k| self.values[k] * direction[k])
             .sum();
         let curvature: f64 = (0..count)
-            .filter(|k| in_contact[*k])
+            .filter(|k| self.in_contact[*k])
             .map(|k| (response[k] - mean_response) * direction[k])
             .sum();
-        // A direction the load constraint cancels (constant over the contact) has no
-        // curvature: start the conjugation again from the gap itself. The gap has none
-        // only where it is flat over the contact to rounding: solved, if nothing outside
-        // penetrates (else the method is stuck: say so rather than answer).
-        let scale: f64 = masked(&direction, &in_contact).map(|d| d * d).sum();
-        let curved = curvature > 1e-12 * scale * own;
-        if !curved {
-            if conjugate {
-                conjugate = false;
-                continue;
-            }
-            if apart && exact {
-                return Ok(done(pressure, mean_gap, iteration));
-            }
-            if !exact {
-                deflection = deflect(&pressure);
-                exact = true;
-                continue;
-            }
-            break;
-        }
-        let step = along / curvature;
-        let before = pressure.clone();
+        (along, curvature)
+    }
+
+    /// Moves the contact's pressure by `step` along `direction`, clipped at zero; pixels
+    /// penetrated outside the contact join it. Says whether any joined and any was clipped.
+    fn step(&self, pressure: &mut [f64], direction: &[f64], step: f64) -> (bool, bool) {
         let (mut overlap, mut clipped) = (false, false);
-        for k in 0..count {
-            if in_contact[k] {
+        for k in 0..pressure.len() {
+            if self.in_contact[k] {
                 let moved = pressure[k] - step * direction[k];
                 clipped |= moved < 0.0;
                 pressure[k] = moved.max(0.0);
-            } else if gap[k] < 0.0 {
+            } else if self.values[k] < 0.0 {
                 // Penetrated outside the contact: it joins, and the conjugation restarts.
-                pressure[k] = -step * gap[k];
+                pressure[k] = -step * self.values[k];
                 overlap = true;
             }
         }
-        conjugate = !overlap;
-        if pressure.iter().all(|p| *p == 0.0) {
-            // The step emptied the contact: take it back, and go down the gap alone.
-            pressure = before;
-            conjugate = false;
-            continue;
-        }
-        let scale = normalise(&mut pressure, load / area);
-        if overlap || clipped {
-            deflection = deflect(&pressure);
-            exact = true;
-        } else {
-            for (u, r) in deflection.iter_mut().zip(&response) {
-                *u = scale * (*u - step * r);
-            }
-            exact = false;
-        }
+        (overlap, clipped)
     }
-    Err(ModelError::NoConvergence {
-        what: "continuum contact pressure (conjugate gradients)",
-        iterations: MAX_ITERATIONS,
-    })
 }
 
 /// The contact's edges along x in each row of `grid` (y = grid.y(j)), from the grid's

@@ -120,26 +120,14 @@ pub fn roll(rolled: &Rolled, start: Vec<f64>, tolerance: f64) -> Result<RolledCo
     let mut pressure = start;
     let mut tails: Vec<Vec<f64>> = memories
         .iter()
-        .map(|memory| {
-            let mut tail = vec![0.0; nx * ny];
-            for k in (0..ny * (nx - 1)).rev() {
-                tail[k] = memory.brought(k, ny, &pressure, &tail);
-            }
-            tail
-        })
+        .map(|memory| memory.always(nx, ny, &pressure))
         .collect();
     let mut step_tolerance = LOOSEST;
     let mut last_change = f64::INFINITY;
     let max_steps = MAX_STEPS_PER_PIXEL * nx;
     for step in 1..=max_steps {
         rolled.stop.check()?;
-        let mut remembered = vec![0.0; nx * ny];
-        for (memory, tail) in memories.iter().zip(&tails) {
-            for (r, t) in remembered.iter_mut().zip(tail) {
-                *r += memory.share * t;
-            }
-        }
-        let memory = surface.deflect(&remembered);
+        let memory = surface.deflect(&remembered(&memories, &tails, nx * ny));
         let rolling = Pressing {
             instant,
             memory: Some(&memory),
@@ -177,6 +165,18 @@ pub fn roll(rolled: &Rolled, start: Vec<f64>, tolerance: f64) -> Result<RolledCo
     })
 }
 
+/// The pressure the layer still remembers at each of `pixels` pixels: every term's tail
+/// weighted by its share, summed term after term.
+fn remembered(memories: &[Memory], tails: &[Vec<f64>], pixels: usize) -> Vec<f64> {
+    let mut remembered = vec![0.0; pixels];
+    for (memory, tail) in memories.iter().zip(tails) {
+        for (r, t) in remembered.iter_mut().zip(tail) {
+            *r += memory.share * t;
+        }
+    }
+    remembered
+}
+
 /// One retardation term of the layer's creep ([`crate::spectrum::Creep`]) on a row of
 /// pixels: the share c_k of the response it carries, and its exact weights for pressure
 /// constant on pixels, with λ = V θ_k.
@@ -191,6 +191,16 @@ struct Memory {
 }
 
 impl Memory {
+    /// The tail of a pressure that had always been `pressure`, on an nx × ny grid: built
+    /// from the front row back, each row bringing what the rows ahead left.
+    fn always(&self, nx: usize, ny: usize, pressure: &[f64]) -> Vec<f64> {
+        let mut tail = vec![0.0; nx * ny];
+        for k in (0..ny * (nx - 1)).rev() {
+            tail[k] = self.brought(k, ny, pressure, &tail);
+        }
+        tail
+    }
+
     fn new(share: f64, lambda: f64, pixel: f64) -> Memory {
         Memory {
             share,

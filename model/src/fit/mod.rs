@@ -329,28 +329,8 @@ pub fn fit<E>(
         stop,
     };
     // Screen the start and the corners of the box's middle half by their cost alone.
-    let mut candidates = vec![start.clone()];
-    for corner in 0..1usize << start.len() {
-        candidates.push(DVector::from_fn(start.len(), |i, _| {
-            let quarter = if corner >> i & 1 == 0 { 0.25 } else { 0.75 };
-            lower[i] + quarter * (upper[i] - lower[i])
-        }));
-    }
-    let mut costs = Vec::new();
-    for (i, x) in candidates.iter().enumerate() {
-        if let Some(cost) = residuals.cost(x).map_err(FitError::Stopped)? {
-            costs.push((cost, i));
-        }
-    }
-    costs.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let mut starts = vec![0];
-    starts.extend(
-        costs
-            .iter()
-            .map(|&(_, i)| i)
-            .filter(|&i| i != 0)
-            .take(STARTS - 1),
-    );
+    let candidates = candidates(&start, &lower, &upper);
+    let starts = residuals.screen(&candidates).map_err(FitError::Stopped)?;
     let mut best: Option<lm::Minimum> = None;
     let (mut steps, mut finished, mut stopped) = (0, 0, None);
     for &i in &starts {
@@ -406,6 +386,24 @@ pub fn fit<E>(
     Ok((fitted, stopped))
 }
 
+/// The candidate starts, in the logarithms of the free parameters: `start` first, then the
+/// corners of the middle half of the box [`lower`, `upper`], so that a fit whose start lies
+/// in the wrong basin has another to try.
+fn candidates(
+    start: &DVector<f64>,
+    lower: &DVector<f64>,
+    upper: &DVector<f64>,
+) -> Vec<DVector<f64>> {
+    let mut candidates = vec![start.clone()];
+    for corner in 0..1usize << start.len() {
+        candidates.push(DVector::from_fn(start.len(), |i, _| {
+            let quarter = if corner >> i & 1 == 0 { 0.25 } else { 0.75 };
+            lower[i] + quarter * (upper[i] - lower[i])
+        }));
+    }
+    candidates
+}
+
 /// The weighted residuals of a problem in the logarithms of its free parameters.
 struct Residuals<'a, E> {
     problem: &'a Problem,
@@ -416,6 +414,28 @@ struct Residuals<'a, E> {
 }
 
 impl<E> Residuals<'_, E> {
+    /// The candidates to minimise from, by index: the given start (the first), then the
+    /// [`STARTS`] − 1 others of least cost, among those the model answers. A cost is cheap
+    /// beside a minimisation, so screening saves minimising from a poor start.
+    fn screen(&mut self, candidates: &[DVector<f64>]) -> Result<Vec<usize>, E> {
+        let mut costs = Vec::new();
+        for (i, x) in candidates.iter().enumerate() {
+            if let Some(cost) = self.cost(x)? {
+                costs.push((cost, i));
+            }
+        }
+        costs.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let mut starts = vec![0];
+        starts.extend(
+            costs
+                .iter()
+                .map(|&(_, i)| i)
+                .filter(|&i| i != 0)
+                .take(STARTS - 1),
+        );
+        Ok(starts)
+    }
+
     /// The layer at `x`, if inside the model's ranges (T_ε ≥ T_σ among them).
     fn layer(&self, x: &DVector<f64>) -> Option<Layer> {
         let values: Vec<f64> = x.iter().map(|x| x.exp()).collect();
