@@ -10,9 +10,10 @@ use serde_json::Value;
 use super::{Kind, Limits};
 use crate::model::text::quantity_to;
 use crate::render::svg::Chart;
+use crate::render::RenderError;
 
 /// Why an answer cannot be drawn: it is not the answer of the kind asked (a fault of ours).
-pub type PictureError = String;
+pub type PictureError = RenderError;
 
 /// The parts of an answer a kind's picture shows, read from the answer's JSON.
 pub trait Picture: DeserializeOwned {
@@ -22,7 +23,8 @@ pub trait Picture: DeserializeOwned {
 
 /// The picture of the answer whose JSON is `json`, drawn as `P`.
 pub fn draw<P: Picture>(json: &[u8]) -> Result<Chart, PictureError> {
-    let picture: P = serde_json::from_slice(json).map_err(|e| format!("the answer: {e}"))?;
+    let picture: P =
+        serde_json::from_slice(json).map_err(|e| RenderError::new(format!("the answer: {e}")))?;
     picture.chart()
 }
 
@@ -37,7 +39,7 @@ impl Asked {
     pub fn job<K: Kind>(self) -> Result<K, PictureError> {
         K::validate(self.input, &Limits::default())
             .map(|validated| validated.job)
-            .map_err(|e| format!("the answer's input does not read back: {e}"))
+            .map_err(|e| RenderError::new(format!("the answer's input does not read back: {e}")))
     }
 }
 

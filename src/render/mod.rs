@@ -109,17 +109,10 @@ impl Format {
     }
 }
 
-/// Why an answer could not be rendered: a fault of the service, never of the job.
-#[derive(Clone, Debug, PartialEq)]
+/// Why an answer could not be rendered or drawn: a fault of the service, never of the job.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error("{0}")]
 pub struct RenderError(String);
-
-impl fmt::Display for RenderError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(&self.0)
-    }
-}
-
-impl std::error::Error for RenderError {}
 
 impl RenderError {
     pub fn new(message: impl Into<String>) -> RenderError {
@@ -190,7 +183,7 @@ impl<T: Output> Render for T {
 }
 
 /// Draws an answer from its JSON (each job kind has its own).
-pub type Draw = fn(&[u8]) -> Result<svg::Chart, String>;
+pub type Draw = fn(&[u8]) -> Result<svg::Chart, RenderError>;
 
 /// The answer to any job, whatever its kind, and how to draw it.
 #[derive(Debug)]

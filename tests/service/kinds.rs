@@ -15,7 +15,7 @@ use thirdbody::job::{
     Control, Job, JobError, Kind, Limits, Meta, References, Validated, Work, ROLLING_REFERENCES,
 };
 use thirdbody::render::svg::{Axis, Chart, Layer};
-use thirdbody::render::{Column, Format, Output, Table, UnitTable};
+use thirdbody::render::{Column, Format, Output, RenderError, Table, UnitTable};
 use thirdbody::unit_table;
 use utoipa::ToSchema;
 
@@ -53,7 +53,7 @@ struct CountdownPicture {
 
 impl Picture for CountdownPicture {
     /// The steps as one bar.
-    fn chart(self) -> Result<Chart, String> {
+    fn chart(self) -> Result<Chart, RenderError> {
         let steps = self.steps;
         Ok(Chart {
             title: "countdown".to_string(),

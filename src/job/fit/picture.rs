@@ -82,7 +82,7 @@ impl FitPicture {
         for r in self.residuals.iter().filter(|r| r.series == series) {
             let compared = r
                 .comparison(quantity)
-                .ok_or("a residual has no comparison")?;
+                .ok_or_else(|| PictureError::new("a residual has no comparison"))?;
             let (x, _) = x(&r.at)?;
             measured.push((x, compared.measured));
             segments.push(Layer::Line {
@@ -127,14 +127,17 @@ impl FitPicture {
 
 impl Picture for FitPicture {
     fn chart(self) -> Result<Chart, PictureError> {
-        let first = self.curves.first().ok_or("the fit has no curve")?;
+        let first = self
+            .curves
+            .first()
+            .ok_or_else(|| PictureError::new("the fit has no curve"))?;
         let (quantity, along) = (first.quantity, first.along.clone());
         // The condition along the curves, with its unit, at a point.
         let x = |at: &Conditions| -> Result<(f64, &'static str), PictureError> {
             let given = at.given().into_iter().find(|c| c.0 == along);
             given
                 .map(|c| (c.2, c.1))
-                .ok_or_else(|| format!("a point has no {along}"))
+                .ok_or_else(|| PictureError::new(format!("a point has no {along}")))
         };
         let mut layers = Vec::new();
         let mut left_out = 0;
@@ -152,7 +155,9 @@ impl Picture for FitPicture {
                 .map(|p| {
                     let (x, unit) = x(&p.at)?;
                     x_unit = unit;
-                    let y = p.value(quantity).ok_or("a curve point has no value")?;
+                    let y = p
+                        .value(quantity)
+                        .ok_or_else(|| PictureError::new("a curve point has no value"))?;
                     Ok((x, y))
                 })
                 .collect::<Result<Vec<_>, PictureError>>()?;

@@ -166,7 +166,9 @@ fn layers(curves: Vec<Curve>) -> Vec<Layer> {
 impl Picture for SweepPicture {
     fn chart(self) -> Result<Chart, PictureError> {
         let (rows, y_name) = self.points.drawn();
-        let first = rows.first().ok_or("the sweep has no point")?;
+        let first = rows
+            .first()
+            .ok_or_else(|| PictureError::new("the sweep has no point"))?;
         let varied = varied(&rows, first);
         // The longest list; of equal ones, the first (`max_by_key` keeps the last).
         let along = varied.iter().rev().max_by_key(|v| v.1).map_or(0, |v| v.0);
