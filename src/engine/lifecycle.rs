@@ -15,13 +15,13 @@ use tracing::Instrument;
 use uuid::Uuid;
 
 use super::backlog::{Backlog, Ticket};
+use super::config::EngineConfig;
+use super::error::EngineError;
 use super::fleet::{placement, Health, Shared, Worker};
 use super::ids::{self, JobIds, Unknown};
 use super::metrics::{self as names, Metrics};
 use super::solver::Solver;
-use super::spill::JobResult;
-use super::store::{JobRecord, JobState, JobStatus, JobStore, Listing, Owner, Page};
-use super::{EngineConfig, EngineError};
+use super::store::{JobRecord, JobResult, JobState, JobStatus, JobStore, Listing, Owner, Page};
 use crate::job::{Control, JobError, Keyed, Work};
 
 /// How long a cancel waits for the job to stop (it checks between units of work, which take

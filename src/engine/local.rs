@@ -16,6 +16,7 @@ use async_trait::async_trait;
 use uuid::Uuid;
 
 use super::archive::Archive;
+use super::store::memory::Place;
 use super::store::{JobRecord, JobState, JobStore, Listing, MemoryJobStore, Page, Refusal};
 
 /// Why a read of the database failed, for the client (the log says more).
@@ -162,16 +163,24 @@ impl JobStore for LocalJobStore {
     /// memory, marked so, and saved once writes succeed again.
     async fn update(&self, id: Uuid, state: JobState, done: usize) {
         let status = state.status();
-        let (kept, finished) = self.memory.update(id, state, done).await;
-        let Some(finished) = finished else {
+        let updated = self.memory.update(id, state.clone(), done).await;
+        let Some(finished) = updated.finished_at else {
             // A start not recorded reads as the job queued: it is not lost for that.
             let _ = self
                 .write("record a job's start", move |db| db.set_status(id, status))
                 .await;
             return;
         };
-        match self.save_end(id, kept, done, finished).await {
-            Ok(()) => self.save_unsaved().await,
+        let result = state.result().cloned();
+        match self.save_end(id, state, done, finished).await {
+            Ok(()) => {
+                // A result beyond the memory budget is read from the database from now on.
+                if let Some(result) = result.filter(|_| updated.place == Place::Database) {
+                    self.memory
+                        .store_result(id, self.archive.saved(id, &result));
+                }
+                self.save_unsaved().await
+            }
             Err(_) => {
                 self.memory.mark_unsaved(id, true);
                 self.unsaved().push(id);

@@ -63,7 +63,7 @@ struct Inner {
     prometheus: PrometheusHandle,
     /// Large request bodies read at once (see `body::offload`).
     readers: Arc<tokio::sync::Semaphore>,
-    /// Event streams open at once (`--max-event-streams`).
+    /// Event streams open at once (an eighth of `--max-connections`).
     streams: Arc<tokio::sync::Semaphore>,
 }
 
@@ -74,7 +74,7 @@ impl AppState {
     pub fn new(config: Config) -> Result<Self, String> {
         let storage = match &config.fleet {
             Some(fleet) => crate::engine::fleet::storage(&config.engine, fleet.clone())?,
-            None => Storage::in_process(&config.engine)?,
+            None => Storage::in_process(&config.engine).map_err(|e| e.to_string())?,
         };
         Ok(AppState::with_storage(config, storage))
     }

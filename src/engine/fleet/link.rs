@@ -363,6 +363,19 @@ pub fn redacted(url: &str) -> String {
     shown
 }
 
+/// A script run inside a transaction: `EVAL` with its text, so that it needs no loading.
+pub(super) fn eval(script: &str, keys: &[&str], args: &[&[u8]]) -> Cmd {
+    let mut cmd = redis::cmd("EVAL");
+    cmd.arg(script).arg(keys.len());
+    for key in keys {
+        cmd.arg(*key);
+    }
+    for arg in args {
+        cmd.arg(*arg);
+    }
+    cmd
+}
+
 #[cfg(test)]
 mod redaction {
     use super::redacted;

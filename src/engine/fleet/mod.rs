@@ -26,7 +26,8 @@ pub use store::RedisJobStore;
 pub use worker::{Shared, Worker};
 
 use super::cache::MemoryCache;
-use super::{EngineConfig, Storage};
+use super::config::EngineConfig;
+use super::storage::Storage;
 
 /// How the fleet's processes share work through Redis.
 #[derive(Clone, Debug, PartialEq)]
@@ -194,7 +195,7 @@ impl Fleet {
     pub async fn watch(&self) {
         let epoch = async {
             loop {
-                let now = store::unix_millis(std::time::SystemTime::now());
+                let now = crate::engine::clock::unix_millis(std::time::SystemTime::now());
                 let mark = redis::Cmd::set_options(
                     keys::EPOCH,
                     now,

@@ -13,12 +13,12 @@ use bytes::Bytes;
 use redis::Cmd;
 use uuid::Uuid;
 
-use super::cache::millis;
+use super::link::eval;
 use super::{keys, Failure, Fleet};
-use crate::engine::spill::{JobResult, ResultPlace, StoredResult};
-pub(super) use crate::engine::store::unix_millis;
+use crate::engine::clock::{from_unix_millis, millis, unix_millis};
 use crate::engine::store::{
-    from_unix_millis, JobRecord, JobState, JobStatus, JobStore, Listing, Owner, Page, Refusal,
+    JobRecord, JobResult, JobState, JobStatus, JobStore, Listing, Owner, Page, Refusal,
+    ResultPlace, StoredResult,
 };
 use crate::job::parts::RenderedPart;
 use crate::job::registry::KindName;
@@ -103,19 +103,6 @@ return 0
 
 /// The most jobs of one owner listed: the newest.
 const LISTED: isize = 10_000;
-
-/// A script run inside a transaction: `EVAL` with its text, so that it needs no loading.
-pub(super) fn eval(script: &str, keys: &[&str], args: &[&[u8]]) -> Cmd {
-    let mut cmd = redis::cmd("EVAL");
-    cmd.arg(script).arg(keys.len());
-    for key in keys {
-        cmd.arg(*key);
-    }
-    for arg in args {
-        cmd.arg(*arg);
-    }
-    cmd
-}
 
 /// A job as a worker needs it.
 pub struct Runnable {

@@ -27,7 +27,7 @@ use crate::engine::cache::Solved;
 use crate::engine::metrics as names;
 use crate::engine::pool::Pool;
 use crate::engine::solver::Solver;
-use crate::engine::spill::JobResult;
+use crate::engine::store::JobResult;
 use crate::engine::store::{JobState, JobStatus};
 use crate::job::parts::{self, RenderedPart};
 use crate::job::{tenant_of, Control, Job, JobError, Keyed, Unfinished, Work};
@@ -412,7 +412,7 @@ async fn next_entry(
             keys::STREAM,
             keys::GROUP,
             &fleet.consumer,
-            super::cache::millis(idle),
+            crate::engine::clock::millis(idle),
             "0-0",
             StreamAutoClaimOptions::default().count(1),
         );

@@ -40,8 +40,8 @@ impl fmt::Display for TooSlow {
         write!(
             f,
             "the request body arrived too slowly: {} bytes in {:.1} s; this service waits at \
-             most {} s for each piece of a body (--body-timeout) and, after that long, takes \
-             at least {} bytes/s on average (--body-min-rate)",
+             most {} s for each piece of a body and, after that long, takes at least {} \
+             bytes/s on average",
             self.received,
             self.after.as_secs_f64(),
             self.pace.timeout.as_secs_f64(),
