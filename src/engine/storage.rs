@@ -1,5 +1,5 @@
 //! Where an engine keeps answers and job records: in this process (memory and its database),
-//! or in a fleet's Redis ([`super::fleet::storage`]).
+//! or in a fleet's Redis ([`Storage::in_fleet`]).
 
 use std::sync::Arc;
 
@@ -7,7 +7,7 @@ use super::archive::{Archive, ArchiveError};
 use super::budget::Budget;
 use super::cache::{MemoryCache, ResultCache};
 use super::config::EngineConfig;
-use super::fleet::Shared;
+use super::fleet::{Fleet, FleetConfig, LinkError, RedisJobStore, Shared, TieredCache};
 use super::local::LocalJobStore;
 use super::store::{JobStore, MemoryJobStore};
 
@@ -38,6 +38,24 @@ impl Storage {
             cache: Arc::new(MemoryCache::for_engine(config)),
             jobs: Arc::new(LocalJobStore::new(memory, archive)),
             fleet: None,
+        })
+    }
+
+    /// In the fleet of `fleet`: this process's memory in front of Redis for answers, Redis
+    /// for jobs and their work.
+    pub fn in_fleet(config: &EngineConfig, fleet: FleetConfig) -> Result<Storage, LinkError> {
+        let fleet = Arc::new(Fleet::open(fleet)?);
+        let l1 = MemoryCache::for_engine(config);
+        // A fleet's finished jobs are its history: kept in Redis for the history's retention.
+        let store = Arc::new(RedisJobStore::new(
+            fleet.clone(),
+            config.history_retention,
+            config.job_deadline,
+        ));
+        Ok(Storage {
+            cache: Arc::new(TieredCache::new(l1, fleet.clone(), config.cache_ttl)),
+            jobs: store.clone(),
+            fleet: Some(Arc::new(Shared::new(fleet, store))),
         })
     }
 }

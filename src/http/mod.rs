@@ -73,7 +73,9 @@ impl AppState {
     /// cannot start.
     pub fn new(config: Config) -> Result<Self, String> {
         let storage = match &config.fleet {
-            Some(fleet) => crate::engine::fleet::storage(&config.engine, fleet.clone())?,
+            Some(fleet) => {
+                Storage::in_fleet(&config.engine, fleet.clone()).map_err(|e| e.to_string())?
+            }
             None => Storage::in_process(&config.engine).map_err(|e| e.to_string())?,
         };
         Ok(AppState::with_storage(config, storage))
