@@ -179,6 +179,7 @@ pub struct JobRecord {
     pub kind: KindName,
     /// The work the job takes.
     pub work: Work,
+    /// Where it is in its life: queued, running, or ended with its result or error.
     pub state: JobState,
     /// Work done when the record was last written (a running job's own count is live in
     /// the process that runs it).

@@ -51,16 +51,16 @@ pub struct FleetArgs {
 impl FleetArgs {
     /// The fleet's settings, if there is a fleet.
     pub fn validate(self) -> Result<Option<FleetConfig>, ConfigError> {
+        let cache_bytes = Bounded::count("--redis-cache-bytes", self.redis_cache_bytes, 0, 0);
         check_all([
             Bounded::count("--max-deliveries", self.max_deliveries, 1, MAX_DELIVERIES),
             Bounded::count("--part-points", self.part_points, 1, MAX_COUNT),
-            Bounded::count(
-                "--redis-cache-bytes",
-                self.redis_cache_bytes,
-                MIN_CACHE_BYTES,
-                MAX_BYTES,
-            )
-            .in_unit("bytes (1 TiB)"),
+            Bounded {
+                least: MIN_CACHE_BYTES,
+                most: MAX_BYTES,
+                unit: "bytes (1 TiB)",
+                ..cache_bytes
+            },
         ])?;
         let Some(cache_url) = self.redis_url else {
             return Ok(None);
