@@ -87,14 +87,10 @@ impl Archive {
     /// saying how to go on). Jobs an earlier run left unfinished are marked interrupted:
     /// that run stopped before they ended.
     pub fn open(path: &str, retention: Duration) -> Result<Arc<Archive>, ArchiveError> {
-        Archive::opened(path, retention).map_err(|why| ArchiveError {
+        let error = |why: String| ArchiveError {
             path: path.to_string(),
             why,
-        })
-    }
-
-    /// [`Archive::open`], failing with why.
-    fn opened(path: &str, retention: Duration) -> Result<Arc<Archive>, String> {
+        };
         let failed = |e: rusqlite::Error| {
             let hint = match e.sqlite_error_code() {
                 Some(rusqlite::ErrorCode::DatabaseBusy | rusqlite::ErrorCode::DatabaseLocked) => {
@@ -106,7 +102,7 @@ impl Archive {
                 }
                 _ => "",
             };
-            format!("{e}{hint}")
+            error(format!("{e}{hint}"))
         };
         let durable = path != IN_MEMORY;
         if durable {
@@ -114,7 +110,7 @@ impl Archive {
                 .parent()
                 .filter(|d| !d.as_os_str().is_empty())
             {
-                std::fs::create_dir_all(dir).map_err(|e| e.to_string())?;
+                std::fs::create_dir_all(dir).map_err(|e| error(e.to_string()))?;
             }
         }
         let db = Connection::open(path).map_err(failed)?;
@@ -131,7 +127,7 @@ impl Archive {
             .query_row("PRAGMA quick_check", [], |row| row.get(0))
             .map_err(failed)?;
         if check != "ok" {
-            return Err(format!("{check}{DAMAGED}"));
+            return Err(error(format!("{check}{DAMAGED}")));
         }
         db.execute_batch(SCHEMA).map_err(failed)?;
         let added: i64 = db
@@ -159,7 +155,10 @@ impl Archive {
             );
         }
         let file = match durable {
-            true => Some((path.to_string(), identity(path).map_err(|e| e.to_string())?)),
+            true => Some((
+                path.to_string(),
+                identity(path).map_err(|e| error(e.to_string()))?,
+            )),
             false => None,
         };
         let archive = Arc::new(Archive {

@@ -389,7 +389,7 @@ impl Lifecycle {
             .jobs
             .list(listing)
             .await
-            .map_err(EngineError::Unavailable)?;
+            .map_err(|e| EngineError::Unavailable(e.to_string()))?;
         let live = self.live();
         for record in &mut page.jobs {
             if let Some(job) = live.get(&record.id) {
@@ -408,7 +408,7 @@ impl Lifecycle {
         self.jobs
             .with_input(input_hash)
             .await
-            .map_err(EngineError::Unavailable)
+            .map_err(|e| EngineError::Unavailable(e.to_string()))
     }
 
     /// What can be told of a job `id` that the job store does not know.

@@ -17,10 +17,17 @@ use uuid::Uuid;
 
 use super::archive::Archive;
 use super::store::memory::Place;
-use super::store::{JobRecord, JobState, JobStore, Listing, MemoryJobStore, Page, Refusal};
+use super::store::{
+    JobRecord, JobState, JobStore, Listing, MemoryJobStore, Page, Refusal, Unreadable,
+};
 
-/// Why a read of the database failed, for the client (the log says more).
-const UNREADABLE: &str = "the database of saved analyses cannot be read now (the log says why)";
+/// Why a write to the database failed, for the client (the log says more).
+#[derive(Clone, Debug, thiserror::Error)]
+#[error(
+    "the database of saved analyses cannot be written now (the log says why: a full disk?), \
+     so the job is not accepted, that none is lost; it is retried with every submission"
+)]
+struct Unwritable;
 
 /// A process's jobs: in memory, and in its database.
 pub struct LocalJobStore {
@@ -48,19 +55,14 @@ impl LocalJobStore {
         &self,
         what: &'static str,
         call: impl FnOnce(&Arc<Archive>) -> rusqlite::Result<()> + Send + 'static,
-    ) -> Result<(), String> {
+    ) -> Result<(), Unwritable> {
         let outcome = match self.db(what, call).await {
-            Some(()) => None,
-            None => Some(
-                "the database of saved analyses cannot be written now (the log says why: a \
-                 full disk?), so the job is not accepted, that none is lost; it is retried with \
-                 every submission"
-                    .to_string(),
-            ),
+            Some(()) => Ok(()),
+            None => Err(Unwritable),
         };
         let mut failing = self.failing.lock().unwrap_or_else(|p| p.into_inner());
-        *failing = outcome.clone();
-        outcome.map_or(Ok(()), Err)
+        *failing = outcome.as_ref().err().map(Unwritable::to_string);
+        outcome
     }
 
     /// Runs `call` on the database off the async threads; an error is logged with `what`
@@ -90,7 +92,7 @@ impl LocalJobStore {
         kept: JobState,
         done: usize,
         finished: SystemTime,
-    ) -> Result<(), String> {
+    ) -> Result<(), Unwritable> {
         let bodies = match kept.result() {
             Some(result) => match result.bodies().await {
                 Ok(bodies) => Some(bodies),
@@ -143,9 +145,9 @@ impl JobStore for LocalJobStore {
         }
         let id = record.id;
         self.memory.insert(record.clone()).await?;
-        if let Err(why) = self.write("save a job", move |db| db.insert(&record)).await {
+        if let Err(e) = self.write("save a job", move |db| db.insert(&record)).await {
             self.memory.remove(id).await;
-            return Err(Refusal::Unwritable { why });
+            return Err(Refusal::Unwritable { why: e.to_string() });
         }
         self.save_unsaved().await;
         Ok(())
@@ -199,18 +201,18 @@ impl JobStore for LocalJobStore {
         self.memory.purge_expired().await + purged.unwrap_or(0)
     }
 
-    async fn list(&self, listing: &Listing) -> Result<Page, String> {
+    async fn list(&self, listing: &Listing) -> Result<Page, Unreadable> {
         let query = listing.clone();
         self.db("list jobs", move |db| db.list(&query))
             .await
-            .ok_or_else(|| UNREADABLE.to_string())
+            .ok_or(Unreadable::Database)
     }
 
-    async fn with_input(&self, input_hash: &str) -> Result<Option<JobRecord>, String> {
+    async fn with_input(&self, input_hash: &str) -> Result<Option<JobRecord>, Unreadable> {
         let hash = input_hash.to_string();
         self.db("find an input's answer", move |db| db.with_input(&hash))
             .await
-            .ok_or_else(|| UNREADABLE.to_string())
+            .ok_or(Unreadable::Database)
     }
 
     fn durable(&self) -> bool {

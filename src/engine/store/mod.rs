@@ -12,7 +12,7 @@ use uuid::Uuid;
 pub use memory::MemoryJobStore;
 pub use record::{
     JobRecord, JobResult, JobState, JobStatus, Listing, Owner, Page, Refusal, ResultPlace,
-    StoredResult,
+    StoredResult, Unreadable,
 };
 
 /// Where the records of asynchronous jobs are kept.
@@ -33,10 +33,10 @@ pub trait JobStore: Send + Sync {
     async fn purge_expired(&self) -> usize;
     /// The jobs of `listing`'s owner, newest first, filtered and paged; an error says why
     /// the store cannot be read.
-    async fn list(&self, listing: &Listing) -> Result<Page, String>;
+    async fn list(&self, listing: &Listing) -> Result<Page, Unreadable>;
     /// The newest job that succeeded on the input whose hash is `input_hash`; an error says
     /// why the store cannot be read.
-    async fn with_input(&self, input_hash: &str) -> Result<Option<JobRecord>, String>;
+    async fn with_input(&self, input_hash: &str) -> Result<Option<JobRecord>, Unreadable>;
 
     /// Whether every process of the fleet shares the store (so any of them answers for any
     /// job, and a job unknown to it is unknown to all).

@@ -399,6 +399,16 @@ pub enum JobResult {
     Stored(Arc<StoredResult>),
 }
 
+/// Why a job store cannot be read now, for the client (the log says more).
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum Unreadable {
+    #[error("the database of saved analyses cannot be read now (the log says why)")]
+    Database,
+    /// The fleet's Redis, and why.
+    #[error("{0}")]
+    Redis(String),
+}
+
 impl JobResult {
     /// Whether the answer is whole (else what a stopped job finished).
     pub fn complete(&self) -> bool {

@@ -187,9 +187,14 @@ fn check_durations<'a>(
     Ok(())
 }
 
+/// A duration that cannot be read, with an example of what can.
+#[derive(Debug, thiserror::Error)]
+#[error("{0} (write e.g. 30s, 500ms, 10m)")]
+struct BadDuration(humantime::DurationError);
+
 /// A duration flag's parser: humantime's, with an example of what it reads.
-fn duration(text: &str) -> Result<Duration, String> {
-    humantime::parse_duration(text).map_err(|e| format!("{e} (write e.g. 30s, 500ms, 10m)"))
+fn duration(text: &str) -> Result<Duration, BadDuration> {
+    humantime::parse_duration(text).map_err(BadDuration)
 }
 
 impl ServeArgs {
