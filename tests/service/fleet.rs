@@ -95,12 +95,6 @@ pub(crate) fn start(
             &default_url[..]
         })
         .args(["--log-format", "text"])
-        // Unless the test sizes them: parts of 100 points until the fleet measures a cost.
-        .args(if flags.contains(&"--part-points") {
-            &[][..]
-        } else {
-            &["--part-points", "100"][..]
-        })
         .args(["--pool-size", "2"])
         .env("RUST_LOG", "info")
         .args(flags);

@@ -3,7 +3,7 @@
 
 use std::time::Duration;
 
-use super::{check_all, Bounded, ConfigError, MAX_BYTES, MAX_COUNT};
+use super::{check_all, Bounded, ConfigError, MAX_BYTES};
 use crate::engine::fleet::FleetConfig;
 
 /// How long a part of a job may go without its process's heartbeat before another process
@@ -11,6 +11,11 @@ use crate::engine::fleet::FleetConfig;
 /// it over is one that died or hung, never one a loaded machine slowed; and a dead
 /// process's part waits no longer than that for another.
 pub const CLAIM_IDLE: Duration = Duration::from_secs(10);
+/// Points per part of a sweep on the fleet's stream until the fleet has measured what a
+/// point of its kind costs (then parts are sized by cost: one for a cheap sweep): 100
+/// points of the costliest kind take a few seconds, so that the first sweep of a kind is
+/// spread over the fleet and measured soon, and a part lost with its process is little work.
+pub const PART_POINTS: usize = 100;
 /// Most deliveries of a part of a job: a part whose processes died a hundred times will
 /// not finish on the hundred-and-first.
 const MAX_DELIVERIES: u64 = 100;
@@ -35,11 +40,6 @@ pub struct FleetArgs {
     #[arg(long, env = "THIRDBODY_MAX_DELIVERIES", default_value_t = 3)]
     pub max_deliveries: u32,
 
-    /// Points per part of a sweep on the fleet's stream until the fleet has measured what
-    /// a point of its kind costs (then parts are sized by cost: one for a cheap sweep).
-    #[arg(long, env = "THIRDBODY_PART_POINTS", default_value_t = 250)]
-    pub part_points: usize,
-
     /// When one Redis holds both the cache and the jobs: the bytes the cached answers may
     /// take there at most (the oldest go first), so that answers never crowd out jobs; and
     /// never more than half of the server's maxmemory (read when connected, and every
@@ -54,7 +54,6 @@ impl FleetArgs {
         let cache_bytes = Bounded::count("--redis-cache-bytes", self.redis_cache_bytes, 0, 0);
         check_all([
             Bounded::count("--max-deliveries", self.max_deliveries, 1, MAX_DELIVERIES),
-            Bounded::count("--part-points", self.part_points, 1, MAX_COUNT),
             Bounded {
                 least: MIN_CACHE_BYTES,
                 most: MAX_BYTES,
@@ -77,7 +76,7 @@ impl FleetArgs {
             jobs_url,
             claim_idle: CLAIM_IDLE,
             max_deliveries: self.max_deliveries,
-            part_points: self.part_points,
+            part_points: PART_POINTS,
             shared_cache_bytes: self.redis_cache_bytes,
         }))
     }

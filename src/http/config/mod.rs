@@ -335,7 +335,6 @@ mod tests {
                 ["--max-deliveries", "4294967295"],
                 "--max-deliveries 4294967295: allowed 1 to 100",
             ),
-            (["--part-points", "0"], "--part-points 0: allowed 1 to 100000000"),
             (
                 ["--body-limit", most],
                 "--body-limit 18446744073709551615: allowed 1024 to 1073741824 bytes (1 GiB)",
