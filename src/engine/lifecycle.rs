@@ -46,7 +46,7 @@ struct LiveJob {
 }
 
 /// Called with what a job really cost (its time on a solver thread) when it ends: a quota
-/// trues up the estimate it charged ([`super::Engine::submit`]).
+/// trues up the estimate it charged (the engine's `submit`).
 pub type OnEnd = Box<dyn FnOnce(Duration) + Send>;
 
 impl LiveJob {

@@ -44,13 +44,6 @@ pub use storage::Storage;
 use crate::job::{Control, Job, JobError};
 use crate::render::Answer;
 
-/// The hasher of the engine's in-process maps (answers, input keys, sweep points, solves in
-/// flight) and of the doorkeeper. Their keys churn at the request rate: with SipHash,
-/// hashing was a tenth of an uncached request's CPU (under moka, which rehashed its table as
-/// entries came and went). foldhash is seeded per process, so keys cannot be chosen to
-/// collide without knowing the seed.
-type KeyHasher = foldhash::fast::RandomState;
-
 /// Runs `job` to its answer, or until `control` stops it.
 pub fn run(job: &Job, control: &Control) -> Result<Answer, JobError> {
     job.run(job.meta(), control)

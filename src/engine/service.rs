@@ -241,7 +241,7 @@ impl Engine {
     }
 
     /// What can be told of a job `id` that the job store does not know.
-    pub async fn unknown(&self, id: Uuid) -> super::Unknown {
+    pub async fn unknown(&self, id: Uuid) -> super::ids::Unknown {
         self.jobs.unknown(id).await
     }
 
