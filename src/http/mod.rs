@@ -68,8 +68,8 @@ struct Inner {
 }
 
 impl AppState {
-    /// A service with its own engine, its answers and jobs in its own memory (and spill
-    /// directory and database) or its fleet's Redis, and its own metrics registry; or why it
+    /// A service with its own engine, its answers and jobs in its own memory (and its
+    /// database) or its fleet's Redis, and its own metrics registry; or why it
     /// cannot start.
     pub fn new(config: Config) -> Result<Self, String> {
         let storage = match &config.fleet {
