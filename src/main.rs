@@ -496,16 +496,29 @@ impl Signals {
     }
 }
 
+/// A job file that cannot be read.
+#[derive(Debug, thiserror::Error)]
+#[error("cannot read {path}: {source}")]
+struct Unread {
+    /// The file, or "standard input".
+    path: String,
+    source: std::io::Error,
+}
+
 /// The text of the job file at `path` (`-`: standard input), or why it cannot be read.
-fn read_input(path: &str) -> Result<Vec<u8>, String> {
+fn read_input(path: &str) -> Result<Vec<u8>, Unread> {
+    let unread = |source, path: &str| Unread {
+        path: path.to_string(),
+        source,
+    };
     if path == "-" {
         let mut text = Vec::new();
         std::io::stdin()
             .read_to_end(&mut text)
             .map(|_| text)
-            .map_err(|e| format!("cannot read standard input: {e}"))
+            .map_err(|e| unread(e, "standard input"))
     } else {
-        std::fs::read(path).map_err(|e| format!("cannot read {path}: {e}"))
+        std::fs::read(path).map_err(|e| unread(e, path))
     }
 }
 

@@ -10,8 +10,8 @@ use std::time::{Duration, Instant};
 
 use tokio::sync::OwnedMutexGuard;
 
+use super::error::EngineError;
 use super::fleet::Fleet;
-use super::EngineError;
 
 /// The longest a fleet's lock is held if its holder dies: far longer than a count and an
 /// insert take.

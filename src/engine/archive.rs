@@ -19,10 +19,9 @@ use bytes::Bytes;
 use rusqlite::{params, Connection, OptionalExtension, Row};
 use uuid::Uuid;
 
-use super::spill::{JobResult, ResultPlace, StoredResult};
-use super::store::{
-    from_unix_millis, unix_millis, JobRecord, JobState, JobStatus, Listing, Owner, Page,
-};
+use super::clock::{from_unix_millis, unix_millis};
+use super::store::{JobRecord, JobState, JobStatus, Listing, Owner, Page};
+use super::store::{JobResult, ResultPlace, StoredResult};
 use crate::job::registry::KindName;
 use crate::job::{JobError, Work};
 
@@ -87,7 +86,11 @@ impl Archive {
     /// jobs for `retention`, after a quick check of its integrity (a damaged file is refused,
     /// saying how to go on). Jobs an earlier run left unfinished are marked interrupted:
     /// that run stopped before they ended.
-    pub fn open(path: &str, retention: Duration) -> Result<Arc<Archive>, String> {
+    pub fn open(path: &str, retention: Duration) -> Result<Arc<Archive>, ArchiveError> {
+        let error = |why: String| ArchiveError {
+            path: path.to_string(),
+            why,
+        };
         let failed = |e: rusqlite::Error| {
             let hint = match e.sqlite_error_code() {
                 Some(rusqlite::ErrorCode::DatabaseBusy | rusqlite::ErrorCode::DatabaseLocked) => {
@@ -99,7 +102,7 @@ impl Archive {
                 }
                 _ => "",
             };
-            format!("--database {path}: {e}{hint}")
+            error(format!("{e}{hint}"))
         };
         let durable = path != IN_MEMORY;
         if durable {
@@ -107,7 +110,7 @@ impl Archive {
                 .parent()
                 .filter(|d| !d.as_os_str().is_empty())
             {
-                std::fs::create_dir_all(dir).map_err(|e| format!("--database {path}: {e}"))?;
+                std::fs::create_dir_all(dir).map_err(|e| error(e.to_string()))?;
             }
         }
         let db = Connection::open(path).map_err(failed)?;
@@ -124,7 +127,7 @@ impl Archive {
             .query_row("PRAGMA quick_check", [], |row| row.get(0))
             .map_err(failed)?;
         if check != "ok" {
-            return Err(format!("--database {path}: {check}{DAMAGED}"));
+            return Err(error(format!("{check}{DAMAGED}")));
         }
         db.execute_batch(SCHEMA).map_err(failed)?;
         let added: i64 = db
@@ -154,7 +157,7 @@ impl Archive {
         let file = match durable {
             true => Some((
                 path.to_string(),
-                identity(path).map_err(|e| format!("--database {path}: {e}"))?,
+                identity(path).map_err(|e| error(e.to_string()))?,
             )),
             false => None,
         };
@@ -165,6 +168,22 @@ impl Archive {
         });
         archive.purge().map_err(failed)?;
         Ok(archive)
+    }
+
+    /// `result` of job `id` as the database keeps it (once its end is saved): read from
+    /// there when asked for.
+    pub fn saved(self: &Arc<Self>, id: Uuid, result: &JobResult) -> JobResult {
+        let saved = Arc::new(Saved {
+            archive: self.clone(),
+            id,
+        });
+        let stored = StoredResult::new(
+            result.key().to_string(),
+            result.kind(),
+            result.complete(),
+            saved,
+        );
+        JobResult::Stored(Arc::new(stored))
     }
 
     fn db(&self) -> MutexGuard<'_, Connection> {
@@ -439,6 +458,14 @@ fn millis(time: SystemTime) -> i64 {
 /// The time stored as `unix_ms`.
 fn time(unix_ms: i64) -> SystemTime {
     from_unix_millis(u64::try_from(unix_ms).unwrap_or(0))
+}
+
+/// Why the database of saved analyses cannot be opened.
+#[derive(Debug, thiserror::Error)]
+#[error("--database {path}: {why}")]
+pub struct ArchiveError {
+    path: String,
+    why: String,
 }
 
 /// A result in the database.

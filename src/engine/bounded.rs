@@ -18,6 +18,13 @@ use quick_cache::{OptionsBuilder, Weighter};
 
 use super::budget;
 
+/// The hasher of the engine's in-process maps (answers, input keys, sweep points, solves in
+/// flight) and of the doorkeeper. Their keys churn at the request rate: with SipHash,
+/// hashing was a tenth of an uncached request's CPU (under moka, which rehashed its table as
+/// entries came and went). foldhash is seeded per process, so keys cannot be chosen to
+/// collide without knowing the seed.
+pub(super) type KeyHasher = foldhash::fast::RandomState;
+
 /// Shards of a map, at most, each with its own lock and an equal share of the bytes (a small
 /// map has fewer: quick_cache gives a shard at least 32 typical entries). An entry heavier
 /// than most of a share is not kept: with 4 shards, one heavier than about a quarter of the
@@ -27,7 +34,7 @@ const SHARDS: usize = 4;
 /// A map from text keys to values of `V`, holding at most about `max_bytes` (as weighed by
 /// its weigher, plus [`budget::ENTRY_OVERHEAD`] per entry), each entry for at most its TTL.
 pub struct Bounded<V> {
-    map: Cache<String, Timed<V>, Weigh<V>, super::KeyHasher>,
+    map: Cache<String, Timed<V>, Weigh<V>, KeyHasher>,
     ttl: Duration,
 }
 

@@ -180,7 +180,7 @@ pub struct MemoryCache {
 
 impl MemoryCache {
     /// The cache of an engine with `config`: its share of the memory budget, its TTL.
-    pub fn for_engine(config: &super::EngineConfig) -> Self {
+    pub fn for_engine(config: &super::config::EngineConfig) -> Self {
         MemoryCache::new(
             budget::Budget::split(config.memory_budget).answers,
             config.cache_ttl,

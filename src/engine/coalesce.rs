@@ -7,8 +7,9 @@ use std::sync::{Arc, Mutex, MutexGuard};
 
 use futures_util::future::{BoxFuture, FutureExt, Shared, WeakShared};
 
+use super::bounded::KeyHasher;
 use super::cache::Solved;
-use super::EngineError;
+use super::error::EngineError;
 
 /// A solve in flight.
 pub type Solving = BoxFuture<'static, Result<Arc<Solved>, EngineError>>;
@@ -20,9 +21,9 @@ pub struct Coalescer {
     in_flight: Mutex<InFlight>,
 }
 
-/// The solves in flight, by key, hashed as the engine's other maps are ([`super::KeyHasher`]:
+/// The solves in flight, by key, hashed as the engine's other maps are ([`KeyHasher`]:
 /// SipHash was 1,300 of an uncached request's instructions here).
-type InFlight = HashMap<String, WeakShared<Solving>, super::KeyHasher>;
+type InFlight = HashMap<String, WeakShared<Solving>, KeyHasher>;
 
 impl Coalescer {
     fn in_flight(&self) -> MutexGuard<'_, InFlight> {

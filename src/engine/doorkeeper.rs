@@ -12,12 +12,14 @@
 use std::hash::BuildHasher;
 use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
 
+use super::bounded::KeyHasher;
+
 /// The sightings of inputs, as bits set.
 pub struct Doorkeeper {
     bits: Box<[AtomicU64]>,
     /// First sightings since the last reset.
     marked: AtomicUsize,
-    hasher: super::KeyHasher,
+    hasher: KeyHasher,
 }
 
 impl Doorkeeper {
@@ -31,7 +33,7 @@ impl Doorkeeper {
         Doorkeeper {
             bits: (0..bits / 64).map(|_| AtomicU64::new(0)).collect(),
             marked: AtomicUsize::new(0),
-            hasher: super::KeyHasher::default(),
+            hasher: KeyHasher::default(),
         }
     }
 

@@ -1,4 +1,4 @@
-//! Heavy work (solving, parsing large bodies, drawing, writing spilled results) runs on
+//! Heavy work (solving, parsing large bodies, drawing, reading and writing the database) runs on
 //! tokio's blocking threads, and at a lower scheduling priority than the async threads
 //! that accept connections and answer `/healthz`. On a machine with few cores the two
 //! compete: under a burst of 100 clients each sending a 70 kB sweep, two threads parsing

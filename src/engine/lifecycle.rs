@@ -15,13 +15,14 @@ use tracing::Instrument;
 use uuid::Uuid;
 
 use super::backlog::{Backlog, Ticket};
+use super::cache::Solved;
+use super::config::EngineConfig;
+use super::error::EngineError;
 use super::fleet::{placement, Health, Shared, Worker};
 use super::ids::{self, JobIds, Unknown};
 use super::metrics::{self as names, Metrics};
 use super::solver::Solver;
-use super::spill::JobResult;
-use super::store::{JobRecord, JobState, JobStatus, JobStore, Listing, Owner, Page};
-use super::{EngineConfig, EngineError};
+use super::store::{JobRecord, JobResult, JobState, JobStatus, JobStore, Listing, Owner, Page};
 use crate::job::{Control, JobError, Keyed, Work};
 
 /// How long a cancel waits for the job to stop (it checks between units of work, which take
@@ -45,7 +46,7 @@ struct LiveJob {
 }
 
 /// Called with what a job really cost (its time on a solver thread) when it ends: a quota
-/// trues up the estimate it charged ([`super::Engine::submit`]).
+/// trues up the estimate it charged (the engine's `submit`).
 pub type OnEnd = Box<dyn FnOnce(Duration) + Send>;
 
 impl LiveJob {
@@ -195,26 +196,51 @@ impl Lifecycle {
         };
         // A job whose answer is cached is answered at once: it takes no place in the queue.
         if let Some(solved) = self.solver.cached(keyed.key()).await {
-            let mut record = queued(self.ids.next()).holding(solved.weight());
-            let done = match work {
-                Work::Known(total) => total,
-                Work::Unknown => 0,
-            };
-            self.jobs
-                .insert(record.clone())
-                .await
-                .map_err(EngineError::from)?;
-            let state = JobState::Succeeded(JobResult::Ready(solved));
-            self.jobs.update(record.id, state.clone(), done).await;
-            self.uncollected().insert(record.id, self.config.max_jobs);
-            record.state = state;
-            record.done = done;
-            return Ok(record);
+            let record = queued(self.ids.next()).holding(solved.weight());
+            return self.answered(record, solved, work).await;
         }
         if let Some(shared) = &self.fleet {
             let record = queued(self.ids.next());
             return self.enqueue(shared, keyed, record).await;
         }
+        let ticket = self.take_place(&keyed)?;
+        let record = queued(self.ids.next());
+        if let Err(refusal) = self.jobs.insert(record.clone()).await {
+            self.queued.fetch_sub(1, Ordering::SeqCst);
+            return Err(refusal.into());
+        }
+        self.jobs_queued.increment(1.0);
+        let anonymous = owner.as_ref().is_none_or(|o| !o.is_tenant());
+        self.spawn(record.id, keyed, ticket, anonymous, on_end);
+        Ok(record)
+    }
+
+    /// Records `record`, whose answer `solved` was cached, as succeeded at once.
+    async fn answered(
+        &self,
+        mut record: JobRecord,
+        solved: Arc<Solved>,
+        work: Work,
+    ) -> Result<JobRecord, EngineError> {
+        let done = match work {
+            Work::Known(total) => total,
+            Work::Unknown => 0,
+        };
+        self.jobs
+            .insert(record.clone())
+            .await
+            .map_err(EngineError::from)?;
+        let state = JobState::Succeeded(JobResult::Ready(solved));
+        self.jobs.update(record.id, state.clone(), done).await;
+        self.uncollected().insert(record.id, self.config.max_jobs);
+        record.state = state;
+        record.done = done;
+        Ok(record)
+    }
+
+    /// A place in this process's queue for `keyed`, and its turn in the backlog; refused
+    /// when the queue is full, or when the work before it would keep it past its deadline.
+    fn take_place(&self, keyed: &Keyed) -> Result<Ticket, EngineError> {
         let max = self.config.max_queued_jobs;
         if self
             .queued
@@ -225,27 +251,32 @@ impl Lifecycle {
         {
             return Err(EngineError::Overloaded);
         }
-        let ticket = match self.backlog.admit(keyed.job().cost_class(), work.units()) {
-            Ok(ticket) => ticket,
-            Err(backlogged) => {
+        let work = keyed.job().work();
+        self.backlog
+            .admit(keyed.job().cost_class(), work.units())
+            .map_err(|backlogged| {
                 self.queued.fetch_sub(1, Ordering::SeqCst);
-                return Err(EngineError::Backlogged(backlogged));
-            }
-        };
-        let record = queued(self.ids.next());
-        let id = record.id;
-        if let Err(refusal) = self.jobs.insert(record.clone()).await {
-            self.queued.fetch_sub(1, Ordering::SeqCst);
-            return Err(refusal.into());
-        }
-        self.jobs_queued.increment(1.0);
+                EngineError::Backlogged(backlogged)
+            })
+    }
+
+    /// Runs job `id` in this process, on its task, until it ends; then records its end.
+    fn spawn(
+        self: &Arc<Self>,
+        id: Uuid,
+        keyed: Keyed,
+        ticket: Ticket,
+        anonymous: bool,
+        on_end: Option<OnEnd>,
+    ) {
+        let (kind, work) = (keyed.job().kind(), keyed.job().work());
         let deadline = Instant::now() + self.config.job_deadline;
         let live = Arc::new(LiveJob {
             control: Arc::new(self.solver.control(deadline)),
             cancel: CancellationToken::new(),
             interrupted: AtomicBool::new(false),
             status: watch::Sender::new(JobStatus::Queued),
-            anonymous: owner.as_ref().is_none_or(|o| !o.is_tenant()),
+            anonymous,
             solved_in: AtomicU64::new(0),
         });
         self.live().insert(id, live.clone());
@@ -276,7 +307,6 @@ impl Lifecycle {
             }
             .instrument(span),
         );
-        Ok(record)
     }
 
     /// Puts `job` on the fleet's work stream (in parts, if it splits into more than a part's
@@ -359,7 +389,7 @@ impl Lifecycle {
             .jobs
             .list(listing)
             .await
-            .map_err(EngineError::Unavailable)?;
+            .map_err(|e| EngineError::Unavailable(e.to_string()))?;
         let live = self.live();
         for record in &mut page.jobs {
             if let Some(job) = live.get(&record.id) {
@@ -378,7 +408,7 @@ impl Lifecycle {
         self.jobs
             .with_input(input_hash)
             .await
-            .map_err(EngineError::Unavailable)
+            .map_err(|e| EngineError::Unavailable(e.to_string()))
     }
 
     /// What can be told of a job `id` that the job store does not know.

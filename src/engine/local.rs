@@ -16,10 +16,18 @@ use async_trait::async_trait;
 use uuid::Uuid;
 
 use super::archive::Archive;
-use super::store::{JobRecord, JobState, JobStore, Listing, MemoryJobStore, Page, Refusal};
+use super::store::memory::Place;
+use super::store::{
+    JobRecord, JobState, JobStore, Listing, MemoryJobStore, Page, Refusal, Unreadable,
+};
 
-/// Why a read of the database failed, for the client (the log says more).
-const UNREADABLE: &str = "the database of saved analyses cannot be read now (the log says why)";
+/// Why a write to the database failed, for the client (the log says more).
+#[derive(Clone, Debug, thiserror::Error)]
+#[error(
+    "the database of saved analyses cannot be written now (the log says why: a full disk?), \
+     so the job is not accepted, that none is lost; it is retried with every submission"
+)]
+struct Unwritable;
 
 /// A process's jobs: in memory, and in its database.
 pub struct LocalJobStore {
@@ -47,19 +55,14 @@ impl LocalJobStore {
         &self,
         what: &'static str,
         call: impl FnOnce(&Arc<Archive>) -> rusqlite::Result<()> + Send + 'static,
-    ) -> Result<(), String> {
+    ) -> Result<(), Unwritable> {
         let outcome = match self.db(what, call).await {
-            Some(()) => None,
-            None => Some(
-                "the database of saved analyses cannot be written now (the log says why: a \
-                 full disk?), so the job is not accepted, that none is lost; it is retried with \
-                 every submission"
-                    .to_string(),
-            ),
+            Some(()) => Ok(()),
+            None => Err(Unwritable),
         };
         let mut failing = self.failing.lock().unwrap_or_else(|p| p.into_inner());
-        *failing = outcome.clone();
-        outcome.map_or(Ok(()), Err)
+        *failing = outcome.as_ref().err().map(Unwritable::to_string);
+        outcome
     }
 
     /// Runs `call` on the database off the async threads; an error is logged with `what`
@@ -89,7 +92,7 @@ impl LocalJobStore {
         kept: JobState,
         done: usize,
         finished: SystemTime,
-    ) -> Result<(), String> {
+    ) -> Result<(), Unwritable> {
         let bodies = match kept.result() {
             Some(result) => match result.bodies().await {
                 Ok(bodies) => Some(bodies),
@@ -142,9 +145,9 @@ impl JobStore for LocalJobStore {
         }
         let id = record.id;
         self.memory.insert(record.clone()).await?;
-        if let Err(why) = self.write("save a job", move |db| db.insert(&record)).await {
+        if let Err(e) = self.write("save a job", move |db| db.insert(&record)).await {
             self.memory.remove(id).await;
-            return Err(Refusal::Unwritable { why });
+            return Err(Refusal::Unwritable { why: e.to_string() });
         }
         self.save_unsaved().await;
         Ok(())
@@ -162,16 +165,24 @@ impl JobStore for LocalJobStore {
     /// memory, marked so, and saved once writes succeed again.
     async fn update(&self, id: Uuid, state: JobState, done: usize) {
         let status = state.status();
-        let (kept, finished) = self.memory.update(id, state, done).await;
-        let Some(finished) = finished else {
+        let updated = self.memory.update(id, state.clone(), done).await;
+        let Some(finished) = updated.finished_at else {
             // A start not recorded reads as the job queued: it is not lost for that.
             let _ = self
                 .write("record a job's start", move |db| db.set_status(id, status))
                 .await;
             return;
         };
-        match self.save_end(id, kept, done, finished).await {
-            Ok(()) => self.save_unsaved().await,
+        let result = state.result().cloned();
+        match self.save_end(id, state, done, finished).await {
+            Ok(()) => {
+                // A result beyond the memory budget is read from the database from now on.
+                if let Some(result) = result.filter(|_| updated.place == Place::Database) {
+                    self.memory
+                        .store_result(id, self.archive.saved(id, &result));
+                }
+                self.save_unsaved().await
+            }
             Err(_) => {
                 self.memory.mark_unsaved(id, true);
                 self.unsaved().push(id);
@@ -190,18 +201,18 @@ impl JobStore for LocalJobStore {
         self.memory.purge_expired().await + purged.unwrap_or(0)
     }
 
-    async fn list(&self, listing: &Listing) -> Result<Page, String> {
+    async fn list(&self, listing: &Listing) -> Result<Page, Unreadable> {
         let query = listing.clone();
         self.db("list jobs", move |db| db.list(&query))
             .await
-            .ok_or_else(|| UNREADABLE.to_string())
+            .ok_or(Unreadable::Database)
     }
 
-    async fn with_input(&self, input_hash: &str) -> Result<Option<JobRecord>, String> {
+    async fn with_input(&self, input_hash: &str) -> Result<Option<JobRecord>, Unreadable> {
         let hash = input_hash.to_string();
         self.db("find an input's answer", move |db| db.with_input(&hash))
             .await
-            .ok_or_else(|| UNREADABLE.to_string())
+            .ok_or(Unreadable::Database)
     }
 
     fn durable(&self) -> bool {

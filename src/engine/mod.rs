@@ -14,8 +14,11 @@ mod backlog;
 mod bounded;
 mod budget;
 pub mod cache;
+pub mod clock;
 mod coalesce;
+mod config;
 mod doorkeeper;
+mod error;
 pub mod fleet;
 pub mod heavy;
 mod ids;
@@ -27,23 +30,19 @@ pub mod pool;
 pub mod quota;
 mod service;
 mod solver;
-pub mod spill;
+mod storage;
 pub mod store;
 
 pub use backlog::Backlogged;
+pub use config::EngineConfig;
+pub use error::EngineError;
 pub use ids::Unknown;
-pub use service::{Engine, EngineConfig, EngineError, Held, Storage};
+pub use service::Engine;
 pub use solver::{CacheStatus, CacheUse, Solver};
+pub use storage::Storage;
 
 use crate::job::{Control, Job, JobError};
 use crate::render::Answer;
-
-/// The hasher of the engine's in-process maps (answers, input keys, sweep points, solves in
-/// flight) and of the doorkeeper. Their keys churn at the request rate: with SipHash,
-/// hashing was a tenth of an uncached request's CPU (under moka, which rehashed its table as
-/// entries came and went). foldhash is seeded per process, so keys cannot be chosen to
-/// collide without knowing the seed.
-type KeyHasher = foldhash::fast::RandomState;
 
 /// Runs `job` to its answer, or until `control` stops it.
 pub fn run(job: &Job, control: &Control) -> Result<Answer, JobError> {

@@ -5,7 +5,6 @@
 //! refusals) and hands each call to its part.
 
 use std::future::Future;
-use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
@@ -13,146 +12,22 @@ use tokio::sync::watch;
 use uuid::Uuid;
 
 use super::admission::{Admissions, Turn};
-use super::archive::Archive;
-use super::backlog::Backlogged;
-use super::budget::Budget;
-use super::cache::{MemoryCache, ResultCache, Solved};
-use super::fleet::{Fleet, Shared};
+use super::archive::ArchiveError;
+use super::cache::Solved;
+use super::config::EngineConfig;
+use super::error::EngineError;
+use super::fleet::Fleet;
 use super::lifecycle::{Lifecycle, OnEnd};
-use super::local::LocalJobStore;
 use super::metrics::{self as names, Metrics};
 use super::quota::{Charge, Exceeded, PointCounts};
 use super::solver::{CacheStatus, CacheUse, Solver};
-use super::spill::SpillDir;
-use super::store::{JobRecord, JobStatus, JobStore, Listing, MemoryJobStore, Owner, Page, Refusal};
-use crate::job::{JobError, Keyed};
-
-/// The limits of an engine.
-#[derive(Clone, Debug, PartialEq)]
-pub struct EngineConfig {
-    /// Solver threads, and so jobs solved at once.
-    pub pool_size: usize,
-    /// How long a synchronous solve may take.
-    pub solve_deadline: Duration,
-    /// How long an asynchronous job may take from its submission.
-    pub job_deadline: Duration,
-    /// Asynchronous jobs that may wait for a solver thread.
-    pub max_queued_jobs: usize,
-    /// Memory for everything kept between requests (bytes, estimated): cached answers, the
-    /// results of finished jobs, the input memo, solved points ([`Budget`]).
-    pub memory_budget: u64,
-    /// Records of asynchronous jobs kept at most (the oldest finished are forgotten first).
-    pub max_jobs: usize,
-    /// How long an answer stays cached.
-    pub cache_ttl: Duration,
-    /// How long a finished asynchronous job's record and result stay in memory for its
-    /// client to collect.
-    pub job_retention: Duration,
-    /// The database of saved analyses: a file, or [`super::archive::IN_MEMORY`].
-    pub database: String,
-    /// How long finished jobs are kept in the history (the database, or the fleet's Redis).
-    pub history_retention: Duration,
-    /// Where results too large for the memory budget are kept (a directory of this
-    /// process's is made there), and how many bytes of them at most; `None` or 0 bytes: in
-    /// memory only.
-    pub spill: Option<(PathBuf, u64)>,
-}
-
-/// Where an engine keeps answers and job records.
-#[derive(Clone)]
-pub struct Storage {
-    pub cache: Arc<dyn ResultCache>,
-    pub jobs: Arc<dyn JobStore>,
-    /// The fleet the engine works in, if any ([`super::fleet`]): its jobs then run on the
-    /// fleet's work stream, not in this process's tasks.
-    pub fleet: Option<Arc<Shared>>,
-}
-
-impl Storage {
-    /// In this process's memory (and its spill directory), within `config`'s bounds, and
-    /// its database of saved analyses: the default. Fails if the spill directory cannot be
-    /// made or the database opened.
-    pub fn in_process(config: &EngineConfig) -> Result<Storage, String> {
-        let budget = Budget::split(config.memory_budget);
-        let spill = match &config.spill {
-            Some((parent, bytes)) if *bytes > 0 => Some(
-                SpillDir::create(parent, *bytes)
-                    .map_err(|e| format!("--spill-dir {}: {e}", parent.display()))?,
-            ),
-            _ => None,
-        };
-        let memory = MemoryJobStore::new(
-            config.job_retention,
-            config.max_jobs,
-            budget.job_results,
-            spill,
-        );
-        let archive = Archive::open(&config.database, config.history_retention)?;
-        Ok(Storage {
-            cache: Arc::new(MemoryCache::for_engine(config)),
-            jobs: Arc::new(LocalJobStore::new(memory, archive)),
-            fleet: None,
-        })
-    }
-}
-
-/// Why the engine did not answer.
-#[derive(Clone, Debug, PartialEq)]
-pub enum EngineError {
-    /// The job's own error (invalid, failed, past its deadline...).
-    Job(JobError),
-    /// No solver thread free (synchronous), or the job queue is full (asynchronous).
-    Overloaded,
-    /// The service is shutting down and takes no new work.
-    Draining,
-    /// The shared job store cannot be reached (why): asynchronous work is refused rather
-    /// than accepted and possibly lost.
-    Unavailable(String),
-    /// The work accepted before an asynchronous job and its own would not end within its
-    /// deadline ([`super::backlog`]).
-    Backlogged(Backlogged),
-    /// The job store cannot hold the job's result now (what is full, and when room is
-    /// next made): the job is refused before any work rather than its result dropped after.
-    ResultsFull { what: String, retry_after: Duration },
-    /// The job's result would not fit in the job store even if it were empty.
-    ResultTooLarge { needed: u64, limit: u64 },
-}
-
-impl From<Refusal> for EngineError {
-    fn from(refusal: Refusal) -> Self {
-        match refusal {
-            Refusal::Full { what, retry_after } => EngineError::ResultsFull { what, retry_after },
-            Refusal::TooLarge { needed, limit } => EngineError::ResultTooLarge { needed, limit },
-            Refusal::Unwritable { why } => EngineError::Unavailable(why),
-        }
-    }
-}
-
-impl From<JobError> for EngineError {
-    fn from(e: JobError) -> Self {
-        EngineError::Job(e)
-    }
-}
-
-/// The most jobs of one owner [`Engine::held_by`] reads (as many as a fleet lists).
-const HELD_LISTED: usize = 10_000;
-
-/// The bytes the answers of one owner's jobs may take, kept for their retention.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Held {
-    pub bytes: u64,
-    /// The jobs holding them.
-    pub jobs: usize,
-    /// When some of them are freed at the earliest (`None`: nothing is held).
-    pub freed_in: Option<Duration>,
-}
+use super::storage::Storage;
+use super::store::{JobRecord, JobStatus, Listing, Owner, Page};
+use crate::job::Keyed;
 
 /// The compute service: the solve path and the asynchronous jobs.
 pub struct Engine {
     solve_deadline: Duration,
-    /// How long the job store lists a finished job and keeps its answer (its history's
-    /// retention: what holds a tenant's bytes, after the job leaves memory too).
-    history_retention: Duration,
     solver: Arc<Solver>,
     jobs: Arc<Lifecycle>,
     /// The points each tenant asked for in the current minute (its quota's count).
@@ -164,7 +39,7 @@ pub struct Engine {
 
 impl Engine {
     /// An engine that keeps everything in this process.
-    pub fn new(config: EngineConfig, metrics: Metrics) -> Result<Arc<Engine>, String> {
+    pub fn new(config: EngineConfig, metrics: Metrics) -> Result<Arc<Engine>, ArchiveError> {
         let storage = Storage::in_process(&config)?;
         Ok(Engine::with_storage(config, metrics, storage))
     }
@@ -188,7 +63,6 @@ impl Engine {
         );
         Arc::new(Engine {
             solve_deadline: config.solve_deadline,
-            history_retention: config.history_retention,
             solver,
             jobs: Arc::new(jobs),
             points,
@@ -216,37 +90,6 @@ impl Engine {
         self.points
             .charge(tenant, points, limit, std::time::SystemTime::now())
             .await
-    }
-
-    /// What the jobs of `owner` within their retention hold (the newest [`HELD_LISTED`]),
-    /// as the job store lists them.
-    pub async fn held_by(&self, owner: &Owner) -> Result<Held, EngineError> {
-        let listing = Listing {
-            owner: owner.clone(),
-            kind: None,
-            status: None,
-            offset: 0,
-            limit: HELD_LISTED,
-        };
-        let jobs = self.jobs.list(&listing).await?.jobs;
-        let now = std::time::SystemTime::now();
-        // A finished job's bytes are freed when the store forgets it (the history's
-        // retention, not the shorter one in memory); an unfinished one's has not begun.
-        let freed_in = jobs
-            .iter()
-            .filter(|job| job.result_bytes > 0)
-            .map(|job| match job.finished_at {
-                Some(at) => (at + self.history_retention)
-                    .duration_since(now)
-                    .unwrap_or_default(),
-                None => self.history_retention,
-            })
-            .min();
-        Ok(Held {
-            bytes: jobs.iter().map(|job| job.result_bytes).sum(),
-            jobs: jobs.len(),
-            freed_in,
-        })
     }
 
     /// The jobs of `owner` not finished yet (queued or running), as the job store lists them.
@@ -398,7 +241,7 @@ impl Engine {
     }
 
     /// What can be told of a job `id` that the job store does not know.
-    pub async fn unknown(&self, id: Uuid) -> super::Unknown {
+    pub async fn unknown(&self, id: Uuid) -> super::ids::Unknown {
         self.jobs.unknown(id).await
     }
 

@@ -14,11 +14,12 @@ use super::bounded::Bounded;
 use super::budget::{self, Budget};
 use super::cache::{Claim, ResultCache, Solved};
 use super::coalesce::Coalescer;
+use super::config::EngineConfig;
 use super::doorkeeper::Doorkeeper;
+use super::error::EngineError;
 use super::memo::PointMemo;
 use super::metrics::{self as names, Metrics, SolveDurations};
 use super::pool::{Permit, Pool};
-use super::{EngineConfig, EngineError};
 use crate::job::{Control, JobError, Keyed, Unfinished};
 
 /// Whether an answer came from the cache or was solved for this call.
@@ -330,7 +331,6 @@ mod tests {
             max_jobs: 1,
             cache_ttl: Duration::from_secs(60),
             job_retention: Duration::from_secs(60),
-            spill: None,
             database: crate::engine::archive::IN_MEMORY.to_string(),
             history_retention: Duration::from_secs(3600),
         };

@@ -283,7 +283,7 @@ impl ApiError {
             Kind::TooManyStreams,
             format!(
                 "{limit} event streams are open, the most this service follows at once \
-                 (--max-event-streams): poll GET /v1/jobs/{{id}} instead, or follow the job \
+                 (an eighth of --max-connections): poll GET /v1/jobs/{{id}} instead, or follow the job \
                  again later"
             ),
         )
@@ -470,7 +470,7 @@ impl From<EngineError> for ApiError {
                 Kind::ResultTooLarge,
                 format!(
                     "the job's result may take up to {:.1} MB, more than the {:.1} MB this \
-                     service keeps for one result (--memory-budget, --spill-bytes): split the \
+                     service keeps for one result (--memory-budget; a --database file keeps larger ones): split the \
                      job, or ask for fewer points",
                     needed as f64 / 1e6,
                     limit as f64 / 1e6
@@ -542,7 +542,7 @@ pub async fn problem_for_errors(response: Response) -> Response {
                 .to_string()
         }
         StatusCode::REQUEST_TIMEOUT => "the request took longer than this service gives one \
-            (its --request-timeout): send less work at once, or submit it to /v1/jobs"
+            (its --solve-deadline and 30 s more): send less work at once, or submit it to /v1/jobs"
             .to_string(),
         _ => status.canonical_reason().unwrap_or("").to_string(),
     });

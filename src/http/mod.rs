@@ -63,26 +63,29 @@ struct Inner {
     prometheus: PrometheusHandle,
     /// Large request bodies read at once (see `body::offload`).
     readers: Arc<tokio::sync::Semaphore>,
-    /// Event streams open at once (`--max-event-streams`).
+    /// Event streams open at once (an eighth of `--max-connections`).
     streams: Arc<tokio::sync::Semaphore>,
 }
 
-/// Why the service cannot start: its storage cannot be opened (the database, the spill
-/// directory, the fleet's Redis), in words for the operator.
+/// Why the service cannot start: its storage cannot be opened (the database, or the fleet's
+/// Redis), in words for the operator.
 #[derive(Debug, thiserror::Error)]
-#[error("{0}")]
-pub struct CannotStart(pub String);
+pub enum CannotStart {
+    #[error(transparent)]
+    Database(#[from] crate::engine::archive::ArchiveError),
+    #[error(transparent)]
+    Fleet(#[from] crate::engine::fleet::link::LinkError),
+}
 
 impl AppState {
-    /// A service with its own engine, its answers and jobs in its own memory (and spill
-    /// directory and database) or its fleet's Redis, and its own metrics registry; or why it
+    /// A service with its own engine, its answers and jobs in its own memory (and its
+    /// database) or its fleet's Redis, and its own metrics registry; or why it
     /// cannot start.
     pub fn new(config: Config) -> Result<Self, CannotStart> {
         let storage = match &config.fleet {
-            Some(fleet) => crate::engine::fleet::storage(&config.engine, fleet.clone()),
-            None => Storage::in_process(&config.engine),
-        }
-        .map_err(CannotStart)?;
+            Some(fleet) => Storage::in_fleet(&config.engine, fleet.clone())?,
+            None => Storage::in_process(&config.engine)?,
+        };
         Ok(AppState::with_storage(config, storage))
     }
 

@@ -240,6 +240,6 @@ problems!(
     /// Every event stream the service follows at once is open.
     TooManyStreams {
         (429, "too-many-streams: every event stream this service follows at once is open \
-            (--max-event-streams); poll the job instead", true),
+            (an eighth of --max-connections); poll the job instead", true),
     }
 );

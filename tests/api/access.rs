@@ -7,7 +7,9 @@ use reqwest::{Method, Response, StatusCode};
 use serde_json::{json, Value};
 use thirdbody::http::access::keys::hash_hex;
 
-use crate::helpers::{spawn_app, TestApp};
+use std::time::Duration;
+
+use crate::helpers::{spawn_app, spawn_app_adjusted, TestApp};
 
 const LAB_A: &str = "key-of-lab-a-0000000000000001";
 const LAB_A_ROTATED: &str = "key-of-lab-a-0000000000000002";
@@ -375,7 +377,10 @@ async fn a_tenant_learns_nothing_of_what_another_asked() {
 /// its own job's answer (it found the newest job's, lab-b's, and so none for lab-a).
 #[tokio::test]
 async fn each_tenants_link_finds_its_own_job_out_of_the_cache() {
-    let app = spawn_app(&["--api-keys", &keys(), "--cache-ttl", "1ms"]).await;
+    let app = spawn_app_adjusted(&["--api-keys", &keys()], |c| {
+        c.engine.cache_ttl = Duration::from_millis(1)
+    })
+    .await;
     let job = rolling_job("34 nm");
     let ours = submit(&app, Some(LAB_A), &job).await;
     let ours = within_done(&app, &ours, LAB_A).await;
@@ -395,7 +400,10 @@ async fn each_tenants_link_finds_its_own_job_out_of_the_cache() {
 #[tokio::test]
 async fn a_tenants_answer_by_its_input_needs_its_key_once_out_of_the_cache() {
     // A cache too small to keep the answer: the link reads the job's saved answer.
-    let app = spawn_app(&["--api-keys", &keys(), "--cache-ttl", "1ms"]).await;
+    let app = spawn_app_adjusted(&["--api-keys", &keys()], |c| {
+        c.engine.cache_ttl = Duration::from_millis(1)
+    })
+    .await;
     let ours = submit(&app, Some(LAB_A), &rolling_job("33 nm")).await;
     let job = within_done(&app, &ours, LAB_A).await;
     let link = format!("/v1/results/{}", job["input_hash"].as_str().unwrap());
@@ -481,8 +489,10 @@ async fn over_quota(response: Response) -> String {
 
 #[tokio::test]
 async fn points_a_minute_are_each_tenants_and_anonymous_callers_share_theirs() {
-    let flags = ["--quota-points", "5", "--anonymous-quota-points", "2"];
-    let app = spawn_app(&[&["--api-keys", &keys()][..], &flags[..]].concat()).await;
+    // The callers without a key are one tenant under the quota: two points here, five
+    // for the tenants below.
+    let keys = keys();
+    let app = spawn_app(&["--api-keys", &keys, "--quota-points", "2"]).await;
     crate::clock::early_in_a_minute().await;
     let rolling = |radius: &str| json!({"radius": radius});
     // Callers without a key: two points a minute between them.
@@ -503,6 +513,7 @@ async fn points_a_minute_are_each_tenants_and_anonymous_callers_share_theirs() {
 
     // A tenant's five are its own: a sweep of three points and two contacts, then no more,
     // whichever of its keys asks; another tenant is not held back.
+    let app = spawn_app(&["--api-keys", &keys, "--quota-points", "5"]).await;
     let sweep = json!({"base": {"radius": "30 nm"}, "vary": {"load": ["1 nN", "2 nN", "3 nN"]}});
     let swept = send(&app, Method::POST, "/v1/sweeps", Some(LAB_A), Some(&sweep)).await;
     assert_eq!(swept.status(), StatusCode::OK);
@@ -617,18 +628,17 @@ async fn a_tenant_has_at_most_its_quota_of_unfinished_jobs() {
 /// 5 got in); anonymous callers have their one share too.
 #[tokio::test]
 async fn concurrent_submissions_pass_a_quota_of_jobs_no_more_than_it_allows() {
-    let app = spawn_app(&[
-        "--api-keys",
-        &keys(),
-        "--quota-jobs",
-        "2",
-        "--anonymous-quota-jobs",
-        "3",
-        "--anonymous",
-        "submit,read",
-    ])
-    .await;
     for (key, quota) in [(Some(LAB_A), 2), (None, 3)] {
+        // The callers without a key are one tenant under the same quota: 3 for them here.
+        let app = spawn_app(&[
+            "--api-keys",
+            &keys(),
+            "--quota-jobs",
+            &quota.to_string(),
+            "--anonymous",
+            "submit,read",
+        ])
+        .await;
         let statuses = futures_util::future::join_all((0..20).map(|i| {
             let job = crate::helpers::long_sweep(20 + i);
             let app = &app;
@@ -702,90 +712,6 @@ async fn quotas_charge_what_work_costs() {
         let response = send(&app, Method::POST, "/v1/rolling", Some(LAB_A), Some(&local)).await;
         assert_eq!(response.status(), StatusCode::OK);
     }
-}
-
-/// The most the answer of `job` may take, as the service counts it.
-fn room_of(job: &Value) -> u64 {
-    use thirdbody::job::{Job, Limits};
-    Job::from_value(job.clone(), &Limits::default())
-        .unwrap()
-        .result_bytes()
-}
-
-#[tokio::test]
-async fn a_tenant_holds_at_most_its_quota_of_result_bytes() {
-    let sweep = |first: u32, n: u32| {
-        let loads: Vec<String> = (first..first + n).map(|i| format!("{i} pN")).collect();
-        json!({"kind": "sweep", "input": {"vary": {"load": loads}}})
-    };
-    // Room for one sweep of 50 points and not two.
-    let one = room_of(&sweep(1000, 50));
-    let limit = (2 * one - 1).to_string();
-    let app = spawn_app(&[
-        "--api-keys",
-        &keys(),
-        "--quota-result-bytes",
-        &limit,
-        "--job-retention",
-        "20s",
-        "--history-retention",
-        "40s",
-    ])
-    .await;
-    let first = submit(&app, Some(LAB_A), &sweep(1000, 50)).await;
-    within_done(&app, &first, LAB_A).await;
-    let response = send(
-        &app,
-        Method::POST,
-        "/v1/jobs",
-        Some(LAB_A_ROTATED),
-        Some(&sweep(2000, 50)),
-    )
-    .await;
-    // Retry when the store forgets the first job: past its time in memory, within its
-    // history's.
-    let retry_after: u64 = response.headers()["retry-after"]
-        .to_str()
-        .unwrap()
-        .parse()
-        .unwrap();
-    assert!((21..=40).contains(&retry_after), "{retry_after}");
-    let detail = refused(response, StatusCode::TOO_MANY_REQUESTS, "quota-exceeded").await;
-    assert!(
-        detail.contains(&format!(
-            "holds {one} bytes in the answers of its 1 jobs kept"
-        )),
-        "{detail}"
-    );
-    assert!(
-        detail.contains(&format!(
-            "of the {limit} it may (--quota-result-bytes); this job's may take {one} more. \
-             Delete a job it no longer needs"
-        )),
-        "{detail}"
-    );
-    // Another tenant's bytes are its own; a job whose answer alone is over: no wait helps.
-    submit(&app, Some(LAB_B), &sweep(2000, 50)).await;
-    let alone = send(
-        &app,
-        Method::POST,
-        "/v1/jobs",
-        Some(LAB_B),
-        Some(&sweep(1, 150)),
-    )
-    .await;
-    assert!(alone.headers().get("retry-after").is_none());
-    let detail = refused(alone, StatusCode::TOO_MANY_REQUESTS, "quota-exceeded").await;
-    assert!(
-        detail.contains(&format!(
-            "more than the {limit} the API key of \"lab-b\" may hold (--quota-result-bytes)"
-        )),
-        "{detail}"
-    );
-    // A job deleted frees its room.
-    let deleted = send(&app, Method::DELETE, &first, Some(LAB_A), None).await;
-    assert!(deleted.status().is_success());
-    submit(&app, Some(LAB_A), &sweep(2000, 50)).await;
 }
 
 #[tokio::test]

@@ -2,7 +2,11 @@
 
 use serde_json::{json, Value};
 
-use crate::helpers::{long_sweep, problem, problem_type, spawn_app, within};
+use std::time::Duration;
+
+use crate::helpers::{
+    long_sweep, problem, problem_type, spawn_app, spawn_app_adjusted, spawn_app_on_disk, within,
+};
 
 #[tokio::test]
 async fn malformed_json_is_400() {
@@ -164,7 +168,7 @@ async fn unknown_routes_jobs_and_figures_are_404_and_wrong_methods_405() {
 
 #[tokio::test]
 async fn a_full_pool_is_429_at_once_and_a_full_job_queue_too() {
-    let app = spawn_app(&[
+    let app = spawn_app_on_disk(&[
         "--pool-size",
         "1",
         "--max-sweep-points",
@@ -201,7 +205,7 @@ async fn a_full_pool_is_429_at_once_and_a_full_job_queue_too() {
 
 #[tokio::test]
 async fn a_draining_service_is_503_for_new_work_and_readiness() {
-    let mut app = spawn_app(&["--drain-delay", "10m"]).await;
+    let mut app = spawn_app_adjusted(&[], |c| c.drain_delay = Duration::from_secs(600)).await;
     assert_eq!(app.get("/readyz").await.status(), 200);
     // Seen and cached before the drain: refused all the same, not answered from the cache.
     assert_eq!(app.post("/v1/rolling", &json!({})).await.status(), 200);

@@ -20,6 +20,26 @@ pub struct TestApp {
     pub client: Client,
     shutdown: Option<oneshot::Sender<()>>,
     pub server: JoinHandle<std::io::Result<()>>,
+    /// The database file of [`spawn_app_on_disk`], removed with the app.
+    database: Option<DatabaseFile>,
+}
+
+/// A database file of one test's, removed (with its log) when the test's app goes.
+struct DatabaseFile(std::path::PathBuf);
+
+impl DatabaseFile {
+    fn new() -> DatabaseFile {
+        let name = format!("thirdbody-test-{}.db", uuid::Uuid::new_v4().simple());
+        DatabaseFile(std::env::temp_dir().join(name))
+    }
+}
+
+impl Drop for DatabaseFile {
+    fn drop(&mut self) {
+        for end in ["", "-wal", "-shm"] {
+            let _ = std::fs::remove_file(format!("{}{end}", self.0.display()));
+        }
+    }
 }
 
 /// The validated settings of `thirdbody serve` with these flags; the database of saved
@@ -51,6 +71,34 @@ pub async fn spawn_app(flags: &[&str]) -> TestApp {
     serve(state(flags)).await
 }
 
+/// Serves on 127.0.0.1, port 0, with `flags` and a database file of its own: results beyond
+/// the memory budget are kept there (a database in memory keeps none), as a test of a job
+/// whose answer may be large needs.
+pub async fn spawn_app_on_disk(flags: &[&str]) -> TestApp {
+    let database = DatabaseFile::new();
+    let path = database
+        .0
+        .to_str()
+        .expect("a UTF-8 temporary directory")
+        .to_string();
+    let flags: Vec<&str> = ["--database", path.as_str()]
+        .into_iter()
+        .chain(flags.iter().copied())
+        .collect();
+    let mut app = spawn_app(&flags).await;
+    app.database = Some(database);
+    app
+}
+
+/// Serves on 127.0.0.1, port 0, with `flags` and then `adjust` applied to the settings:
+/// for a bound that the binary holds constant (a connection's timeouts, the drain's delay,
+/// the cache's time to live), shortened or lengthened so that a test sees it act.
+pub async fn spawn_app_adjusted(flags: &[&str], adjust: impl FnOnce(&mut Config)) -> TestApp {
+    let mut config = config(flags);
+    adjust(&mut config);
+    serve(AppState::new(config).expect("the service starts")).await
+}
+
 /// Serves `state` on 127.0.0.1, port 0.
 pub async fn serve(state: AppState) -> TestApp {
     let listener = TcpListener::bind("127.0.0.1:0").await.unwrap();
@@ -65,6 +113,7 @@ pub async fn serve(state: AppState) -> TestApp {
         client: Client::new(),
         shutdown: Some(tx),
         server,
+        database: None,
     }
 }
 

@@ -6,7 +6,7 @@ use std::time::Duration;
 use serde_json::{json, Value};
 use thirdbody::job::{Job, Limits};
 
-use crate::helpers::{long_sweep, problem, problem_type, spawn_app, Events};
+use crate::helpers::{long_sweep, problem, problem_type, spawn_app, spawn_app_on_disk, Events};
 use crate::solve::engine_answer;
 
 fn small_sweep() -> Value {
@@ -44,7 +44,7 @@ async fn a_job_is_accepted_then_polled_to_its_result() {
 
 #[tokio::test]
 async fn a_job_streams_progress_then_its_completion() {
-    let app = spawn_app(&["--pool-size", "1", "--max-sweep-points", "1000000"]).await;
+    let app = spawn_app_on_disk(&["--pool-size", "1", "--max-sweep-points", "1000000"]).await;
     // A long job holds the only solver thread, so the job followed is seen queued first.
     let blocker = app.submit(&long_sweep(100)).await;
     let location = app.submit(&long_sweep(20)).await;
@@ -83,7 +83,7 @@ async fn a_job_streams_progress_then_its_completion() {
 
 #[tokio::test]
 async fn a_running_job_is_cancelled_at_the_solvers_next_check() {
-    let app = spawn_app(&["--max-sweep-points", "1000000"]).await;
+    let app = spawn_app_on_disk(&["--max-sweep-points", "1000000"]).await;
     let location = app.submit(&long_sweep(100)).await;
     app.wait_for_job(&location, |j| j["status"] == "running")
         .await;
@@ -124,7 +124,7 @@ async fn a_finished_job_expires_after_the_retention_time() {
 
 #[tokio::test]
 async fn a_deleted_job_is_cancelled_and_forgotten() {
-    let app = spawn_app(&["--max-sweep-points", "1000000"]).await;
+    let app = spawn_app_on_disk(&["--max-sweep-points", "1000000"]).await;
     let location = app.submit(&long_sweep(100)).await;
     app.wait_for_job(&location, |j| j["status"] == "running")
         .await;

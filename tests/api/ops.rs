@@ -4,7 +4,7 @@ use reqwest::Method;
 use serde_json::{json, Value};
 use thirdbody::http::openapi;
 
-use crate::helpers::{long_sweep, spawn_app, within, Events};
+use crate::helpers::{long_sweep, spawn_app, spawn_app_on_disk, within, Events};
 
 #[tokio::test]
 async fn probes_answer_and_requests_carry_an_id() {
@@ -143,7 +143,7 @@ async fn the_served_spec_is_the_committed_one_and_the_docs_are_served() {
 
 #[tokio::test]
 async fn on_shutdown_a_running_job_finishes_before_the_server_exits() {
-    let mut app = spawn_app(&[
+    let mut app = spawn_app_on_disk(&[
         "--pool-size",
         "1",
         "--max-sweep-points",

@@ -6,7 +6,7 @@ use std::io::Read;
 
 use serde_json::{json, Value};
 
-use crate::helpers::{long_sweep, problem, problem_type, spawn_app};
+use crate::helpers::{long_sweep, problem, problem_type, spawn_app, within};
 
 /// A rolling sweep of `n` × 100 points, each a table look-up.
 fn sweep(n: usize) -> Value {
@@ -150,8 +150,9 @@ async fn a_sweep_past_its_deadline_fails_but_keeps_the_points_it_finished() {
 
 #[tokio::test]
 async fn a_job_whose_result_cannot_be_kept_is_refused_at_submission_never_after_its_work() {
-    // 8 MB of budget: 1.5 MB for results, no spill to disk.
-    let app = spawn_app(&["--memory-budget", "8000000", "--spill-bytes", "0"]).await;
+    // 8 MB of budget: 1.5 MB for results, and a database in memory, which keeps no result
+    // beyond them.
+    let app = spawn_app(&["--memory-budget", "8000000", "--database", ":memory:"]).await;
     // Its result takes about 0.5 MB; one that may take 1.2 MB does not fit beside it.
     let first = app.submit(&sweep(5)).await;
     app.wait_for_job(&first, |j| j["status"] == "succeeded")
@@ -174,18 +175,20 @@ async fn a_job_whose_result_cannot_be_kept_is_refused_at_submission_never_after_
     assert_eq!(kept.status(), 200);
     let huge = problem(app.post("/v1/jobs", &sweep(100)).await, 422).await;
     assert_eq!(huge["type"], problem_type("result-too-large"));
-    assert!(huge["detail"].as_str().unwrap().contains("--spill-bytes"));
+    assert!(huge["detail"].as_str().unwrap().contains("--database"));
 }
 
 #[tokio::test]
 async fn results_beyond_the_memory_budget_are_kept_on_disk_and_served_from_there() {
+    // On disk: the database of saved analyses, a file here.
     let dir = std::env::temp_dir().join(format!("thirdbody-spill-test-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
+    let database = dir.join("thirdbody.db");
     let app = spawn_app(&[
         "--memory-budget",
         "1000000",
-        "--spill-dir",
-        dir.to_str().unwrap(),
+        "--database",
+        database.to_str().unwrap(),
     ])
     .await;
     let job = sweep(20);
@@ -193,8 +196,6 @@ async fn results_beyond_the_memory_budget_are_kept_on_disk_and_served_from_there
     let view = app
         .wait_for_job(&location, |j| j["status"] == "succeeded")
         .await;
-    let spilled: Vec<_> = std::fs::read_dir(&dir).unwrap().collect();
-    assert_eq!(spilled.len(), 1, "one directory of this service's");
     let answer = app.result(&view).await;
     let whole: Value = app
         .post("/v1/sweeps", &job["input"])
@@ -215,12 +216,37 @@ async fn results_beyond_the_memory_budget_are_kept_on_disk_and_served_from_there
             .starts_with(kind));
         assert!(response.bytes().await.unwrap().len() > 10_000);
     }
-    // Deleted, the job's files go with it.
+    // Accepted (a database in memory refuses it: the test above), and its result kept in
+    // the database file (saved there as the job ends).
+    within(async {
+        while stored_results(&database, &location) != 1 {
+            tokio::time::sleep(std::time::Duration::from_millis(20)).await;
+        }
+    })
+    .await;
+    // Deleted, the job's result goes with it.
     app.delete(&location).await;
-    let files: usize = std::fs::read_dir(&dir)
-        .unwrap()
-        .map(|d| std::fs::read_dir(d.unwrap().path()).unwrap().count())
-        .sum();
-    assert_eq!(files, 0);
+    assert_eq!(stored_results(&database, &location), 0);
+    drop(app);
     std::fs::remove_dir_all(&dir).ok();
+}
+
+/// The results the database at `path` holds for the job at `location`.
+fn stored_results(path: &std::path::Path, location: &str) -> usize {
+    let id = location.rsplit('/').next().unwrap();
+    // The service holds the file exclusively: read a copy of it and its log.
+    let copy = path.with_extension("copy");
+    for (from, to) in [("", ""), ("-wal", "-wal")] {
+        let from = format!("{}{from}", path.display());
+        if std::path::Path::new(&from).exists() {
+            std::fs::copy(&from, format!("{}{to}", copy.display())).unwrap();
+        }
+    }
+    let db = rusqlite::Connection::open(&copy).unwrap();
+    let count: i64 = db
+        .query_row("SELECT COUNT(*) FROM results WHERE id = ?1", [id], |row| {
+            row.get(0)
+        })
+        .unwrap();
+    count as usize
 }

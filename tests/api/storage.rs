@@ -10,7 +10,7 @@ use crate::helpers::{config, serve};
 #[tokio::test]
 async fn services_sharing_a_storage_share_answers_and_jobs() {
     let config = config(&[]);
-    let storage = Storage::in_process(&config.engine).expect("the spill directory is made");
+    let storage = Storage::in_process(&config.engine).expect("the database opens");
     let a = serve(AppState::with_storage(config.clone(), storage.clone())).await;
     let b = serve(AppState::with_storage(config, storage)).await;
 

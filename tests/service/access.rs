@@ -329,47 +329,6 @@ async fn a_tenants_points_are_counted_once_for_the_whole_fleet() {
 /// A tenant's answers held are counted from the records in Redis: a job kept by one
 /// process counts in the other.
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
-async fn a_tenants_result_bytes_are_counted_once_for_the_whole_fleet() {
-    let Some((redis, _redis)) = fresh_redis() else {
-        return;
-    };
-    let (key, entry) = new_key(&["--name", "lab-a"]);
-    let keys = json!({"keys": [entry]}).to_string();
-    let job = |radius: &str| json!({"kind": "rolling", "input": {"radius": radius}});
-    let room = thirdbody::job::Job::from_value(job("20 nm"), &Default::default())
-        .unwrap()
-        .result_bytes();
-    let limit = (2 * room - 1).to_string();
-    let flags = ["--api-keys", &keys, "--quota-result-bytes", &limit];
-    let http = Client::new();
-    let (_fleet, [one, two]) = two_services(&http, redis, &flags).await;
-    let submit = |base: &String, radius: &str| {
-        http.post(format!("{base}/v1/jobs"))
-            .header("x-api-key", &key)
-            .json(&job(radius))
-            .send()
-    };
-    let kept = submit(&one, "20 nm").await.unwrap();
-    assert_eq!(
-        kept.status(),
-        StatusCode::ACCEPTED,
-        "{}",
-        kept.text().await.unwrap()
-    );
-    let refused = submit(&two, "21 nm").await.unwrap();
-    assert_eq!(refused.status(), StatusCode::TOO_MANY_REQUESTS);
-    assert!(refused.headers().contains_key("retry-after"));
-    let problem: Value = refused.json().await.unwrap();
-    let detail = problem["detail"].as_str().unwrap();
-    assert!(
-        detail.contains(&format!("holds {room} bytes in the answers of its 1 jobs")),
-        "{detail}"
-    );
-}
-
-/// A worker's routes for operators (`--metrics-bind`): a probe reads its health and
-/// readiness, Prometheus the parts it solved, under the access rules of `serve`.
-#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn a_worker_serves_its_metrics_and_probes_to_whom_the_keys_allow() {
     let Some((redis, _redis)) = fresh_redis() else {
         return;

@@ -224,13 +224,6 @@ fn every_numeric_flag_out_of_range_is_status_2_naming_flag_value_and_range() {
         ),
         (
             &fleet,
-            "--spill-bytes",
-            "18446744073709551615",
-            "thirdbody worker: invalid setting: --spill-bytes 18446744073709551615: allowed 0 \
-             (none) to 1099511627776 bytes (1 TiB)",
-        ),
-        (
-            &fleet,
             "--redis-cache-bytes",
             "0",
             "thirdbody worker: invalid setting: --redis-cache-bytes 0: allowed 65536 to \
@@ -318,7 +311,6 @@ fn the_container_configuration_starts_a_service_that_drains_on_sigterm() {
         .arg("serve")
         .envs(env.iter().map(|(k, v)| (k.as_str(), v.as_str())))
         .env("THIRDBODY_BIND", format!("127.0.0.1:{port}"))
-        .env("THIRDBODY_DRAIN_DELAY", "0s")
         .env("THIRDBODY_DATABASE", volume.join("thirdbody.db"))
         .stdout(Stdio::null())
         .stderr(Stdio::piped())
@@ -414,7 +406,6 @@ fn ctrl_c_says_what_the_drain_waits_for_and_a_second_exits_at_once() {
             .args(["--log-format", format, "--shutdown-timeout", "30s"])
             // Without a database file: its results would outlive the process.
             .args(["--database", ":memory:"])
-            .env("THIRDBODY_DRAIN_DELAY", "0s")
             .env("RUST_LOG", "info")
             .stdout(Stdio::null())
             .stderr(Stdio::piped())

@@ -94,13 +94,7 @@ pub(crate) fn start(
         } else {
             &default_url[..]
         })
-        .args(["--claim-idle", "2s", "--log-format", "text"])
-        // Unless the test sizes them: parts of 100 points until the fleet measures a cost.
-        .args(if flags.contains(&"--part-points") {
-            &[][..]
-        } else {
-            &["--part-points", "100"][..]
-        })
+        .args(["--log-format", "text"])
         .args(["--pool-size", "2"])
         .env("RUST_LOG", "info")
         .args(flags);
@@ -536,7 +530,6 @@ async fn a_worker_on_its_own_takes_a_job_from_the_stream_and_stores_its_answer()
         max_jobs: 1,
         cache_ttl: minute,
         job_retention: minute,
-        spill: None,
         database: thirdbody::engine::archive::IN_MEMORY.to_string(),
         history_retention: Duration::from_secs(3600),
     };

@@ -364,7 +364,7 @@ async fn three_rolling_restarts_during_a_long_job_hand_its_parts_back_and_it_fin
     };
     let http = reqwest::Client::new();
     // One delivery per part: a hand-back charged as a delivery would fail the job.
-    let strict = ["--max-deliveries", "1", "--part-points", "20"];
+    let strict = ["--max-deliveries", "1"];
     let a = serve(port, &http, &strict).await;
     let id = submit(&http, &a.base, long_sweep()).await;
     let rolled = ["--shutdown-timeout", "10ms"];
@@ -400,7 +400,7 @@ async fn three_rolling_restarts_during_a_long_job_hand_its_parts_back_and_it_fin
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn no_key_is_left_without_a_time_to_live_after_deletes_and_cancels() {
-    let Some((port, _redis, http, a)) = one_service(&["--part-points", "20"]).await else {
+    let Some((port, _redis, http, a)) = one_service(&[]).await else {
         return;
     };
     let mut ids = Vec::new();

@@ -46,8 +46,7 @@ async fn single(http: &Client, database: &str, flags: &[&str]) -> (Process, Stri
     let mut cmd = thirdbody();
     cmd.args(["serve", "--bind", &format!("127.0.0.1:{port}")])
         .args(["--database", database, "--log-format", "text"])
-        .args(flags)
-        .env("THIRDBODY_DRAIN_DELAY", "0s");
+        .args(flags);
     let name = format!("serve on port {port} ({database})");
     let (process, _) = spawn_logged(&mut cmd, &name, Some(port), None);
     (process, answering(http, port).await)

@@ -125,11 +125,10 @@ fn engine() -> Arc<Engine> {
         max_jobs: 100,
         cache_ttl: Duration::from_secs(60),
         job_retention: Duration::from_secs(60),
-        spill: None,
         database: thirdbody::engine::archive::IN_MEMORY.to_string(),
         history_retention: Duration::from_secs(3600),
     };
-    Engine::new(config, Metrics::noop()).expect("an engine without a spill directory starts")
+    Engine::new(config, Metrics::noop()).expect("an engine on a database in memory starts")
 }
 
 #[test]

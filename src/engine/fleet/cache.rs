@@ -13,6 +13,7 @@ use uuid::Uuid;
 
 use super::{keys, Fleet, Health};
 use crate::engine::cache::{Claim, MemoryCache, ResultCache, Solved};
+use crate::engine::clock::millis;
 use crate::job::registry::KindName;
 use crate::job::JobError;
 use crate::render::Format;
@@ -147,10 +148,10 @@ impl ResultCache for TieredCache {
             .ignore();
         if self.fleet.one_server() {
             let bytes = (solved.json().len() + csv.len() + key.len()).to_string();
-            let now = super::store::unix_millis(std::time::SystemTime::now()).to_string();
+            let now = crate::engine::clock::unix_millis(std::time::SystemTime::now()).to_string();
             let bound = self.fleet.cache_bytes().to_string();
             let ttl = self.ttl_millis().to_string();
-            pipe.add_command(super::store::eval(
+            pipe.add_command(super::link::eval(
                 BOUND,
                 &[keys::ANSWERS_BY_AGE, keys::ANSWER_SIZES, &key],
                 &[
@@ -238,11 +239,4 @@ impl ResultCache for TieredCache {
                 .await;
         }
     }
-}
-
-/// `duration` in whole milliseconds, at least one.
-pub fn millis(duration: Duration) -> u64 {
-    u64::try_from(duration.as_millis())
-        .unwrap_or(u64::MAX)
-        .max(1)
 }

@@ -117,16 +117,19 @@ pub struct Link {
 
 impl Link {
     /// A link to the server at `url`; connects at the first call (the server may start later).
-    pub fn open(role: &'static str, url: &str) -> Result<Link, String> {
-        let shown = redacted(url);
-        let client = redis::Client::open(url).map_err(|e| format!("{role} URL {shown}: {e}"))?;
+    pub fn open(role: &'static str, url: &str) -> Result<Link, LinkError> {
+        let failed = |source| LinkError {
+            role,
+            url: redacted(url),
+            source,
+        };
+        let client = redis::Client::open(url).map_err(failed)?;
         let config = ConnectionManagerConfig::new()
             .set_connection_timeout(Some(CALL_TIMEOUT))
             .set_response_timeout(Some(CALL_TIMEOUT))
             .set_number_of_retries(1)
             .set_max_delay(Duration::from_millis(200));
-        let connection = ConnectionManager::new_lazy_with_config(client, config)
-            .map_err(|e| format!("{role} URL {shown}: {e}"))?;
+        let connection = ConnectionManager::new_lazy_with_config(client, config).map_err(failed)?;
         Ok(Link {
             role,
             url: url.to_string(),
@@ -142,7 +145,7 @@ impl Link {
 
     /// A link of its own to the same server, for a caller that blocks on it (a worker
     /// waiting for work): on the shared link a blocked call would hold up every other.
-    pub fn dedicated(&self) -> Result<Link, String> {
+    pub fn dedicated(&self) -> Result<Link, LinkError> {
         Link::open(self.role, &self.url)
     }
 
@@ -361,6 +364,28 @@ pub fn redacted(url: &str) -> String {
         shown = format!("{base}?{}", parameters.join("&"));
     }
     shown
+}
+
+/// Why a Redis URL cannot be used (its password hidden).
+#[derive(Debug, thiserror::Error)]
+#[error("{role} URL {url}: {source}")]
+pub struct LinkError {
+    role: &'static str,
+    url: String,
+    source: RedisError,
+}
+
+/// A script run inside a transaction: `EVAL` with its text, so that it needs no loading.
+pub(super) fn eval(script: &str, keys: &[&str], args: &[&[u8]]) -> Cmd {
+    let mut cmd = redis::cmd("EVAL");
+    cmd.arg(script).arg(keys.len());
+    for key in keys {
+        cmd.arg(*key);
+    }
+    for arg in args {
+        cmd.arg(*arg);
+    }
+    cmd
 }
 
 #[cfg(test)]

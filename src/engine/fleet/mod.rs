@@ -17,16 +17,12 @@ pub mod worker;
 
 use std::collections::HashMap;
 use std::sync::atomic::{AtomicU64, Ordering};
-use std::sync::Arc;
 use std::time::Duration;
 
 pub use cache::TieredCache;
-pub use link::{Failure, Health, Link};
+pub use link::{Failure, Health, Link, LinkError};
 pub use store::RedisJobStore;
 pub use worker::{Shared, Worker};
-
-use super::cache::MemoryCache;
-use super::{EngineConfig, Storage};
 
 /// How the fleet's processes share work through Redis.
 #[derive(Clone, Debug, PartialEq)]
@@ -155,7 +151,7 @@ pub struct Fleet {
 
 impl Fleet {
     /// Links to the servers of `config` (connected at the first call).
-    pub fn open(config: FleetConfig) -> Result<Fleet, String> {
+    pub fn open(config: FleetConfig) -> Result<Fleet, LinkError> {
         let cache = Link::open("cache", &config.cache_url)?;
         let jobs = Link::open("jobs", &config.jobs_url)?;
         let host = std::env::var("HOSTNAME").unwrap_or_else(|_| "thirdbody".to_string());
@@ -194,7 +190,7 @@ impl Fleet {
     pub async fn watch(&self) {
         let epoch = async {
             loop {
-                let now = store::unix_millis(std::time::SystemTime::now());
+                let now = crate::engine::clock::unix_millis(std::time::SystemTime::now());
                 let mark = redis::Cmd::set_options(
                     keys::EPOCH,
                     now,
@@ -298,24 +294,6 @@ async fn maxmemory(link: &Link) -> Option<Maxmemory> {
         Err(_) if link.is_up() => Some(Maxmemory::Unknown),
         Err(_) => None,
     }
-}
-
-/// An engine's storage in the fleet of `fleet`: this process's memory in front of Redis for
-/// answers, Redis for jobs and their work.
-pub fn storage(config: &EngineConfig, fleet: FleetConfig) -> Result<Storage, String> {
-    let fleet = Arc::new(Fleet::open(fleet)?);
-    let l1 = MemoryCache::for_engine(config);
-    // A fleet's finished jobs are its history: kept in Redis for the history's retention.
-    let store = Arc::new(RedisJobStore::new(
-        fleet.clone(),
-        config.history_retention,
-        config.job_deadline,
-    ));
-    Ok(Storage {
-        cache: Arc::new(TieredCache::new(l1, fleet.clone(), config.cache_ttl)),
-        jobs: store.clone(),
-        fleet: Some(Arc::new(Shared::new(fleet, store))),
-    })
 }
 
 #[cfg(test)]

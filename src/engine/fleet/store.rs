@@ -13,12 +13,12 @@ use bytes::Bytes;
 use redis::Cmd;
 use uuid::Uuid;
 
-use super::cache::millis;
+use super::link::eval;
 use super::{keys, Failure, Fleet};
-use crate::engine::spill::{JobResult, ResultPlace, StoredResult};
-pub(super) use crate::engine::store::unix_millis;
+use crate::engine::clock::{from_unix_millis, millis, unix_millis};
 use crate::engine::store::{
-    from_unix_millis, JobRecord, JobState, JobStatus, JobStore, Listing, Owner, Page, Refusal,
+    JobRecord, JobResult, JobState, JobStatus, JobStore, Listing, Owner, Page, Refusal,
+    ResultPlace, StoredResult, Unreadable,
 };
 use crate::job::parts::RenderedPart;
 use crate::job::registry::KindName;
@@ -103,19 +103,6 @@ return 0
 
 /// The most jobs of one owner listed: the newest.
 const LISTED: isize = 10_000;
-
-/// A script run inside a transaction: `EVAL` with its text, so that it needs no loading.
-pub(super) fn eval(script: &str, keys: &[&str], args: &[&[u8]]) -> Cmd {
-    let mut cmd = redis::cmd("EVAL");
-    cmd.arg(script).arg(keys.len());
-    for key in keys {
-        cmd.arg(*key);
-    }
-    for arg in args {
-        cmd.arg(*arg);
-    }
-    cmd
-}
 
 /// A job as a worker needs it.
 pub struct Runnable {
@@ -654,16 +641,19 @@ impl JobStore for RedisJobStore {
 
     /// Reads every job in the owner's list (the newest [`LISTED`]), so that the filters and
     /// the total are exact; jobs expired since are dropped from the list.
-    async fn list(&self, listing: &Listing) -> Result<Page, String> {
+    async fn list(&self, listing: &Listing) -> Result<Page, Unreadable> {
         let list = keys::owner(listing.owner.as_str());
         let ids: Vec<String> = self
             .fleet
             .jobs
             .query(&Cmd::zrevrange(&list, 0, LISTED - 1))
             .await
-            .map_err(|e| e.why)?;
+            .map_err(|e| Unreadable::Redis(e.why))?;
         let ids: Vec<Uuid> = ids.iter().filter_map(|id| id.parse().ok()).collect();
-        let records = self.records(&ids).await.map_err(|e| e.why)?;
+        let records = self
+            .records(&ids)
+            .await
+            .map_err(|e| Unreadable::Redis(e.why))?;
         let gone: Vec<String> = ids
             .iter()
             .zip(&records)
@@ -688,13 +678,21 @@ impl JobStore for RedisJobStore {
         Ok(Page::of(matching, listing))
     }
 
-    async fn with_input(&self, input_hash: &str) -> Result<Option<JobRecord>, String> {
+    async fn with_input(&self, input_hash: &str) -> Result<Option<JobRecord>, Unreadable> {
         let cmd = Cmd::get(keys::input(input_hash));
-        let id: Option<String> = self.fleet.jobs.query(&cmd).await.map_err(|e| e.why)?;
+        let id: Option<String> = self
+            .fleet
+            .jobs
+            .query(&cmd)
+            .await
+            .map_err(|e| Unreadable::Redis(e.why))?;
         let Some(id) = id.and_then(|id| id.parse().ok()) else {
             return Ok(None);
         };
-        let record = self.record(id).await.map_err(|e| e.why)?;
+        let record = self
+            .record(id)
+            .await
+            .map_err(|e| Unreadable::Redis(e.why))?;
         Ok(record.filter(|r| matches!(r.state, JobState::Succeeded(_))))
     }
 

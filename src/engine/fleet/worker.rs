@@ -27,7 +27,7 @@ use crate::engine::cache::Solved;
 use crate::engine::metrics as names;
 use crate::engine::pool::Pool;
 use crate::engine::solver::Solver;
-use crate::engine::spill::JobResult;
+use crate::engine::store::JobResult;
 use crate::engine::store::{JobState, JobStatus};
 use crate::job::parts::{self, RenderedPart};
 use crate::job::{tenant_of, Control, Job, JobError, Keyed, Unfinished, Work};
@@ -196,10 +196,46 @@ impl Worker {
         let shared = &self.shared;
         let store = &shared.store;
         let id = entry.job;
-        let (runnable, deliveries) = match store.take(id, &entry.part_name()).await {
+        let Some((runnable, keyed, deliveries)) = self.take(&entry).await else {
+            return;
+        };
+        let control = Arc::new(self.solver.control(runnable.deadline));
+        shared.running().insert(entry.id.clone(), control.clone());
+        // Kept until the entry is done with, assembly included (the last part's entry
+        // stays pending while its job is assembled and stored).
+        let _heartbeat = AbortOnDrop(tokio::spawn(heartbeat(
+            shared.fleet.clone(),
+            store.clone(),
+            entry.id.clone(),
+            id,
+            control.clone(),
+            entry.part.is_none(),
+        )));
+        tracing::info!(entry = entry.id, job = %id, part = entry.part_name(), deliveries, "solving a part");
+        if runnable.status == JobStatus::Queued {
+            let _ = store.set_state(id, &JobState::Running, None).await;
+        }
+        let started = Instant::now();
+        let result = self.solve(&entry, &keyed, &control).await;
+        shared.running().remove(&entry.id);
+        self.count(&entry, &keyed, &result, started.elapsed());
+        self.settle(&entry, &keyed, &runnable, &control, result)
+            .await;
+    }
+
+    /// The job of `entry` to run and how many times the entry was delivered; `None` when
+    /// there is nothing to run: the job is gone or finished (the entry acknowledged), Redis
+    /// is away (the entry stays ours, and is taken over later), or the job was failed here
+    /// (delivered too many times, or not the job accepted).
+    async fn take(&self, entry: &Entry) -> Option<(Runnable, Keyed, u64)> {
+        let shared = &self.shared;
+        let (runnable, deliveries) = match shared.store.take(entry.job, &entry.part_name()).await {
             Ok((Some(r), deliveries)) if !r.status.is_finished() => (r, deliveries),
-            Ok(_) => return acknowledge(&shared.fleet, &entry).await, // gone or finished
-            Err(_) => return, // Redis is away: the entry stays ours, and is taken over later.
+            Ok(_) => {
+                acknowledge(&shared.fleet, entry).await;
+                return None;
+            }
+            Err(_) => return None,
         };
         if deliveries > 1 {
             self.solver
@@ -218,14 +254,14 @@ impl Worker {
                  before finishing it (killed, or out of memory): the job is given up",
                 entry.part_name(),
             ));
-            self.finish(&entry, JobState::failed(error), None).await;
-            return;
+            self.finish(entry, JobState::failed(error), None).await;
+            return None;
         }
         let job = match Job::from_wire(&runnable.wire) {
             Ok(job) => job,
             Err(e) => {
-                self.finish(&entry, JobState::failed(e), None).await;
-                return;
+                self.finish(entry, JobState::failed(e), None).await;
+                return None;
             }
         };
         // Kept among its tenant's answers, as it was accepted ([`Keyed::scoped`]).
@@ -234,38 +270,31 @@ impl Worker {
             let error = JobError::Internal(
                 "the job read back from the job store is not the job accepted".to_string(),
             );
-            self.finish(&entry, JobState::failed(error), None).await;
-            return;
+            self.finish(entry, JobState::failed(error), None).await;
+            return None;
         }
-        let control = Arc::new(self.solver.control(runnable.deadline));
-        shared.running().insert(entry.id.clone(), control.clone());
-        // Kept until the entry is done with, assembly included (the last part's entry
-        // stays pending while its job is assembled and stored).
-        let _heartbeat = AbortOnDrop(tokio::spawn(heartbeat(
-            shared.fleet.clone(),
-            store.clone(),
-            entry.id.clone(),
-            id,
-            control.clone(),
-            entry.part.is_none(),
-        )));
-        tracing::info!(entry = entry.id, job = %id, part = entry.part_name(), deliveries, "solving a part");
-        if runnable.status == JobStatus::Queued {
-            let _ = store.set_state(id, &JobState::Running, None).await;
-        }
+        Some((runnable, keyed, deliveries))
+    }
+
+    /// Solves `entry`'s part of `keyed` (or the whole job) on a solver thread under
+    /// `control`; the CSV is rendered there too, not on an async thread.
+    async fn solve(
+        &self,
+        entry: &Entry,
+        keyed: &Keyed,
+        control: &Arc<Control>,
+    ) -> Result<Outcome, JobError> {
         let permit = self.solver.permit(keyed.job().cost().bytes).await;
-        let running = self.solver.running();
+        let _running = self.solver.running();
         let part = entry.part.clone();
         let (solving, meta, key) = keyed.clone().into_parts();
-        let started = Instant::now();
         let kept = |solved: Solved| {
             solved
                 .kept()
                 .map(Arc::new)
                 .map_err(|e| JobError::Internal(format!("cannot render the answer: {e}")))
         };
-        // The CSV is rendered here too, on the solver thread, not on an async one.
-        let result = Pool::run(permit, control.clone(), move |control| match part {
+        Pool::run(permit, control.clone(), move |control| match part {
             None => match solving.run_keeping(meta, control) {
                 Ok(answer) => Ok(Outcome::Whole(kept(Solved::new(
                     key,
@@ -286,10 +315,19 @@ impl Worker {
                 &solving.run_points(meta, range, control)?,
             )?)),
         })
-        .await;
-        drop(running);
-        shared.running().remove(&entry.id);
-        let outcome = match &result {
+        .await
+    }
+
+    /// Counts the part's outcome, and tells the fleet what a point of its kind cost when it
+    /// was solved (in the background: the part's answer does not wait for it).
+    fn count(
+        &self,
+        entry: &Entry,
+        keyed: &Keyed,
+        result: &Result<Outcome, JobError>,
+        took: Duration,
+    ) {
+        let outcome = match result {
             Ok(_) => "succeeded",
             Err(JobError::Cancelled) => "cancelled",
             Err(_) => "failed",
@@ -303,41 +341,54 @@ impl Worker {
                 Some((_, range)) => range.len(),
                 None => keyed.job().points().unwrap_or(1),
             };
-            // Told the fleet in the background: the part's answer does not wait for it.
-            let (shared, class, took) =
-                (shared.clone(), keyed.job().cost_class(), started.elapsed());
+            let (shared, class) = (self.shared.clone(), keyed.job().cost_class());
             tokio::spawn(async move { shared.learn(class, took, points).await });
         }
+    }
+
+    /// Stores what solving `entry` gave: the job's end, or its part (and the whole job once
+    /// every part is in); a part the drain stopped is handed back.
+    async fn settle(
+        &self,
+        entry: &Entry,
+        keyed: &Keyed,
+        runnable: &Runnable,
+        control: &Control,
+        result: Result<Outcome, JobError>,
+    ) {
+        let shared = &self.shared;
         match result {
             Ok(Outcome::Whole(solved)) => {
                 let total = match keyed.job().work() {
                     Work::Known(total) => total,
                     Work::Unknown => control.done(),
                 };
-                self.succeed(&entry, solved, total).await;
+                self.succeed(entry, solved, total).await;
             }
             Ok(Outcome::Stopped(error, partial)) => {
                 let state = JobState::Failed {
                     error,
                     partial: Some(JobResult::Ready(partial)),
                 };
-                self.finish(&entry, state, Some(control.done())).await;
+                self.finish(entry, state, Some(control.done())).await;
             }
             Ok(Outcome::Part(rendered)) => {
                 let part = entry.part.as_ref().map_or((0, 0), |(i, r)| (*i, r.len()));
-                let stored = store.part_done(id, &runnable, part, &rendered, &entry.id);
+                let stored = shared
+                    .store
+                    .part_done(entry.job, runnable, part, &rendered, &entry.id);
                 // Acknowledged with the part, unless it was the last: then once assembled.
                 if let Ok(Some(true)) = stored.await {
-                    self.assemble(&entry, &keyed, &runnable).await;
+                    self.assemble(entry, keyed, runnable).await;
                 }
             }
             // Stopped by the drain: handed back at once, its delivery not counted.
             Err(JobError::Cancelled) if self.draining.is_cancelled() => {
-                hand_back(shared, &entry).await;
+                hand_back(shared, entry).await;
             }
-            Err(JobError::Cancelled) => acknowledge(&shared.fleet, &entry).await,
+            Err(JobError::Cancelled) => acknowledge(&shared.fleet, entry).await,
             Err(e) => {
-                self.finish(&entry, JobState::failed(e), Some(control.done()))
+                self.finish(entry, JobState::failed(e), Some(control.done()))
                     .await;
             }
         }
@@ -412,7 +463,7 @@ async fn next_entry(
             keys::STREAM,
             keys::GROUP,
             &fleet.consumer,
-            super::cache::millis(idle),
+            crate::engine::clock::millis(idle),
             "0-0",
             StreamAutoClaimOptions::default().count(1),
         );

@@ -44,7 +44,7 @@ impl Scopes {
     ];
 
     /// The scopes of a comma-separated list of names (`none` alone for the empty set).
-    pub fn parse(list: &str) -> Result<Scopes, String> {
+    pub fn parse(list: &str) -> Result<Scopes, UnknownScope> {
         if list.trim() == "none" {
             return Ok(Scopes::NONE);
         }
@@ -56,18 +56,18 @@ impl Scopes {
     }
 
     /// The scopes named in `names`; an error names the first unknown one.
-    fn of_names<'a>(names: impl IntoIterator<Item = &'a str>) -> Result<Scopes, String> {
+    fn of_names<'a>(names: impl IntoIterator<Item = &'a str>) -> Result<Scopes, UnknownScope> {
         names
             .into_iter()
             .try_fold(Scopes::NONE, |all, name| Ok(all.with(Scopes::named(name)?)))
     }
 
-    fn named(name: &str) -> Result<Scopes, String> {
+    fn named(name: &str) -> Result<Scopes, UnknownScope> {
         Scopes::NAMED
             .iter()
             .find(|(n, _)| *n == name)
             .map(|(_, scope)| *scope)
-            .ok_or_else(|| format!("unknown scope {name:?}: allowed submit, read, metrics, admin"))
+            .ok_or_else(|| UnknownScope(name.to_string()))
     }
 
     fn with(self, other: Scopes) -> Scopes {
@@ -129,17 +129,43 @@ struct Entry {
     expires: Option<String>,
 }
 
+/// A scope name that is not one.
+#[derive(Debug, PartialEq, thiserror::Error)]
+#[error("unknown scope {0:?}: allowed submit, read, metrics, admin")]
+pub struct UnknownScope(String);
+
+/// Why the keys cannot be used.
+#[derive(Debug, thiserror::Error)]
+pub enum KeysError {
+    /// Not the JSON of a keys file.
+    #[error("{0} (expected {{\"keys\": [{{\"name\", \"sha256\", \"scopes\", \"expires\"?}}]}})")]
+    Json(serde_json::Error),
+    /// Entry `index`, named `name`, is wrong in what `what` says.
+    #[error("keys[{index}] ({name:?}): {what}")]
+    Entry {
+        index: usize,
+        name: String,
+        what: String,
+    },
+    /// The file cannot be read.
+    #[error("--api-keys {path}: {source}")]
+    Unreadable {
+        path: String,
+        source: std::io::Error,
+    },
+}
+
 impl Ring {
     /// The keys of `text`; an error names the entry and what is wrong with it.
-    fn parse(text: &str) -> Result<Ring, String> {
-        let file: File = serde_json::from_str(text).map_err(|e| {
-            format!(
-                "{e} (expected {{\"keys\": [{{\"name\", \"sha256\", \"scopes\", \"expires\"?}}]}})"
-            )
-        })?;
+    fn parse(text: &str) -> Result<Ring, KeysError> {
+        let file: File = serde_json::from_str(text).map_err(KeysError::Json)?;
         let mut ring = HashMap::new();
         for (i, entry) in file.keys.into_iter().enumerate() {
-            let at = |what: String| format!("keys[{i}] ({:?}): {what}", entry.name);
+            let at = |what: String| KeysError::Entry {
+                index: i,
+                name: entry.name.clone(),
+                what,
+            };
             if !is_tenant_name(&entry.name) {
                 return Err(at(
                     "name: allowed 1 to 64 characters of A-Z, a-z, 0-9, '-', '_' and '.'".into(),
@@ -148,7 +174,8 @@ impl Ring {
             let hash = hex32(&entry.sha256).ok_or_else(|| {
                 at("sha256: allowed 64 hexadecimal digits, the SHA-256 of the key".into())
             })?;
-            let scopes = Scopes::of_names(entry.scopes.iter().map(String::as_str)).map_err(at)?;
+            let scopes = Scopes::of_names(entry.scopes.iter().map(String::as_str))
+                .map_err(|e| at(e.to_string()))?;
             if scopes == Scopes::NONE {
                 return Err(at(
                     "scopes: allowed a list of submit, read, metrics, admin".into()
@@ -211,7 +238,11 @@ pub fn hash_hex(key: &str) -> String {
 /// A new key for the tenant `name` with `scopes` (comma-separated), expiring at `expires`
 /// (RFC 3339) if given: the key itself (244 random bits; shown once, kept nowhere) and its
 /// entry for the keys file, checked as the service will read it.
-pub fn issue(name: &str, scopes: &str, expires: Option<&str>) -> Result<(String, String), String> {
+pub fn issue(
+    name: &str,
+    scopes: &str,
+    expires: Option<&str>,
+) -> Result<(String, String), KeysError> {
     let random = || uuid::Uuid::new_v4().simple().to_string();
     let key = format!("tb_{}{}", random(), random());
     let scopes: Vec<&str> = scopes
@@ -246,11 +277,15 @@ impl Source {
         }
     }
 
-    fn read(&self) -> Result<String, String> {
+    fn read(&self) -> Result<String, KeysError> {
         match self {
             Source::Inline(text) => Ok(text.clone()),
-            Source::File(path) => std::fs::read_to_string(path)
-                .map_err(|e| format!("--api-keys {}: {e}", path.display())),
+            Source::File(path) => {
+                std::fs::read_to_string(path).map_err(|source| KeysError::Unreadable {
+                    path: path.display().to_string(),
+                    source,
+                })
+            }
         }
     }
 }
@@ -277,6 +312,16 @@ impl fmt::Debug for Keys {
     }
 }
 
+/// Why `--api-keys` cannot be used: a file that cannot be read names itself; keys that are
+/// not valid are told under the flag's name.
+#[derive(Debug, thiserror::Error)]
+pub enum LoadError {
+    #[error(transparent)]
+    Unreadable(KeysError),
+    #[error("--api-keys: {0}")]
+    Invalid(KeysError),
+}
+
 /// What a presented key turns out to be.
 pub enum Lookup {
     Valid(Arc<Key>),
@@ -286,11 +331,11 @@ pub enum Lookup {
 
 impl Keys {
     /// The keys of `source` (none: no key is accepted); an error if they cannot be read.
-    pub fn load(source: Option<Source>) -> Result<Keys, String> {
+    pub fn load(source: Option<Source>) -> Result<Keys, LoadError> {
         let (text, ring) = match &source {
             Some(source) => {
-                let text = source.read()?;
-                let ring = Ring::parse(&text).map_err(|e| format!("--api-keys: {e}"))?;
+                let text = source.read().map_err(LoadError::Unreadable)?;
+                let ring = Ring::parse(&text).map_err(LoadError::Invalid)?;
                 (text, ring)
             }
             None => (String::new(), Ring::default()),
@@ -416,8 +461,14 @@ mod tests {
             (found.name.as_str(), found.scopes.to_string().as_str()),
             ("lab-b", "read, metrics")
         );
-        assert!(issue("a b", "read", None).unwrap_err().contains("name"));
-        assert!(issue("a", "fly", None).unwrap_err().contains("\"fly\""));
+        assert!(issue("a b", "read", None)
+            .unwrap_err()
+            .to_string()
+            .contains("name"));
+        assert!(issue("a", "fly", None)
+            .unwrap_err()
+            .to_string()
+            .contains("\"fly\""));
     }
 
     #[test]
@@ -429,6 +480,7 @@ mod tests {
         assert!(Scopes::ADMIN.allow(Scopes::METRICS.with(Scopes::SUBMIT)));
         assert!(Scopes::parse("submit,write")
             .unwrap_err()
+            .to_string()
             .contains("\"write\""));
     }
 
@@ -469,7 +521,9 @@ mod tests {
                 "unknown field",
             ),
         ] {
-            let error = Keys::load(Some(Source::of(&file(&entries)))).unwrap_err();
+            let error = Keys::load(Some(Source::of(&file(&entries))))
+                .unwrap_err()
+                .to_string();
             assert!(error.contains(needle), "{entries}: {error}");
         }
     }

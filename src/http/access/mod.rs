@@ -22,7 +22,6 @@ use axum::response::{IntoResponse, Response};
 
 pub use keys::{Keys, Scopes, Source};
 
-use super::config::CorsOrigins;
 use super::error::ApiError;
 use super::AppState;
 use crate::engine::admission::Turn;
@@ -33,33 +32,26 @@ use crate::job::{Keyed, Work};
 /// The header that carries an API key (`Authorization: Bearer` does too).
 pub const API_KEY_HEADER: &str = "x-api-key";
 
-/// The service's access rules: its keys, what anonymous callers may do, and the quotas.
+/// The service's access rules: its keys, what anonymous callers may do, and the quota.
 #[derive(Debug)]
 pub struct Access {
     pub keys: Keys,
     /// What a caller without a key may do.
     pub anonymous: Scopes,
-    pub quotas: Quotas,
+    /// What each tenant may use: each API key's name, and the anonymous callers together.
+    pub quota: Quota,
     /// Whether a refused cross-origin preflight has been logged (it is, once).
     preflight_logged: AtomicBool,
 }
 
-/// What one tenant may use (0: no limit).
+/// What one tenant may use (0: no limit): the work it asks for, and the jobs it leaves
+/// waiting.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Quota {
     /// Points asked to be computed in a minute.
     pub points_per_minute: u64,
     /// Unfinished asynchronous jobs at once.
     pub jobs: usize,
-    /// Bytes of the answers of its jobs within their retention.
-    pub result_bytes: u64,
-}
-
-/// The quota of each API key's tenant, and the one share of all anonymous callers.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct Quotas {
-    pub keyed: Quota,
-    pub anonymous: Quota,
 }
 
 impl Access {
@@ -68,7 +60,7 @@ impl Access {
         Access {
             keys,
             anonymous,
-            quotas: Quotas::default(),
+            quota: Quota::default(),
             preflight_logged: AtomicBool::new(false),
         }
     }
@@ -196,11 +188,12 @@ impl Caller {
         self.key.as_ref().map(|key| key.name.as_str())
     }
 
-    /// The quota this caller draws on, and the name it is counted under (its tenant's).
-    fn quota(&self, quotas: &Quotas) -> (Quota, String) {
+    /// The name this caller's quota is counted under: its tenant's, or the anonymous
+    /// callers' together.
+    fn tenant_name(&self) -> String {
         match self.owner(None) {
-            Some(tenant) => (quotas.keyed, tenant.as_str().to_string()),
-            None => (quotas.anonymous, "anonymous".to_string()),
+            Some(tenant) => tenant.as_str().to_string(),
+            None => "anonymous".to_string(),
         }
     }
 
@@ -249,8 +242,8 @@ pub async fn charge_all(
     caller: &Caller,
     jobs: &[Keyed],
 ) -> Result<Option<Charge>, ApiError> {
-    let (quota, tenant) = caller.quota(&state.config().access.quotas);
-    let limit = quota.points_per_minute;
+    let tenant = caller.tenant_name();
+    let limit = state.config().access.quota.points_per_minute;
     if limit == 0 {
         return Ok(None);
     }
@@ -277,14 +270,10 @@ pub async fn charge_all(
         Err(Exceeded { used, retry_after }) => (used, retry_after),
     };
     let whose = caller.describe();
-    let flag = match caller.owner(None) {
-        Some(_) => "--quota-points",
-        None => "--anonymous-quota-points",
-    };
     let detail = match retry_after {
         None => format!(
             "this asks for {points} points, more than the {limit} a minute {whose} may ask \
-             for ({flag}): split it"
+             for (--quota-points): split it"
         ),
         Some(wait) => format!(
             "{whose} asked for {used} points this minute, of the {limit} it may; this asks for \
@@ -295,99 +284,55 @@ pub async fn charge_all(
     Err(ApiError::quota_exceeded(detail, retry_after))
 }
 
-/// A job `caller` submits: within its tenant's unfinished jobs and the bytes its answers
-/// hold (anonymous callers: within their one share of unfinished jobs, and the service's own
-/// limits), and its points charged. The quotas are counted in the tenant's turn
-/// ([`Engine::turn`](crate::engine::Engine::turn)), which the caller holds until the job
-/// is stored: two submissions never both pass the last place.
+/// A job `caller` submits: within its tenant's unfinished jobs (anonymous callers: theirs
+/// together, and the service's own limits), and its points charged. The quota is counted in
+/// the tenant's turn ([`Engine::turn`](crate::engine::Engine::turn)), which the caller holds
+/// until the job is stored: two submissions never both pass the last place.
 pub async fn admit_job(
     state: &AppState,
     caller: &Caller,
     keyed: &Keyed,
 ) -> Result<Admitted, ApiError> {
-    let (quota, name) = caller.quota(&state.config().access.quotas);
-    let tenant = caller.owner(None);
-    let holds = tenant.is_some() && quota.result_bytes > 0;
-    let turn = match quota.jobs > 0 || holds {
-        true => Some(state.engine().turn(&name).await?),
+    let jobs = state.config().access.quota.jobs;
+    let turn = match jobs > 0 {
+        true => Some(state.engine().turn(&caller.tenant_name()).await?),
         false => None,
     };
-    if let Some(owner) = tenant.as_ref().filter(|_| holds) {
-        hold(state, caller, owner, quota.result_bytes, keyed).await?;
-    }
-    if quota.jobs > 0 {
-        let (unfinished, flag) = match &tenant {
-            Some(owner) => (state.engine().unfinished_of(owner).await?, "--quota-jobs"),
-            None => (
-                state.engine().unfinished_anonymous(),
-                "--anonymous-quota-jobs",
-            ),
-        };
-        if unfinished >= quota.jobs {
-            let who = match tenant {
-                Some(_) => format!("{} has", caller.describe()),
-                None => "the callers without an API key together have".to_string(),
-            };
-            return Err(ApiError::quota_exceeded(
-                format!(
-                    "{who} {unfinished} unfinished jobs, as many as allowed at once ({flag} \
-                     {}): wait for one to end, or cancel one",
-                    quota.jobs
-                ),
-                Some(Duration::from_secs(5)),
-            ));
-        }
+    if jobs > 0 {
+        within_jobs(state, caller, jobs).await?;
     }
     let charge = charge(state, caller, keyed).await?;
     Ok(Admitted { turn, charge })
+}
+
+/// Lets `caller` leave one more job unfinished if its tenant has fewer than `limit`; else
+/// 429, to retry in a few seconds.
+async fn within_jobs(state: &AppState, caller: &Caller, limit: usize) -> Result<(), ApiError> {
+    let tenant = caller.owner(None);
+    let unfinished = match &tenant {
+        Some(owner) => state.engine().unfinished_of(owner).await?,
+        None => state.engine().unfinished_anonymous(),
+    };
+    if unfinished < limit {
+        return Ok(());
+    }
+    let who = match tenant {
+        Some(_) => format!("{} has", caller.describe()),
+        None => "the callers without an API key together have".to_string(),
+    };
+    Err(ApiError::quota_exceeded(
+        format!(
+            "{who} {unfinished} unfinished jobs, as many as allowed at once (--quota-jobs \
+             {limit}): wait for one to end, or cancel one"
+        ),
+        Some(Duration::from_secs(5)),
+    ))
 }
 
 /// A job let in: its tenant's turn, held until the job is stored, and its points charged.
 pub struct Admitted {
     pub turn: Option<Turn>,
     pub charge: Option<Charge>,
-}
-
-/// Lets `owner`'s job `keyed` in if the room its answer may take, added to what the
-/// tenant's jobs hold, is within `limit`; else 429, with `Retry-After` when the first of
-/// them is freed (none when the job alone is over the limit).
-async fn hold(
-    state: &AppState,
-    caller: &Caller,
-    owner: &Owner,
-    limit: u64,
-    keyed: &Keyed,
-) -> Result<(), ApiError> {
-    let needed = keyed.job().result_bytes();
-    let whose = caller.describe();
-    if needed > limit {
-        return Err(ApiError::quota_exceeded(
-            format!(
-                "this job's answer may take {needed} bytes, more than the {limit} {whose} may \
-                 hold (--quota-result-bytes): split it"
-            ),
-            None,
-        ));
-    }
-    let held = state.engine().held_by(owner).await?;
-    if held.bytes.saturating_add(needed) <= limit {
-        return Ok(());
-    }
-    let wait = held
-        .freed_in
-        .unwrap_or_default()
-        .max(Duration::from_secs(1));
-    Err(ApiError::quota_exceeded(
-        format!(
-            "{whose} holds {} bytes in the answers of its {} jobs kept, of the {limit} it may \
-             (--quota-result-bytes); this job's may take {needed} more. Delete a job it no \
-             longer needs (DELETE /v1/jobs/{{id}}), or retry in {} s, when the first expires",
-            held.bytes,
-            held.jobs,
-            wait.as_secs()
-        ),
-        Some(wait),
-    ))
 }
 
 /// The scope a request needs: the API's reads `read` and its other methods `submit`,
@@ -443,25 +388,10 @@ pub async fn refuse_foreign_preflight(
     let Some(origin) = origin else {
         return next.run(request).await;
     };
-    let origins = &state.config().cors_origins;
-    let shown = String::from_utf8_lossy(origin.as_bytes()).into_owned();
-    let detail = match origins {
-        CorsOrigins::Any => return next.run(request).await,
-        CorsOrigins::List(list) if list.contains(origin) => return next.run(request).await,
-        CorsOrigins::None => format!(
-            "a page at {shown} may not call this service: it was started without \
-             --cors-origin (THIRDBODY_CORS_ORIGINS). Start it with --cors-origin {shown} to \
-             allow that origin"
-        ),
-        CorsOrigins::List(list) => format!(
-            "a page at {shown} may not call this service: its --cors-origin \
-             (THIRDBODY_CORS_ORIGINS) allows {}. Add {shown} to allow that origin",
-            list.iter()
-                .map(|o| String::from_utf8_lossy(o.as_bytes()).into_owned())
-                .collect::<Vec<_>>()
-                .join(", ")
-        ),
+    let Some(detail) = state.config().cors_origins.refusal(origin) else {
+        return next.run(request).await;
     };
+    let shown = String::from_utf8_lossy(origin.as_bytes()).into_owned();
     let access = &state.config().access;
     if !access.preflight_logged.swap(true, Ordering::Relaxed) {
         tracing::warn!(origin = %shown, "cross-origin request refused: {detail} (said once)");

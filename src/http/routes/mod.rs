@@ -28,7 +28,7 @@ use super::body::{offload, JsonBody};
 use super::error::ApiError;
 use super::AppState;
 use crate::engine::cache::{picture, Solved};
-use crate::engine::spill::JobResult;
+use crate::engine::store::JobResult;
 use crate::engine::{heavy, CacheStatus};
 use crate::job::meta::{GIT_COMMIT, SOFTWARE_VERSION};
 use crate::job::{input_hash_of, Job, Keyed};
@@ -195,36 +195,28 @@ impl Answering {
         })
     }
 
-    /// A job's result as [`Answering::respond`] gives an answer, wherever it is kept: a
-    /// result spilled to disk is streamed from its file, one in the fleet's Redis read in
-    /// the form asked for only (a picture is drawn from either's JSON).
+    /// A job's result as [`Answering::respond`] gives an answer, wherever it is kept: one in
+    /// the database or the fleet's Redis is read in the form asked for only (a picture is
+    /// drawn from its JSON).
     pub async fn respond_result(&self, result: &JobResult) -> Result<Response, ApiError> {
         let unreadable = |e: std::io::Error| {
             ApiError::internal(format!("the job's result cannot be read back: {e}"))
         };
         let (key, kind, complete) = match result {
             JobResult::Ready(solved) => return self.respond(solved, None),
-            JobResult::Spilled(spilled) => (&spilled.key, spilled.kind, spilled.complete),
             JobResult::Stored(stored) => (&stored.key, stored.kind, stored.complete),
         };
         let body = match (self.format, result) {
             (Format::Svg, _) => {
-                let json = match result {
-                    JobResult::Spilled(spilled) => spilled.json().await,
-                    _ => self.stored_body(result, Format::Json).await,
-                }
-                .map_err(unreadable)?;
+                let json = self
+                    .stored_body(result, Format::Json)
+                    .await
+                    .map_err(unreadable)?;
                 let svg = heavy::run(move || picture(kind, &json))
                     .await
                     .map_err(|e| ApiError::internal(e.to_string()))?
                     .map_err(|e| ApiError::internal(e.to_string()))?;
                 Body::from(svg)
-            }
-            (format, JobResult::Spilled(spilled)) => {
-                let file = tokio::fs::File::open(spilled.file(format))
-                    .await
-                    .map_err(unreadable)?;
-                Body::from_stream(tokio_util::io::ReaderStream::new(file))
             }
             (format, _) => Body::from(self.stored_body(result, format).await.map_err(unreadable)?),
         };

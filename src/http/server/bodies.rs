@@ -30,8 +30,8 @@ pub struct BodyPace {
 #[derive(Debug, thiserror::Error)]
 #[error(
     "the request body arrived too slowly: {received} bytes in {secs:.1} s; this service waits at \
-     most {wait} s for each piece of a body (--body-timeout) and, after that long, takes \
-     at least {rate} bytes/s on average (--body-min-rate)",
+     most {wait} s for each piece of a body and, after that long, takes at least {rate} \
+     bytes/s on average",
     secs = .after.as_secs_f64(),
     wait = .pace.timeout.as_secs_f64(),
     rate = .pace.min_rate
