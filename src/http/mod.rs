@@ -17,14 +17,14 @@ mod request_id;
 mod responses;
 pub mod routes;
 mod server;
+mod stack;
 
 use std::future::Future;
 use std::sync::Arc;
 use std::time::Duration;
 
-use axum::extract::{DefaultBodyLimit, Request, State};
+use axum::extract::DefaultBodyLimit;
 use axum::http::{header, HeaderName, HeaderValue, Method, StatusCode};
-use axum::middleware::Next;
 use axum::response::{IntoResponse, Response};
 use axum::{middleware, Router};
 use metrics_exporter_prometheus::{PrometheusBuilder, PrometheusHandle};
@@ -161,14 +161,14 @@ pub fn app(state: AppState) -> Router {
                         .latency_unit(LatencyUnit::Micros),
                 ),
         )
-        .layer(middleware::from_fn_with_state(state.clone(), observed))
+        .layer(stack::ObservedLayer(state.clone()))
         .option_layer(cors(&config.cors_origins))
-        .layer(middleware::map_response(weaken_compressed_etag))
+        .map_response(weaken_compressed_etag)
         // gzip for a client that accepts it (the default predicate leaves out small bodies,
         // images other than SVG, and event streams); the fastest level: a sweep's numbers
         // shrink about fivefold at a fraction of the CPU of the default level.
         .layer(CompressionLayer::new().quality(CompressionLevel::Fastest))
-        .layer(middleware::map_response(error::problem_for_errors))
+        .and_then(stack::problems)
         .map_response(IntoResponse::into_response)
         .layer(CatchPanicLayer::custom(error::panic_response))
         .layer(TimeoutLayer::with_status_code(
@@ -176,7 +176,7 @@ pub fn app(state: AppState) -> Router {
             config.request_timeout,
         ))
         .layer(DefaultBodyLimit::max(config.body_limit))
-        .layer(middleware::from_fn_with_state(state.clone(), admitted));
+        .layer(stack::AdmittedLayer(state.clone()));
     api.merge(SwaggerUi::new("/docs").url("/openapi.json", spec))
         .merge(dashboard::router())
         .route_layer(observe::TagRouteLayer)
@@ -185,30 +185,10 @@ pub fn app(state: AppState) -> Router {
         .with_state(state)
 }
 
-/// Counts and times every request, and refuses a cross-origin preflight this service does
-/// not allow: two middlewares in one (each `from_fn` clones what is below it and boxes two
-/// things on every request).
-async fn observed(State(state): State<AppState>, request: Request, next: Next) -> Response {
-    let timing = observe::Timing::start(&request);
-    let response = access::refuse_foreign_preflight(State(state.clone()), request, next).await;
-    timing.record(&state, &response);
-    response
-}
-
-/// Refuses at once (413) a body whose declared length is over the limit, rather than
-/// reading it up to the limit first; then lets the request in if its caller may do what it
-/// asks ([`access::admit`]).
-async fn admitted(State(state): State<AppState>, request: Request, next: Next) -> Response {
-    match observe::declared_overflow(&state, &request) {
-        Some(refusal) => refusal,
-        None => access::admit(State(state), request, next).await,
-    }
-}
-
 /// A compressed body is another representation of the answer: its `ETag` becomes weak
 /// (RFC 9110 §8.8.1), as nginx does, so that it is never taken for the uncompressed bytes;
 /// `If-None-Match` compares weakly, so a client's validator still matches.
-async fn weaken_compressed_etag<B>(mut response: Response<B>) -> Response<B> {
+fn weaken_compressed_etag<B>(mut response: Response<B>) -> Response<B> {
     let headers = response.headers_mut();
     if headers.contains_key(header::CONTENT_ENCODING) {
         if let Some(etag) = headers.get(header::ETAG) {

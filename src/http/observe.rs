@@ -196,7 +196,7 @@ impl Timing {
     }
 
     /// Counts and times the request answered by `response`.
-    pub fn record(self, state: &AppState, response: &Response) {
+    pub fn record<B>(self, state: &AppState, response: &Response<B>) {
         let route = response
             .extensions()
             .get::<MatchedPath>()
