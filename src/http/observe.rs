@@ -127,8 +127,8 @@ where
 
 /// The request series ([`HTTP_REQUESTS`], [`HTTP_DURATION`]) of each method, route and
 /// status, looked up on the recorder once: a look-up builds the key, copying its labels
-/// (the status formatted), and hashes it, about 2,000 instructions a request otherwise.
-/// A few dozen routes, methods and statuses: a list.
+/// (the status formatted), and hashes it, on every request otherwise. A few dozen routes,
+/// methods and statuses: a list.
 #[derive(Default)]
 pub struct RequestSeries {
     seen: RwLock<Vec<Series>>,

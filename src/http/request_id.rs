@@ -86,7 +86,8 @@ where
 }
 
 /// An answer's future, whose answer gets the request's id unless it has one. (The futures
-/// below it, tracing's around a `from_fn`'s box, are `Unpin`: no pin projection is needed.)
+/// below it, tracing's around the metrics layer's box, are `Unpin`: no pin projection is
+/// needed.)
 pub struct WithRequestId<F> {
     inner: F,
     id: Option<HeaderValue>,

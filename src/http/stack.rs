@@ -1,8 +1,7 @@
 //! The service's own layers in [`super::app`]'s stack, written as tower services rather
 //! than with `axum::middleware::from_fn` or `map_response`: those clone the service below
-//! them, box it into a `Next` and box their future on every request (about 2,000
-//! instructions each, issue 46). The work is the same functions' ([`observe`],
-//! [`access`], [`error`]).
+//! them, box it into a `Next` and box their future on every request (issue 46). The work
+//! is the same functions' ([`observe`], [`access`], [`error`]).
 
 use std::convert::Infallible;
 use std::future::Future;
