@@ -1,10 +1,13 @@
 #!/usr/bin/env bash
-# Instructions a server executes per rolling request, cached or uncached, counted by
-# callgrind: a ruler that the machine's load does not move (this VM's speed changes by
-# 40 % within an hour, and it has no hardware counters). Cache misses and memory traffic
-# are not counted: read it next to loadtest/ratio.sh, not instead of it.
+# Instructions a server executes per request (a rolling one, cached or uncached, or GET
+# /healthz), counted by callgrind: a ruler that the machine's load does not move (this VM's
+# speed changes by 40 % within an hour, and it has no hardware counters). Cache misses and
+# memory traffic are not counted: read it next to loadtest/ratio.sh, not instead of it.
 #
-#   loadtest/instructions.sh cached|uncached N BINARY...
+#   loadtest/instructions.sh cached|uncached|healthz N BINARY...
+#
+# A BINARY is run as `BINARY serve --bind ADDRESS --database :memory:` (loadtest/bare/, the
+# floor without thirdbody's layers, takes the same arguments).
 #
 # Each binary serves, under valgrind, 300 requests to warm up and then N more, and the same
 # 300 alone in a second run; the difference over N is one request's instructions (every
@@ -17,16 +20,19 @@ MODE="$1"
 N="$2"
 shift 2
 
-# POSTs COUNT rolling jobs on one connection: the default one, or each with a load of its
-# own (from OFFSET on).
+# Sends COUNT requests on one connection: rolling jobs (the default one, or each with a load
+# of its own, from OFFSET on), or GET /healthz.
 drive() {
   python3 - "$1" "$2" "$MODE" "$3" <<'EOF'
 import http.client, sys
 port, count, mode, offset = int(sys.argv[1]), int(sys.argv[2]), sys.argv[3], int(sys.argv[4])
 connection = http.client.HTTPConnection("127.0.0.1", port)
 for i in range(count):
-    body = "{}" if mode == "cached" else '{"load": %.17g}' % (1e-9 * (1 + (offset + i) * 1e-9))
-    connection.request("POST", "/v1/rolling", body, {"Content-Type": "application/json"})
+    if mode == "healthz":
+        connection.request("GET", "/healthz")
+    else:
+        body = "{}" if mode == "cached" else '{"load": %.17g}' % (1e-9 * (1 + (offset + i) * 1e-9))
+        connection.request("POST", "/v1/rolling", body, {"Content-Type": "application/json"})
     response = connection.getresponse()
     response.read()
     assert response.status == 200, response.status

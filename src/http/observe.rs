@@ -1,19 +1,22 @@
 //! What operators see of each request: a tracing span with its request id, and Prometheus
 //! counts and latencies by route.
 
+use std::future::Future;
+use std::pin::Pin;
+use std::sync::{Arc, RwLock};
+use std::task::{Context, Poll};
 use std::time::Instant;
 
-use axum::extract::{MatchedPath, Request, State};
-use axum::http::{header, HeaderValue, Method};
-use axum::middleware::Next;
+use axum::extract::{MatchedPath, Request};
+use axum::http::{header, Method};
 use axum::response::{IntoResponse, Response};
+use metrics::{Counter, Histogram};
+use tower::{Layer, Service};
 use tracing::Span;
 
 use super::error::{too_large, ApiError};
+use super::request_id::X_REQUEST_ID;
 use super::AppState;
-
-/// The request id header, set by the client or by the service.
-const REQUEST_ID: &str = "x-request-id";
 use crate::engine::metrics::Metrics;
 
 /// Requests answered, by method, route and status.
@@ -43,7 +46,7 @@ pub fn describe(metrics: &Metrics) {
 pub fn request_span(request: &Request) -> Span {
     let id = request
         .headers()
-        .get(REQUEST_ID)
+        .get(X_REQUEST_ID)
         .and_then(|v| v.to_str().ok())
         .unwrap_or("");
     tracing::info_span!(
@@ -56,41 +59,156 @@ pub fn request_span(request: &Request) -> Span {
 
 /// Passes the route a request matched out with its response (routing happens inside the
 /// router, after the layers that measure), so that metrics are by route template rather
-/// than by raw path.
-pub async fn tag_route(request: Request, next: Next) -> Response {
-    let route = request.extensions().get::<MatchedPath>().cloned();
-    let mut response = next.run(request).await;
-    if let Some(route) = route {
-        response.extensions_mut().insert(route);
+/// than by raw path. A route's own layer (`route_layer`): a method the route does not take
+/// (405) is counted as `unmatched`, as before.
+///
+/// A tower layer rather than an `axum::middleware::from_fn`, which clones the route below
+/// it and boxes two things on every request.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct TagRouteLayer;
+
+impl<S> Layer<S> for TagRouteLayer {
+    type Service = TagRoute<S>;
+
+    fn layer(&self, inner: S) -> TagRoute<S> {
+        TagRoute { inner }
     }
-    response
 }
 
-/// Counts and times every request.
-pub async fn record_request(
-    State(state): State<AppState>,
-    request: Request,
-    next: Next,
-) -> Response {
-    let start = Instant::now();
-    let method = method_label(request.method());
-    let response = next.run(request).await;
-    let route = response
-        .extensions()
-        .get::<MatchedPath>()
-        .map_or("unmatched", |r| r.as_str());
-    let status = response.status().as_u16().to_string();
-    let metrics = state.engine().metrics();
-    metrics
-        .counter(
-            HTTP_REQUESTS,
-            &[("method", method), ("route", route), ("status", &status)],
-        )
-        .increment(1);
-    metrics
-        .histogram(HTTP_DURATION, &[("method", method), ("route", route)])
-        .record(start.elapsed());
-    response
+/// See [`TagRouteLayer`].
+#[derive(Clone, Debug)]
+pub struct TagRoute<S> {
+    inner: S,
+}
+
+impl<S> Service<Request> for TagRoute<S>
+where
+    S: Service<Request, Response = Response>,
+    S::Future: Unpin,
+{
+    type Response = Response;
+    type Error = S::Error;
+    type Future = Tagged<S::Future>;
+
+    fn poll_ready(&mut self, cx: &mut Context<'_>) -> Poll<Result<(), Self::Error>> {
+        self.inner.poll_ready(cx)
+    }
+
+    fn call(&mut self, request: Request) -> Self::Future {
+        let route = request.extensions().get::<MatchedPath>().cloned();
+        Tagged {
+            inner: self.inner.call(request),
+            route,
+        }
+    }
+}
+
+/// A route's answer, to be tagged with the route.
+pub struct Tagged<F> {
+    inner: F,
+    route: Option<MatchedPath>,
+}
+
+impl<F, E> Future for Tagged<F>
+where
+    F: Future<Output = Result<Response, E>> + Unpin,
+{
+    type Output = Result<Response, E>;
+
+    fn poll(self: Pin<&mut Self>, cx: &mut Context<'_>) -> Poll<Self::Output> {
+        let this = self.get_mut();
+        let mut response = std::task::ready!(Pin::new(&mut this.inner).poll(cx))?;
+        if let Some(route) = this.route.take() {
+            response.extensions_mut().insert(route);
+        }
+        Poll::Ready(Ok(response))
+    }
+}
+
+/// The request series ([`HTTP_REQUESTS`], [`HTTP_DURATION`]) of each method, route and
+/// status, looked up on the recorder once: a look-up builds the key, copying its labels
+/// (the status formatted), and hashes it, on every request otherwise. A few dozen routes,
+/// methods and statuses: a list.
+#[derive(Default)]
+pub struct RequestSeries {
+    seen: RwLock<Vec<Series>>,
+}
+
+struct Series {
+    method: &'static str,
+    route: Arc<str>,
+    status: u16,
+    requests: Counter,
+    duration: Histogram,
+}
+
+impl RequestSeries {
+    /// Counts a request answered with `status` and records its time to the answer.
+    fn record(
+        &self,
+        metrics: &Metrics,
+        method: &'static str,
+        route: &str,
+        status: u16,
+        elapsed: std::time::Duration,
+    ) {
+        let matches = |s: &&Series| s.status == status && s.method == method && &*s.route == route;
+        {
+            let seen = self.seen.read().unwrap_or_else(|e| e.into_inner());
+            if let Some(series) = seen.iter().find(matches) {
+                series.requests.increment(1);
+                series.duration.record(elapsed);
+                return;
+            }
+        }
+        let mut seen = self.seen.write().unwrap_or_else(|e| e.into_inner());
+        if !seen.iter().any(|s| matches(&s)) {
+            let code = status.to_string();
+            seen.push(Series {
+                method,
+                route: route.into(),
+                status,
+                requests: metrics.counter(
+                    HTTP_REQUESTS,
+                    &[("method", method), ("route", route), ("status", &code)],
+                ),
+                duration: metrics.histogram(HTTP_DURATION, &[("method", method), ("route", route)]),
+            });
+        }
+        let series = seen.iter().find(matches).expect("just added");
+        series.requests.increment(1);
+        series.duration.record(elapsed);
+    }
+}
+
+/// A request being counted and timed: started as it comes in, recorded with its response.
+pub struct Timing {
+    start: Instant,
+    method: &'static str,
+}
+
+impl Timing {
+    pub fn start(request: &Request) -> Timing {
+        Timing {
+            start: Instant::now(),
+            method: method_label(request.method()),
+        }
+    }
+
+    /// Counts and times the request answered by `response`.
+    pub fn record<B>(self, state: &AppState, response: &Response<B>) {
+        let route = response
+            .extensions()
+            .get::<MatchedPath>()
+            .map_or("unmatched", |r| r.as_str());
+        state.request_series().record(
+            state.engine().metrics(),
+            self.method,
+            route,
+            response.status().as_u16(),
+            self.start.elapsed(),
+        );
+    }
 }
 
 /// The method as a metric label: one of the standard methods, or `other`, so that a client
@@ -113,31 +231,9 @@ fn method_label(method: &Method) -> &'static str {
         .map_or("other", Method::as_str)
 }
 
-/// A request id a client may choose: up to 128 letters, digits and `-_.:`; anything else
-/// (which could forge fields in a text log line) is replaced by one of ours.
-pub async fn sanitize_request_id(mut request: Request, next: Next) -> Response {
-    let valid = |v: &HeaderValue| {
-        let bytes = v.as_bytes();
-        !bytes.is_empty()
-            && bytes.len() <= 128
-            && bytes
-                .iter()
-                .all(|b| b.is_ascii_alphanumeric() || b"-_.:".contains(b))
-    };
-    let headers = request.headers_mut();
-    if headers.get(REQUEST_ID).is_some_and(|v| !valid(v)) {
-        headers.remove(REQUEST_ID);
-    }
-    next.run(request).await
-}
-
-/// Refuses at once (413) a body whose declared length is over the limit, rather than
-/// reading it up to the limit first.
-pub async fn refuse_declared_overflow(
-    State(state): State<AppState>,
-    request: Request,
-    next: Next,
-) -> Response {
+/// The refusal (413) of a body whose declared length is over the limit, at once rather
+/// than after reading it up to the limit.
+pub fn declared_overflow(state: &AppState, request: &Request) -> Option<Response> {
     let limit = state.config().body_limit;
     let declared = request
         .headers()
@@ -146,8 +242,8 @@ pub async fn refuse_declared_overflow(
         .and_then(|v| v.parse::<u64>().ok());
     match declared {
         Some(length) if length > limit as u64 => {
-            ApiError::payload_too_large(too_large(Some(length), limit)).into_response()
+            Some(ApiError::payload_too_large(too_large(Some(length), limit)).into_response())
         }
-        _ => next.run(request).await,
+        _ => None,
     }
 }

@@ -358,43 +358,41 @@ fn needed(method: &Method, path: &str) -> Option<Scopes> {
 /// known to the handlers ([`Caller`]); else 401 (no key, or a key not accepted) or 403 (a
 /// key without the scope).
 pub async fn admit(State(state): State<AppState>, mut request: Request, next: Next) -> Response {
-    let Some(needed) = needed(request.method(), request.uri().path()) else {
-        return next.run(request).await;
-    };
+    match refuse_or_admit(&state, &mut request) {
+        Some(refused) => refused,
+        None => next.run(request).await,
+    }
+}
+
+/// What [`admit`] answers a request it does not let in; `None` (and the caller in the
+/// request's extensions) for one it does.
+pub fn refuse_or_admit(state: &AppState, request: &mut Request) -> Option<Response> {
+    let needed = needed(request.method(), request.uri().path())?;
     let access = &state.config().access;
     let caller = match access.caller(request.headers(), SystemTime::now()) {
         Ok(caller) => caller,
-        Err(refused) => return refused.into_response(),
+        Err(refused) => return Some(refused.into_response()),
     };
     if !caller.scopes.allow(needed) {
-        return access.refusal(&caller, needed).into_response();
+        return Some(access.refusal(&caller, needed).into_response());
     }
     request.extensions_mut().insert(caller);
-    next.run(request).await
+    None
 }
 
 /// Answers a cross-origin preflight from an origin `--cors-origin` does not allow with a
 /// problem naming the flag (a browser shows only "Failed to fetch", so the log says it
-/// too, once); other requests go on.
-pub async fn refuse_foreign_preflight(
-    State(state): State<AppState>,
-    request: Request,
-    next: Next,
-) -> Response {
+/// too, once); `None` for other requests, which go on.
+pub fn refuse_foreign_preflight(state: &AppState, request: &Request) -> Option<Response> {
     let headers = request.headers();
     let preflight = request.method() == Method::OPTIONS
         && headers.contains_key(header::ACCESS_CONTROL_REQUEST_METHOD);
-    let origin = headers.get(header::ORIGIN).filter(|_| preflight);
-    let Some(origin) = origin else {
-        return next.run(request).await;
-    };
-    let Some(detail) = state.config().cors_origins.refusal(origin) else {
-        return next.run(request).await;
-    };
+    let origin = headers.get(header::ORIGIN).filter(|_| preflight)?;
+    let detail = state.config().cors_origins.refusal(origin)?;
     let shown = String::from_utf8_lossy(origin.as_bytes()).into_owned();
     let access = &state.config().access;
     if !access.preflight_logged.swap(true, Ordering::Relaxed) {
         tracing::warn!(origin = %shown, "cross-origin request refused: {detail} (said once)");
     }
-    ApiError::forbidden(detail).into_response()
+    Some(ApiError::forbidden(detail).into_response())
 }
