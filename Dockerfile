@@ -33,8 +33,7 @@ USER thirdbody
 ENV THIRDBODY_BIND=0.0.0.0:8080 \
     THIRDBODY_LOG_FORMAT=json \
     THIRDBODY_DATABASE=/var/lib/thirdbody/thirdbody.db \
-    THIRDBODY_SHUTDOWN_TIMEOUT=25s \
-    THIRDBODY_DRAIN_DELAY=2s
+    THIRDBODY_SHUTDOWN_TIMEOUT=25s
 EXPOSE 8080
 # Alive when /healthz answers on THIRDBODY_BIND. `thirdbody worker` serves no API: it answers
 # /healthz, /readyz and /metrics only on THIRDBODY_METRICS_BIND (--metrics-bind), so its

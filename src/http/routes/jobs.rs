@@ -376,7 +376,7 @@ pub async fn events(
 
 /// Turns a job's changes into events.
 struct Watcher {
-    /// The stream's place among `--max-event-streams`, given back when the stream ends.
+    /// The stream's place among the event streams' share of `--max-connections`, given back when the stream ends.
     _permit: tokio::sync::OwnedSemaphorePermit,
     engine: Arc<Engine>,
     /// The job as last read.
