@@ -9,7 +9,7 @@ use thirdbody::http::access::keys::hash_hex;
 
 use std::time::Duration;
 
-use crate::helpers::{spawn_app, spawn_app_adjusted, TestApp};
+use crate::helpers::{retry_after, spawn_app, spawn_app_adjusted, TestApp};
 
 const LAB_A: &str = "key-of-lab-a-0000000000000001";
 const LAB_A_ROTATED: &str = "key-of-lab-a-0000000000000002";
@@ -82,6 +82,11 @@ fn uuid_like(path: &str) -> String {
     path.replace(id_of(path), "01a21b77-0000-7000-8000-000000000000")
 }
 
+/// POSTs `body` as JSON to `path` with the API key `key`.
+async fn post_as(app: &TestApp, path: &str, key: &str, body: &Value) -> Response {
+    send(app, Method::POST, path, Some(key), Some(body)).await
+}
+
 /// The default rolling contact, solved now with `key`.
 async fn solve_with(app: &TestApp, key: &str) -> Response {
     send(
@@ -146,11 +151,10 @@ async fn scopes_decide_what_a_caller_may_do() {
     // A key with submit: as x-api-key or as a bearer token.
     assert_eq!(solve_with(&app, LAB_A).await.status(), StatusCode::OK);
     let bearer = app
-        .send(
-            Method::POST,
+        .post_with(
             "/v1/rolling",
             &[("authorization", &format!("Bearer {LAB_B}"))],
-            Some(&json!({})),
+            &json!({}),
         )
         .await;
     assert_eq!(bearer.status(), StatusCode::OK);
@@ -189,14 +193,12 @@ async fn scopes_decide_what_a_caller_may_do() {
         "{detail}"
     );
     let two = app
-        .send(
-            Method::GET,
+        .get_with(
             "/openapi.json",
             &[
                 ("x-api-key", LAB_A),
                 ("authorization", &format!("Bearer {LAB_B}")),
             ],
-            None,
         )
         .await;
     assert!(refused(two, StatusCode::UNAUTHORIZED, "unauthorized")
@@ -204,12 +206,10 @@ async fn scopes_decide_what_a_caller_may_do() {
         .contains("two different keys"));
     // Another scheme (a proxy's Basic credentials) is not a key: the caller is anonymous.
     let basic = [("authorization", "Basic YTpi")];
-    let read = app.send(Method::GET, "/openapi.json", &basic, None).await;
+    let read = app.get_with("/openapi.json", &basic).await;
     assert_eq!(read.status(), StatusCode::OK);
     let body = json!({});
-    let submitted = app
-        .send(Method::POST, "/v1/rolling", &basic, Some(&body))
-        .await;
+    let submitted = app.post_with("/v1/rolling", &basic, &body).await;
     let detail = refused(submitted, StatusCode::UNAUTHORIZED, "unauthorized").await;
     assert!(detail.contains("callers without an API key"), "{detail}");
 }
@@ -478,11 +478,7 @@ async fn a_cross_origin_preflight_not_allowed_names_the_flag() {
 
 /// A refusal for a quota: 429 with `Retry-After` (within the minute) and its detail.
 async fn over_quota(response: Response) -> String {
-    let retry_after: u64 = response.headers()["retry-after"]
-        .to_str()
-        .unwrap()
-        .parse()
-        .unwrap();
+    let retry_after = retry_after(&response);
     assert!((1..=60).contains(&retry_after), "{retry_after}");
     refused(response, StatusCode::TOO_MANY_REQUESTS, "quota-exceeded").await
 }
@@ -515,54 +511,26 @@ async fn points_a_minute_are_each_tenants_and_anonymous_callers_share_theirs() {
     // whichever of its keys asks; another tenant is not held back.
     let app = spawn_app(&["--api-keys", &keys, "--quota-points", "5"]).await;
     let sweep = json!({"base": {"radius": "30 nm"}, "vary": {"load": ["1 nN", "2 nN", "3 nN"]}});
-    let swept = send(&app, Method::POST, "/v1/sweeps", Some(LAB_A), Some(&sweep)).await;
+    let swept = post_as(&app, "/v1/sweeps", LAB_A, &sweep).await;
     assert_eq!(swept.status(), StatusCode::OK);
     let job = rolling_job("23 nm");
     submit(&app, Some(LAB_A_ROTATED), &job).await;
-    let solved = send(
-        &app,
-        Method::POST,
-        "/v1/rolling",
-        Some(LAB_A),
-        Some(&rolling("24 nm")),
-    )
-    .await;
+    let solved = post_as(&app, "/v1/rolling", LAB_A, &rolling("24 nm")).await;
     assert_eq!(solved.status(), StatusCode::OK);
-    let past = send(
-        &app,
-        Method::POST,
-        "/v1/rolling",
-        Some(LAB_A),
-        Some(&rolling("25 nm")),
-    )
-    .await;
+    let past = post_as(&app, "/v1/rolling", LAB_A, &rolling("25 nm")).await;
     let detail = over_quota(past).await;
     assert!(
         detail.contains("\"lab-a\" asked for 5 points this minute, of the 5"),
         "{detail}"
     );
-    let job = send(
-        &app,
-        Method::POST,
-        "/v1/jobs",
-        Some(LAB_A),
-        Some(&rolling_job("26 nm")),
-    )
-    .await;
+    let job = post_as(&app, "/v1/jobs", LAB_A, &rolling_job("26 nm")).await;
     over_quota(job).await;
-    let theirs = send(
-        &app,
-        Method::POST,
-        "/v1/rolling",
-        Some(LAB_B),
-        Some(&rolling("25 nm")),
-    )
-    .await;
+    let theirs = post_as(&app, "/v1/rolling", LAB_B, &rolling("25 nm")).await;
     assert_eq!(theirs.status(), StatusCode::OK);
     // More than a minute's points at once: no wait would help.
     let big =
         json!({"base": {}, "vary": {"load": ["1 nN", "2 nN", "3 nN", "4 nN", "5 nN", "6 nN"]}});
-    let response = send(&app, Method::POST, "/v1/sweeps", Some(LAB_B), Some(&big)).await;
+    let response = post_as(&app, "/v1/sweeps", LAB_B, &big).await;
     assert!(response.headers().get("retry-after").is_none());
     let detail = refused(response, StatusCode::TOO_MANY_REQUESTS, "quota-exceeded").await;
     assert!(
@@ -583,14 +551,7 @@ async fn a_tenant_has_at_most_its_quota_of_unfinished_jobs() {
     ])
     .await;
     let first = submit(&app, Some(LAB_A), &crate::helpers::long_sweep(40)).await;
-    let second = send(
-        &app,
-        Method::POST,
-        "/v1/jobs",
-        Some(LAB_A_ROTATED),
-        Some(&rolling_job("27 nm")),
-    )
-    .await;
+    let second = post_as(&app, "/v1/jobs", LAB_A_ROTATED, &rolling_job("27 nm")).await;
     let detail = over_quota(second).await;
     assert!(detail.contains("has 1 unfinished jobs"), "{detail}");
     // Another tenant's jobs, and anonymous ones, are not counted.
@@ -683,7 +644,7 @@ async fn quotas_charge_what_work_costs() {
             "points": [{"velocity": "1 nm/s", "value": 0.01}, {"velocity": "2 nm/s", "value": 0.009},
                        {"velocity": "4 nm/s", "value": 0.008}]}],
         "parameters": {"relaxation_time": {}, "retardation_time": {}}}});
-    let refused_fit = send(&app, Method::POST, "/v1/jobs", Some(LAB_A), Some(&fit)).await;
+    let refused_fit = post_as(&app, "/v1/jobs", LAB_A, &fit).await;
     let detail = refused(refused_fit, StatusCode::TOO_MANY_REQUESTS, "quota-exceeded").await;
     assert!(detail.contains("more than the 5000 a minute"), "{detail}");
     assert!(
@@ -691,14 +652,7 @@ async fn quotas_charge_what_work_costs() {
         "a continuum fit of 3 points: {detail}"
     );
     let continuum = json!({"layer": {"model": "continuum"}});
-    let refused_solve = send(
-        &app,
-        Method::POST,
-        "/v1/rolling",
-        Some(LAB_A),
-        Some(&continuum),
-    )
-    .await;
+    let refused_solve = post_as(&app, "/v1/rolling", LAB_A, &continuum).await;
     let detail = refused(
         refused_solve,
         StatusCode::TOO_MANY_REQUESTS,
@@ -709,7 +663,7 @@ async fn quotas_charge_what_work_costs() {
     // A local answer is a point.
     for radius in ["25 nm", "26 nm", "27 nm"] {
         let local = json!({"radius": radius});
-        let response = send(&app, Method::POST, "/v1/rolling", Some(LAB_A), Some(&local)).await;
+        let response = post_as(&app, "/v1/rolling", LAB_A, &local).await;
         assert_eq!(response.status(), StatusCode::OK);
     }
 }
@@ -731,7 +685,7 @@ async fn a_checks_suite_is_charged_its_points_whole_before_it_runs() {
     let run = |radii: &'static [&'static str]| {
         let body = suite(radii);
         let app = &app;
-        async move { send(app, Method::POST, "/v1/checks", Some(LAB_A), Some(&body)).await }
+        async move { post_as(app, "/v1/checks", LAB_A, &body).await }
     };
     // Four checks are more points than a minute's: refused whole, no wait would help.
     let response = run(&["20 nm", "21 nm", "22 nm", "23 nm"]).await;

@@ -3,7 +3,6 @@
 
 use std::process::{Command, Output};
 
-use reqwest::Method;
 use serde_json::{json, Value};
 
 use crate::helpers::{problem, problem_type, spawn_app, within};
@@ -43,12 +42,7 @@ async fn failed_checks_answer_422_with_the_report_as_a_problem_or_as_junit() {
         .contains("651 nm"));
 
     let xml = app
-        .send(
-            Method::POST,
-            "/v1/checks",
-            &[("accept", "application/xml")],
-            Some(&checks),
-        )
+        .post_with("/v1/checks", &[("accept", "application/xml")], &checks)
         .await;
     assert_eq!(xml.status(), 422);
     assert_eq!(xml.headers()["content-type"], "application/xml");
@@ -67,14 +61,9 @@ async fn failed_checks_answer_422_with_the_report_as_a_problem_or_as_junit() {
 #[tokio::test]
 async fn every_answer_says_where_it_comes_from_and_a_job_result_comes_as_csv() {
     let app = spawn_app(&[]).await;
-    let response = app
-        .send(
-            Method::POST,
-            "/v1/sweeps",
-            &[("accept", "text/csv")],
-            Some(&json!({"vary": {"load": ["1 nN", "1.1 nN"]}})),
-        )
-        .await;
+    let accept_csv = [("accept", "text/csv")];
+    let sweep = json!({"vary": {"load": ["1 nN", "1.1 nN"]}});
+    let response = app.post_with("/v1/sweeps", &accept_csv, &sweep).await;
     let headers = response.headers().clone();
     assert_eq!(headers["x-model-version"], thirdbody::model::MODEL_VERSION);
     assert_eq!(headers["x-software-version"], env!("CARGO_PKG_VERSION"));
@@ -93,9 +82,7 @@ async fn every_answer_says_where_it_comes_from_and_a_job_result_comes_as_csv() {
     let result = format!("{location}/result");
     app.wait_for_job(&location, |j| j["status"] == "succeeded")
         .await;
-    let csv = app
-        .send(Method::GET, &result, &[("accept", "text/csv")], None)
-        .await;
+    let csv = app.get_with(&result, &accept_csv).await;
     assert_eq!(csv.status(), 200);
     assert_eq!(csv.headers()["x-input-hash"], hash.as_str());
     assert_eq!(
@@ -135,9 +122,7 @@ async fn the_readme_s_checks_pass_against_the_service_with_200() {
     assert_eq!(report["summary"]["checks"], 4);
 
     let accept = [("accept", "application/xml")];
-    let xml = app
-        .send(Method::POST, "/v1/checks", &accept, Some(&checks))
-        .await;
+    let xml = app.post_with("/v1/checks", &accept, &checks).await;
     assert_eq!(xml.status(), 200);
     assert!(xml
         .text()

@@ -6,24 +6,18 @@ use serde_json::{json, Value};
 use thirdbody::job::{Job, Limits};
 
 use crate::helpers::{problem, spawn_app};
+use crate::json::field_of_each;
 use crate::solve::engine_answer;
 
 fn rows(validity: &Value) -> Vec<&str> {
-    validity["assumptions"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|a| a["name"].as_str().unwrap())
-        .collect()
+    field_of_each(&validity["assumptions"], "name")
 }
 
 #[tokio::test]
 async fn the_default_job_on_the_continuum_answers_with_its_own_error() {
     let app = spawn_app(&[]).await;
     let input = json!({"layer": {"model": "continuum"}});
-    let response = app.post("/v1/rolling", &input).await;
-    assert_eq!(response.status(), 200);
-    let body: Value = response.json().await.unwrap();
+    let body = app.answer("/v1/rolling", &input).await;
     // Issue 23: about 8.3 nm² (the local law's 85.2 nm²), Hertz-like at rest (13.4 nm²).
     let area = body["contact_area"].as_f64().unwrap() * 1e18;
     assert!((8.1..8.4).contains(&area), "{area}");
@@ -60,12 +54,7 @@ async fn the_default_job_on_the_continuum_answers_with_its_own_error() {
 #[tokio::test]
 async fn the_local_laws_warning_points_to_the_continuum() {
     let app = spawn_app(&[]).await;
-    let body: Value = app
-        .post("/v1/rolling", &json!({}))
-        .await
-        .json()
-        .await
-        .unwrap();
+    let body: Value = app.post_json("/v1/rolling", &json!({})).await;
     assert_eq!(body["meta"]["input"]["layer"]["model"], "local");
     let local_layer = body["meta"]["validity"]["assumptions"]
         .as_array()
@@ -146,12 +135,7 @@ async fn a_three_body_system_on_the_continuum_runs_as_a_job_with_progress() {
     assert!(verification.get("layer_table_error").is_none());
     assert!(answer["meta"]["references"].to_string().contains("Carbone"));
     let local = json!({"operating": {"total_load": "1 mN"}});
-    let local: Value = app
-        .post("/v1/three-body", &local)
-        .await
-        .json()
-        .await
-        .unwrap();
+    let local: Value = app.post_json("/v1/three-body", &local).await;
     let mu = |a: &Value| a["friction_coefficient"]["rolling"].as_f64().unwrap();
     assert!(
         mu(&local) > 3.0 * mu(&answer),

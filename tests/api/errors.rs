@@ -11,9 +11,7 @@ use crate::helpers::{
 #[tokio::test]
 async fn malformed_json_is_400() {
     let app = spawn_app(&[]).await;
-    let response = app
-        .post_raw("/v1/rolling", "application/json", "{\"radius\": ".into())
-        .await;
+    let response = app.post_json_text("/v1/rolling", "{\"radius\": ").await;
     let malformed = problem(response, 400).await;
     assert_eq!(malformed["type"], problem_type("malformed-json"));
 }
@@ -35,7 +33,7 @@ async fn a_body_over_the_limit_is_413() {
     let app = spawn_app(&["--body-limit", "1024"]).await;
     let padding = " ".repeat(2048);
     let response = app
-        .post_raw("/v1/rolling", "application/json", format!("{{{padding}}}"))
+        .post_json_text("/v1/rolling", &format!("{{{padding}}}"))
         .await;
     let too_large = problem(response, 413).await;
     assert_eq!(too_large["type"], problem_type("payload-too-large"));
@@ -178,9 +176,7 @@ async fn a_full_pool_is_429_at_once_and_a_full_job_queue_too() {
     ])
     .await;
     // One long job takes the only solver thread...
-    let running = app.submit(&long_sweep(100)).await;
-    app.wait_for_job(&running, |j| j["status"] == "running")
-        .await;
+    let running = app.submit_running(&long_sweep(100)).await;
     // ...so a synchronous solve is refused, not queued.
     let response = app.post("/v1/rolling", &json!({"radius": "40 nm"})).await;
     assert_eq!(response.headers()["retry-after"], "1");

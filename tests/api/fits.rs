@@ -17,9 +17,7 @@ fn example() -> Value {
 async fn a_fit_is_answered_now_with_the_contracts_fields() {
     let app = spawn_app(&[]).await;
     let job = example();
-    let response = app.post("/v1/fits", &job["input"]).await;
-    assert_eq!(response.status(), 200);
-    let answer: Value = response.json().await.unwrap();
+    let answer = app.answer("/v1/fits", &job["input"]).await;
     let names = ["relaxation_time", "retardation_time", "elastic_modulus"];
     assert_eq!(answer["parameter_names"], json!(names));
     for name in names {

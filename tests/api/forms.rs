@@ -22,7 +22,7 @@ async fn every_job_answer_comes_as_csv_when_asked() {
             "total_load [N],velocity [m/s],mean_diameter [m],separation [m]",
         ),
     ] {
-        let response = app.send(Method::POST, path, &csv, Some(&body)).await;
+        let response = app.post_with(path, &csv, &body).await;
         assert_eq!(response.status(), 200, "{path}");
         assert!(response.headers()["etag"]
             .to_str()
@@ -33,14 +33,9 @@ async fn every_job_answer_comes_as_csv_when_asked() {
         assert_eq!(text.lines().count(), 2, "{text}");
     }
     // The CSV row holds the same numbers as the JSON answer.
-    let json: Value = app
-        .post("/v1/rolling", &json!({}))
-        .await
-        .json()
-        .await
-        .unwrap();
+    let json: Value = app.post_json("/v1/rolling", &json!({})).await;
     let text = app
-        .send(Method::POST, "/v1/rolling", &csv, Some(&json!({})))
+        .post_with("/v1/rolling", &csv, &json!({}))
         .await
         .text()
         .await
@@ -60,7 +55,7 @@ async fn every_job_answer_comes_as_csv_when_asked() {
 async fn a_form_no_resource_offers_is_406_before_any_work() {
     let app = spawn_app(&[]).await;
     let png = [("accept", "image/png")];
-    let refused = app.send(Method::GET, "/v1/figures/6", &png, None).await;
+    let refused = app.get_with("/v1/figures/6", &png).await;
     let refusal = problem(refused, 406).await;
     assert_eq!(refusal["type"], problem_type("not-acceptable"));
     assert!(refusal["detail"].as_str().unwrap().contains("text/csv"));
@@ -84,9 +79,9 @@ async fn a_form_no_resource_offers_is_406_before_any_work() {
         problem(response, 406).await;
     }
     let location = app.submit(&body).await;
-    problem(app.send(Method::GET, &location, &csv, None).await, 406).await;
+    problem(app.get_with(&location, &csv).await, 406).await;
     let events = format!("{location}/events");
-    problem(app.send(Method::GET, &events, &csv, None).await, 406).await;
+    problem(app.get_with(&events, &csv).await, 406).await;
 
     // Wildcards and browsers' lists are served.
     for accept in [
@@ -94,9 +89,7 @@ async fn a_form_no_resource_offers_is_406_before_any_work() {
         "application/*",
         "text/html,application/xhtml+xml,*/*;q=0.8",
     ] {
-        let response = app
-            .send(Method::GET, "/healthz", &[("accept", accept)], None)
-            .await;
+        let response = app.get_with("/healthz", &[("accept", accept)]).await;
         assert_eq!(response.status(), 200, "{accept}");
     }
 }

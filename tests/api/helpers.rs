@@ -148,6 +148,38 @@ impl TestApp {
         self.send(Method::POST, path, &[], Some(body)).await
     }
 
+    /// POSTs `body` as JSON to `path`, checks that it is answered (200), and reads the
+    /// answer.
+    pub async fn answer(&self, path: &str, body: &Value) -> Value {
+        let response = self.post(path, body).await;
+        assert_eq!(response.status(), StatusCode::OK);
+        response.json().await.unwrap()
+    }
+
+    /// POSTs `body` as JSON to `path` and reads the answer as JSON, whatever its status.
+    pub async fn post_json(&self, path: &str, body: &Value) -> Value {
+        self.post(path, body).await.json().await.unwrap()
+    }
+
+    /// GETs `path` with `headers` (an `accept`, an `origin`, a request id).
+    pub async fn get_with(&self, path: &str, headers: &[(&str, &str)]) -> Response {
+        self.send(Method::GET, path, headers, None).await
+    }
+
+    /// POSTs `body` as JSON to `path` with `headers`.
+    pub async fn post_with(&self, path: &str, headers: &[(&str, &str)], body: &Value) -> Response {
+        self.send(Method::POST, path, headers, Some(body)).await
+    }
+
+    /// The request id a probe's answer carries when asked with `id` as its `x-request-id`.
+    pub async fn request_id_for(&self, id: &str) -> String {
+        let response = self.get_with("/healthz", &[("x-request-id", id)]).await;
+        response.headers()["x-request-id"]
+            .to_str()
+            .unwrap()
+            .to_string()
+    }
+
     pub async fn delete(&self, path: &str) -> Response {
         self.send(Method::DELETE, path, &[], None).await
     }
@@ -156,6 +188,12 @@ impl TestApp {
     pub async fn cancel(&self, location: &str) -> Response {
         let path = format!("{location}/cancel");
         self.send(Method::POST, &path, &[], None).await
+    }
+
+    /// POSTs `text` as it is, as `application/json` (its spelling is what is tested).
+    pub async fn post_json_text(&self, path: &str, text: &str) -> Response {
+        self.post_raw(path, "application/json", text.to_string())
+            .await
     }
 
     /// POSTs `body` as it is, with `content_type`.
@@ -214,6 +252,14 @@ impl TestApp {
         assert_eq!(response.status(), StatusCode::ACCEPTED);
         let location = response.headers()["location"].to_str().unwrap().to_string();
         assert!(location.starts_with("/v1/jobs/"), "{location}");
+        location
+    }
+
+    /// Submits `job` and waits until a solver thread runs it; returns its URL.
+    pub async fn submit_running(&self, job: &Value) -> String {
+        let location = self.submit(job).await;
+        self.wait_for_job(&location, |j| j["status"] == "running")
+            .await;
         location
     }
 
@@ -308,6 +354,15 @@ impl Events {
         })
         .await
     }
+}
+
+/// The seconds a response's `Retry-After` header asks a client to wait.
+pub fn retry_after(response: &Response) -> u64 {
+    response.headers()["retry-after"]
+        .to_str()
+        .unwrap()
+        .parse()
+        .unwrap()
 }
 
 /// The problem document of an error response, checked for its status and content type.

@@ -84,9 +84,7 @@ async fn a_job_streams_progress_then_its_completion() {
 #[tokio::test]
 async fn a_running_job_is_cancelled_at_the_solvers_next_check() {
     let app = spawn_app_on_disk(&["--max-sweep-points", "1000000"]).await;
-    let location = app.submit(&long_sweep(100)).await;
-    app.wait_for_job(&location, |j| j["status"] == "running")
-        .await;
+    let location = app.submit_running(&long_sweep(100)).await;
     let response = app.cancel(&location).await;
     assert_eq!(response.status(), 200);
     let job: Value = response.json().await.unwrap();
@@ -125,9 +123,7 @@ async fn a_finished_job_expires_after_the_retention_time() {
 #[tokio::test]
 async fn a_deleted_job_is_cancelled_and_forgotten() {
     let app = spawn_app_on_disk(&["--max-sweep-points", "1000000"]).await;
-    let location = app.submit(&long_sweep(100)).await;
-    app.wait_for_job(&location, |j| j["status"] == "running")
-        .await;
+    let location = app.submit_running(&long_sweep(100)).await;
     let deleted: Value = app.delete(&location).await.json().await.unwrap();
     assert_eq!(deleted["status"], "cancelled");
     let gone = problem(app.get(&location).await, 404).await;

@@ -6,11 +6,11 @@ use std::net::TcpStream;
 use std::time::{Duration, Instant};
 
 use reqwest::Method;
-use serde_json::json;
+use serde_json::{json, Value};
 
 use crate::helpers::{
-    long_sweep, problem, problem_type, spawn_app, spawn_app_adjusted, spawn_app_on_disk, within,
-    Events,
+    long_sweep, problem, problem_type, retry_after, spawn_app, spawn_app_adjusted,
+    spawn_app_on_disk, within, Events, TestApp,
 };
 
 /// `n` seconds.
@@ -21,6 +21,26 @@ fn secs(n: u64) -> Duration {
 /// A raw connection to the test server.
 fn connect(base: &str) -> TcpStream {
     TcpStream::connect(base.trim_start_matches("http://")).unwrap()
+}
+
+/// What `f` makes of the server at `base`, run on a blocking thread: the raw connections
+/// these tests hold block.
+async fn with_raw_connections<T: Send + 'static>(
+    app: &TestApp,
+    f: impl FnOnce(&str) -> T + Send + 'static,
+) -> T {
+    let base = app.base.clone();
+    tokio::task::spawn_blocking(move || f(&base)).await.unwrap()
+}
+
+/// Whether the server closes the first of `held` within 5 s (read on a blocking thread).
+async fn first_closed_within_5s(held: Vec<TcpStream>) -> bool {
+    tokio::task::spawn_blocking(move || {
+        let first = held.into_iter().next().unwrap();
+        read_until_closed(first, Duration::from_secs(5)).0
+    })
+    .await
+    .unwrap()
 }
 
 /// Reads until the server closes the connection (or `patience` passes); returns whether it
@@ -35,16 +55,15 @@ fn read_until_closed(mut stream: TcpStream, patience: Duration) -> (bool, String
 #[tokio::test]
 async fn a_client_that_sends_its_headers_slowly_or_idles_is_disconnected() {
     let app = spawn_app_adjusted(&[], |c| c.connections.header_timeout = secs(1)).await;
-    let base = app.base.clone();
-    let (slow, idle) = tokio::task::spawn_blocking(move || {
-        let mut slow = connect(&base);
+    let (slow, idle) = with_raw_connections(&app, move |base| {
+        let mut slow = connect(base);
         slow.write_all(b"GET /healthz HTTP/1.1\r\nHost: x\r\n")
             .unwrap();
         let start = Instant::now();
         let (closed, _) = read_until_closed(slow, Duration::from_secs(20));
         let slow = (closed, start.elapsed());
         // A keep-alive connection that sent one request and then idles.
-        let mut idle = connect(&base);
+        let mut idle = connect(base);
         idle.write_all(b"GET /healthz HTTP/1.1\r\nHost: x\r\n\r\n")
             .unwrap();
         let start = Instant::now();
@@ -52,8 +71,7 @@ async fn a_client_that_sends_its_headers_slowly_or_idles_is_disconnected() {
         assert!(text.starts_with("HTTP/1.1 200"), "{text}");
         (slow, (closed, start.elapsed()))
     })
-    .await
-    .unwrap();
+    .await;
     for (closed, after) in [slow, idle] {
         assert!(
             closed && after < Duration::from_secs(10),
@@ -83,12 +101,7 @@ async fn at_the_connection_cap_a_silent_connection_makes_room_for_a_new_client()
         start.elapsed()
     );
     let base = app.base.clone();
-    let closed = tokio::task::spawn_blocking(move || {
-        let first = held.into_iter().next().unwrap();
-        read_until_closed(first, Duration::from_secs(5)).0
-    })
-    .await
-    .unwrap();
+    let closed = first_closed_within_5s(held).await;
     assert!(closed, "the oldest silent connection was closed");
     assert_eq!(within(app.get("/healthz")).await.status(), 200, "{base}");
 }
@@ -99,10 +112,9 @@ async fn at_the_connection_cap_a_fresh_connection_keeps_its_place_over_a_crawlin
         c.connections.body.timeout = secs(60)
     })
     .await;
-    let base = app.base.clone();
-    let (fresh, crawling) = tokio::task::spawn_blocking(move || {
+    let (fresh, crawling) = with_raw_connections(&app, move |base| {
         // A body that crawls holds one place...
-        let mut crawling = connect(&base);
+        let mut crawling = connect(base);
         write!(
             crawling,
             "POST /v1/rolling HTTP/1.1\r\nHost: x\r\nContent-Type: application/json\r\n\
@@ -111,9 +123,9 @@ async fn at_the_connection_cap_a_fresh_connection_keeps_its_place_over_a_crawlin
         .unwrap();
         std::thread::sleep(Duration::from_millis(400));
         // ...a client has just connected to the other and not yet sent its request...
-        let mut fresh = connect(&base);
+        let mut fresh = connect(base);
         // ...when a third arrives: the crawling body goes, not the client's new connection.
-        let mut third = connect(&base);
+        let mut third = connect(base);
         write!(
             third,
             "GET /healthz HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n"
@@ -131,8 +143,7 @@ async fn at_the_connection_cap_a_fresh_connection_keeps_its_place_over_a_crawlin
             read_until_closed(crawling, Duration::from_secs(1)),
         )
     })
-    .await
-    .unwrap();
+    .await;
     assert!(fresh.1.starts_with("HTTP/1.1 200"), "{fresh:?}");
     assert!(crawling.0, "the crawling body was closed: {crawling:?}");
 }
@@ -170,12 +181,7 @@ async fn at_the_connection_cap_an_idle_keep_alive_connection_makes_room() {
         "{:?}",
         start.elapsed()
     );
-    let closed = tokio::task::spawn_blocking(move || {
-        let first = held.into_iter().next().unwrap();
-        read_until_closed(first, Duration::from_secs(5)).0
-    })
-    .await
-    .unwrap();
+    let closed = first_closed_within_5s(held).await;
     assert!(closed, "the connection idle longest was closed");
 }
 
@@ -185,9 +191,8 @@ async fn an_idle_keep_alive_connection_is_closed_after_the_keep_alive_timeout() 
         c.connections.keep_alive_timeout = Duration::from_millis(500)
     })
     .await;
-    let base = app.base.clone();
-    let after = tokio::task::spawn_blocking(move || {
-        let mut idle = connect(&base);
+    let after = with_raw_connections(&app, move |base| {
+        let mut idle = connect(base);
         idle.write_all(b"GET /healthz HTTP/1.1\r\nHost: x\r\n\r\n")
             .unwrap();
         let start = Instant::now();
@@ -195,26 +200,28 @@ async fn an_idle_keep_alive_connection_is_closed_after_the_keep_alive_timeout() 
         assert!(closed && text.starts_with("HTTP/1.1 200"), "{text}");
         start.elapsed()
     })
-    .await
-    .unwrap();
+    .await;
     // The header timeout (10 s) would have closed it later.
     assert!(after < Duration::from_secs(4), "{after:?}");
+}
+
+/// A sweep of 5,000 loads: its answer (about 3.3 MB) is more than a socket's buffers hold.
+fn five_thousand_loads() -> Value {
+    json!({"vary": {"load": (0..5000).map(|i| 1e-9 + i as f64 * 1e-13).collect::<Vec<_>>()}})
 }
 
 #[tokio::test]
 async fn a_client_that_stops_reading_its_answers_is_disconnected_after_the_send_timeout() {
     let app = spawn_app_adjusted(&[], |c| c.connections.send_timeout = secs(1)).await;
-    let sweep =
-        json!({"vary": {"load": (0..5000).map(|i| 1e-9 + i as f64 * 1e-13).collect::<Vec<_>>()}});
+    let sweep = five_thousand_loads();
     let body = sweep.to_string();
     assert_eq!(
         app.post("/v1/sweeps", &sweep).await.status(),
         200,
         "solved and cached"
     );
-    let base = app.base.clone();
-    let (closed, after) = tokio::task::spawn_blocking(move || {
-        let mut stream = connect(&base);
+    let (closed, after) = with_raw_connections(&app, move |base| {
+        let mut stream = connect(base);
         // Pipelined requests for ~100 MB of answers, more than the kernel's buffers hold,
         // none of which is read: the server's writes wait, then time out.
         let request = format!(
@@ -238,8 +245,7 @@ async fn a_client_that_stops_reading_its_answers_is_disconnected_after_the_send_
         };
         (closed, start.elapsed())
     })
-    .await
-    .unwrap();
+    .await;
     assert!(closed, "closed after {after:?}");
     assert_eq!(within(app.get("/healthz")).await.status(), 200);
 }
@@ -247,8 +253,7 @@ async fn a_client_that_stops_reading_its_answers_is_disconnected_after_the_send_
 #[tokio::test]
 async fn a_reader_cut_by_the_send_timeout_is_reset_so_its_answer_leaves_the_kernel() {
     let app = spawn_app_adjusted(&[], |c| c.connections.send_timeout = secs(1)).await;
-    let sweep =
-        json!({"vary": {"load": (0..5000).map(|i| 1e-9 + i as f64 * 1e-13).collect::<Vec<_>>()}});
+    let sweep = five_thousand_loads();
     let body = sweep.to_string();
     assert_eq!(app.post("/v1/sweeps", &sweep).await.status(), 200, "cached");
     // A client with a small receive buffer, as a reader that wants the server to queue its
@@ -285,9 +290,8 @@ async fn a_reader_cut_by_the_send_timeout_is_reset_so_its_answer_leaves_the_kern
 #[tokio::test]
 async fn a_body_that_crawls_is_answered_408_naming_the_knobs() {
     let app = spawn_app_adjusted(&[], |c| c.connections.body.timeout = secs(1)).await;
-    let base = app.base.clone();
-    let (text, after) = tokio::task::spawn_blocking(move || {
-        let mut stream = connect(&base);
+    let (text, after) = with_raw_connections(&app, move |base| {
+        let mut stream = connect(base);
         let head = "POST /v1/rolling HTTP/1.1\r\nHost: x\r\nContent-Type: application/json\r\n\
                     Content-Length: 100\r\n\r\n{";
         stream.write_all(head.as_bytes()).unwrap();
@@ -313,8 +317,7 @@ async fn a_body_that_crawls_is_answered_408_naming_the_knobs() {
         }
         (String::from_utf8_lossy(&text).into_owned(), start.elapsed())
     })
-    .await
-    .unwrap();
+    .await;
     assert!(text.starts_with("HTTP/1.1 408"), "{text}");
     assert!(
         text.contains("for each piece of a body") && text.contains("bytes/s on average"),
@@ -358,9 +361,8 @@ async fn event_streams_beyond_their_allowance_are_refused_and_polling_still_work
 #[tokio::test]
 async fn a_body_declared_too_large_is_refused_before_it_is_read() {
     let app = spawn_app(&[]).await;
-    let base = app.base.clone();
-    let (text, after) = tokio::task::spawn_blocking(move || {
-        let mut stream = connect(&base);
+    let (text, after) = with_raw_connections(&app, move |base| {
+        let mut stream = connect(base);
         let head = "POST /v1/rolling HTTP/1.1\r\nHost: x\r\nContent-Type: application/json\r\n\
                     Content-Length: 67108864\r\n\r\n";
         stream.write_all(head.as_bytes()).unwrap();
@@ -369,8 +371,7 @@ async fn a_body_declared_too_large_is_refused_before_it_is_read() {
         let (_, text) = read_until_closed(stream, Duration::from_secs(30));
         (text, start.elapsed())
     })
-    .await
-    .unwrap();
+    .await;
     assert!(text.starts_with("HTTP/1.1 413"), "{text}");
     assert!(text.contains("payload-too-large"), "{text}");
     assert!(after < Duration::from_secs(5), "{after:?}");
@@ -392,24 +393,14 @@ async fn made_up_methods_do_not_make_up_metric_series_and_request_ids_are_clean(
     );
 
     let forged = "abc\" level=ERROR msg=\"forged";
-    let response = app
-        .send(Method::GET, "/healthz", &[("x-request-id", forged)], None)
-        .await;
-    let id = response.headers()["x-request-id"].to_str().unwrap();
+    let id = app.request_id_for(forged).await;
     assert_ne!(id, forged);
     assert!(
         id.chars().all(|c| c.is_ascii_alphanumeric() || c == '-'),
         "{id}"
     );
-    let kept = app
-        .send(
-            Method::GET,
-            "/healthz",
-            &[("x-request-id", "trace-42.a:b_c")],
-            None,
-        )
-        .await;
-    assert_eq!(kept.headers()["x-request-id"], "trace-42.a:b_c");
+    let kept = app.request_id_for("trace-42.a:b_c").await;
+    assert_eq!(kept, "trace-42.a:b_c");
 }
 
 #[tokio::test]
@@ -445,9 +436,7 @@ async fn a_shutdown_finishes_the_accepted_jobs_and_keeps_answering_their_clients
         .await;
     tokio::time::sleep(Duration::from_millis(200)).await;
     // ...a job running and one queued behind it when the shutdown starts: both finish.
-    let running = app.submit(&long_sweep(20)).await;
-    app.wait_for_job(&running, |j| j["status"] == "running")
-        .await;
+    let running = app.submit_running(&long_sweep(20)).await;
     let queued = app
         .submit(&json!({"kind": "rolling", "input": {"load": "1.01 nN"}}))
         .await;
@@ -475,12 +464,23 @@ async fn a_shutdown_finishes_the_accepted_jobs_and_keeps_answering_their_clients
     within(&mut app.server).await.unwrap().unwrap();
 }
 
+/// A server shutting down within `shutdown_timeout`, and the URL of a job it runs that is
+/// longer than that.
+async fn running_past_the_bound(shutdown_timeout: &str) -> (TestApp, String) {
+    let app = spawn_app_on_disk(&[
+        "--max-sweep-points",
+        "1000000",
+        "--shutdown-timeout",
+        shutdown_timeout,
+    ])
+    .await;
+    let long = app.submit_running(&long_sweep(100)).await;
+    (app, long)
+}
+
 #[tokio::test]
 async fn a_job_the_shutdown_bound_cannot_fit_ends_interrupted() {
-    let mut app =
-        spawn_app_on_disk(&["--max-sweep-points", "1000000", "--shutdown-timeout", "2s"]).await;
-    let long = app.submit(&long_sweep(100)).await;
-    app.wait_for_job(&long, |j| j["status"] == "running").await;
+    let (mut app, long) = running_past_the_bound("2s").await;
     let mut events = Events::new(app.get(&format!("{long}/events")).await);
     app.shut_down();
     let (_, completion) = events.until_completion().await;
@@ -490,10 +490,7 @@ async fn a_job_the_shutdown_bound_cannot_fit_ends_interrupted() {
 
 #[tokio::test]
 async fn pollers_of_a_job_the_shutdown_interrupts_learn_it_before_the_port_closes() {
-    let mut app =
-        spawn_app_on_disk(&["--max-sweep-points", "1000000", "--shutdown-timeout", "6s"]).await;
-    let long = app.submit(&long_sweep(100)).await;
-    app.wait_for_job(&long, |j| j["status"] == "running").await;
+    let (mut app, long) = running_past_the_bound("6s").await;
     let started = Instant::now();
     app.shut_down();
     // Five clients poll once a second (the pace the job's Retry-After asks), each from its
@@ -556,11 +553,7 @@ async fn a_job_that_could_not_end_within_its_deadline_behind_the_queue_is_refuse
     // running beside `stress --cpu 2` the first job took fifteen times as long, and 1,331
     // points alone were then estimated past it, a refusal of another kind.)
     let answer = app.post("/v1/jobs", &long_sweep(10)).await;
-    let wait: u64 = answer.headers()["retry-after"]
-        .to_str()
-        .unwrap()
-        .parse()
-        .unwrap();
+    let wait = retry_after(&answer);
     assert!(wait >= 3, "Retry-After {wait}");
     let refusal = problem(answer, 429).await;
     assert_eq!(refusal["type"], problem_type("overloaded"));

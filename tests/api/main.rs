@@ -12,6 +12,8 @@ mod forms;
 mod helpers;
 mod in_process;
 mod jobs;
+#[path = "../shared/json.rs"]
+mod json;
 mod limits;
 mod ops;
 mod pictures;

@@ -17,15 +17,7 @@ async fn probes_answer_and_requests_carry_an_id() {
         json!({"status": "ok"})
     );
     assert_eq!(app.get("/readyz").await.status(), 200);
-    let echoed = app
-        .send(
-            Method::GET,
-            "/healthz",
-            &[("x-request-id", "abc-123")],
-            None,
-        )
-        .await;
-    assert_eq!(echoed.headers()["x-request-id"], "abc-123");
+    assert_eq!(app.request_id_for("abc-123").await, "abc-123");
 }
 
 #[tokio::test]
@@ -96,13 +88,9 @@ async fn a_dashboard_on_an_allowed_origin_may_post_and_read_the_location() {
         .unwrap()
         .contains("content-type"));
 
+    let dashboard = [("origin", "https://dashboard.example")];
     let posted = app
-        .send(
-            Method::POST,
-            "/v1/jobs",
-            &[("origin", "https://dashboard.example")],
-            Some(&json!({"kind": "rolling"})),
-        )
+        .post_with("/v1/jobs", &dashboard, &json!({"kind": "rolling"}))
         .await;
     assert_eq!(posted.status(), 202);
     let exposed = posted.headers()["access-control-expose-headers"]
@@ -114,12 +102,7 @@ async fn a_dashboard_on_an_allowed_origin_may_post_and_read_the_location() {
     }
 
     let stranger = app
-        .send(
-            Method::GET,
-            "/healthz",
-            &[("origin", "https://elsewhere.example")],
-            None,
-        )
+        .get_with("/healthz", &[("origin", "https://elsewhere.example")])
         .await;
     assert!(!stranger
         .headers()

@@ -1,7 +1,6 @@
 //! Pictures over HTTP: `Accept: image/svg+xml` (or `?format=svg` for links) on every route
 //! that answers, finished jobs included; an unknown form is 406; the dashboard at `/`.
 
-use reqwest::Method;
 use serde_json::{json, Value};
 
 use crate::helpers::{problem, problem_type, spawn_app};
@@ -32,45 +31,28 @@ async fn every_answer_is_a_picture_when_asked_by_accept_or_by_query() {
     let app = spawn_app(&[]).await;
     let accept = [("accept", "image/svg+xml")];
     let body = json!({"load": "1.1 nN"});
-    let (etag, picture) = svg(app
-        .send(Method::POST, "/v1/rolling", &accept, Some(&body))
-        .await)
-    .await;
+    let (etag, picture) = svg(app.post_with("/v1/rolling", &accept, &body).await).await;
     assert!(etag.ends_with(".svg\""), "{etag}");
     assert!(picture.contains("Contact region, R = 25 nm, P = 1.1 nN"));
-    let (_, by_query) = svg(app
-        .send(Method::POST, "/v1/rolling?format=svg", &[], Some(&body))
-        .await)
-    .await;
+    let (_, by_query) = svg(app.post_with("/v1/rolling?format=svg", &[], &body).await).await;
     assert_eq!(by_query, picture);
     svg(app.get("/v1/figures/6?format=svg").await).await;
     let three_body = json!({"operating": {"total_load": "1 mN"}});
-    svg(app
-        .send(Method::POST, "/v1/three-body", &accept, Some(&three_body))
-        .await)
-    .await;
+    svg(app.post_with("/v1/three-body", &accept, &three_body).await).await;
     let sweep = json!({"vary": {"load": ["1 nN", "2 nN"]}});
-    svg(app
-        .send(Method::POST, "/v1/sweeps", &accept, Some(&sweep))
-        .await)
-    .await;
+    svg(app.post_with("/v1/sweeps", &accept, &sweep).await).await;
 
     // A finished job's result, too.
     let location = app.submit(&json!({"kind": "sweep", "input": sweep})).await;
     app.wait_for_job(&location, |job| job["status"] == "succeeded")
         .await;
     let result = format!("{location}/result");
-    let (_, job_picture) = svg(app.send(Method::GET, &result, &accept, None).await).await;
+    let (_, job_picture) = svg(app.get_with(&result, &accept).await).await;
     assert!(job_picture.contains("Sweep: friction coefficient against load"));
 
     // A form the service does not draw.
     let png = app
-        .send(
-            Method::GET,
-            "/v1/figures/3",
-            &[("accept", "image/png")],
-            None,
-        )
+        .get_with("/v1/figures/3", &[("accept", "image/png")])
         .await;
     let refused = problem(png, 406).await;
     assert_eq!(refused["type"], problem_type("not-acceptable"));

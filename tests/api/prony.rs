@@ -198,9 +198,7 @@ async fn a_fit_finds_the_modulus_scale_and_shift_factor_of_a_series() {
     let input = json!({"layer": {"prony": series_json(1.0)},
                        "series": [{"points": points}],
                        "parameters": {"modulus_scale": {}, "shift_factor": {}}});
-    let response = app.post("/v1/fits", &input).await;
-    assert_eq!(response.status(), 200);
-    let answer: Value = response.json().await.unwrap();
+    let answer = app.answer("/v1/fits", &input).await;
     for (name, expected) in [("modulus_scale", 2.0), ("shift_factor", 10.0)] {
         let value = answer["parameters"][name]["value"].as_f64().unwrap();
         assert!((value / expected - 1.0).abs() < 1e-4, "{name}: {value}");

@@ -37,14 +37,7 @@ async fn the_largest_sweep_the_defaults_allow_is_kept_whole_compact_and_compress
     assert!(per_point <= 700, "{per_point} bytes per point");
     // gzip for a client that accepts it, the same answer, its validator weak.
     let url = job["result_url"].as_str().unwrap();
-    let zipped = app
-        .send(
-            reqwest::Method::GET,
-            url,
-            &[("accept-encoding", "gzip")],
-            None,
-        )
-        .await;
+    let zipped = app.get_with(url, &[("accept-encoding", "gzip")]).await;
     assert_eq!(zipped.headers()["content-encoding"], "gzip");
     assert_eq!(
         zipped.headers()["etag"].to_str().unwrap(),
@@ -70,9 +63,7 @@ async fn the_largest_sweep_the_defaults_allow_is_kept_whole_compact_and_compress
 async fn a_sweep_answers_every_point_it_can_and_names_the_refused_ones() {
     let app = spawn_app(&[]).await;
     let input = json!({"vary": {"load": ["1 nN", "1 mN"]}});
-    let response = app.post("/v1/sweeps", &input).await;
-    assert_eq!(response.status(), 200);
-    let answer: Value = response.json().await.unwrap();
+    let answer = app.answer("/v1/sweeps", &input).await;
     let points = answer["points"].as_array().unwrap();
     assert_eq!(points[0]["status"], "warn");
     assert!(points[0]["friction_coefficient"].as_f64().unwrap() > 0.0);
@@ -87,12 +78,7 @@ async fn a_sweep_answers_every_point_it_can_and_names_the_refused_ones() {
     assert_eq!(answer["meta"]["counts"]["refused"], 1);
     assert_eq!(answer["meta"]["validity"]["status"], "warn");
     let csv = app
-        .send(
-            reqwest::Method::POST,
-            "/v1/sweeps",
-            &[("accept", "text/csv")],
-            Some(&input),
-        )
+        .post_with("/v1/sweeps", &[("accept", "text/csv")], &input)
         .await
         .text()
         .await
@@ -137,7 +123,7 @@ async fn a_sweep_past_its_deadline_fails_but_keeps_the_points_it_finished() {
     // The CSV lists the missing points too.
     let url = job["result_url"].as_str().unwrap();
     let csv = app
-        .send(reqwest::Method::GET, url, &[("accept", "text/csv")], None)
+        .get_with(url, &[("accept", "text/csv")])
         .await
         .text()
         .await
@@ -197,18 +183,11 @@ async fn results_beyond_the_memory_budget_are_kept_on_disk_and_served_from_there
         .wait_for_job(&location, |j| j["status"] == "succeeded")
         .await;
     let answer = app.result(&view).await;
-    let whole: Value = app
-        .post("/v1/sweeps", &job["input"])
-        .await
-        .json()
-        .await
-        .unwrap();
+    let whole: Value = app.post_json("/v1/sweeps", &job["input"]).await;
     assert_eq!(answer, whole);
     let url = view["result_url"].as_str().unwrap();
     for (accept, kind) in [("text/csv", "text/csv"), ("image/svg+xml", "image/svg+xml")] {
-        let response = app
-            .send(reqwest::Method::GET, url, &[("accept", accept)], None)
-            .await;
+        let response = app.get_with(url, &[("accept", accept)]).await;
         assert_eq!(response.status(), 200);
         assert!(response.headers()["content-type"]
             .to_str()

@@ -1,7 +1,6 @@
 //! The synchronous endpoints: answers equal the engine's, the cache and its validators.
 
 use futures_util::future::join_all;
-use reqwest::Method;
 use serde_json::{json, Value};
 use thirdbody::engine;
 use thirdbody::job::{Control, FigureJob, Job, Limits};
@@ -41,11 +40,7 @@ async fn rolling_answers_the_model_section_3_reference_row() {
 async fn a_repeated_input_is_a_hit_whatever_its_key_order_and_spacing() {
     let app = spawn_app(&[]).await;
     let first = app
-        .post_raw(
-            "/v1/rolling",
-            "application/json",
-            r#"{"radius": "25 nm", "load": "1 nN"}"#.to_string(),
-        )
+        .post_json_text("/v1/rolling", r#"{"radius": "25 nm", "load": "1 nN"}"#)
         .await;
     assert_eq!(first.headers()["x-cache"], "miss");
     let first = first.text().await.unwrap();
@@ -53,20 +48,14 @@ async fn a_repeated_input_is_a_hit_whatever_its_key_order_and_spacing() {
         r#"{"load":"1 nN","radius":"25 nm"}"#,
         "{ \"radius\" : \"25 nm\",\n \"load\": \"1 nN\" }",
     ] {
-        let again = app
-            .post_raw("/v1/rolling", "application/json", body.to_string())
-            .await;
+        let again = app.post_json_text("/v1/rolling", body).await;
         assert_eq!(again.headers()["x-cache"], "hit", "{body}");
         assert_eq!(again.text().await.unwrap(), first);
     }
     assert_eq!(app.metric("thirdbody_cache_hits_total", &[]).await, 2.0);
     // The same text as another kind is another job.
     let sweep = app
-        .post_raw(
-            "/v1/sweeps",
-            "application/json",
-            r#"{"load":"1 nN","radius":"25 nm"}"#.to_string(),
-        )
+        .post_json_text("/v1/sweeps", r#"{"load":"1 nN","radius":"25 nm"}"#)
         .await;
     assert_eq!(sweep.status(), 422, "a sweep has no field radius");
 }
@@ -128,24 +117,19 @@ async fn the_same_job_again_is_a_cache_hit_whatever_its_units_and_if_none_match_
     assert_eq!(second.text().await.unwrap(), first);
 
     let not_modified = app
-        .send(
-            Method::POST,
+        .post_with(
             "/v1/rolling",
             &[("if-none-match", etag.to_str().unwrap())],
-            Some(&json!({"radius": "25 nm"})),
+            &json!({"radius": "25 nm"}),
         )
         .await;
     assert_eq!(not_modified.status(), 304);
     assert_eq!(not_modified.headers()["etag"], etag);
     assert!(not_modified.bytes().await.unwrap().is_empty());
 
+    let another = [("if-none-match", "\"another\"")];
     let other = app
-        .send(
-            Method::POST,
-            "/v1/rolling",
-            &[("if-none-match", "\"another\"")],
-            Some(&json!({"radius": "26 nm"})),
-        )
+        .post_with("/v1/rolling", &another, &json!({"radius": "26 nm"}))
         .await;
     assert_eq!(other.status(), 200);
     assert_eq!(app.metric("thirdbody_cache_hits_total", &[]).await, 2.0);
@@ -187,12 +171,7 @@ async fn a_sweep_answers_json_or_csv_with_one_row_per_point() {
     );
 
     let csv = app
-        .send(
-            Method::POST,
-            "/v1/sweeps",
-            &[("accept", "text/csv")],
-            Some(input),
-        )
+        .post_with("/v1/sweeps", &[("accept", "text/csv")], input)
         .await;
     assert_eq!(csv.status(), 200);
     assert!(csv.headers()["content-type"]
@@ -216,12 +195,7 @@ async fn a_figure_answers_json_or_csv() {
     assert_eq!(body, engine_answer(Job::new(FigureJob::new(6).unwrap())));
 
     let csv = app
-        .send(
-            Method::GET,
-            "/v1/figures/3",
-            &[("accept", "text/csv")],
-            None,
-        )
+        .get_with("/v1/figures/3", &[("accept", "text/csv")])
         .await;
     assert_eq!(csv.status(), 200);
     let text = csv.text().await.unwrap();

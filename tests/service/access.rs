@@ -11,7 +11,7 @@ use crate::fleet::{
     answering, finished, free_port, fresh_redis, get_json, heavy_sweep, metric_in,
     redis_server_available, redis_with, start, submit, taken_by, text_of, Process,
 };
-use crate::processes::{logs_near, spawn_logged, thirdbody, PATIENCE};
+use crate::processes::{logs_near, scratch, spawn_logged, thirdbody, PATIENCE};
 
 /// `thirdbody new-key` with `args`: the key and its entry.
 fn new_key(args: &[&str]) -> (String, Value) {
@@ -94,8 +94,7 @@ fn new_key_refuses_what_the_service_would_refuse() {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn keys_are_added_rotated_and_revoked_without_a_restart() {
-    let dir = std::env::temp_dir().join(format!("thirdbody-keys-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = scratch("keys");
     let file = dir.join("keys.json");
     let (old, old_entry) = new_key(&["--name", "lab-a"]);
     let (ops, ops_entry) = new_key(&["--name", "ops", "--scopes", "admin"]);

@@ -6,6 +6,8 @@ use std::process::{Command, Output, Stdio};
 
 use serde_json::Value;
 
+use crate::processes::scratch;
+
 fn thirdbody(args: &[&str], stdin: Option<&str>) -> Output {
     let mut child = crate::processes::thirdbody()
         .args(args)
@@ -578,14 +580,6 @@ fn every_output_parses_with_its_provenance() {
             .collect();
         assert_eq!(comments, [format!(" {line} ")], "{svg}");
     }
-}
-
-/// A fresh directory for files a test writes.
-fn scratch(name: &str) -> std::path::PathBuf {
-    let dir = std::env::temp_dir().join(format!("thirdbody-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
 }
 
 #[test]

@@ -259,6 +259,14 @@ fn system_friction(layer: &Layer, total_load: f64, speed: f64) -> f64 {
     point.value(layer, Law::Local, Stop::NEVER).unwrap()
 }
 
+/// A series' points against speed: at each of `speeds` (nm/s), the value `at` gives there.
+pub(crate) fn against_speed(speeds: &[f64], at: impl Fn(f64) -> f64) -> Vec<Value> {
+    speeds
+        .iter()
+        .map(|&v| json!({"velocity": format!("{v} nm/s"), "value": at(v)}))
+        .collect()
+}
+
 #[test]
 fn a_three_body_series_gives_back_the_layer_its_friction_came_from() {
     // The system's friction coefficient against speed at two total loads (docs/model.md §4
@@ -267,10 +275,8 @@ fn a_three_body_series_gives_back_the_layer_its_friction_came_from() {
     let series: Vec<Value> = [0.5, 1.0]
         .iter()
         .map(|&w| {
-            let points: Vec<Value> = [0.0, 1.0, 2.0, 4.0, 8.0, 16.0]
-                .iter()
-                .map(|&v| json!({"velocity": format!("{v} nm/s"), "value": system_friction(&truth, w, v)}))
-                .collect();
+            let speeds = [0.0, 1.0, 2.0, 4.0, 8.0, 16.0];
+            let points = against_speed(&speeds, |v| system_friction(&truth, w, v));
             json!({"system": {}, "total_load": format!("{w} mN"), "points": points})
         })
         .collect();

@@ -9,7 +9,7 @@ use serde_json::{json, Value};
 use thirdbody::model::fit::{Law, Measured, Point, Setting};
 use thirdbody::model::{Layer, Stop};
 
-use crate::fit::{fit, value, Noise};
+use crate::fit::{against_speed, fit, value, Noise};
 
 /// A layer 5 nm thick: contacts of 2–6 nm radius at these loads, as wide as it is thick.
 fn thin() -> Layer {
@@ -134,13 +134,7 @@ fn the_truth_lies_in_the_95_percent_interval_90_to_99_percent_of_the_time_on_the
 #[test]
 fn noiseless_rolling_friction_gives_back_the_relaxation_time_on_the_continuum() {
     let truth = Layer::default();
-    let points: Vec<Value> = [2.0, 8.0]
-        .iter()
-        .map(|&speed| {
-            let value = friction(&truth, 25.0, 1.0, speed);
-            json!({"velocity": format!("{speed} nm/s"), "value": value})
-        })
-        .collect();
+    let points = against_speed(&[2.0, 8.0], |speed| friction(&truth, 25.0, 1.0, speed));
     let answer = fit(json!({
         "layer": {"model": "continuum", "relaxation_time": "60 ms"},
         "series": [{"radius": "25 nm", "load": "1 nN", "points": points}],

@@ -41,9 +41,16 @@ pub(crate) fn redis_with(port: u16, args: &[&str]) -> Process {
         .stdout(Stdio::null())
         .spawn()
         .expect("redis-server starts");
-    let mut redis = Process(child);
+    redis_when_up(Process(child), port, || {
+        std::net::TcpStream::connect(("127.0.0.1", port)).is_ok()
+    })
+}
+
+/// The redis-server `redis` on `port`, once `up` says it answers; fails if it exits first
+/// or is not up within [`PATIENCE`].
+pub(crate) fn redis_when_up(mut redis: Process, port: u16, up: impl Fn() -> bool) -> Process {
     let start = Instant::now();
-    while std::net::TcpStream::connect(("127.0.0.1", port)).is_err() {
+    while !up() {
         if let Some(status) = redis.0.try_wait().unwrap() {
             panic!("redis-server on port {port} exited: {status}");
         }
@@ -268,6 +275,24 @@ pub(crate) fn heavy_sweep() -> Value {
         "vary": {"load": loads, "velocity": speeds}}})
 }
 
+/// Submits a rolling job at `load` to `submit_to` and polls it on `read_from` (the same
+/// service or another of the fleet) until it finished; returns its view.
+pub(crate) async fn rolling_job_finished(
+    http: &reqwest::Client,
+    submit_to: &str,
+    read_from: &str,
+    load: &str,
+) -> Value {
+    let id = submit_rolling(http, submit_to, load).await;
+    finished(http, read_from, &id).await
+}
+
+/// Submits a rolling job at `load` to `base`; returns its id.
+pub(crate) async fn submit_rolling(http: &reqwest::Client, base: &str, load: &str) -> String {
+    let job = json!({"kind": "rolling", "input": {"load": load}});
+    submit(http, base, job).await
+}
+
 pub(crate) async fn submit(http: &reqwest::Client, base: &str, job: Value) -> String {
     let response = post(http, format!("{base}/v1/jobs"), &job).await;
     let status = response.status();
@@ -287,12 +312,7 @@ async fn two_services_and_a_worker_share_answers_jobs_and_sweeps_through_redis()
     let (worker, worker_log) = start("worker", redis_port, None, &[]);
 
     // A job submitted to A is polled and followed on B.
-    let id = submit(
-        &http,
-        &a.base,
-        json!({"kind": "rolling", "input": {"load": "1.5 nN"}}),
-    )
-    .await;
+    let id = submit_rolling(&http, &a.base, "1.5 nN").await;
     let view = finished(&http, &b.base, &id).await;
     assert_eq!(view["status"], "succeeded", "{view}");
     let answer = result(&http, &b.base, &view).await;
@@ -473,13 +493,10 @@ async fn two_services_and_a_worker_share_answers_jobs_and_sweeps_through_redis()
     assert_eq!(on_a.headers()["x-cache"], "miss");
     let on_b = post(&http, format!("{}/v1/rolling", b.base), &body).await;
     assert_eq!(on_b.headers()["x-cache"], "hit");
-    let id = submit(
-        &http,
-        &b.base,
-        json!({"kind": "rolling", "input": {"load": "2.5 nN"}}),
-    )
-    .await;
-    assert_eq!(finished(&http, &a.base, &id).await["status"], "succeeded");
+    assert_eq!(
+        rolling_job_finished(&http, &b.base, &a.base, "2.5 nN").await["status"],
+        "succeeded"
+    );
 }
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]

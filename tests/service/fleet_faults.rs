@@ -10,10 +10,10 @@ use serde_json::{json, Value};
 
 use super::fleet::{
     answering, finished, free_port, fresh_redis, one_service, post, readyz_until, redis_cli,
-    redis_server_available, redis_with, result, serve, start, start_redis, submit, taken_by,
-    Process,
+    redis_server_available, redis_when_up, redis_with, result, rolling_job_finished, serve, start,
+    start_redis, submit, submit_rolling, taken_by, Process,
 };
-use crate::processes::{logs_near, spawn_logged, thirdbody, PATIENCE};
+use crate::processes::{logs_near, scratch, spawn_logged, thirdbody, PATIENCE};
 
 fn reasons(ready: &Value) -> String {
     ready["reasons"].to_string()
@@ -76,13 +76,10 @@ async fn a_full_cache_never_fails_a_job_and_a_full_job_store_is_told_truly() {
     // Room again: ready within a second or two, and jobs are taken.
     redis_cli(port, &["CONFIG", "SET", "maxmemory", "0"]);
     readyz_until(&http, &a.base, |r| r["status"] == "ready").await;
-    let id = submit(
-        &http,
-        &a.base,
-        json!({"kind": "rolling", "input": {"load": "3.5 nN"}}),
-    )
-    .await;
-    assert_eq!(finished(&http, &a.base, &id).await["status"], "succeeded");
+    assert_eq!(
+        rolling_job_finished(&http, &a.base, &a.base, "3.5 nN").await["status"],
+        "succeeded"
+    );
 }
 
 /// On a 32 MB server holding both roles, the answers take at most half of it whatever
@@ -192,19 +189,9 @@ fn start_persisted_redis(port: u16, dir: &std::path::Path) -> Process {
         .stdout(Stdio::null())
         .spawn()
         .expect("redis-server starts");
-    let mut redis = Process(child);
-    let start = Instant::now();
-    while redis_cli(port, &["PING"]).trim() != "PONG" {
-        if let Some(status) = redis.0.try_wait().unwrap() {
-            panic!("redis-server on port {port} exited: {status}");
-        }
-        assert!(
-            start.elapsed() < PATIENCE,
-            "redis-server did not start on port {port} in {PATIENCE:?}"
-        );
-        std::thread::sleep(Duration::from_millis(20));
-    }
-    redis
+    redis_when_up(Process(child), port, || {
+        redis_cli(port, &["PING"]).trim() == "PONG"
+    })
 }
 
 /// Polls `url` (for up to [`PATIENCE`]: the links are checked every half second) until it
@@ -238,18 +225,12 @@ async fn jobs_outlive_a_restart_of_a_persisted_store_and_are_told_lost_with_one_
         eprintln!("SKIPPED: redis-server is not on PATH (`.ci/run` installs it)");
         return;
     }
-    let dir = std::env::temp_dir().join(format!("thirdbody-aof-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = scratch("aof");
     let port = free_port();
     let redis = start_persisted_redis(port, &dir);
     let http = reqwest::Client::new();
     let a = serve(port, &http, &[]).await;
-    let id = submit(
-        &http,
-        &a.base,
-        json!({"kind": "rolling", "input": {"load": "1.1 nN"}}),
-    )
-    .await;
+    let id = submit_rolling(&http, &a.base, "1.1 nN").await;
     let view = finished(&http, &a.base, &id).await;
     let before = result(&http, &a.base, &view).await;
 
@@ -338,13 +319,10 @@ async fn a_slow_redis_sends_synchronous_solves_to_the_process_and_readyz_says_wh
         );
     }
     // Jobs still go through the slow store, and end.
-    let id = submit(
-        &http,
-        &a.base,
-        json!({"kind": "rolling", "input": {"load": "2.9 nN"}}),
-    )
-    .await;
-    assert_eq!(finished(&http, &a.base, &id).await["status"], "succeeded");
+    assert_eq!(
+        rolling_job_finished(&http, &a.base, &a.base, "2.9 nN").await["status"],
+        "succeeded"
+    );
 }
 
 /// A sweep on the layer as a continuum: 240 points of ~25 ms, in parts of 20 points.

@@ -3,7 +3,6 @@
 //! database of a single `thirdbody serve`, and in Redis for a fleet.
 
 use std::path::PathBuf;
-use std::process::Command;
 use std::time::{Duration, Instant};
 
 use reqwest::{Client, StatusCode};
@@ -13,6 +12,7 @@ use crate::fleet::{
     answering, finished, free_port, fresh_redis, get_json, redis_cli, serve, Process,
 };
 use crate::fleet_faults::long_sweep;
+use crate::json::field_of_each;
 use crate::processes::{logs_near, spawn_logged, thirdbody, PATIENCE};
 
 const OWNER: &str = "owner-token-of-the-test-0001";
@@ -75,18 +75,18 @@ async fn list(http: &Client, base: &str, path: &str, owner: Option<&str>) -> (St
 
 /// The ids of a page of jobs, in its order.
 fn ids(page: &Value) -> Vec<&str> {
-    page["jobs"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|job| job["id"].as_str().unwrap())
-        .collect()
+    field_of_each(&page["jobs"], "id")
 }
 
 /// The body of `GET url` (as `accept`).
 async fn body(http: &Client, url: String, accept: &str) -> (StatusCode, String) {
     let response = http.get(url).header("accept", accept).send().await.unwrap();
     (response.status(), response.text().await.unwrap())
+}
+
+/// The status and text of job `id`'s view on `base`, asked for as JSON.
+async fn job_view(http: &Client, base: &str, id: &str) -> (StatusCode, String) {
+    body(http, format!("{base}/v1/jobs/{id}"), "application/json").await
 }
 
 fn sweep(loads: &[&str]) -> Value {
@@ -100,12 +100,7 @@ fn rolling(radius: &str) -> Value {
 
 /// Sends SIGTERM to `process` and waits (at most `bound`) for it to exit; its exit code.
 fn terminate(process: &mut Process, bound: Duration) -> Option<i32> {
-    let pid = process.0.id().to_string();
-    assert!(Command::new("kill")
-        .args(["-TERM", &pid])
-        .status()
-        .unwrap()
-        .success());
+    process.sigterm();
     let start = Instant::now();
     loop {
         if let Some(status) = process.0.try_wait().unwrap() {
@@ -275,12 +270,7 @@ async fn saved_analyses_outlive_a_restart_of_the_embedded_database() {
     assert_eq!(deleted.status(), StatusCode::OK);
     let (_, page) = list(&http, &base, "/v1/jobs", Some(OWNER)).await;
     assert_eq!(ids(&page), [long_id.as_str(), rolled_id]);
-    let gone = body(
-        &http,
-        format!("{base}/v1/jobs/{swept_id}"),
-        "application/json",
-    )
-    .await;
+    let gone = job_view(&http, &base, swept_id).await;
     assert_eq!(gone.0, StatusCode::NOT_FOUND, "{}", gone.1);
     assert!(gone.1.contains("deleted, or it expired"), "{}", gone.1);
     assert_eq!(
@@ -335,7 +325,7 @@ async fn the_embedded_history_forgets_jobs_past_its_retention() {
     tokio::time::sleep(past).await;
     let (_, page) = list(&http, &base, "/v1/jobs", Some(OWNER)).await;
     assert_eq!(page["total"], 0, "{page}");
-    let gone = body(&http, format!("{base}/v1/jobs/{id}"), "application/json").await;
+    let gone = job_view(&http, &base, id).await;
     assert_eq!(gone.0, StatusCode::NOT_FOUND, "{}", gone.1);
 }
 
@@ -420,11 +410,6 @@ async fn a_fleets_history_outlives_its_processes_and_expires_in_redis() {
     tokio::time::sleep(Duration::from_millis(6500)).await;
     let (_, page) = list(&http, base, "/v1/jobs", Some(OWNER)).await;
     assert_eq!(page["total"], 0, "{page}");
-    let gone = body(
-        &http,
-        format!("{base}/v1/jobs/{kept_id}"),
-        "application/json",
-    )
-    .await;
+    let gone = job_view(&http, base, kept_id).await;
     assert_eq!(gone.0, StatusCode::NOT_FOUND, "{}", gone.1);
 }

@@ -14,6 +14,8 @@ mod fleet_faults;
 mod history;
 mod honest_answers;
 mod jobs;
+#[path = "../shared/json.rs"]
+mod json;
 mod kinds;
 mod pictures;
 mod processes;

@@ -22,8 +22,29 @@ pub(crate) const PATIENCE: Duration = Duration::from_secs(120);
 /// for however long it takes; its own deadline still ends it.
 pub(crate) const STALL: Duration = Duration::from_secs(180);
 
+/// A fresh directory for files a test writes: `thirdbody-{name}-{pid}` in the system's
+/// temporary directory, emptied of what an earlier run left.
+pub(crate) fn scratch(name: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("thirdbody-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
 /// A child process, killed when dropped.
 pub(crate) struct Process(pub Child);
+
+impl Process {
+    /// Sends SIGTERM (the signal that starts a drain), checking that `kill` delivered it.
+    pub(crate) fn sigterm(&self) {
+        let pid = self.0.id().to_string();
+        assert!(Command::new("kill")
+            .args(["-TERM", &pid])
+            .status()
+            .unwrap()
+            .success());
+    }
+}
 
 impl Drop for Process {
     fn drop(&mut self) {

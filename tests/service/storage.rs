@@ -12,7 +12,7 @@ use reqwest::{Client, StatusCode};
 use serde_json::{json, Value};
 
 use crate::fleet::{answering, free_port};
-use crate::processes::{thirdbody, Process};
+use crate::processes::{scratch, thirdbody, Process};
 
 /// A tmpfs of `size` mounted at a directory of the test's own; unmounted when dropped.
 struct SmallDisk(PathBuf);
@@ -105,12 +105,7 @@ async fn finished(http: &Client, base: &str, id: &str) -> Value {
 
 /// Stops `process` by SIGTERM, waiting for its drain.
 fn terminate(process: &mut Process) {
-    let pid = process.0.id().to_string();
-    assert!(Command::new("kill")
-        .args(["-TERM", &pid])
-        .status()
-        .unwrap()
-        .success());
+    process.sigterm();
     let status = process.0.wait().unwrap();
     assert!(status.success(), "{status}");
 }
@@ -186,8 +181,7 @@ async fn a_full_disk_refuses_jobs_rather_than_lose_them() {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn a_database_removed_while_running_degrades_readiness_and_refuses_jobs() {
-    let dir = std::env::temp_dir().join(format!("thirdbody-removed-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = scratch("removed");
     let database = dir.join("analyses.db");
     let http = Client::new();
     let (_server, base) = serve(&http, &database).await;
@@ -208,8 +202,7 @@ async fn a_database_removed_while_running_degrades_readiness_and_refuses_jobs() 
 
 #[test]
 fn a_damaged_database_is_refused_at_start_saying_how_to_go_on() {
-    let dir = std::env::temp_dir().join(format!("thirdbody-damaged-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = scratch("damaged");
     let database = dir.join("analyses.db");
     // 4 KiB of bytes that are no database.
     let noise: Vec<u8> = (0..4096u32)
@@ -233,8 +226,7 @@ fn a_damaged_database_is_refused_at_start_saying_how_to_go_on() {
 /// process to give: the drain does not wait out its timeout for its client (it did).
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn the_drain_does_not_wait_for_unread_jobs_the_database_keeps() {
-    let dir = std::env::temp_dir().join(format!("thirdbody-unread-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = scratch("unread");
     let database = dir.join("analyses.db");
     let http = Client::new();
     let port = free_port();
@@ -255,13 +247,8 @@ async fn the_drain_does_not_wait_for_unread_jobs_the_database_keeps() {
     // Finished, as the log of its end shows to a reader of the database after a restart;
     // not read by its client here.
     let start = Instant::now();
-    let pid = server.0.id().to_string();
     tokio::time::sleep(Duration::from_millis(200)).await;
-    assert!(Command::new("kill")
-        .args(["-TERM", &pid])
-        .status()
-        .unwrap()
-        .success());
+    server.sigterm();
     let exited = loop {
         if let Some(status) = server.0.try_wait().unwrap() {
             break status;

@@ -5,7 +5,7 @@ use proptest::prelude::*;
 use serde_json::{json, Value};
 use thirdbody::engine;
 use thirdbody::job::sweep::SweepOutput;
-use thirdbody::job::sweep::SweepPoints;
+use thirdbody::job::sweep::{SweepPoints, ThreeBodySweepPoint};
 use thirdbody::job::three_body::ThreeBodyOutput;
 use thirdbody::job::{Control, Job, JobError, Limits};
 use thirdbody::model::limits::relaxed;
@@ -323,15 +323,10 @@ fn where_the_asperities_carry_the_load_alone_the_system_is_answered_with_a_warni
 
 #[test]
 fn a_three_body_sweep_across_the_asperity_only_regime_answers_every_point() {
-    let out: SweepOutput = run(json!({"kind": "sweep", "input": {"kind": "three_body",
+    let out = three_body_sweep(json!({"kind": "sweep", "input": {"kind": "three_body",
         "base": {"asperities": tall_asperities()},
-        "vary": {"separation": ["40 nm", "60 nm", "70 nm", "80 nm"]}}}))
-    .unwrap()
-    .downcast()
-    .unwrap();
-    let SweepPoints::ThreeBody(points) = &out.points else {
-        panic!()
-    };
+        "vary": {"separation": ["40 nm", "60 nm", "70 nm", "80 nm"]}}}));
+    let points = three_body_rows(&out);
     assert_eq!(points.len(), 4);
     // 40 nm squeezes the largest particle beyond the model: that point alone is refused.
     let mut reason = String::new();
@@ -349,6 +344,19 @@ fn a_three_body_sweep_across_the_asperity_only_regime_answers_every_point() {
 fn run(value: Value) -> Result<Answer, JobError> {
     let job = Job::from_value(value, &Limits::default())?;
     engine::run(&job, &Control::default())
+}
+
+/// The answer of the three-body sweep job `value`.
+fn three_body_sweep(value: Value) -> SweepOutput {
+    run(value).unwrap().downcast().unwrap()
+}
+
+/// The rows of a three-body sweep's answer.
+fn three_body_rows(out: &SweepOutput) -> &[ThreeBodySweepPoint] {
+    let SweepPoints::ThreeBody(points) = &out.points else {
+        panic!("not a three-body sweep")
+    };
+    points
 }
 
 #[test]
@@ -462,15 +470,10 @@ fn bad_three_body_input_gets_clear_errors() {
 
 #[test]
 fn three_body_sweeps_vary_the_operating_point_speed_and_mean_diameter() {
-    let out: SweepOutput = run(json!({"kind": "sweep", "input": {
+    let out = three_body_sweep(json!({"kind": "sweep", "input": {
         "kind": "three_body",
-        "vary": {"total_load": ["0.1 mN", "1 mN"], "velocity": [0, "4 nm/s"], "mean_diameter": ["40 nm", "50 nm"]}}}))
-    .unwrap()
-    .downcast()
-    .unwrap();
-    let SweepPoints::ThreeBody(points) = &out.points else {
-        panic!()
-    };
+        "vary": {"total_load": ["0.1 mN", "1 mN"], "velocity": [0, "4 nm/s"], "mean_diameter": ["40 nm", "50 nm"]}}}));
+    let points = three_body_rows(&out);
     assert_eq!(points.len(), 8);
     let first = &points[0];
     assert_eq!(first.operating, json!({"total_load": 1e-4}));

@@ -608,17 +608,9 @@ fn answers_across_speed_and_viscosity_are_within_their_bounds() {
 /// lateral tips (width ≈ V T_σ in b) no longer escapes the rule and its companion alike.
 #[test]
 fn every_rule_bounds_its_own_error_in_slow_rolling() {
-    let rules = [
-        Quadrature::Gauss { nodes: 4 },
-        Quadrature::Gauss { nodes: 16 },
-        Quadrature::Gauss { nodes: 32 },
-        Quadrature::Gauss { nodes: 128 },
-        Quadrature::Gauss { nodes: 1024 },
-        Quadrature::Midpoint { strips: 40 },
-        Quadrature::Midpoint { strips: 1000 },
-    ];
+    let rules = crate::rules(&[4, 16, 32, 128, 1024], &[40, 1000]);
     for r in SLOW.iter().chain(&SMALL_KAPPA) {
-        for rule in rules {
+        for &rule in &rules {
             let s = model::solve(&rolling(r), &SolveOptions::integrals_only(rule)).unwrap();
             let bound = s.verification.quadrature_error_estimate;
             for (name, error) in QUANTITIES.iter().zip(errors(&s, r)) {

@@ -33,25 +33,14 @@ fn relative(q: f64, reference: f64) -> f64 {
 #[test]
 fn the_quadrature_error_estimate_bounds_the_error_of_every_quantity_for_every_rule() {
     let reference_rule = Quadrature::Gauss { nodes: 1024 };
-    let rules = [
-        Quadrature::Gauss { nodes: 2 },
-        Quadrature::Gauss { nodes: 3 },
-        Quadrature::Gauss { nodes: 4 },
-        Quadrature::Gauss { nodes: 8 },
-        Quadrature::Gauss { nodes: 16 },
-        Quadrature::Gauss { nodes: 64 },
-        Quadrature::Midpoint { strips: 1 },
-        Quadrature::Midpoint { strips: 2 },
-        Quadrature::Midpoint { strips: 5 },
-        Quadrature::Midpoint { strips: 40 },
-    ];
+    let rules = crate::rules(&[2, 3, 4, 8, 16, 64], &[1, 2, 5, 40]);
     let mut worst_ratio: f64 = 0.0;
     for (radius, load) in [(25e-9, 1e-9), (350e-9, 1.4e-9)] {
         for velocity in [0.0, 2e-9, 4e-9, 1e-8, 1e-6] {
             for kappa in [0.01, 4.0, 1e4] {
                 let contact = at(radius, load, velocity, kappa);
                 let truth = solved(&contact, reference_rule);
-                for rule in rules {
+                for &rule in &rules {
                     let s = solved(&contact, rule);
                     let estimate = s.verification.quadrature_error_estimate;
                     for (name, q, t) in [
@@ -83,10 +72,7 @@ fn the_quadrature_error_estimate_bounds_the_error_of_every_quantity_for_every_ru
 #[test]
 fn tiny_rules_do_not_claim_to_be_exact() {
     let contact = Rolling::default();
-    for rule in [
-        Quadrature::Gauss { nodes: 2 },
-        Quadrature::Midpoint { strips: 1 },
-    ] {
+    for rule in crate::rules(&[2], &[1]) {
         let estimate = solved(&contact, rule)
             .verification
             .quadrature_error_estimate;

@@ -34,6 +34,14 @@ fn material() -> Layer {
     series(3e9, (2.0, 0.01), &[(1.5, 0.1), (1.0, 1.0), (0.5, 10.0)])
 }
 
+/// A series whose second term (of strength `k2`) is `slower` times slower than its first
+/// (`k1`, `t1`), and the one-term layer it should act as: that term a spring in parallel.
+fn slow_term_and_its_spring(e: f64, (k1, t1): (f64, f64), k2: f64, slower: f64) -> (Layer, Layer) {
+    let stiff = series(e, (k1, t1), &[(k2, t1 * slower)]);
+    let spring = series(e * (1.0 + k2), (k1 / (1.0 + k2), t1), &[]);
+    (stiff, spring)
+}
+
 fn rolling(velocity: f64, layer: Layer) -> Rolling {
     Rolling {
         velocity,
@@ -98,8 +106,7 @@ fn scaling_every_time_is_scaling_the_speed() {
 fn terms_far_from_the_contact_time_are_springs_or_nothing() {
     let (e, k1, t1, k2) = (3e9, 2.0, 0.1, 1.5);
     let v = 4e-9;
-    let stiff = series(e, (k1, t1), &[(k2, t1 * 1e9)]);
-    let spring = series(e * (1.0 + k2), (k1 / (1.0 + k2), t1), &[]);
+    let (stiff, spring) = slow_term_and_its_spring(e, (k1, t1), k2, 1e9);
     assert_same(&local(v, stiff), &local(v, spring), 1e-6, "slow arm");
     let relaxed_arm = series(e, (k1, t1), &[(k2, t1 * 1e-9)]);
     assert_same(
@@ -149,8 +156,7 @@ fn the_area_falls_with_speed_across_the_series() {
 fn on_the_continuum_a_far_slow_term_is_a_spring() {
     let (e, k1, t1, k2) = (3e9, 4.0, 0.1, 1.0);
     let v = 4e-9;
-    let stiff = series(e, (k1, t1), &[(k2, t1 * 1e6)]);
-    let spring = series(e * (1.0 + k2), (k1 / (1.0 + k2), t1), &[]);
+    let (stiff, spring) = slow_term_and_its_spring(e, (k1, t1), k2, 1e6);
     let options = SolveOptions::default();
     let a = continuum::solve(&rolling(v, stiff), &options, Stop::NEVER).unwrap();
     let b = continuum::solve(&rolling(v, spring), &options, Stop::NEVER).unwrap();

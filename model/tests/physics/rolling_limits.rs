@@ -722,13 +722,7 @@ fn invalid_parameters_are_errors_not_panics() {
 #[test]
 fn invalid_options_are_errors_not_panics() {
     let good = Rolling::default();
-    for quadrature in [
-        Quadrature::Gauss { nodes: 0 },
-        Quadrature::Gauss { nodes: 1 },
-        Quadrature::Gauss { nodes: 1025 },
-        Quadrature::Midpoint { strips: 0 },
-        Quadrature::Midpoint { strips: 100_001 },
-    ] {
+    for quadrature in crate::rules(&[0, 1, 1025], &[0, 100_001]) {
         match solve_without_panic(&good, &options(quadrature)) {
             Err(ModelError::InvalidOption(e)) => {
                 assert_eq!(e.option, SolveOption::Strips, "{quadrature:?}");
