@@ -4,6 +4,7 @@
 //! ids, the drain, the fleet's stream). The engine admits or refuses new work (and counts
 //! refusals) and hands each call to its part.
 
+use std::collections::HashSet;
 use std::future::Future;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -24,6 +25,9 @@ use super::solver::{CacheStatus, CacheUse, Solver};
 use super::storage::Storage;
 use super::store::{JobRecord, JobStatus, Listing, Owner, Page};
 use crate::job::Keyed;
+
+/// The unfinished jobs of one tenant counted at most: far more than any quota of them.
+const UNFINISHED_COUNTED: usize = 10_000;
 
 /// The compute service: the solve path and the asynchronous jobs.
 pub struct Engine {
@@ -94,18 +98,21 @@ impl Engine {
 
     /// The jobs of `owner` not finished yet (queued or running), as the job store lists them.
     pub async fn unfinished_of(&self, owner: &Owner) -> Result<usize, EngineError> {
-        let mut unfinished = 0;
+        // Two listings, one a status: a job that starts running between them is in both,
+        // and counted once by its id (counted by totals, it was counted twice).
+        let mut unfinished = HashSet::new();
         for status in [JobStatus::Queued, JobStatus::Running] {
             let listing = Listing {
                 owner: owner.clone(),
                 kind: None,
                 status: Some(status),
                 offset: 0,
-                limit: 1,
+                limit: UNFINISHED_COUNTED,
             };
-            unfinished += self.jobs.list(&listing).await?.total;
+            let page = self.jobs.list(&listing).await?;
+            unfinished.extend(page.jobs.iter().map(|job| job.id));
         }
-        Ok(unfinished)
+        Ok(unfinished.len())
     }
 
     pub fn metrics(&self) -> &Metrics {
