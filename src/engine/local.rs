@@ -165,16 +165,26 @@ impl JobStore for LocalJobStore {
     /// memory, marked so, and saved once writes succeed again.
     async fn update(&self, id: Uuid, state: JobState, done: usize) {
         let status = state.status();
-        let updated = self.memory.update(id, state.clone(), done).await;
-        let Some(finished) = updated.finished_at else {
+        if !status.is_finished() {
+            self.memory.update(id, state, done).await;
             // A start not recorded reads as the job queued: it is not lost for that.
             let _ = self
                 .write("record a job's start", move |db| db.set_status(id, status))
                 .await;
             return;
+        }
+        // The end is saved before memory shows it: a client told that the job finished
+        // finds it finished after a restart too (shown first, a kill between the two left
+        // it `interrupted`).
+        // (A job ends once: an end already kept keeps its time.)
+        let now = match self.memory.get(id).await.and_then(|job| job.finished_at) {
+            Some(ended) => ended,
+            None => SystemTime::now(),
         };
         let result = state.result().cloned();
-        match self.save_end(id, state, done, finished).await {
+        let saved = self.save_end(id, state.clone(), done, now).await;
+        let updated = self.memory.update_at(id, state, done, now).await;
+        match saved {
             Ok(()) => {
                 // A result beyond the memory budget is read from the database from now on.
                 if let Some(result) = result.filter(|_| updated.place == Place::Database) {

@@ -225,6 +225,17 @@ impl MemoryJobStore {
     /// forgot the job), and where room was made for its result (the database: the caller
     /// moves it there, [`MemoryJobStore::store_result`], once saved).
     pub async fn update(&self, id: Uuid, state: JobState, done: usize) -> Updated {
+        self.update_at(id, state, done, SystemTime::now()).await
+    }
+
+    /// [`MemoryJobStore::update`], a job finishing now taken to have finished at `now`.
+    pub async fn update_at(
+        &self,
+        id: Uuid,
+        state: JobState,
+        done: usize,
+        now: SystemTime,
+    ) -> Updated {
         let finishing = state.status().is_finished();
         let mut records = self.records();
         // The room made for the result, taken once: by the update that finishes the job.
@@ -243,12 +254,12 @@ impl MemoryJobStore {
         }
         let place = reservation.map_or(Place::Memory, |r| r.place);
         let Some(record) = records.jobs.get_mut(&id) else {
-            let finished_at = finishing.then(SystemTime::now);
+            let finished_at = finishing.then_some(now);
             return Updated { finished_at, place };
         };
         let finished = finishing && record.finished_at.is_none();
         if finished {
-            record.finished_at = Some(SystemTime::now());
+            record.finished_at = Some(now);
         }
         record.state = state;
         record.done = done;
