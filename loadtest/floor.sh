@@ -13,14 +13,11 @@
 # loadtest/instructions.sh for a steady ruler.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+source loadtest/lib.sh
 ROUNDS="$1"
 shift
 PORT=18081
 BASE="http://127.0.0.1:$PORT"
-
-ticks() {
-  sed 's/.*) //' "/proc/$1/stat" | awk '{print $12 + $13}'
-}
 
 # "RATE CPU_US" of a 5 s run of wrk with the arguments, against the server $1.
 run() {
@@ -37,10 +34,7 @@ for _ in $(seq "$ROUNDS"); do
   for binary in "$@"; do
     RUST_LOG=warn "$binary" serve --bind "127.0.0.1:$PORT" --database :memory: 2>/dev/null &
     server=$!
-    for _ in $(seq 100); do
-      curl -sf "$BASE/healthz" >/dev/null && break
-      sleep 0.1
-    done
+    wait_ready "$BASE"
     curl -sf -X POST -H 'content-type: application/json' -d '{}' "$BASE/v1/rolling" >/dev/null
     read -r health_rate health_cpu <<<"$(run "$server" -s loadtest/summary.lua "$BASE/healthz")"
     read -r cached_rate cached_cpu <<<"$(run "$server" -s loadtest/post.lua "$BASE/v1/rolling")"

@@ -16,6 +16,7 @@
 # that the real CPU spends ~1,000 on.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+source loadtest/lib.sh
 MODE="$1"
 N="$2"
 shift 2
@@ -46,10 +47,7 @@ total() {
   RUST_LOG=warn valgrind --tool=callgrind --callgrind-out-file="$out" \
     "$binary" serve --bind "127.0.0.1:$port" --database :memory: >/dev/null 2>&1 &
   local server=$!
-  for _ in $(seq 300); do
-    curl -sf "http://127.0.0.1:$port/healthz" >/dev/null && break
-    sleep 0.2
-  done
+  wait_ready "http://127.0.0.1:$port" 300 0.2
   drive "$port" 300 7000000
   drive "$port" "$count" 0
   kill -TERM "$server"

@@ -13,6 +13,7 @@
 # read the CPU per request, which the load generator sharing the cores moves less.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+source loadtest/lib.sh
 ROUNDS="${1:-4}"
 shift || true
 BINARIES=("$@")
@@ -27,12 +28,6 @@ rate() {
   wrk -t1 -c16 -d5s "$@" | awk '/^RESULT/ {print $2}'
 }
 
-# The CPU time (clock ticks, user + system) process $1 has used (the fields after the
-# process's name, which may hold spaces).
-ticks() {
-  sed 's/.*) //' "/proc/$1/stat" | awk '{print $12 + $13}'
-}
-
 # µs of CPU per request: ticks $1 over a 5 s run at $2 requests/s ("n/a" if none answered).
 per_request() {
   awk -v t="$1" -v r="$2" -v hz="$(getconf CLK_TCK)" \
@@ -43,10 +38,7 @@ for round in $(seq "$ROUNDS"); do
   for binary in "${BINARIES[@]}"; do
     RUST_LOG=warn "$binary" serve --bind "127.0.0.1:$PORT" 2>/dev/null &
     server=$!
-    for _ in $(seq 100); do
-      curl -sf "$BASE/healthz" >/dev/null && break
-      sleep 0.1
-    done
+    wait_ready "$BASE"
     curl -sf -X POST -H 'content-type: application/json' -d '{}' "$BASE/v1/rolling" >/dev/null
     start=$(ticks "$server")
     cached=$(rate -s loadtest/post.lua "$BASE/v1/rolling")

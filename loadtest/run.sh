@@ -9,6 +9,7 @@
 # (pool size = cores) and RUST_LOG=warn, so that per-request log lines are not measured.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+source loadtest/lib.sh
 DURATION="${1:-10}"
 
 if ! command -v wrk >/dev/null; then
@@ -22,10 +23,7 @@ BASE="http://127.0.0.1:$PORT"
 RUST_LOG=warn target/release/thirdbody serve --bind "127.0.0.1:$PORT" 2>/tmp/thirdbody-loadtest.log &
 SERVER=$!
 trap 'kill "$SERVER" 2>/dev/null || true' EXIT
-for _ in $(seq 100); do
-  curl -sf "$BASE/healthz" >/dev/null && break
-  sleep 0.1
-done
+wait_ready "$BASE"
 
 # One case: prints `| name | connections | ok req/s | all req/s | p50 | p99 | non-2xx |`.
 measure() {

@@ -5,16 +5,15 @@
 #   loadtest/bare/capture.sh [BINARY]     (default target/release/thirdbody)
 set -euo pipefail
 cd "$(dirname "$0")"
+# shellcheck source=loadtest/lib.sh
+source ../lib.sh
 BINARY="${1:-../../target/release/thirdbody}"
 PORT=18090
 BASE="http://127.0.0.1:$PORT"
 RUST_LOG=warn "$BINARY" serve --bind "127.0.0.1:$PORT" --database :memory: 2>/dev/null &
 server=$!
 trap 'kill "$server" 2>/dev/null || true' EXIT
-for _ in $(seq 100); do
-  curl -sf "$BASE/healthz" >/dev/null && break
-  sleep 0.1
-done
+wait_ready "$BASE"
 post() {
   curl -sf -X POST -H 'content-type: application/json' -d '{}' "$@" "$BASE/v1/rolling"
 }
