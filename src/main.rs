@@ -330,13 +330,14 @@ fn worker(args: WorkerArgs) -> ExitCode {
             None => None,
         };
         let engine = state.engine().clone();
-        engine.start_workers(pool_size, false);
+        engine.jobs.start_workers(pool_size, false);
         tracing::info!(workers = pool_size, "taking work from Redis");
         let _served = operations.map(|listener| http::serve_operations(listener, state.clone()));
         let _chores = http::chores(&state);
         Signals::new().next().await;
-        engine.begin_drain();
+        engine.jobs.begin_drain();
         engine
+            .jobs
             .finish_jobs(tokio::time::Instant::now() + timeout)
             .await;
         Ok::<_, String>(())
@@ -401,8 +402,8 @@ fn init_logging(format: LogFormat) {
 /// come back. The second signal exits at once, saying what it abandons.
 async fn shut_down_on(mut signals: Signals, engine: Arc<Engine>, timeout: Duration) {
     signals.next().await;
-    let unfinished = engine.unfinished_jobs() as f64;
-    let unread = engine.unread_jobs() as f64;
+    let unfinished = engine.jobs.unfinished_jobs() as f64;
+    let unread = engine.jobs.unread_jobs() as f64;
     let mut waited = Vec::new();
     if unfinished > 0.0 {
         waited.push(count(unfinished, "unfinished job", "unfinished jobs"));
@@ -425,12 +426,12 @@ async fn shut_down_on(mut signals: Signals, engine: Arc<Engine>, timeout: Durati
     tokio::spawn(async move {
         let status = signals.next().await;
         let mut abandoned = Vec::new();
-        let unfinished = engine.unfinished_jobs() as f64;
+        let unfinished = engine.jobs.unfinished_jobs() as f64;
         if unfinished > 0.0 {
             let jobs = count(unfinished, "unfinished job", "unfinished jobs");
             abandoned.push(format!("{jobs} interrupted"));
         }
-        let unread = engine.unread_jobs() as f64;
+        let unread = engine.jobs.unread_jobs() as f64;
         if unread > 0.0 {
             let results = count(unread, "unread result", "unread results");
             abandoned.push(format!("{results} dropped"));

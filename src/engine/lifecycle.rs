@@ -95,7 +95,7 @@ impl Uncollected {
 }
 
 /// The asynchronous jobs of an engine.
-pub(super) struct Lifecycle {
+pub struct Lifecycle {
     config: EngineConfig,
     solver: Arc<Solver>,
     jobs: Arc<dyn JobStore>,
@@ -159,7 +159,7 @@ impl Lifecycle {
     /// `share_with_requests` (a process that also serves HTTP) they take the job slots, so
     /// that a synchronous request always finds a solver thread. They stop when the drain
     /// begins.
-    pub(super) fn start_workers(&self, loops: usize, share_with_requests: bool) {
+    pub fn start_workers(&self, loops: usize, share_with_requests: bool) {
         let Some(shared) = self.fleet.clone() else {
             return;
         };
@@ -337,7 +337,7 @@ impl Lifecycle {
     }
 
     /// `Unavailable` while the fleet's job store cannot be reached.
-    pub(super) fn store_reachable(&self) -> Result<(), EngineError> {
+    pub fn store_reachable(&self) -> Result<(), EngineError> {
         match &self.fleet {
             Some(shared) if !shared.fleet.jobs.is_up() => {
                 let jobs = &shared.fleet.jobs;
@@ -352,23 +352,23 @@ impl Lifecycle {
     }
 
     /// The jobs no tenant owns that this process runs or queues.
-    pub(super) fn unfinished_anonymous(&self) -> usize {
+    pub fn unfinished_anonymous(&self) -> usize {
         self.live().values().filter(|job| job.anonymous).count()
     }
 
     /// Why the job store cannot keep new jobs now, if it cannot.
-    pub(super) fn store_problem(&self) -> Option<String> {
+    pub fn store_problem(&self) -> Option<String> {
         self.jobs.problem()
     }
 
     /// The reachability of each Redis role, when the engine works in a fleet.
-    pub(super) fn fleet_health(&self) -> Option<[(&'static str, Health); 2]> {
+    pub fn fleet_health(&self) -> Option<[(&'static str, Health); 2]> {
         self.fleet.as_ref().map(|shared| shared.fleet.health())
     }
 
     /// The asynchronous job `id`, unless unknown or expired; a job this process runs has
     /// its progress counted up to now.
-    pub(super) async fn job(&self, id: Uuid) -> Option<JobRecord> {
+    pub async fn job(&self, id: Uuid) -> Option<JobRecord> {
         let mut record = self.jobs.get(id).await?;
         if record.state.status().is_finished() {
             self.collected(id);
@@ -383,7 +383,7 @@ impl Lifecycle {
 
     /// The jobs of `listing`'s owner, newest first, filtered and paged; a job this process
     /// runs has its progress counted up to now.
-    pub(super) async fn list(&self, listing: &Listing) -> Result<Page, EngineError> {
+    pub async fn list(&self, listing: &Listing) -> Result<Page, EngineError> {
         self.store_reachable()?;
         let mut page = self
             .jobs
@@ -400,10 +400,7 @@ impl Lifecycle {
     }
 
     /// The newest job that succeeded on the input whose hash is `input_hash`.
-    pub(super) async fn with_input(
-        &self,
-        input_hash: &str,
-    ) -> Result<Option<JobRecord>, EngineError> {
+    pub async fn with_input(&self, input_hash: &str) -> Result<Option<JobRecord>, EngineError> {
         self.store_reachable()?;
         self.jobs
             .with_input(input_hash)
@@ -412,7 +409,7 @@ impl Lifecycle {
     }
 
     /// What can be told of a job `id` that the job store does not know.
-    pub(super) async fn unknown(&self, id: Uuid) -> Unknown {
+    pub async fn unknown(&self, id: Uuid) -> Unknown {
         if !ids::is_ours(id) {
             return Unknown::NeverIssued;
         }
@@ -429,13 +426,13 @@ impl Lifecycle {
     }
 
     /// A receiver of the status changes of the job `id`, if this process runs it.
-    pub(super) fn watch(&self, id: Uuid) -> Option<watch::Receiver<JobStatus>> {
+    pub fn watch(&self, id: Uuid) -> Option<watch::Receiver<JobStatus>> {
         self.live().get(&id).map(|live| live.status.subscribe())
     }
 
     /// Cancels the job `id`: a queued job at once, a running one at the solver's next check;
     /// waits a little for it to stop and returns it then. A finished job is left as it is.
-    pub(super) async fn cancel(&self, id: Uuid) -> Option<JobRecord> {
+    pub async fn cancel(&self, id: Uuid) -> Option<JobRecord> {
         let before = self.job(id).await?;
         let live = self.live().get(&id).cloned();
         if live.is_none() && self.jobs.shared() && !before.state.status().is_finished() {
@@ -454,14 +451,14 @@ impl Lifecycle {
 
     /// Cancels the job `id` if it has not finished (see [`Lifecycle::cancel`]) and forgets it;
     /// returns it as it ended.
-    pub(super) async fn delete(&self, id: Uuid) -> Option<JobRecord> {
+    pub async fn delete(&self, id: Uuid) -> Option<JobRecord> {
         let record = self.cancel(id).await?;
         self.jobs.remove(id).await;
         Some(record)
     }
 
     /// Forgets the finished jobs past their retention.
-    pub(super) async fn purge_expired_jobs(&self) -> usize {
+    pub async fn purge_expired_jobs(&self) -> usize {
         self.jobs.purge_expired().await
     }
 
@@ -473,7 +470,7 @@ impl Lifecycle {
     /// only if the store would lose them with the process (in memory, or a database that
     /// cannot be written): a durable store gives them to the next process, and a client that
     /// never comes back made every drain wait its whole timeout.
-    pub(super) fn begin_drain(&self) {
+    pub fn begin_drain(&self) {
         self.draining.cancel();
         let unfinished: Vec<Uuid> = self.live().keys().copied().collect();
         let kept = self.jobs.durable() && self.jobs.problem().is_none();
@@ -502,7 +499,7 @@ impl Lifecycle {
     /// Resolves when every job unfinished at the start of the drain has been read finished
     /// by its client (polled, or followed to its completion event), so that none of their
     /// answers is lost with the process.
-    pub(super) async fn jobs_collected(&self) {
+    pub async fn jobs_collected(&self) {
         /// How often the drain looks.
         const LOOK: Duration = Duration::from_millis(20);
         while !self.owed().is_empty() {
@@ -511,13 +508,13 @@ impl Lifecycle {
     }
 
     /// Asynchronous jobs of this process queued or running: those a drain waits to finish.
-    pub(super) fn unfinished_jobs(&self) -> usize {
+    pub fn unfinished_jobs(&self) -> usize {
         self.live().len()
     }
 
     /// Jobs finished that no client has read yet: those a drain waits for clients to read
     /// (once it has begun, the jobs it owes that are finished; before, every one unread).
-    pub(super) fn unread_jobs(&self) -> usize {
+    pub fn unread_jobs(&self) -> usize {
         if self.is_draining() {
             let live: HashSet<Uuid> = self.live().keys().copied().collect();
             self.owed().iter().filter(|id| !live.contains(id)).count()
@@ -526,7 +523,7 @@ impl Lifecycle {
         }
     }
 
-    pub(super) fn is_draining(&self) -> bool {
+    pub fn is_draining(&self) -> bool {
         self.draining.is_cancelled()
     }
 
@@ -540,7 +537,7 @@ impl Lifecycle {
     /// then is interrupted ([`Lifecycle::interrupt_unfinished_jobs`]) and given a second to stop.
     /// Returns whether every job finished in time.
     /// Whatever the store could not save before is saved then, if it now can.
-    pub(super) async fn finish_jobs(&self, end: tokio::time::Instant) -> bool {
+    pub async fn finish_jobs(&self, end: tokio::time::Instant) -> bool {
         let finished = tokio::time::timeout_at(end, self.jobs_finished())
             .await
             .is_ok();

@@ -9,7 +9,6 @@
 
 pub mod admission;
 pub mod archive;
-mod background;
 mod backlog;
 mod bounded;
 mod budget;
@@ -22,7 +21,7 @@ mod error;
 pub mod fleet;
 pub mod heavy;
 mod ids;
-mod lifecycle;
+pub mod lifecycle;
 mod local;
 mod memo;
 pub mod metrics;

@@ -9,9 +9,6 @@ use std::future::Future;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-use tokio::sync::watch;
-use uuid::Uuid;
-
 use super::admission::{Admissions, Turn};
 use super::archive::ArchiveError;
 use super::cache::Solved;
@@ -23,7 +20,7 @@ use super::metrics::{self as names, Metrics};
 use super::quota::{Charge, Exceeded, PointCounts};
 use super::solver::{CacheStatus, CacheUse, Solver};
 use super::storage::Storage;
-use super::store::{JobRecord, JobStatus, Listing, Owner, Page};
+use super::store::{JobRecord, JobStatus, Listing, Owner};
 use crate::job::Keyed;
 
 /// The unfinished jobs of one tenant counted at most: far more than any quota of them.
@@ -32,8 +29,10 @@ const UNFINISHED_COUNTED: usize = 10_000;
 /// The compute service: the solve path and the asynchronous jobs.
 pub struct Engine {
     solve_deadline: Duration,
-    solver: Arc<Solver>,
-    jobs: Arc<Lifecycle>,
+    /// The solve path: cache, one solve per key, permits, solver threads.
+    pub solver: Arc<Solver>,
+    /// The asynchronous jobs: their records, the drain, the fleet's workers.
+    pub jobs: Arc<Lifecycle>,
     /// The points each tenant asked for in the current minute (its quota's count).
     points: Arc<PointCounts>,
     /// One admission at a time per tenant (its quotas counted, then its job stored).
@@ -79,12 +78,6 @@ impl Engine {
     /// its admissions before, in this process and across a fleet ([`Admissions`]).
     pub async fn turn(&self, tenant: &str) -> Result<Turn, EngineError> {
         self.admissions.turn(tenant, self.fleet.as_ref()).await
-    }
-
-    /// The jobs without a tenant that this process runs or queues (in a fleet, which runs
-    /// jobs on its workers, none).
-    pub fn unfinished_anonymous(&self) -> usize {
-        self.jobs.unfinished_anonymous()
     }
 
     /// Charges `points` of work to `tenant`, unless its points this minute would pass
@@ -202,116 +195,8 @@ impl Engine {
         self.points.refund(charge).await;
     }
 
-    /// Starts `loops` workers on the fleet's stream (none without a fleet). With
-    /// `share_with_requests` (a process that also serves HTTP) they take the job slots, so
-    /// that a synchronous request always finds a solver thread. They stop when the engine
-    /// drains.
-    pub fn start_workers(&self, loops: usize, share_with_requests: bool) {
-        self.jobs.start_workers(loops, share_with_requests)
-    }
-
-    /// `Unavailable` while the fleet's job store cannot be reached.
-    pub fn store_reachable(&self) -> Result<(), EngineError> {
-        self.jobs.store_reachable()
-    }
-
-    /// The reachability of each Redis role, when the engine works in a fleet.
-    pub fn fleet_health(&self) -> Option<[(&'static str, super::fleet::Health); 2]> {
-        self.jobs.fleet_health()
-    }
-
-    /// Why the job store cannot keep new jobs now (a database that cannot be written, or
-    /// was removed), if it cannot.
-    pub fn store_problem(&self) -> Option<String> {
-        self.jobs.store_problem()
-    }
-
-    /// The asynchronous job `id`, unless unknown or expired; a job this process runs has
-    /// its progress counted up to now.
-    pub async fn job(&self, id: Uuid) -> Option<JobRecord> {
-        self.jobs.job(id).await
-    }
-
-    /// The jobs of `listing`'s owner, newest first, filtered and paged.
-    pub async fn list(&self, listing: &Listing) -> Result<Page, EngineError> {
-        self.jobs.list(listing).await
-    }
-
-    /// The newest job that succeeded on the input whose hash is `input_hash`.
-    pub async fn with_input(&self, input_hash: &str) -> Result<Option<JobRecord>, EngineError> {
-        self.jobs.with_input(input_hash).await
-    }
-
-    /// The cached answer whose key (input hash) is `key`, if any.
-    pub async fn cached(&self, key: &str) -> Option<Arc<Solved>> {
-        self.solver.cached(key).await
-    }
-
-    /// What can be told of a job `id` that the job store does not know.
-    pub async fn unknown(&self, id: Uuid) -> super::ids::Unknown {
-        self.jobs.unknown(id).await
-    }
-
-    /// A receiver of the status changes of the job `id`, if this process runs it.
-    pub fn watch(&self, id: Uuid) -> Option<watch::Receiver<JobStatus>> {
-        self.jobs.watch(id)
-    }
-
-    /// Cancels the job `id`: a queued job at once, a running one at the solver's next check;
-    /// waits a little for it to stop and returns it then. A finished job is left as it is.
-    pub async fn cancel(&self, id: Uuid) -> Option<JobRecord> {
-        self.jobs.cancel(id).await
-    }
-
-    /// Cancels the job `id` if it has not finished (see [`Engine::cancel`]) and forgets it;
-    /// returns it as it ended.
-    pub async fn delete(&self, id: Uuid) -> Option<JobRecord> {
-        self.jobs.delete(id).await
-    }
-
-    /// Forgets the finished jobs past their retention.
-    pub async fn purge_expired_jobs(&self) -> usize {
-        self.jobs.purge_expired_jobs().await
-    }
-
-    /// Stops taking work: new solves and jobs are refused. The jobs accepted, queued or
-    /// running, go on; [`Engine::finish_jobs`] waits for them to finish and
-    /// [`Engine::jobs_collected`] for their clients to read them.
-    pub fn begin_drain(&self) {
-        self.jobs.begin_drain()
-    }
-
-    pub fn is_draining(&self) -> bool {
-        self.jobs.is_draining()
-    }
-
-    /// Resolves when every job unfinished at the start of the drain has been read finished
-    /// by its client (polled, or followed to its completion event), so that none of their
-    /// answers is lost with the process.
-    pub async fn jobs_collected(&self) {
-        self.jobs.jobs_collected().await
-    }
-
-    /// Asynchronous jobs of this process queued or running: those a drain waits to finish.
-    pub fn unfinished_jobs(&self) -> usize {
-        self.jobs.unfinished_jobs()
-    }
-
-    /// Jobs finished that no client has read yet: those a drain waits for clients to read
-    /// (once it has begun, the jobs it owes that are finished; before, every one unread).
-    pub fn unread_jobs(&self) -> usize {
-        self.jobs.unread_jobs()
-    }
-
-    /// Waits (after `begin_drain`) for the jobs to finish until `end`; what is still running
-    /// then is interrupted and given a second to stop. Returns whether every job finished in
-    /// time.
-    pub async fn finish_jobs(&self, end: tokio::time::Instant) -> bool {
-        self.jobs.finish_jobs(end).await
-    }
-
     fn admit(&self) -> Result<(), EngineError> {
-        if self.is_draining() {
+        if self.jobs.is_draining() {
             Err(self.refused(EngineError::Draining))
         } else {
             Ok(())

@@ -9,7 +9,6 @@ use std::time::Instant;
 use futures_util::FutureExt;
 use metrics::{Counter, Gauge};
 
-use super::background::Background;
 use super::bounded::Bounded;
 use super::budget::{self, Budget};
 use super::cache::{Claim, ResultCache, Solved};
@@ -84,8 +83,6 @@ pub struct Solver {
     doorkeeper: Doorkeeper,
     /// Solved points of sweeps, for a retry after a deadline.
     points: Arc<PointMemo>,
-    /// Work jobs leave for later (tables to build); `None` if its thread could not start.
-    background: Option<Arc<Background>>,
     metrics: Metrics,
     solve_durations: SolveDurations,
     cache_hits: Counter,
@@ -110,11 +107,6 @@ impl Solver {
             ),
             doorkeeper: Doorkeeper::new(budget.inputs / budget::ENTRY_OVERHEAD),
             points: Arc::new(PointMemo::new(budget.points, config.cache_ttl)),
-            background: Background::start()
-                .inspect_err(|e| {
-                    tracing::warn!("no background thread ({e}): no tables built later")
-                })
-                .ok(),
             cache_hits: metrics.counter(names::CACHE_HITS, &[]),
             cache_misses: metrics.counter(names::CACHE_MISSES, &[]),
             jobs_running: metrics.gauge(names::JOBS_RUNNING),
@@ -143,7 +135,7 @@ impl Solver {
     }
 
     /// The cached answer under `key`, counted as a hit.
-    pub(super) async fn cached(&self, key: &str) -> Option<Arc<Solved>> {
+    pub async fn cached(&self, key: &str) -> Option<Arc<Solved>> {
         let solved = self.cache.get(key).await;
         if solved.is_some() {
             self.cache_hits.increment(1);
@@ -228,14 +220,9 @@ impl Solver {
         self.pool.acquire(bytes).await
     }
 
-    /// The control of a job run by this engine: one thread, `deadline`, the point memo and
-    /// the background thread.
+    /// The control of a job run by this engine: one thread, `deadline`, the point memo.
     pub(super) fn control(&self, deadline: Instant) -> Control {
-        let control = Control::new(Some(deadline), 1).with_memo(self.points.clone());
-        match &self.background {
-            Some(background) => control.with_later(background.clone()),
-            None => control,
-        }
+        Control::new(Some(deadline), 1).with_memo(self.points.clone())
     }
 
     /// Counts a job as running (the `jobs_running` gauge) until the guard is dropped.

@@ -278,7 +278,7 @@ pub async fn run(
     // In a fleet, this process also works the fleet's stream, leaving a solver thread to
     // synchronous requests.
     let workers = config.engine.pool_size.saturating_sub(1).max(1);
-    state.engine().start_workers(workers, true);
+    state.engine().jobs.start_workers(workers, true);
     let stop_accepting = CancellationToken::new();
     let _chores = chores(&state);
     let deadline = Arc::new(std::sync::Mutex::new(None::<tokio::time::Instant>));
@@ -307,15 +307,15 @@ pub async fn run(
     *deadline.lock().unwrap_or_else(|p| p.into_inner()) = Some(end);
     // The caller says what the drain waits for, in its own words (`thirdbody serve`).
     tracing::debug!("shutting down: draining");
-    engine.begin_drain();
+    engine.jobs.begin_drain();
     tokio::time::sleep(config.drain_delay).await;
     // Jobs still running when the notice begins are interrupted, and the port stays open to
     // its end: every client polling such a job (there may be several: a script and a
     // dashboard) learns its fate from this process, not from a refused connection.
     let notice = FATE_NOTICE.min(config.shutdown_timeout / 2);
-    if engine.finish_jobs(end - notice).await {
+    if engine.jobs.finish_jobs(end - notice).await {
         // Their clients read them (within what is left of the timeout) before the port closes.
-        if tokio::time::timeout_at(end, engine.jobs_collected())
+        if tokio::time::timeout_at(end, engine.jobs.jobs_collected())
             .await
             .is_err()
         {
@@ -388,7 +388,7 @@ async fn housekeeping(state: AppState) {
     loop {
         tick.tick().await;
         state.inner.prometheus.run_upkeep();
-        state.engine().purge_expired_jobs().await;
+        state.engine().jobs.purge_expired_jobs().await;
     }
 }
 

@@ -164,7 +164,7 @@ async fn the_engine_runs_an_unregistered_kind_reports_its_progress_and_cancels_i
     );
     let started = Instant::now();
     loop {
-        let now = engine.job(record.id).await.unwrap();
+        let now = engine.jobs.job(record.id).await.unwrap();
         if now.done >= 20 {
             assert_eq!(now.state.status(), JobStatus::Running);
             break;
@@ -173,7 +173,7 @@ async fn the_engine_runs_an_unregistered_kind_reports_its_progress_and_cancels_i
         tokio::time::sleep(Duration::from_millis(5)).await;
     }
     let cancel = Instant::now();
-    let stopped = engine.cancel(record.id).await.unwrap();
+    let stopped = engine.jobs.cancel(record.id).await.unwrap();
     assert_eq!(stopped.state.status(), JobStatus::Cancelled);
     // The job checks its control every millisecond; the whole run would take 17 minutes.
     assert!(
@@ -186,9 +186,9 @@ async fn the_engine_runs_an_unregistered_kind_reports_its_progress_and_cancels_i
         .submit(Job::new(Countdown { steps: 30 }).keyed(), None, None)
         .await
         .unwrap();
-    let mut status = engine.watch(short.id).unwrap();
+    let mut status = engine.jobs.watch(short.id).unwrap();
     status.wait_for(|s| s.is_finished()).await.unwrap();
-    let done = engine.job(short.id).await.unwrap();
+    let done = engine.jobs.job(short.id).await.unwrap();
     assert_eq!((done.state.status(), done.done), (JobStatus::Succeeded, 30));
 }
 

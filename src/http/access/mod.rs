@@ -250,7 +250,7 @@ pub async fn charge_all(
     // What each job is estimated to cost (`Cost`: a point a local answer).
     let (mut points, mut guessed) = (0, false);
     for keyed in jobs {
-        if state.engine().cached(keyed.key()).await.is_none() {
+        if state.engine().solver.cached(keyed.key()).await.is_none() {
             points += keyed.job().cost().points;
             guessed |= keyed.job().work() == Work::Unknown;
         }
@@ -311,7 +311,7 @@ async fn within_jobs(state: &AppState, caller: &Caller, limit: usize) -> Result<
     let tenant = caller.owner(None);
     let unfinished = match &tenant {
         Some(owner) => state.engine().unfinished_of(owner).await?,
-        None => state.engine().unfinished_anonymous(),
+        None => state.engine().jobs.unfinished_anonymous(),
     };
     if unfinished < limit {
         return Ok(());

@@ -227,7 +227,12 @@ pub async fn list(
 ) -> Result<Json<JobList>, ApiError> {
     let query = ListQuery::parse(query.as_deref())?;
     let listing = query.listing(query.owner(&caller, token)?)?;
-    let page = state.engine().list(&listing).await.map_err(unreadable)?;
+    let page = state
+        .engine()
+        .jobs
+        .list(&listing)
+        .await
+        .map_err(unreadable)?;
     let next = (listing.offset + page.jobs.len() < page.total)
         .then(|| next_page(&listing, query.tenant.as_deref()));
     Ok(Json(JobList {
@@ -314,13 +319,17 @@ pub async fn by_input(
     };
     let key = scoped_key(&input_hash, tenant).ok_or_else(missing)?;
     let engine = state.engine();
-    if let Some(solved) = engine.cached(&key).await {
+    if let Some(solved) = engine.solver.cached(&key).await {
         return answering.respond(&solved, None);
     }
-    let mut record = engine.with_input(&key).await.map_err(unreadable)?;
+    let mut record = engine.jobs.with_input(&key).await.map_err(unreadable)?;
     if record.is_none() && tenant.is_some() {
         // A tenant's job saved before answers were kept by tenant: under the bare hash.
-        record = engine.with_input(&input_hash).await.map_err(unreadable)?;
+        record = engine
+            .jobs
+            .with_input(&input_hash)
+            .await
+            .map_err(unreadable)?;
     }
     let record = record.filter(|r| match tenant {
         Some(name) => r.owner == Some(Owner::of_tenant(name)),

@@ -18,7 +18,7 @@ use uuid::Uuid;
 
 use super::shared::{JobView, OwnerHeader, OWNER_HEADER};
 use super::{Answering, FormatQuery};
-use crate::engine::store::{JobRecord, JobState, JobStatus, Owner};
+use crate::engine::store::{JobRecord, JobState, JobStatus};
 use crate::engine::{Engine, Unknown};
 use crate::http::accept::{Accept, AcceptsJson};
 use crate::http::access::{self, Caller};
@@ -54,7 +54,7 @@ impl FromRequestParts<AppState> for FoundJob {
             .await
             .map_err(|_| ApiError::not_found("no such job: its id is a UUID"))?;
         let engine = state.engine();
-        if let Some(record) = engine.job(id).await {
+        if let Some(record) = engine.jobs.job(id).await {
             let caller = Caller::of(&parts.extensions);
             if !caller.may_read(record.owner.as_ref()) {
                 return Err(never_issued(id, state));
@@ -62,8 +62,8 @@ impl FromRequestParts<AppState> for FoundJob {
             return Ok(FoundJob(record));
         }
         // Unknown here may be unknown only while the fleet's store is away.
-        engine.store_reachable()?;
-        Err(match engine.unknown(id).await {
+        engine.jobs.store_reachable()?;
+        Err(match engine.jobs.unknown(id).await {
             Unknown::NeverIssued => never_issued(id, state),
             Unknown::Gone => ApiError::not_found(format!(
                 "no job {id}: it was deleted, or it expired (it finished more than the \
@@ -188,27 +188,37 @@ pub async fn status(_: AcceptsJson, FoundJob(record): FoundJob) -> Json<JobView>
 pub async fn cancel(
     State(state): State<AppState>,
     _: AcceptsJson,
-    caller: Caller,
-    OwnerHeader(token): OwnerHeader,
-    FoundJob(record): FoundJob,
+    ChangeableJob(record): ChangeableJob,
 ) -> Result<Json<JobView>, ApiError> {
-    changeable(&record, &caller, token)?;
-    let record = state.engine().cancel(record.id).await.unwrap_or(record);
+    let record = state
+        .engine()
+        .jobs
+        .cancel(record.id)
+        .await
+        .unwrap_or(record);
     Ok(Json(JobView::of(&record)))
 }
 
-/// Refuses a change to `record` unless the request comes from its owner (the same API
-/// key's tenant, or the same owner's token) or an admin; a job without an owner is anyone's
-/// who holds its id.
-fn changeable(record: &JobRecord, caller: &Caller, token: Option<Owner>) -> Result<(), ApiError> {
-    if caller.may_change(record.owner.as_ref(), token) {
-        return Ok(());
+/// The job of the path, which the request may change (cancel or delete): its owner's (the
+/// same API key's tenant, or the same owner's token) or an admin's; a job without an owner
+/// is anyone's who holds its id.
+pub struct ChangeableJob(JobRecord);
+
+impl FromRequestParts<AppState> for ChangeableJob {
+    type Rejection = ApiError;
+
+    async fn from_request_parts(parts: &mut Parts, state: &AppState) -> Result<Self, ApiError> {
+        let OwnerHeader(token) = OwnerHeader::from_request_parts(parts, state).await?;
+        let FoundJob(record) = FoundJob::from_request_parts(parts, state).await?;
+        if Caller::of(&parts.extensions).may_change(record.owner.as_ref(), token) {
+            return Ok(ChangeableJob(record));
+        }
+        Err(ApiError::forbidden(format!(
+            "job {} was submitted with an owner's token: only a request with the same \
+             {OWNER_HEADER} header (or an admin's API key) may cancel or delete it",
+            record.id
+        )))
     }
-    Err(ApiError::forbidden(format!(
-        "job {} was submitted with an owner's token: only a request with the same \
-         {OWNER_HEADER} header (or an admin's API key) may cancel or delete it",
-        record.id
-    )))
 }
 
 /// The owner's token, for a job submitted with one.
@@ -245,12 +255,14 @@ pub struct OwnerParam {
 pub async fn delete(
     State(state): State<AppState>,
     _: AcceptsJson,
-    caller: Caller,
-    OwnerHeader(token): OwnerHeader,
-    FoundJob(record): FoundJob,
+    ChangeableJob(record): ChangeableJob,
 ) -> Result<Json<JobView>, ApiError> {
-    changeable(&record, &caller, token)?;
-    let record = state.engine().delete(record.id).await.unwrap_or(record);
+    let record = state
+        .engine()
+        .jobs
+        .delete(record.id)
+        .await
+        .unwrap_or(record);
     Ok(Json(JobView::of(&record)))
 }
 
@@ -362,7 +374,7 @@ pub async fn events(
     let watcher = Watcher {
         _permit: permit,
         engine: state.engine().clone(),
-        changes: state.engine().watch(record.id),
+        changes: state.engine().jobs.watch(record.id),
         record,
         last: None,
         finished: false,
@@ -420,7 +432,7 @@ impl Watcher {
                 _ = tick.tick() => {}
             }
             // Gone (expired) while followed: the last record read stands.
-            if let Some(record) = self.engine.job(self.record.id).await {
+            if let Some(record) = self.engine.jobs.job(self.record.id).await {
                 self.record = record;
             }
         }

@@ -63,10 +63,10 @@ pub async fn readyz(
     _: AcceptsJson,
 ) -> Result<Json<Health>, ApiError> {
     let engine = state.engine();
-    if engine.is_draining() {
+    if engine.jobs.is_draining() {
         return Err(ApiError::draining());
     }
-    let roles = engine.fleet_health();
+    let roles = engine.jobs.fleet_health();
     let redis = roles.as_ref().map(|roles| {
         roles
             .iter()
@@ -77,7 +77,7 @@ pub async fn readyz(
         .iter()
         .flatten()
         .filter_map(|(role, health)| health.reason(role))
-        .chain(engine.store_problem())
+        .chain(engine.jobs.store_problem())
         .chain(state.config().access.keys.problem())
         .collect();
     Ok(Json(Health {
