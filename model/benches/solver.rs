@@ -45,16 +45,16 @@ fn rolling(c: &mut Criterion) {
         let options = SolveOptions::integrals_only(Quadrature::Midpoint { strips: 40 });
         b.iter(|| solve(black_box(&default), &options).unwrap())
     });
-    // Through the layer's similarity table, once built (as every answer after the first
-    // on a layer is in the service).
+    // Through the layer's similarity table, once built (as a sweep's points and a three-body
+    // system's sizes are).
     tables::get_or_build(default.layer.kappa(), Quadrature::default()).unwrap();
     group.bench_function("tabulated_default_job", |b| {
         let options = SolveOptions::default();
-        b.iter(|| tables::solve(black_box(&default), &options, Use::IfBuilt).unwrap())
+        b.iter(|| tables::solve(black_box(&default), &options, Use::Build).unwrap())
     });
     group.bench_function("tabulated_integrals_only", |b| {
         let options = SolveOptions::integrals_only(Quadrature::default());
-        b.iter(|| tables::solve(black_box(&default), &options, Use::IfBuilt).unwrap())
+        b.iter(|| tables::solve(black_box(&default), &options, Use::Build).unwrap())
     });
     group.finish();
 }

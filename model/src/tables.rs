@@ -3,9 +3,9 @@
 //! bounded in number.
 //!
 //! Building a table costs about 5 ms for κ ≤ 100, as much as some 220 exact solves at a given
-//! load (BENCHMARKS.md), so who builds when is the caller's choice ([`Use`]): a sweep or a
-//! figure builds at once, a single rolling answer uses a table only if one is built and
-//! otherwise solves exactly (and may have one built in the background, [`wanted`]).
+//! load (BENCHMARKS.md), so who builds when is the caller's choice ([`Use`]): a large sweep or
+//! a figure builds at once; a single rolling answer always solves exactly, so that its digits
+//! do not depend on the tables earlier jobs of the process built.
 
 use std::sync::{Arc, Mutex, OnceLock};
 
@@ -75,8 +75,6 @@ pub fn of_series(layer: &Layer, quadrature: Quadrature) -> Result<SimilarityTabl
 pub enum Use {
     /// Strip sums only.
     Exact,
-    /// The layer's table if this process has built it; strip sums otherwise.
-    IfBuilt,
     /// The layer's table, built now if need be.
     Build,
 }
@@ -118,7 +116,6 @@ pub fn solve(
     let table = match tables {
         _ if !tabulable(rolling, options) => None,
         Use::Exact => None,
-        Use::IfBuilt => built(kappa, options.quadrature),
         // Never build for an invalid input: its solve reports what is wrong.
         Use::Build => match built(kappa, options.quadrature) {
             None if rolling.violations().is_empty() => {
@@ -129,16 +126,6 @@ pub fn solve(
     }
     .filter(|table| table.error() <= ACCEPTED_TABLE_ERROR);
     solve_with(rolling, options, table.as_deref())
-}
-
-/// The κ of a table that would serve `rolling` but is not built yet, if any: what a single
-/// answer solved exactly asks to have built for the answers after it.
-pub fn wanted(rolling: &Rolling, options: &SolveOptions) -> Option<f64> {
-    let kappa = rolling.layer.kappa();
-    (tabulable(rolling, options)
-        && built(kappa, options.quadrature).is_none()
-        && rolling.violations().is_empty())
-    .then_some(kappa)
 }
 
 /// Whether a rolling job may be answered through a table at all: its layer is a viscous

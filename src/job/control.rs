@@ -28,14 +28,6 @@ pub trait Memo: fmt::Debug + Send + Sync {
     fn keep(&self, key: String, value: Kept, bytes: usize);
 }
 
-/// Work a job leaves to be done off its own path, when the machine has time: the engine runs
-/// it on a background thread (see `engine::background`); without one it is dropped.
-pub trait Later: fmt::Debug + Send + Sync {
-    /// Runs `work` some time later, once per `key` while it is pending, or not at all if
-    /// too much is pending already.
-    fn offer(&self, key: String, work: Box<dyn FnOnce() + Send>);
-}
-
 /// What a job that maps over items does with an item the model refuses.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize, Serialize, ToSchema)]
 #[serde(rename_all = "snake_case")]
@@ -82,7 +74,6 @@ pub struct Control {
     recalled: AtomicUsize,
     threads: usize,
     memo: Option<Arc<dyn Memo>>,
-    later: Option<Arc<dyn Later>>,
 }
 
 impl Default for Control {
@@ -102,7 +93,6 @@ impl Control {
             recalled: AtomicUsize::new(0),
             threads: threads.max(1),
             memo: None,
-            later: None,
         }
     }
 
@@ -110,20 +100,6 @@ impl Control {
     pub fn with_memo(mut self, memo: Arc<dyn Memo>) -> Self {
         self.memo = Some(memo);
         self
-    }
-
-    /// The same control, leaving work for later to `later` ([`Control::later`]).
-    pub fn with_later(mut self, later: Arc<dyn Later>) -> Self {
-        self.later = Some(later);
-        self
-    }
-
-    /// Offers `work` to be done later, off this job's path (see [`Later`]); without a
-    /// [`Later`] the work is dropped.
-    pub fn later(&self, key: String, work: impl FnOnce() + Send + 'static) {
-        if let Some(later) = &self.later {
-            later.offer(key, Box::new(work));
-        }
     }
 
     /// Asks the job to stop at its next check.

@@ -25,7 +25,7 @@ pub mod three_body;
 pub mod validity;
 mod wire;
 
-pub use control::{Control, Kept, Later, Memo, OnRefusal, Swept};
+pub use control::{Control, Kept, Memo, OnRefusal, Swept};
 pub use error::{echoed, FieldError, JobError};
 pub use figure::FigureJob;
 pub use fit::FitJob;

@@ -201,3 +201,37 @@ async fn a_figure_answers_json_or_csv() {
     let text = csv.text().await.unwrap();
     assert!(text.starts_with("series,label,"), "{text}");
 }
+
+/// One input, one answer: after the figures (whose points build the layer's similarity
+/// table in this process) a single rolling answer is still the exact strip solve, the digits
+/// a fresh process and `thirdbody solve` give (issue 52: it read the table the figures had
+/// built, and answered A = 1.2402381982101833e-16 for …1803).
+#[tokio::test]
+async fn a_single_answer_does_not_depend_on_what_the_process_did_before() {
+    use thirdbody::model::{solve, Rolling, SolveOptions};
+    let app = spawn_app(&[]).await;
+    for number in 3..=9 {
+        let figure = app.get(&format!("/v1/figures/{number}")).await;
+        assert_eq!(figure.status(), 200);
+    }
+    for (radius, load) in [(5e-8, 1e-9), (2.5e-8, 1.2e-9)] {
+        let body = json!({"radius": radius, "load": load});
+        let answer = app.post_json("/v1/rolling", &body).await;
+        let rolling = Rolling {
+            radius,
+            load,
+            ..Rolling::default()
+        };
+        let exact = solve(&rolling, &SolveOptions::default()).unwrap();
+        let text = |x: f64| serde_json::to_string(&x).unwrap();
+        assert_eq!(
+            answer["contact_area"].to_string(),
+            text(exact.contact_area),
+            "R = {radius:e}, P = {load:e}"
+        );
+        assert_eq!(
+            answer["friction_coefficient"].to_string(),
+            text(exact.friction_coefficient)
+        );
+    }
+}

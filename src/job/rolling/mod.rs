@@ -228,19 +228,9 @@ impl Kind for RollingJob {
     }
 
     fn run(&self, meta: Meta, control: &Control) -> Result<RollingOutput, JobError> {
-        let solution = control.solve(|stop| self.solve(&self.rolling, Use::IfBuilt, stop))?;
-        // Solved exactly, as the first answer on a layer is: the table for the answers after
-        // it is built off this request's path.
-        let local = self.law == LayerModel::Local;
-        if let Some(kappa) = local
-            .then(|| tables::wanted(&self.rolling, &self.options))
-            .flatten()
-        {
-            let quadrature = self.options.quadrature;
-            control.later(format!("similarity table κ = {kappa:e}"), move || {
-                let _ = tables::get_or_build(kappa, quadrature);
-            });
-        }
+        // Strip sums, never a table: a single answer's digits must not depend on which tables
+        // earlier jobs of the process built (issue 52).
+        let solution = control.solve(|stop| self.solve(&self.rolling, Use::Exact, stop))?;
         RollingOutput::new(&self.rolling, &solution, meta)
     }
 }
