@@ -23,9 +23,10 @@ impl Dimension {
     pub const FORCE: Dimension = Dimension([1, 1, -2, 0]);
     pub const PRESSURE: Dimension = Dimension([-1, 1, -2, 0]);
     pub const TEMPERATURE: Dimension = Dimension([0, 0, 0, 1]);
+    pub const MASS: Dimension = Dimension([0, 1, 0, 0]);
 
     /// The named dimensions, with their SI unit and an example as people type it.
-    const NAMED: [(Dimension, &'static str, &'static str, &'static str); 9] = [
+    const NAMED: [(Dimension, &'static str, &'static str, &'static str); 10] = [
         (Dimension::NONE, "a plain number", "", "0.35"),
         (Dimension::LENGTH, "a length", "m", "25 nm"),
         (Dimension::AREA, "an area", "m²", "1 mm^2"),
@@ -35,6 +36,7 @@ impl Dimension {
         (Dimension::FORCE, "a force", "N", "1.2 nN"),
         (Dimension::PRESSURE, "a pressure", "Pa", "3 GPa"),
         (Dimension::TEMPERATURE, "a temperature", "K", "25 °C"),
+        (Dimension::MASS, "a mass", "kg", "2 mg"),
     ];
 
     fn named(self) -> Option<(&'static str, &'static str, &'static str)> {
@@ -113,7 +115,10 @@ pub enum UnitError {
     #[error("does not start with a number")]
     NoNumber,
     /// A unit symbol that is not an SI symbol with an SI prefix.
-    #[error("has an unknown unit \"{0}\" (SI symbols m, g, s, N, Pa, K with SI prefixes, or °C)")]
+    #[error(
+        "has an unknown unit \"{0}\" ({hint}SI symbols m, g, s, N, Pa, K with SI prefixes, or °C)",
+        hint = respelled(.0).map_or(String::new(), |unit| format!("did you mean \"{unit}\"? "))
+    )]
     UnknownUnit(String),
     /// A unit power out of range (`m^127`).
     #[error(
@@ -128,6 +133,12 @@ pub enum UnitError {
     WrongDimension {
         found: Dimension,
         expected: Dimension,
+    },
+    /// A mass where a force is expected (a load typed in kg, as on a balance).
+    #[error("is a mass, not a force: it weighs {} under standard gravity", with_prefix(*.weight, "N"))]
+    MassForForce {
+        /// Its weight (N).
+        weight: f64,
     },
 }
 
@@ -167,7 +178,7 @@ const SYMBOLS: [(&str, i32, Dimension); 6] = [
     ("Pa", 0, Dimension::PRESSURE),
     ("N", 0, Dimension::FORCE),
     ("m", 0, Dimension::LENGTH),
-    ("g", -3, Dimension([0, 1, 0, 0])),
+    ("g", -3, Dimension::MASS),
     ("s", 0, Dimension::TIME),
     ("K", 0, Dimension::TEMPERATURE),
 ];
@@ -216,12 +227,48 @@ pub fn parse_quantity(text: &str, expected: Dimension) -> Result<f64, UnitError>
     } else {
         parse_unit(unit)?
     };
-    if found != expected {
-        return Err(UnitError::WrongDimension { found, expected });
-    }
-    format!("{mantissa}e{}", exponent.saturating_add(power))
+    let value: f64 = format!("{mantissa}e{}", exponent.saturating_add(power))
         .parse()
-        .map_err(|_| UnitError::NoNumber)
+        .map_err(|_| UnitError::NoNumber)?;
+    match (found, expected) {
+        _ if found == expected => Ok(value),
+        (Dimension::MASS, Dimension::FORCE) => Err(UnitError::MassForForce {
+            weight: value * STANDARD_GRAVITY,
+        }),
+        _ => Err(UnitError::WrongDimension { found, expected }),
+    }
+}
+
+/// g₀ (m/s²), by definition (CGPM 1901): what a mass given for a load weighs.
+const STANDARD_GRAVITY: f64 = 9.806_65;
+
+/// `value` of the SI unit `symbol` in the prefixed unit that puts its number between 1 and
+/// 1000, to three significant digits (`9.81 mN`), for messages.
+pub fn with_prefix(value: f64, symbol: &str) -> String {
+    const NAMES: [(&str, i32); 9] = [
+        ("G", 9),
+        ("M", 6),
+        ("k", 3),
+        ("", 0),
+        ("m", -3),
+        ("µ", -6),
+        ("n", -9),
+        ("p", -12),
+        ("f", -15),
+    ];
+    let (prefix, power) = NAMES
+        .into_iter()
+        .find(|(_, p)| value.abs() >= 10f64.powi(*p) * (1.0 - 5e-4))
+        .filter(|_| value != 0.0)
+        .unwrap_or(("", 0));
+    let x = value / 10f64.powi(power);
+    let decimals = 2 - (x.abs().log10().floor() as usize).min(2);
+    let number = format!("{x:.decimals$}");
+    let number = match number.contains('.') {
+        true => number.trim_end_matches('0').trim_end_matches('.'),
+        false => &number,
+    };
+    format!("{number} {prefix}{symbol}")
 }
 
 /// Whether `text` is a number in degrees Celsius (`"25 °C"`).
@@ -305,6 +352,28 @@ fn parse_unit(unit: &str) -> Result<(i32, Dimension), UnitError> {
         dimension = dimension.add(dim, power).ok_or_else(out_of_range)?;
     }
     Ok((ten_power, dimension))
+}
+
+/// `unit` with each unknown symbol replaced by the known one spelled alike but for case
+/// (`Gpa` → `GPa`, `NM` → `nm`... the one with most letters in the case typed), if that makes
+/// a unit.
+fn respelled(unit: &str) -> Option<String> {
+    let mut out = String::new();
+    for piece in unit.split_inclusive(['/', '*', '·', ' ']) {
+        let term = piece.trim_end_matches(['/', '*', '·', ' ']);
+        let (symbol, _) = split_power(term)?;
+        let known = match parse_symbol(symbol) {
+            Some(_) => symbol.to_string(),
+            None => PREFIXES
+                .iter()
+                .flat_map(|(p, _)| SYMBOLS.iter().map(move |(s, ..)| format!("{p}{s}")))
+                .filter(|k| k.to_lowercase() == symbol.to_lowercase())
+                .max_by_key(|k| k.chars().zip(symbol.chars()).filter(|(a, b)| a == b).count())?,
+        };
+        out.push_str(&known);
+        out.push_str(&piece[symbol.len()..]);
+    }
+    (out != unit && parse_unit(&out).is_ok()).then_some(out)
 }
 
 /// Splits "mm^2", "m²", "m^-2", "m⁻²" into the symbol and its power.
@@ -418,6 +487,25 @@ mod tests {
     }
 
     #[test]
+    fn a_mass_given_for_a_force_is_told_its_weight() {
+        let err = parse_quantity("1 kg", Dimension::FORCE).unwrap_err();
+        assert_eq!(
+            err.to_string(),
+            "is a mass, not a force: it weighs 9.81 N under standard gravity"
+        );
+        let err = parse_quantity("100 mg", Dimension::FORCE).unwrap_err();
+        assert!(err.to_string().ends_with("weighs 981 µN under standard gravity"));
+        assert_eq!(
+            parse_quantity("1 kg", Dimension::LENGTH).unwrap_err().to_string(),
+            "is a mass"
+        );
+        assert_eq!(with_prefix(1.0e-3, "N"), "1 mN");
+        assert_eq!(with_prefix(0.9996, "N"), "1 N");
+        assert_eq!(with_prefix(12.345e-9, "m"), "12.3 nm");
+        assert_eq!(with_prefix(0.0, "N"), "0 N");
+    }
+
+    #[test]
     fn refuses_unknown_units_and_missing_numbers() {
         assert!(matches!(
             parse_quantity("25 furlongs", Dimension::LENGTH),
@@ -427,6 +515,16 @@ mod tests {
             parse_quantity("25 Nm", Dimension::LENGTH),
             Err(UnitError::UnknownUnit(_))
         ));
+        // A symbol in the wrong case is told its spelling.
+        for (typed, meant) in [("3 Gpa", "GPa"), ("4 NM/S", "nm/s"), ("2 mpa", "mPa")] {
+            let err = parse_quantity(typed, Dimension::PRESSURE).unwrap_err();
+            assert!(
+                err.to_string().contains(&format!("did you mean \"{meant}\"?")),
+                "{typed}: {err}"
+            );
+        }
+        let err = parse_quantity("25 furlongs", Dimension::LENGTH).unwrap_err();
+        assert!(!err.to_string().contains("did you mean"), "{err}");
         assert_eq!(
             parse_quantity("nm", Dimension::LENGTH),
             Err(UnitError::NoNumber)
