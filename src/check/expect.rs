@@ -1,10 +1,13 @@
 //! What a check expects of an answer, and how an answer is judged against it.
 
+use std::collections::BTreeMap;
+
 use serde_json::Value;
 
 use super::path::{unanswered, FieldPath, NotAPath};
 use super::report::Outcome;
-use super::{ExpectInput, GoldenInput};
+use super::{Amount, ExpectInput, GoldenInput};
+use crate::job::input::units::{parse_quantity, Dimension};
 use crate::render::format_number;
 
 /// The relative tolerance of `equals` and of golden answers when none is given.
@@ -49,8 +52,16 @@ pub enum BadExpectation {
     EqualsAndRange(FieldPath),
     #[error("{0}: rtol and atol go with equals")]
     ToleranceWithoutEquals(FieldPath),
-    #[error("{path}: min {min} is above max {max}")]
+    #[error("{path}: min {} is above max {}", format_number(*.min), format_number(*.max))]
     Inverted { path: FieldPath, min: f64, max: f64 },
+    /// A bound given as a quantity that is not one of the field's dimension.
+    #[error("{path}: {name} \"{text}\" {why}")]
+    Quantity {
+        path: FieldPath,
+        name: &'static str,
+        text: String,
+        why: String,
+    },
     #[error("a golden answer needs `file` or `answer`")]
     NoGolden,
 }
@@ -69,21 +80,61 @@ fn tolerance(name: &'static str, x: Option<f64>, default: f64) -> Result<f64, Ba
     }
 }
 
+/// `amount` in SI: a number as it is, a quantity read in the unit `units` gives the field
+/// at `path` (`None`: the job is invalid, and its error is reported).
+fn si(
+    path: &FieldPath,
+    name: &'static str,
+    amount: Option<Amount>,
+    units: Option<&BTreeMap<String, &'static str>>,
+) -> Result<Option<f64>, BadExpectation> {
+    let text = match amount {
+        None => return Ok(None),
+        Some(Amount::Number(x)) => return finite(name, Some(x)),
+        Some(Amount::Quantity(text)) => text,
+    };
+    let refused = |why: String| BadExpectation::Quantity {
+        path: path.clone(),
+        name,
+        text: text.clone(),
+        why,
+    };
+    let Some(units) = units else {
+        return Err(refused("cannot be read: the job is not valid".to_string()));
+    };
+    let unit = units.get(&path.unit_key()).copied();
+    let Some(dimension) = unit.and_then(Dimension::of_unit) else {
+        return Err(refused(
+            "cannot be read: the answer gives this field no unit (give a number)".to_string(),
+        ));
+    };
+    parse_quantity(&text, dimension)
+        .map(Some)
+        .map_err(|e| refused(format!("{e}; expected {}", dimension.describe())))
+}
+
 impl Expectation {
-    /// The expectation `input` on the field at `path`, or why it cannot be one.
-    pub fn new(path: String, input: ExpectInput) -> Result<Expectation, BadExpectation> {
+    /// The expectation `input` on the field at `path`, or why it cannot be one; `units` is
+    /// the answer's unit table, which a bound given as a quantity is read with.
+    pub fn new(
+        path: String,
+        input: ExpectInput,
+        units: Option<&BTreeMap<String, &'static str>>,
+    ) -> Result<Expectation, BadExpectation> {
         let path = FieldPath::parse(path)?;
-        let (min, max) = (finite("min", input.min)?, finite("max", input.max)?);
-        let equals = finite("equals", input.equals)?;
+        let min = si(&path, "min", input.min, units)?;
+        let max = si(&path, "max", input.max, units)?;
+        let equals = si(&path, "equals", input.equals, units)?;
+        let atol = si(&path, "atol", input.atol, units)?;
         let bound = match (equals, min, max) {
             (Some(value), None, None) => Bound::Equals {
                 value,
                 rtol: tolerance("rtol", input.rtol, DEFAULT_RTOL)?,
-                atol: tolerance("atol", input.atol, 0.0)?,
+                atol: tolerance("atol", atol, 0.0)?,
             },
             (None, None, None) => return Err(BadExpectation::NoBound(path)),
             (Some(_), ..) => return Err(BadExpectation::EqualsAndRange(path)),
-            (None, ..) if input.rtol.is_some() || input.atol.is_some() => {
+            (None, ..) if input.rtol.is_some() || atol.is_some() => {
                 return Err(BadExpectation::ToleranceWithoutEquals(path))
             }
             (None, Some(min), Some(max)) if min > max => {
@@ -298,9 +349,10 @@ mod tests {
         let outcomes = Expectation::new(
             "points[].mu".to_string(),
             ExpectInput {
-                max: Some(0.1),
+                max: Some(0.1.into()),
                 ..Default::default()
             },
+            None,
         )
         .unwrap()
         .judge(&answer, || answer.clone());
@@ -317,13 +369,14 @@ mod tests {
     #[test]
     fn every_number_at_a_path_is_judged_and_a_path_reaching_none_fails() {
         let answer = json!({"points": [{"mu": 0.05}, {"mu": 0.2}], "static": {"mu": 0.3}});
-        let at_most = |path: &str, max| {
+        let at_most = |path: &str, max: f64| {
             Expectation::new(
                 path.to_string(),
                 ExpectInput {
-                    max: Some(max),
+                    max: Some(max.into()),
                     ..Default::default()
                 },
+                None,
             )
             .unwrap()
             .judge(&answer, || answer.clone())
@@ -351,15 +404,16 @@ mod tests {
 
     #[test]
     fn equals_takes_relative_and_absolute_tolerances() {
-        let equals = |value, rtol, atol| {
+        let equals = |value: f64, rtol, atol: Option<f64>| {
             Expectation::new(
                 "x".into(),
                 ExpectInput {
-                    equals: Some(value),
+                    equals: Some(value.into()),
                     rtol,
-                    atol,
+                    atol: atol.map(Amount::from),
                     ..Default::default()
                 },
+                None,
             )
             .unwrap()
         };
@@ -371,27 +425,27 @@ mod tests {
         for bad in [
             ExpectInput::default(),
             ExpectInput {
-                min: Some(2.0),
-                max: Some(1.0),
+                min: Some(2.0.into()),
+                max: Some(1.0.into()),
                 ..Default::default()
             },
             ExpectInput {
-                equals: Some(1.0),
-                max: Some(1.0),
+                equals: Some(1.0.into()),
+                max: Some(1.0.into()),
                 ..Default::default()
             },
             ExpectInput {
-                max: Some(1.0),
+                max: Some(1.0.into()),
                 rtol: Some(0.1),
                 ..Default::default()
             },
             ExpectInput {
-                equals: Some(1.0),
+                equals: Some(1.0.into()),
                 rtol: Some(-1.0),
                 ..Default::default()
             },
         ] {
-            assert!(Expectation::new("x".into(), bad).is_err());
+            assert!(Expectation::new("x".into(), bad, None).is_err());
         }
     }
 
@@ -407,9 +461,10 @@ mod tests {
         let every = Expectation::new(
             "points[].mu".to_string(),
             ExpectInput {
-                max: Some(0.1),
+                max: Some(0.1.into()),
                 ..Default::default()
             },
+            None,
         )
         .unwrap();
         let held = rows(0);
@@ -449,5 +504,75 @@ mod tests {
             off.message
         );
         assert!(off.message.contains("c is new"), "{}", off.message);
+    }
+
+    #[test]
+    fn bounds_take_quantities_in_the_fields_dimension() {
+        let units = BTreeMap::from([("points[].contact_area", "m²"), ("mu", "")]);
+        let units: BTreeMap<String, &'static str> =
+            units.into_iter().map(|(k, v)| (k.to_string(), v)).collect();
+        let quantity = |text: &str| Some(Amount::Quantity(text.to_string()));
+        let area = Expectation::new(
+            "points[3].contact_area".to_string(),
+            ExpectInput {
+                equals: quantity("8.21 nm^2"),
+                atol: quantity("0.01 nm²"),
+                ..Default::default()
+            },
+            Some(&units),
+        )
+        .unwrap();
+        let answer = json!({"points": [{}, {}, {}, {"contact_area": 8.215e-18}]});
+        assert!(area.judge(&answer, || answer.clone())[0].passed);
+        assert_eq!(
+            area.bound,
+            Bound::Equals {
+                value: 8.21e-18,
+                rtol: DEFAULT_RTOL,
+                atol: 1e-20
+            }
+        );
+        let refused = |path: &str, text: &str| {
+            Expectation::new(
+                path.to_string(),
+                ExpectInput {
+                    min: quantity(text),
+                    ..Default::default()
+                },
+                Some(&units),
+            )
+            .unwrap_err()
+            .to_string()
+        };
+        assert_eq!(
+            refused("points[].contact_area", "3 nN"),
+            "points[].contact_area: min \"3 nN\" is a force; expected an area (a number in \
+             m², or a string such as \"1 mm^2\")"
+        );
+        assert!(refused("nothing", "1 nm").contains("gives this field no unit"));
+        assert!(Expectation::new(
+            "mu".to_string(),
+            ExpectInput {
+                max: quantity("0.1"),
+                ..Default::default()
+            },
+            Some(&units)
+        )
+        .is_ok());
+    }
+
+    #[test]
+    fn an_inverted_range_is_said_in_numbers_people_read() {
+        let inverted = Expectation::new(
+            "x".to_string(),
+            ExpectInput {
+                min: Some(1e-20.into()),
+                max: Some(1e-30.into()),
+                ..Default::default()
+            },
+            None,
+        )
+        .unwrap_err();
+        assert_eq!(inverted.to_string(), "x: min 1e-20 is above max 1e-30");
     }
 }

@@ -26,13 +26,19 @@ pub fn run_file(path: &Path, update: bool) -> Result<Report, JobError> {
     let mut value = parse(&text)?;
     let dir = path.parent().unwrap_or(Path::new("."));
     if !update {
-        read_goldens(&mut value, dir)?;
+        if let Err(missing) = read_goldens(&mut value, dir) {
+            // A malformed check is said before a golden file to write: `--update` would
+            // only run into it.
+            Suite::from_value(value, &Limits::default())?;
+            return Err(missing);
+        }
     }
     let suite = Suite::from_value(value, &Limits::default())?;
     let mut reports = Vec::new();
     // Each answer is judged, then dropped before the next job runs: a file of large sweeps
     // holds one answer at a time.
     for mut spec in suite.checks {
+        let started = std::time::Instant::now();
         let json = spec
             .job
             .run(spec.job.meta(), &Control::default())
@@ -49,7 +55,7 @@ pub fn run_file(path: &Path, update: bool) -> Result<Report, JobError> {
             }
             golden.answer = Some(answer);
         }
-        reports.push(spec.judge(json.as_deref()));
+        reports.push(spec.judge(json.as_deref()).timed(started));
     }
     Ok(Report::new(reports))
 }

@@ -56,20 +56,36 @@ pub struct CheckInput {
     pub golden: Option<GoldenInput>,
 }
 
-/// Bounds on a number, or the value it must equal within `rtol`·|value| + `atol`.
+/// Bounds on a number, or the value it must equal within `rtol`·|value| + `atol`. Each
+/// bound is a number in the field's SI unit (its `meta.units`), or a quantity in any unit of
+/// the field's dimension (`"8.21 nm^2"`), as a job's inputs are.
 #[derive(Clone, Debug, Default, Deserialize, ToSchema)]
 #[serde(deny_unknown_fields)]
 pub struct ExpectInput {
     /// The smallest value allowed.
-    pub min: Option<f64>,
+    pub min: Option<Amount>,
     /// The largest value allowed.
-    pub max: Option<f64>,
+    pub max: Option<Amount>,
     /// The value expected.
-    pub equals: Option<f64>,
+    pub equals: Option<Amount>,
     /// Relative tolerance of `equals` (default 1e-9).
     pub rtol: Option<f64>,
     /// Absolute tolerance of `equals`, in the field's unit (default 0).
-    pub atol: Option<f64>,
+    pub atol: Option<Amount>,
+}
+
+/// A bound: a number in the field's SI unit, or a quantity with its unit.
+#[derive(Clone, Debug, Deserialize, ToSchema)]
+#[serde(untagged)]
+pub enum Amount {
+    Number(f64),
+    Quantity(String),
+}
+
+impl From<f64> for Amount {
+    fn from(x: f64) -> Amount {
+        Amount::Number(x)
+    }
 }
 
 /// A golden answer: in a file (the command line reads it, and `--update` rewrites it), or
@@ -129,7 +145,8 @@ impl Suite {
                 .expect
                 .into_iter()
                 .filter_map(|(path, e)| {
-                    Expectation::new(path, e)
+                    let units = job.as_ref().map(|job| job.units().get().get());
+                    Expectation::new(path, e, units)
                         .map_err(|why| {
                             checker.invalid(&format!("{at}.expect"), Value::Null, &why.to_string())
                         })

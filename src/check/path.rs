@@ -59,6 +59,28 @@ impl FieldPath {
     }
 
     /// The path as written.
+    /// The path as the answer's unit table (`meta.units`) names it: every index `[n]` as
+    /// `[]`.
+    pub fn unit_key(&self) -> String {
+        let mut key = String::new();
+        let mut index = false;
+        for c in self.as_str().chars() {
+            match c {
+                '[' => index = true,
+                ']' => {
+                    index = false;
+                    key.push_str("[]");
+                    continue;
+                }
+                _ => {}
+            }
+            if !index {
+                key.push(c);
+            }
+        }
+        key
+    }
+
     pub fn as_str(&self) -> &str {
         &self.text
     }

@@ -68,6 +68,8 @@ pub struct CheckReport {
     /// Why the job itself gave no answer.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub error: Option<String>,
+    /// Time the check took, its job's answer and its judgement (s): what a CI report shows.
+    pub seconds: f64,
 }
 
 impl CheckReport {
@@ -79,7 +81,14 @@ impl CheckReport {
             input_hash: None,
             outcomes: Vec::new(),
             error: None,
+            seconds: 0.0,
         }
+    }
+
+    /// The same report, the check having begun at `started`.
+    pub fn timed(self, started: std::time::Instant) -> CheckReport {
+        let seconds = started.elapsed().as_secs_f64();
+        CheckReport { seconds, ..self }
     }
 
     pub fn fail_with(&mut self, error: String) {
@@ -174,23 +183,26 @@ impl Report {
     /// case per check, a failure element per failed check.
     pub fn to_junit(&self) -> String {
         let s = &self.summary;
+        let time: f64 = self.checks.iter().map(|c| c.seconds).sum();
         let mut xml = String::from("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
         let _ = writeln!(
             xml,
-            "<testsuites name=\"thirdbody check\" tests=\"{}\" failures=\"{}\">",
+            "<testsuites name=\"thirdbody check\" tests=\"{}\" failures=\"{}\" time=\"{time:.6}\">",
             s.checks, s.failed
         );
         let _ = writeln!(
             xml,
-            "  <testsuite name=\"thirdbody check\" tests=\"{}\" failures=\"{}\" errors=\"0\">",
+            "  <testsuite name=\"thirdbody check\" tests=\"{}\" failures=\"{}\" errors=\"0\" \
+             time=\"{time:.6}\">",
             s.checks, s.failed
         );
         for check in &self.checks {
             let _ = write!(
                 xml,
-                "    <testcase name=\"{}\" classname=\"thirdbody.{}\"",
+                "    <testcase name=\"{}\" classname=\"thirdbody.{}\" time=\"{:.6}\"",
                 escape(&check.name),
-                escape(&check.kind)
+                escape(&check.kind),
+                check.seconds
             );
             if check.passed {
                 xml.push_str("/>\n");
@@ -233,16 +245,23 @@ mod tests {
     #[test]
     fn junit_names_each_check_and_escapes_what_it_says() {
         let mut pass = CheckReport::new("mu <0.1>", "rolling");
+        pass.seconds = 0.25;
         pass.settle();
         let mut fail = CheckReport::new("area", "sweep");
+        fail.seconds = 1.5;
         fail.outcomes
             .push(Outcome::failed("x", "at most 1", Some(2.0), "x = 2 & more"));
         fail.settle();
         let report = Report::new(vec![pass, fail]);
         assert!(!report.passed);
         let xml = report.to_junit();
-        assert!(xml.contains("tests=\"2\" failures=\"1\""), "{xml}");
-        assert!(xml.contains("<testcase name=\"mu &lt;0.1&gt;\" classname=\"thirdbody.rolling\"/>"));
+        assert!(
+            xml.contains("tests=\"2\" failures=\"1\" errors=\"0\" time=\"1.750000\""),
+            "{xml}"
+        );
+        assert!(xml.contains(
+            "<testcase name=\"mu &lt;0.1&gt;\" classname=\"thirdbody.rolling\" time=\"0.250000\"/>"
+        ));
         assert!(
             xml.contains("<failure message=\"x = 2 &amp; more\">"),
             "{xml}"

@@ -513,6 +513,11 @@ impl Job {
         )
     }
 
+    /// The unit of every numeric field of the job's answer, by path (`points[].load`).
+    pub fn units(&self) -> &'static crate::render::UnitTable {
+        self.kind.units()
+    }
+
     /// Hash of the canonical input and the model version: equal keys, equal results.
     pub fn cache_key(&self) -> String {
         self.meta().input_hash

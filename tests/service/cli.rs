@@ -627,8 +627,9 @@ fn check_exits_0_when_every_check_holds_1_when_one_fails_2_on_bad_input() {
     );
     assert!(report.contains("PASS  same as before"), "{report}");
     let xml = std::fs::read_to_string(&junit).unwrap();
+    // Each test case says how long it took, as CI reporters show it (issue 52).
     assert!(
-        xml.contains("<testcase name=\"low\" classname=\"thirdbody.rolling\">"),
+        xml.contains("<testcase name=\"low\" classname=\"thirdbody.rolling\" time=\""),
         "{xml}"
     );
     assert!(
@@ -645,6 +646,25 @@ fn check_exits_0_when_every_check_holds_1_when_one_fails_2_on_bad_input() {
     let out = thirdbody(&["check", checks.to_str().unwrap()], None);
     assert_eq!(out.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&out.stdout).contains("contact_area = "));
+
+    // A malformed bound is said first, though a golden file is missing too: `--update`
+    // would only run into it.
+    std::fs::write(
+        &checks,
+        r#"{"checks": [
+            {"name": "inverted", "job": {"kind": "rolling"},
+             "expect": {"contact_area": {"min": "1 µm^2", "max": "1 nm^2"}}},
+            {"name": "new", "job": {"kind": "rolling"}, "golden": {"file": "golden/none.json"}}]}"#,
+    )
+    .unwrap();
+    let out = thirdbody(&["check", checks.to_str().unwrap()], None);
+    assert_eq!(out.status.code(), Some(2));
+    let said = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        said.contains("contact_area: min 1e-12 is above max 1e-18"),
+        "{said}"
+    );
+    assert!(!said.contains("--update"), "{said}");
 
     std::fs::write(
         &checks,

@@ -73,6 +73,7 @@ pub async fn run(
             reports.push(not_run(&spec, &state));
             continue;
         }
+        let began = Instant::now();
         let cache = cache_use(&spec.job, state.config().engine.memory_budget);
         let answer = match state.engine().solve_by(keyed, deadline, cache).await {
             Ok((solved, _)) => Ok(solved),
@@ -84,7 +85,7 @@ pub async fn run(
         let size = answer.as_ref().map_or(0, |solved| solved.json().len());
         let judge = move || {
             let json = answer.as_ref().map(|solved| solved.json().as_ref());
-            Ok(spec.judge(json))
+            Ok(spec.judge(json).timed(began))
         };
         reports.push(offload(&state, size, judge).await?);
     }

@@ -368,7 +368,12 @@ fn respelled(unit: &str) -> Option<String> {
                 .iter()
                 .flat_map(|(p, _)| SYMBOLS.iter().map(move |(s, ..)| format!("{p}{s}")))
                 .filter(|k| k.to_lowercase() == symbol.to_lowercase())
-                .max_by_key(|k| k.chars().zip(symbol.chars()).filter(|(a, b)| a == b).count())?,
+                .max_by_key(|k| {
+                    k.chars()
+                        .zip(symbol.chars())
+                        .filter(|(a, b)| a == b)
+                        .count()
+                })?,
         };
         out.push_str(&known);
         out.push_str(&piece[symbol.len()..]);
@@ -494,9 +499,13 @@ mod tests {
             "is a mass, not a force: it weighs 9.81 N under standard gravity"
         );
         let err = parse_quantity("100 mg", Dimension::FORCE).unwrap_err();
-        assert!(err.to_string().ends_with("weighs 981 µN under standard gravity"));
+        assert!(err
+            .to_string()
+            .ends_with("weighs 981 µN under standard gravity"));
         assert_eq!(
-            parse_quantity("1 kg", Dimension::LENGTH).unwrap_err().to_string(),
+            parse_quantity("1 kg", Dimension::LENGTH)
+                .unwrap_err()
+                .to_string(),
             "is a mass"
         );
         assert_eq!(with_prefix(1.0e-3, "N"), "1 mN");
@@ -519,7 +528,8 @@ mod tests {
         for (typed, meant) in [("3 Gpa", "GPa"), ("4 NM/S", "nm/s"), ("2 mpa", "mPa")] {
             let err = parse_quantity(typed, Dimension::PRESSURE).unwrap_err();
             assert!(
-                err.to_string().contains(&format!("did you mean \"{meant}\"?")),
+                err.to_string()
+                    .contains(&format!("did you mean \"{meant}\"?")),
                 "{typed}: {err}"
             );
         }
