@@ -179,7 +179,12 @@ mod tests {
         let error = job
             .run_points(job.meta(), 1..2, &Control::default())
             .unwrap_err();
-        assert!(error.to_string().starts_with("points[1]: "), "{error}");
+        assert!(
+            error
+                .to_string()
+                .starts_with("points[1] (R = 25 nm, P = 1 mN, V = 4 nm/s): "),
+            "{error}"
+        );
     }
 
     #[test]

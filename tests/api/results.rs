@@ -92,10 +92,33 @@ async fn a_sweep_answers_every_point_it_can_and_names_the_refused_ones() {
     // Asked to, the sweep fails at the first refusal, naming the point.
     let failing = json!({"on_refusal": "fail", "vary": {"load": ["1 nN", "1 mN"]}});
     let refused = problem(app.post("/v1/sweeps", &failing).await, 422).await;
-    assert!(refused["detail"]
+    let detail = refused["detail"].as_str().unwrap();
+    // Named by its index and its inputs, in the units of their magnitude (issue 52).
+    assert!(
+        detail.starts_with("points[1] (R = 25 nm, P = 1 mN, V = 4 nm/s): "),
+        "{detail}"
+    );
+    // As a job it fails, and keeps the points before the refusal, as a cancel does.
+    let job = json!({"kind": "sweep", "input": failing});
+    let location = app.submit(&job).await;
+    let job = app
+        .wait_for_job(&location, |j| j["status"] == "failed")
+        .await;
+    assert_eq!(job["partial"], true, "{job}");
+    assert!(job["problem"]["detail"]
         .as_str()
         .unwrap()
-        .starts_with("points[1]: "));
+        .starts_with("points[1] (R = 25 nm"));
+    let partial = app.result(&job).await;
+    let statuses: Vec<&Value> = partial["points"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| &p["status"])
+        .collect();
+    assert_eq!(statuses.len(), 2);
+    assert!(statuses[0] == "ok" || statuses[0] == "warn", "{statuses:?}");
+    assert_eq!(statuses[1], "missing");
 }
 
 #[tokio::test]

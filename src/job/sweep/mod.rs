@@ -13,6 +13,7 @@ use serde::{Deserialize, Serialize};
 use serde_json::{json, Value};
 use utoipa::ToSchema;
 
+use super::input::units::with_prefix;
 use super::input::LayerModel;
 use super::input::{self, field, Checker, Field, Quantity};
 use super::kind::SMALL_ANSWER;
@@ -290,7 +291,16 @@ impl Kind for SweepJob {
                     );
                     control.map_each(&contacts, on_refusal, |p| SweepPoint::new(p, &kept(p)?))
                 };
-                let swept = refused_at(swept, first, on_refusal)?;
+                let name = |i: usize| {
+                    let p = &contacts[i];
+                    format!(
+                        "R = {}, P = {}, V = {}",
+                        with_prefix(p.radius, "m"),
+                        with_prefix(p.load, "N"),
+                        with_prefix(p.velocity, "m/s")
+                    )
+                };
+                let swept = refused_at(swept, first, on_refusal, name);
                 let stop = swept.stopped.clone();
                 let (rows, summary) = rows::rows(&contacts, swept, first, Subject::Particle);
                 (SweepPoints::Rolling(rows), summary, stop)
@@ -312,7 +322,16 @@ impl Kind for SweepJob {
                 let swept = control.map_each(&systems, on_refusal, |p| {
                     ThreeBodySweepPoint::new(p, &kept(p)?)
                 });
-                let swept = refused_at(swept, first, on_refusal)?;
+                let name = |i: usize| {
+                    let system = &systems[i];
+                    let operating = match system.operating {
+                        OperatingPoint::Separation(d) => format!("d = {}", with_prefix(d, "m")),
+                        OperatingPoint::TotalLoad(w) => format!("W = {}", with_prefix(w, "N")),
+                        OperatingPoint::ParticleLoad(p) => format!("P = {}", with_prefix(p, "N")),
+                    };
+                    format!("{operating}, V = {}", with_prefix(system.velocity, "m/s"))
+                };
+                let swept = refused_at(swept, first, on_refusal, name);
                 let stop = swept.stopped.clone();
                 let (rows, summary) = rows::rows(&systems, swept, first, Subject::System);
                 (SweepPoints::ThreeBody(rows), summary, stop)
@@ -341,19 +360,22 @@ fn point_key<K: Kind>(point: &K) -> String {
     )
 }
 
-/// A sweep that stopped at a refusal (`on_refusal: fail`) fails with it, the point named by
-/// its index in the whole sweep; otherwise what became of its points.
+/// A sweep asked to stop at a refusal (`on_refusal: fail`) fails with it, the point named by
+/// its index in the whole sweep and its inputs (`name`, by index in this part); it keeps the
+/// points before it, as a cancel keeps what it finished, and those from it on are missing.
 fn refused_at<R>(
     mut swept: Swept<R, JobError>,
     first: usize,
     on_refusal: OnRefusal,
-) -> Result<Swept<R, JobError>, JobError> {
+    name: impl Fn(usize) -> String,
+) -> Swept<R, JobError> {
     if on_refusal == OnRefusal::Fail && swept.stopped.is_none() {
         if let Some((i, e)) = swept.take_first_refusal() {
-            return Err(at_point(first + i, e));
+            swept.outcomes[i..].iter_mut().for_each(|o| *o = None);
+            swept.stopped = Some(at_point(first + i, &name(i), e));
         }
     }
-    Ok(swept)
+    swept
 }
 
 /// The points `range` of `points`.
@@ -368,11 +390,12 @@ fn part<T>(mut points: Vec<T>, range: Range<usize>) -> Result<Vec<T>, JobError> 
     Ok(points.split_off(range.start))
 }
 
-/// The error of point `index` of a sweep, said so.
-fn at_point(index: usize, e: JobError) -> JobError {
+/// The error of point `index` of a sweep, whose inputs are `name`, said so.
+fn at_point(index: usize, name: &str, e: JobError) -> JobError {
+    let at = |m: String| format!("points[{index}] ({name}): {m}");
     match e {
-        JobError::OutOfDomain(m) => JobError::OutOfDomain(format!("points[{index}]: {m}")),
-        JobError::Unsolvable(m) => JobError::Unsolvable(format!("points[{index}]: {m}")),
+        JobError::OutOfDomain(m) => JobError::OutOfDomain(at(m)),
+        JobError::Unsolvable(m) => JobError::Unsolvable(at(m)),
         other => other,
     }
 }
