@@ -34,7 +34,7 @@ pub enum Format {
 
 impl Format {
     /// Every format, in the service's order of preference (the first when the client
-    /// accepts any).
+    /// accepts any), which is also the variants' (the tables below are in it).
     pub const ALL: [Format; 3] = [Format::Json, Format::Csv, Format::Svg];
 
     /// The format named `name` (`json`, `csv`, `svg`), as a `?format=` query gives it.
@@ -44,28 +44,19 @@ impl Format {
 
     /// The format's short name, also the extension of a file of it.
     pub fn name(self) -> &'static str {
-        match self {
-            Format::Json => "json",
-            Format::Csv => "csv",
-            Format::Svg => "svg",
-        }
+        ["json", "csv", "svg"][self as usize]
     }
 
     /// The media type a client names in `Accept`.
     pub fn media_type(self) -> &'static str {
-        match self {
-            Format::Json => "application/json",
-            Format::Csv => "text/csv",
-            Format::Svg => "image/svg+xml",
-        }
+        ["application/json", "text/csv", "image/svg+xml"][self as usize]
     }
 
     /// The `Content-Type` of an answer in this format.
     pub fn content_type(self) -> &'static str {
         match self {
-            Format::Json => "application/json",
             Format::Csv => "text/csv; charset=utf-8; header=present",
-            Format::Svg => "image/svg+xml",
+            _ => self.media_type(),
         }
     }
 
@@ -203,12 +194,12 @@ impl Answer {
     /// The answer in `format`: compact JSON, CSV, or its picture.
     pub fn render(&self, format: Format) -> Result<Vec<u8>, RenderError> {
         match format {
-            Format::Json => self.json(false),
+            Format::Json => self.0.json(false),
             Format::Svg => {
                 let draw = self
                     .1
                     .ok_or_else(|| RenderError::new("this answer has no picture"))?;
-                let json = self.json(false)?;
+                let json = self.0.json(false)?;
                 draw_svg(draw, &json).map(String::into_bytes)
             }
             Format::Csv => self
@@ -221,13 +212,8 @@ impl Answer {
 
     /// Indented JSON, for people reading a terminal.
     pub fn to_pretty_json(&self) -> Result<String, RenderError> {
-        let json = self.json(true)?;
+        let json = self.0.json(true)?;
         String::from_utf8(json).map_err(|e| RenderError(e.to_string()))
-    }
-
-    /// The answer as JSON; a non-finite number in it is an error ([`json::write`]).
-    fn json(&self, pretty: bool) -> Result<Vec<u8>, RenderError> {
-        self.0.json(pretty)
     }
 
     /// The answer's table (the rows of its CSV).
@@ -262,7 +248,7 @@ impl Answer {
 /// not finite) equals none.
 impl PartialEq for Answer {
     fn eq(&self, other: &Answer) -> bool {
-        match (self.json(false), other.json(false)) {
+        match (self.0.json(false), other.0.json(false)) {
             (Ok(a), Ok(b)) => a == b,
             _ => false,
         }
@@ -272,7 +258,7 @@ impl PartialEq for Answer {
 /// Writes the answer's JSON (for serde_json serializers: it goes in as raw JSON).
 impl Serialize for Answer {
     fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
-        let json = self.json(false).map_err(serde::ser::Error::custom)?;
+        let json = self.0.json(false).map_err(serde::ser::Error::custom)?;
         let text = String::from_utf8(json).map_err(serde::ser::Error::custom)?;
         let raw = RawValue::from_string(text).map_err(serde::ser::Error::custom)?;
         raw.serialize(s)
