@@ -42,13 +42,14 @@ pub struct Column<R> {
 }
 
 impl<R> Column<R> {
+    const fn new(name: &'static str, unit: &'static str, read: Read<R>) -> Self {
+        let name = Cow::Borrowed(name);
+        Column { name, unit, read }
+    }
+
     /// A column of quantities in `unit` (SI; "" for a plain number).
     pub const fn number(name: &'static str, unit: &'static str, read: fn(&R) -> f64) -> Self {
-        Column {
-            name: Cow::Borrowed(name),
-            unit,
-            read: Read::Number(read),
-        }
+        Self::new(name, unit, Read::Number(read))
     }
 
     /// A column of quantities that some rows do not have (their cell is empty).
@@ -57,38 +58,28 @@ impl<R> Column<R> {
         unit: &'static str,
         read: fn(&R) -> Option<f64>,
     ) -> Self {
-        Column {
-            name: Cow::Borrowed(name),
-            unit,
-            read: Read::Optional(read),
-        }
+        Self::new(name, unit, Read::Optional(read))
     }
 
     /// A column of counts or indices.
     pub const fn count(name: &'static str, read: fn(&R) -> usize) -> Self {
-        Column {
-            name: Cow::Borrowed(name),
-            unit: "",
-            read: Read::Count(read),
-        }
+        Self::new(name, "", Read::Count(read))
     }
 
     /// A column of text, which `write` appends to the string it is given.
     pub const fn text(name: &'static str, write: fn(&R, &mut String)) -> Self {
-        Column {
-            name: Cow::Borrowed(name),
-            unit: "",
-            read: Read::Text(write),
-        }
+        Self::new(name, "", Read::Text(write))
     }
 
     /// A column of numbers named `name`, in `unit`, that `read` gives (empty where `None`).
     pub fn read(name: String, unit: &'static str, read: Reader<R>) -> Self {
-        Column {
-            name: Cow::Owned(name),
-            unit,
-            read: Read::Field(read),
-        }
+        let (name, read) = (Cow::Owned(name), Read::Field(read));
+        Column { name, unit, read }
+    }
+
+    fn heading(&self) -> Heading {
+        let (name, unit) = (self.name.to_string(), Cow::Borrowed(self.unit));
+        Heading { name, unit }
     }
 
     /// The cell of `row` as a number, if it is one (a quantity present, or a count).
@@ -145,13 +136,7 @@ impl Table {
     /// The table of `rows` under `columns`.
     pub fn new<'a, R: 'a>(columns: &[Column<R>], rows: impl IntoIterator<Item = &'a R>) -> Table {
         Table {
-            headings: columns
-                .iter()
-                .map(|c| Heading {
-                    name: c.name.to_string(),
-                    unit: Cow::Borrowed(c.unit),
-                })
-                .collect(),
+            headings: columns.iter().map(Column::heading).collect(),
             rows: rows
                 .into_iter()
                 .map(|row| columns.iter().map(|c| c.cell(row)).collect())
@@ -187,14 +172,7 @@ impl Table {
 /// for an answer of many rows (a sweep's) the table's cells, a vector per row and a string
 /// per text, cost more than writing them.
 pub fn csv<'a, R: 'a>(columns: &[Column<R>], rows: &'a [R]) -> Option<String> {
-    let labels = columns.iter().map(|c| {
-        Heading {
-            name: c.name.to_string(),
-            unit: Cow::Borrowed(c.unit),
-        }
-        .label()
-    });
-    let mut csv = Csv::new(labels, rows.len());
+    let mut csv = Csv::new(columns.iter().map(|c| c.heading().label()), rows.len());
     let mut text = String::new();
     for row in rows {
         for (i, column) in columns.iter().enumerate() {
@@ -224,16 +202,8 @@ struct Csv {
 impl Csv {
     /// The header line of `labels`, room for `rows` rows.
     fn new(labels: impl Iterator<Item = String>, rows: usize) -> Csv {
-        let mut text = String::new();
-        let mut columns = 0;
-        for label in labels {
-            if columns > 0 {
-                text.push(',');
-            }
-            text.push_str(&label);
-            columns += 1;
-        }
-        text.push('\n');
+        let labels: Vec<String> = labels.collect();
+        let (mut text, columns) = (labels.join(",") + "\n", labels.len());
         // About 24 bytes a cell (a number of 17 digits and its exponent).
         text.reserve(24 * columns.max(1) * rows);
         Csv {
