@@ -1,7 +1,6 @@
-//! Every answer leaves through here: as JSON, or as a CSV table built from the columns its
-//! output declares once. The job layer defines the answers ([`Output`]); the HTTP service
-//! and the command line choose a [`Format`] ([`negotiate`] for HTTP) and render an
-//! [`Answer`] into bytes.
+//! Every answer leaves through here, as JSON, CSV or SVG. The job layer defines the answers
+//! ([`Output`]); the HTTP service and the command line choose a [`Format`] ([`negotiate`] for
+//! HTTP) and render an [`Answer`] into bytes.
 
 pub mod fields;
 pub mod fixed;
@@ -11,7 +10,7 @@ mod number;
 pub mod svg;
 mod table;
 
-use std::any::Any;
+use std::any::{Any, TypeId};
 use std::fmt;
 
 use serde::{Serialize, Serializer};
@@ -23,7 +22,6 @@ pub use negotiate::negotiate;
 pub use number::format_number;
 pub use table::{csv, Cell, Column, Heading, Table};
 
-/// The forms an answer can take.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Format {
     Json,
@@ -60,11 +58,9 @@ impl Format {
         }
     }
 
-    /// `text`, an answer in this format, with the provenance `line` (where the answer comes
-    /// from, [`crate::job::Meta::provenance`]) where the format has room for it and still
-    /// parses: CSV as a first `#` line (the comment readers such as pandas' `comment="#"`
-    /// skip), SVG as an XML comment after any XML declaration, JSON not at all (its `meta`
-    /// holds the same and more).
+    /// `text` with the provenance `line` ([`crate::job::Meta::provenance`]) where the format
+    /// still parses: CSV as a first `#` line (pandas' `comment="#"` skips it), SVG as an XML
+    /// comment after any XML declaration, JSON not at all (its `meta` holds more).
     pub fn with_provenance(self, text: String, line: &str) -> String {
         match self {
             Format::Json => text,
@@ -138,12 +134,11 @@ pub trait Output: Serialize + fmt::Debug + Send + Sync + 'static {
 }
 
 /// What [`Answer`] needs of an output, object-safe.
-trait Render: fmt::Debug + Send + Sync {
+trait Render: Any + fmt::Debug + Send + Sync {
     fn json(&self, pretty: bool) -> Result<Vec<u8>, RenderError>;
     fn table(&self) -> Table;
     fn csv(&self) -> Option<String>;
     fn notice(&self) -> Option<String>;
-    fn as_any(&self) -> &dyn Any;
     fn into_any(self: Box<Self>) -> Box<dyn Any>;
 }
 
@@ -162,10 +157,6 @@ impl<T: Output> Render for T {
 
     fn notice(&self) -> Option<String> {
         Output::notice(self)
-    }
-
-    fn as_any(&self) -> &dyn Any {
-        self
     }
 
     fn into_any(self: Box<Self>) -> Box<dyn Any> {
@@ -226,21 +217,13 @@ impl Answer {
         self.0.notice()
     }
 
-    /// The output, if it is a `T`.
-    pub fn downcast_ref<T: Output>(&self) -> Option<&T> {
-        self.0.as_any().downcast_ref()
-    }
-
     /// The output, if it is a `T`; else the answer back.
     pub fn downcast<T: Output>(self) -> Result<T, Answer> {
-        if self.downcast_ref::<T>().is_none() {
+        if (*self.0).type_id() != TypeId::of::<T>() {
             return Err(self);
         }
-        Ok(*self
-            .0
-            .into_any()
-            .downcast()
-            .expect("the type was checked above"))
+        let any = self.0.into_any();
+        Ok(*any.downcast().expect("the type was checked above"))
     }
 }
 
