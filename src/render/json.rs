@@ -14,10 +14,8 @@ use super::RenderError;
 /// `value` as JSON: compact, or with `pretty` one field or list element a line ([`Rows`]).
 /// A non-finite number is an error, never the `null` serde_json would write for it: the
 /// model promises never to return one, and a client must not read `null` as a value.
-///
-/// Compact JSON starts in the room of the thread's last compact answer: written into a fresh
-/// vector, a 7 kB rolling answer grew through seven reallocations and their copies
-/// (BENCHMARKS.md, issue 12), and the next answer is most often of the same kind and size.
+/// Compact JSON starts in the room of the thread's last (the next answer is most often of the
+/// same kind and size): from nothing, a 7 kB answer took seven reallocations (issue 12).
 pub(super) fn write<T: Serialize + ?Sized>(
     value: &T,
     pretty: bool,
@@ -58,14 +56,10 @@ thread_local! {
     static LAST: Cell<usize> = const { Cell::new(0) };
 }
 
-/// serde_json writes `null` for a NaN or an infinity; the answers hold no other `null`
-/// (absent options are skipped), so meeting one, written or in JSON the answer embeds
-/// already written (its canonical input, fixed texts, a part of a sweep), stops the writing.
+/// serde_json writes `null` for a NaN or an infinity; the answers hold no other (absent options
+/// are skipped), so one, written or in JSON embedded already written, stops the writing.
 fn refuse_null() -> io::Result<()> {
-    Err(io::Error::new(
-        io::ErrorKind::InvalidData,
-        "a non-finite number",
-    ))
+    Err(io::Error::other("a non-finite number"))
 }
 
 /// Whether JSON text holds a `null` value. Outside strings the letter `n` can only start
@@ -96,9 +90,8 @@ fn has_null(json: &[u8]) -> bool {
     false
 }
 
-/// JSON for people: objects indented a field a line, as `serde_json`'s pretty form, but each
-/// element of a list on one line of its own. A sweep then reads a point a line (a table, as
-/// in its CSV) rather than twenty lines a point, and is written in a quarter less time.
+/// JSON for people: objects a field a line, each element of a list on one line of its own: a
+/// sweep reads a point a line rather than twenty, and is written in a quarter less time.
 #[derive(Default)]
 struct Rows {
     /// Indentation of the innermost indented container.

@@ -10,11 +10,9 @@ pub fn format_number(x: f64) -> String {
     text
 }
 
-/// [`format_number`] appended to `out`, as `{}` writes a plain number and `{:e}` a
-/// scientific one. The shortest round-trip digits come from `zmij` (Schubfach; serde_json's
-/// formatter, ~20 ns a number where `ryu` took ~29), in its text where that is already this
-/// layout (most numbers), else laid out here byte by byte: through `format!` a number cost
-/// about 100 ns and an allocation, and a sweep's CSV is mostly numbers.
+/// [`format_number`] appended to `out`, laid out as `{}` and `{:e}` would, from the shortest
+/// digits of `zmij` (Schubfach, ~20 ns a number where `ryu` took ~29): through `format!` a
+/// number cost about 100 ns and an allocation, and a sweep's CSV is mostly numbers.
 pub fn write_number(out: &mut String, x: f64) {
     if x == 0.0 || !x.is_finite() {
         // "0", "-0", "inf", "NaN": as `{}` writes them.
@@ -99,9 +97,8 @@ mod tests {
         }
     }
 
-    /// `format_number` reads back as `x`, is as short as `format!`'s text and laid out as it
-    /// is. Where 17 digits are needed, `zmij` and the standard library may end in different
-    /// digits, both reading back as `x` (1 in about 20,000 random doubles).
+    /// `format_number` reads back as `x`, laid out as `format!` does; with 17 digits, `zmij` and
+    /// `format!` may end in different digits, both reading back as `x` (1 in 20,000 doubles).
     fn check(x: f64) -> Result<(), TestCaseError> {
         let (ours, theirs) = (format_number(x), through_format(x));
         if !x.is_nan() {
