@@ -1,7 +1,6 @@
-//! Outputs that describe themselves. Each numeric field of an answer is declared once, in
-//! its struct, with its unit and (if it is one) its CSV column ([`described!`]); the
-//! answer's unit table (`meta.units`) and its CSV columns are both made from that one
-//! declaration, so a field cannot be added, renamed or moved without both following.
+//! Outputs that describe themselves: each numeric field is declared once with its unit and CSV
+//! column, if any ([`described!`]); the unit table (`meta.units`) and the CSV columns are both
+//! made from it, so a field cannot be added, renamed or moved without both following.
 
 use std::collections::BTreeMap;
 use std::fmt;
@@ -46,8 +45,7 @@ impl<T: 'static> Field<T> {
         }]
     }
 
-    /// A number (or numbers: `path` ends in `[]` for a list) at `path`, in `unit`, which is
-    /// no column.
+    /// A number (or numbers: `path` ends in `[]` for a list) at `path`, in `unit`, no column.
     pub fn unit(path: &str, unit: &'static str) -> Vec<Field<T>> {
         Self::paths(path, [(String::new(), unit)])
     }
@@ -115,8 +113,7 @@ fn under(key: &str, path: &str) -> String {
     }
 }
 
-/// What a list or an option holds (so that `[each]` can name the element type of the
-/// field's `Vec`).
+/// What a list or an option holds (the element type that `[each]` names).
 pub trait Element {
     type Item;
 }
@@ -154,7 +151,6 @@ impl UnitGroups {
         UnitGroups(LazyLock::new(build))
     }
 
-    /// Path → unit.
     pub fn get(&self) -> &BTreeMap<String, &'static str> {
         &self.0
     }
@@ -214,6 +210,7 @@ macro_rules! described {
             fn fields() -> Vec<$crate::render::Field<Self>> {
                 let mut fields: Vec<$crate::render::Field<Self>> = Vec::new();
                 $(
+                    #[allow(unused_variables)] // by the arms that flatten
                     let key = $crate::render::fields::key(stringify!($field));
                     fields.extend($crate::described!(@how key, $field, $ty, $($how)*));
                 )*
@@ -221,10 +218,9 @@ macro_rules! described {
             }
         }
     };
-    (@how $key:ident, $field:ident, $ty:ty, ) => {{
-        let _ = $key;
+    (@how $key:ident, $field:ident, $ty:ty, ) => {
         Vec::<$crate::render::Field<Self>>::new()
-    }};
+    };
     (@how $key:ident, $field:ident, $ty:ty, number $unit:literal) => {
         $crate::render::Field::column($key, $unit, |s: &Self| Some(s.$field))
     };
@@ -250,14 +246,12 @@ macro_rules! described {
             s.$field.as_ref()
         })
     };
-    (@how $key:ident, $field:ident, $ty:ty, flatten) => {{
-        let _ = $key;
+    (@how $key:ident, $field:ident, $ty:ty, flatten) => {
         $crate::render::Field::nested("", Some(""), |s: &Self| Some(&s.$field))
-    }};
-    (@how $key:ident, $field:ident, $ty:ty, optional flatten) => {{
-        let _ = $key;
+    };
+    (@how $key:ident, $field:ident, $ty:ty, optional flatten) => {
         $crate::render::Field::nested("", Some(""), |s: &Self| s.$field.as_ref())
-    }};
+    };
     (@how $key:ident, $field:ident, $ty:ty, in $unit:literal) => {
         $crate::render::Field::<Self>::nested_in::<$ty>($key, $unit)
     };
@@ -269,10 +263,9 @@ macro_rules! described {
     (@how $key:ident, $field:ident, $ty:ty, by $paths:expr) => {
         $crate::render::Field::<Self>::paths($key, $paths)
     };
-    (@how $key:ident, $field:ident, $ty:ty, flatten by $paths:expr) => {{
-        let _ = $key;
+    (@how $key:ident, $field:ident, $ty:ty, flatten by $paths:expr) => {
         $crate::render::Field::<Self>::paths("", $paths)
-    }};
+    };
     (@how $key:ident, $field:ident, $ty:ty, each) => {
         $crate::render::Field::<Self>::each::<<$ty as $crate::render::fields::Element>::Item>($key)
     };

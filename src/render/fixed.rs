@@ -1,7 +1,6 @@
-//! The fixed parts of answers: what is the same in every answer of a kind (its references,
-//! its unit table, an assumption in words), kept in a `static` together with its JSON,
-//! rendered once on first use. Building and escaping them again for every answer made up
-//! about a quarter of rendering one.
+//! The parts of answers the same in every answer of a kind (references, the unit table, an
+//! assumption in words), in a `static` with their JSON rendered on first use: building and
+//! escaping them for every answer made up about a quarter of rendering one.
 
 use std::fmt;
 use std::sync::OnceLock;
@@ -25,27 +24,20 @@ impl<T> Fixed<T> {
         }
     }
 
-    /// The value itself.
     pub fn get(&self) -> &T {
         &self.value
     }
 }
 
-impl<T: Serialize> Fixed<T> {
-    /// The JSON, rendered at the first call (two threads meeting it at once may both
-    /// render it; one copy then goes unused, once).
-    fn json(&self) -> serde_json::Result<&RawValue> {
-        if let Some(json) = self.json.get() {
-            return Ok(json);
-        }
-        let rendered = serde_json::value::to_raw_value(&self.value)?;
-        Ok(self.json.get_or_init(|| rendered))
-    }
-}
-
+/// The JSON, rendered at the first use (two threads meeting it at once may both render it;
+/// one copy then goes unused, once).
 impl<T: Serialize> Serialize for Fixed<T> {
     fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
-        self.json().map_err(S::Error::custom)?.serialize(s)
+        if let Some(json) = self.json.get() {
+            return json.serialize(s);
+        }
+        let rendered = serde_json::value::to_raw_value(&self.value).map_err(S::Error::custom)?;
+        self.json.get_or_init(|| rendered).serialize(s)
     }
 }
 
@@ -67,9 +59,8 @@ pub type Text = Fixed<&'static str>;
 /// The unit table of an output kind ([`super::Output::UNITS`]).
 pub type UnitTable = Fixed<super::UnitGroups>;
 
-/// The unit table of output type `$output` ([`super::Output::UNITS`]), made from its
-/// [`super::Fields`] on first use, as a `static` of its own, so that its JSON is rendered
-/// once: `const UNITS: &'static UnitTable = unit_table!(RollingOutput);`.
+/// The unit table of `$output`, a `static` of its own so that its JSON is rendered once:
+/// `const UNITS: &'static UnitTable = unit_table!(RollingOutput);`.
 #[macro_export]
 macro_rules! unit_table {
     ($output:ty) => {{
@@ -84,18 +75,14 @@ macro_rules! unit_table {
 mod tests {
     use super::*;
     use crate::render::UnitGroups;
-    use std::collections::BTreeMap;
-
-    fn units() -> BTreeMap<String, &'static str> {
-        [("b", "m"), ("a", "")]
-            .into_iter()
-            .map(|(path, unit)| (path.to_string(), unit))
-            .collect()
-    }
 
     static SHORT: Fixed<&[u32]> = Fixed::new(&[1, 2]);
     static LONG: Fixed<&[u32]> = Fixed::new(&[1, 2, 3]);
-    static UNITS: UnitTable = Fixed::new(UnitGroups::new(units));
+    static UNITS: UnitTable = Fixed::new(UnitGroups::new(|| {
+        [("b", "m"), ("a", "")]
+            .map(|(path, unit)| (path.to_string(), unit))
+            .into()
+    }));
 
     /// Rendered once, a fixed part still matches a direct rendering on every later use, and
     /// two statics whose values share a prefix stay apart.

@@ -14,28 +14,41 @@ use super::RenderError;
 /// `value` as JSON: compact, or with `pretty` one field or list element a line ([`Rows`]).
 /// A non-finite number is an error, never the `null` serde_json would write for it: the
 /// model promises never to return one, and a client must not read `null` as a value.
+/// Compact JSON starts in the room of the thread's last (the next answer is most often of the
+/// same kind and size): from nothing, a 7 kB answer took seven reallocations (issue 12).
 pub(super) fn write<T: Serialize + ?Sized>(
     value: &T,
     pretty: bool,
 ) -> Result<Vec<u8>, RenderError> {
-    let written = match pretty {
-        true => {
-            let mut json = Vec::with_capacity(PRETTY_ROOM);
-            value
-                .serialize(&mut serde_json::Serializer::with_formatter(
-                    &mut json,
-                    Rows::default(),
-                ))
-                .map(|()| json)
-        }
-        false => compact(value),
+    let last = LAST.get();
+    let room = if pretty {
+        64 << 10
+    } else {
+        last + last / 16 + 64
     };
-    written.map_err(|e| match e.is_io() {
-        // The writer is a vector, which never fails: the error is the formatter's refusal
-        // of a null.
-        true => RenderError::non_finite(),
-        false => RenderError(format!("cannot write the result: {e}")),
-    })
+    let mut json = Vec::with_capacity(room);
+    // Rows inside a one-line container write serde_json's compact text.
+    let rows = Rows {
+        inline: usize::from(!pretty),
+        ..Rows::default()
+    };
+    let mut serializer = serde_json::Serializer::with_formatter(&mut json, rows);
+    value
+        .serialize(&mut serializer)
+        .map_err(|e| match e.is_io() {
+            // The writer is a vector, which never fails: the error is the formatter's refusal
+            // of a null.
+            true => RenderError::non_finite(),
+            false => RenderError(format!("cannot write the result: {e}")),
+        })?;
+    if !pretty {
+        LAST.set(json.len());
+        // A small answer after a large one does not keep the large one's room.
+        if json.capacity() > json.len() + json.len() / 8 + 64 {
+            json.shrink_to_fit();
+        }
+    }
+    Ok(json)
 }
 
 thread_local! {
@@ -43,60 +56,10 @@ thread_local! {
     static LAST: Cell<usize> = const { Cell::new(0) };
 }
 
-/// The room a pretty answer (for a terminal, written once) starts with.
-const PRETTY_ROOM: usize = 64 << 10;
-
-/// `value` as compact JSON, in a vector of the room of the thread's last answer: written
-/// into a fresh vector, a 7 kB rolling answer grew through seven reallocations and their
-/// copies (BENCHMARKS.md, issue 12), and the next answer is most often of the same kind and
-/// size.
-fn compact<T: Serialize + ?Sized>(value: &T) -> serde_json::Result<Vec<u8>> {
-    let last = LAST.get();
-    let mut json = Vec::with_capacity(last + last / 16 + 64);
-    value.serialize(&mut serde_json::Serializer::with_formatter(
-        &mut json, Strict,
-    ))?;
-    LAST.set(json.len());
-    // A small answer after a large one does not keep the large one's room.
-    if json.capacity() > json.len() + json.len() / 8 + 64 {
-        json.shrink_to_fit();
-    }
-    Ok(json)
-}
-
-/// serde_json's compact text, with `null` refused (written or embedded).
-struct Strict;
-
-impl Formatter for Strict {
-    fn write_null<W: ?Sized + Write>(&mut self, _: &mut W) -> io::Result<()> {
-        refuse_null()
-    }
-
-    fn write_raw_fragment<W: ?Sized + Write>(
-        &mut self,
-        w: &mut W,
-        fragment: &str,
-    ) -> io::Result<()> {
-        write_raw(w, fragment)
-    }
-}
-
-/// serde_json writes `null` for a NaN or an infinity; the answers hold no other `null`
-/// (absent options are skipped), so meeting one stops the writing.
+/// serde_json writes `null` for a NaN or an infinity; the answers hold no other (absent options
+/// are skipped), so one, written or in JSON embedded already written, stops the writing.
 fn refuse_null() -> io::Result<()> {
-    Err(io::Error::new(
-        io::ErrorKind::InvalidData,
-        "a non-finite number",
-    ))
-}
-
-/// Writes JSON the answer embeds already written (its canonical input, fixed texts, a part
-/// of a sweep), refusing it if it holds a `null` as [`refuse_null`] does.
-fn write_raw<W: ?Sized + Write>(w: &mut W, fragment: &str) -> io::Result<()> {
-    if has_null(fragment.as_bytes()) {
-        return refuse_null();
-    }
-    w.write_all(fragment.as_bytes())
+    Err(io::Error::other("a non-finite number"))
 }
 
 /// Whether JSON text holds a `null` value. Outside strings the letter `n` can only start
@@ -127,9 +90,8 @@ fn has_null(json: &[u8]) -> bool {
     false
 }
 
-/// JSON for people: objects indented a field a line, as `serde_json`'s pretty form, but each
-/// element of a list on one line of its own. A sweep then reads a point a line (a table, as
-/// in its CSV) rather than twenty lines a point, and is written in a quarter less time.
+/// JSON for people: objects a field a line, each element of a list on one line of its own: a
+/// sweep reads a point a line rather than twenty, and is written in a quarter less time.
 #[derive(Default)]
 struct Rows {
     /// Indentation of the innermost indented container.
@@ -186,12 +148,30 @@ impl Rows {
         }
         Ok(())
     }
+}
 
-    fn valued(&mut self) {
-        if self.inline == 0 {
-            self.has_value = true;
+/// The four methods of a kind of container (lists and objects are written alike).
+macro_rules! container {
+    ($list:literal, $begin:ident, $end:ident, $before:ident, $after:ident) => {
+        fn $begin<W: ?Sized + Write>(&mut self, w: &mut W) -> io::Result<()> {
+            self.open(w, $list)
         }
-    }
+
+        fn $end<W: ?Sized + Write>(&mut self, w: &mut W) -> io::Result<()> {
+            self.close(w, $list)
+        }
+
+        fn $before<W: ?Sized + Write>(&mut self, w: &mut W, first: bool) -> io::Result<()> {
+            self.next(w, first)
+        }
+
+        fn $after<W: ?Sized + Write>(&mut self, _: &mut W) -> io::Result<()> {
+            if self.inline == 0 {
+                self.has_value = true;
+            }
+            Ok(())
+        }
+    };
 }
 
 impl Formatter for Rows {
@@ -204,45 +184,29 @@ impl Formatter for Rows {
         w: &mut W,
         fragment: &str,
     ) -> io::Result<()> {
-        write_raw(w, fragment)
+        if has_null(fragment.as_bytes()) {
+            return refuse_null();
+        }
+        w.write_all(fragment.as_bytes())
     }
 
-    fn begin_array<W: ?Sized + Write>(&mut self, w: &mut W) -> io::Result<()> {
-        self.open(w, true)
-    }
-
-    fn end_array<W: ?Sized + Write>(&mut self, w: &mut W) -> io::Result<()> {
-        self.close(w, true)
-    }
-
-    fn begin_array_value<W: ?Sized + Write>(&mut self, w: &mut W, first: bool) -> io::Result<()> {
-        self.next(w, first)
-    }
-
-    fn end_array_value<W: ?Sized + Write>(&mut self, _: &mut W) -> io::Result<()> {
-        self.valued();
-        Ok(())
-    }
-
-    fn begin_object<W: ?Sized + Write>(&mut self, w: &mut W) -> io::Result<()> {
-        self.open(w, false)
-    }
-
-    fn end_object<W: ?Sized + Write>(&mut self, w: &mut W) -> io::Result<()> {
-        self.close(w, false)
-    }
-
-    fn begin_object_key<W: ?Sized + Write>(&mut self, w: &mut W, first: bool) -> io::Result<()> {
-        self.next(w, first)
-    }
+    container!(
+        true,
+        begin_array,
+        end_array,
+        begin_array_value,
+        end_array_value
+    );
+    container!(
+        false,
+        begin_object,
+        end_object,
+        begin_object_key,
+        end_object_value
+    );
 
     fn begin_object_value<W: ?Sized + Write>(&mut self, w: &mut W) -> io::Result<()> {
         w.write_all(if self.inline == 0 { b": " } else { b":" })
-    }
-
-    fn end_object_value<W: ?Sized + Write>(&mut self, _: &mut W) -> io::Result<()> {
-        self.valued();
-        Ok(())
     }
 }
 
@@ -332,20 +296,6 @@ pub(crate) mod tests {
         })
     }
 
-    proptest! {
-        #![proptest_config(ProptestConfig::with_cases(2000))]
-
-        #[test]
-        fn numbers_are_written_as_serde_json_writes_them(xs in numbers()) {
-            let compact = write(&xs, false).unwrap();
-            prop_assert_eq!(&compact, &serde_json::to_vec(&xs).unwrap());
-            // Rows lays out the same text: only white space differs.
-            let pretty = String::from_utf8(write(&xs, true).unwrap()).unwrap();
-            let unspaced: String = pretty.split_whitespace().collect();
-            prop_assert_eq!(unspaced.as_bytes(), &compact[..]);
-        }
-    }
-
     /// Whether `value` holds a `null` anywhere.
     fn holds_null(value: &Value) -> bool {
         match value {
@@ -358,6 +308,17 @@ pub(crate) mod tests {
 
     proptest! {
         #![proptest_config(ProptestConfig::with_cases(2000))]
+
+        #[test]
+        fn numbers_are_written_as_serde_json_writes_them(xs in numbers()) {
+            let compact = write(&xs, false).unwrap();
+            prop_assert_eq!(&compact, &serde_json::to_vec(&xs).unwrap());
+            // Rows lays out the same text: only white space differs.
+            let pretty = String::from_utf8(write(&xs, true).unwrap()).unwrap();
+            let unspaced: String = pretty.split_whitespace().collect();
+            prop_assert_eq!(unspaced.as_bytes(), &compact[..]);
+        }
+
 
         /// Any JSON, as itself and embedded already written: serde_json's text, or refused
         /// if it holds a `null`.

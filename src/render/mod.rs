@@ -1,7 +1,6 @@
-//! Every answer leaves through here: as JSON, or as a CSV table built from the columns its
-//! output declares once. The job layer defines the answers ([`Output`]); the HTTP service
-//! and the command line choose a [`Format`] ([`negotiate`] for HTTP) and render an
-//! [`Answer`] into bytes.
+//! Every answer leaves through here, as JSON, CSV or SVG. The job layer defines the answers
+//! ([`Output`]); the HTTP service and the command line choose a [`Format`] ([`negotiate`] for
+//! HTTP) and render an [`Answer`] into bytes.
 
 pub mod fields;
 pub mod fixed;
@@ -11,7 +10,7 @@ mod number;
 pub mod svg;
 mod table;
 
-use std::any::Any;
+use std::any::{Any, TypeId};
 use std::fmt;
 
 use serde::{Serialize, Serializer};
@@ -23,7 +22,6 @@ pub use negotiate::negotiate;
 pub use number::format_number;
 pub use table::{csv, Cell, Column, Heading, Table};
 
-/// The forms an answer can take.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Format {
     Json,
@@ -34,7 +32,7 @@ pub enum Format {
 
 impl Format {
     /// Every format, in the service's order of preference (the first when the client
-    /// accepts any).
+    /// accepts any), which is also the variants' (the tables below are in it).
     pub const ALL: [Format; 3] = [Format::Json, Format::Csv, Format::Svg];
 
     /// The format named `name` (`json`, `csv`, `svg`), as a `?format=` query gives it.
@@ -44,36 +42,25 @@ impl Format {
 
     /// The format's short name, also the extension of a file of it.
     pub fn name(self) -> &'static str {
-        match self {
-            Format::Json => "json",
-            Format::Csv => "csv",
-            Format::Svg => "svg",
-        }
+        ["json", "csv", "svg"][self as usize]
     }
 
     /// The media type a client names in `Accept`.
     pub fn media_type(self) -> &'static str {
-        match self {
-            Format::Json => "application/json",
-            Format::Csv => "text/csv",
-            Format::Svg => "image/svg+xml",
-        }
+        ["application/json", "text/csv", "image/svg+xml"][self as usize]
     }
 
     /// The `Content-Type` of an answer in this format.
     pub fn content_type(self) -> &'static str {
         match self {
-            Format::Json => "application/json",
             Format::Csv => "text/csv; charset=utf-8; header=present",
-            Format::Svg => "image/svg+xml",
+            _ => self.media_type(),
         }
     }
 
-    /// `text`, an answer in this format, with the provenance `line` (where the answer comes
-    /// from, [`crate::job::Meta::provenance`]) where the format has room for it and still
-    /// parses: CSV as a first `#` line (the comment readers such as pandas' `comment="#"`
-    /// skip), SVG as an XML comment after any XML declaration, JSON not at all (its `meta`
-    /// holds the same and more).
+    /// `text` with the provenance `line` ([`crate::job::Meta::provenance`]) where the format
+    /// still parses: CSV as a first `#` line (pandas' `comment="#"` skips it), SVG as an XML
+    /// comment after any XML declaration, JSON not at all (its `meta` holds more).
     pub fn with_provenance(self, text: String, line: &str) -> String {
         match self {
             Format::Json => text,
@@ -147,12 +134,11 @@ pub trait Output: Serialize + fmt::Debug + Send + Sync + 'static {
 }
 
 /// What [`Answer`] needs of an output, object-safe.
-trait Render: fmt::Debug + Send + Sync {
+trait Render: Any + fmt::Debug + Send + Sync {
     fn json(&self, pretty: bool) -> Result<Vec<u8>, RenderError>;
     fn table(&self) -> Table;
     fn csv(&self) -> Option<String>;
     fn notice(&self) -> Option<String>;
-    fn as_any(&self) -> &dyn Any;
     fn into_any(self: Box<Self>) -> Box<dyn Any>;
 }
 
@@ -171,10 +157,6 @@ impl<T: Output> Render for T {
 
     fn notice(&self) -> Option<String> {
         Output::notice(self)
-    }
-
-    fn as_any(&self) -> &dyn Any {
-        self
     }
 
     fn into_any(self: Box<Self>) -> Box<dyn Any> {
@@ -203,12 +185,12 @@ impl Answer {
     /// The answer in `format`: compact JSON, CSV, or its picture.
     pub fn render(&self, format: Format) -> Result<Vec<u8>, RenderError> {
         match format {
-            Format::Json => self.json(false),
+            Format::Json => self.0.json(false),
             Format::Svg => {
                 let draw = self
                     .1
                     .ok_or_else(|| RenderError::new("this answer has no picture"))?;
-                let json = self.json(false)?;
+                let json = self.0.json(false)?;
                 draw_svg(draw, &json).map(String::into_bytes)
             }
             Format::Csv => self
@@ -221,13 +203,8 @@ impl Answer {
 
     /// Indented JSON, for people reading a terminal.
     pub fn to_pretty_json(&self) -> Result<String, RenderError> {
-        let json = self.json(true)?;
+        let json = self.0.json(true)?;
         String::from_utf8(json).map_err(|e| RenderError(e.to_string()))
-    }
-
-    /// The answer as JSON; a non-finite number in it is an error ([`json::write`]).
-    fn json(&self, pretty: bool) -> Result<Vec<u8>, RenderError> {
-        self.0.json(pretty)
     }
 
     /// The answer's table (the rows of its CSV).
@@ -240,21 +217,13 @@ impl Answer {
         self.0.notice()
     }
 
-    /// The output, if it is a `T`.
-    pub fn downcast_ref<T: Output>(&self) -> Option<&T> {
-        self.0.as_any().downcast_ref()
-    }
-
     /// The output, if it is a `T`; else the answer back.
     pub fn downcast<T: Output>(self) -> Result<T, Answer> {
-        if self.downcast_ref::<T>().is_none() {
+        if (*self.0).type_id() != TypeId::of::<T>() {
             return Err(self);
         }
-        Ok(*self
-            .0
-            .into_any()
-            .downcast()
-            .expect("the type was checked above"))
+        let any = self.0.into_any();
+        Ok(*any.downcast().expect("the type was checked above"))
     }
 }
 
@@ -262,7 +231,7 @@ impl Answer {
 /// not finite) equals none.
 impl PartialEq for Answer {
     fn eq(&self, other: &Answer) -> bool {
-        match (self.json(false), other.json(false)) {
+        match (self.0.json(false), other.0.json(false)) {
             (Ok(a), Ok(b)) => a == b,
             _ => false,
         }
@@ -272,7 +241,7 @@ impl PartialEq for Answer {
 /// Writes the answer's JSON (for serde_json serializers: it goes in as raw JSON).
 impl Serialize for Answer {
     fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
-        let json = self.json(false).map_err(serde::ser::Error::custom)?;
+        let json = self.0.json(false).map_err(serde::ser::Error::custom)?;
         let text = String::from_utf8(json).map_err(serde::ser::Error::custom)?;
         let raw = RawValue::from_string(text).map_err(serde::ser::Error::custom)?;
         raw.serialize(s)

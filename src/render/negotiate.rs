@@ -23,8 +23,15 @@ impl Range<'_> {
     }
 }
 
-fn ranges<'a>(accept: impl IntoIterator<Item = &'a str>) -> Vec<Range<'a>> {
-    accept
+/// The index in `offered` (the server's order of preference) of the media type the client
+/// prefers, given the values of its `Accept` headers; `None` when it accepts none of them
+/// (the caller answers 406). No `Accept` (or no readable range in it) accepts anything.
+///
+/// Each offered type takes the weight of the most specific range that matches it; the
+/// highest weight wins, then the more specific match, then the range the client listed
+/// first, then the server's order.
+pub fn negotiate<'a>(accept: impl IntoIterator<Item = &'a str>, offered: &[&str]) -> Option<usize> {
+    let ranges: Vec<Range> = accept
         .into_iter()
         .flat_map(|value| value.split(','))
         .enumerate()
@@ -43,18 +50,7 @@ fn ranges<'a>(accept: impl IntoIterator<Item = &'a str>) -> Vec<Range<'a>> {
                 position,
             })
         })
-        .collect()
-}
-
-/// The index in `offered` (the server's order of preference) of the media type the client
-/// prefers, given the values of its `Accept` headers; `None` when it accepts none of them
-/// (the caller answers 406). No `Accept` (or no readable range in it) accepts anything.
-///
-/// Each offered type takes the weight of the most specific range that matches it; the
-/// highest weight wins, then the more specific match, then the range the client listed
-/// first, then the server's order.
-pub fn negotiate<'a>(accept: impl IntoIterator<Item = &'a str>, offered: &[&str]) -> Option<usize> {
-    let ranges = ranges(accept);
+        .collect();
     if ranges.is_empty() {
         return (!offered.is_empty()).then_some(0);
     }
@@ -83,12 +79,8 @@ mod tests {
 
     const OFFERED: [&str; 3] = ["application/json", "text/csv", "image/svg+xml"];
 
-    fn choose(accept: &str) -> Option<&'static str> {
-        negotiate([accept], &OFFERED).map(|i| OFFERED[i])
-    }
-
     #[test]
-    fn the_clients_preference_wins_and_the_servers_order_breaks_ties() {
+    fn the_clients_preference_wins_and_the_servers_order_breaks_ties_or_nothing_is_chosen() {
         for (accept, chosen) in [
             ("text/csv", Some("text/csv")),
             ("text/csv, application/json;q=0.5", Some("text/csv")),
@@ -108,26 +100,17 @@ mod tests {
             // The specific range decides even when a wildcard weighs more.
             ("*/*;q=1, text/csv;q=0.1", Some("application/json")),
             ("*/*;q=0.1, application/json;q=0", Some("text/csv")),
+            // Nothing acceptable.
+            ("text/csv;q=0", None),
+            ("image/png", None),
+            ("text/html", None),
+            ("application/*;q=0, text/plain", None),
         ] {
-            assert_eq!(choose(accept), chosen, "{accept}");
-        }
-    }
-
-    #[test]
-    fn nothing_acceptable_is_none() {
-        for accept in [
-            "text/csv;q=0",
-            "image/png",
-            "text/html",
-            "application/*;q=0, text/plain",
-        ] {
-            assert_eq!(choose(accept), None, "{accept}");
+            let choice = negotiate([accept], &OFFERED).map(|i| OFFERED[i]);
+            assert_eq!(choice, chosen, "{accept}");
         }
         assert_eq!(negotiate(["*/*"], &[]), None);
-    }
-
-    #[test]
-    fn several_header_lines_are_one_list() {
+        // Several header lines are one list.
         let chosen = negotiate(["application/json;q=0.2", "text/csv"], &OFFERED);
         assert_eq!(chosen, Some(1));
     }

@@ -10,11 +10,9 @@ pub fn format_number(x: f64) -> String {
     text
 }
 
-/// [`format_number`] appended to `out`, as `{}` writes a plain number and `{:e}` a
-/// scientific one. The shortest round-trip digits come from `zmij` (Schubfach; serde_json's
-/// formatter, ~20 ns a number where `ryu` took ~29), in its text where that is already this
-/// layout (most numbers), else laid out here byte by byte: through `format!` a number cost
-/// about 100 ns and an allocation, and a sweep's CSV is mostly numbers.
+/// [`format_number`] appended to `out`, laid out as `{}` and `{:e}` would, from the shortest
+/// digits of `zmij` (Schubfach, ~20 ns a number where `ryu` took ~29): through `format!` a
+/// number cost about 100 ns and an allocation, and a sweep's CSV is mostly numbers.
 pub fn write_number(out: &mut String, x: f64) {
     if x == 0.0 || !x.is_finite() {
         // "0", "-0", "inf", "NaN": as `{}` writes them.
@@ -36,105 +34,30 @@ pub fn write_number(out: &mut String, x: f64) {
         let (mantissa, exponent) = text
             .split_once("e+")
             .expect("zmij writes 1e16 up as d.ddde+N");
-        out.push_str(mantissa);
-        out.push('e');
-        out.push_str(exponent);
+        let _ = write!(out, "{mantissa}e{exponent}");
         return;
     }
-    // 1e-5 ≤ |x| < 1e-3 or 1e6 ≤ |x| < 1e16: `zmij`'s plain digits, laid out as `{:e}`.
-    let (digits, exponent) = Digits::of(shortest.format_finite(magnitude).as_bytes());
-    let digits = digits.as_slice();
-    let mut laid = Text::default();
+    // 1e-5 ≤ |x| < 1e-3 or 1e6 ≤ |x| < 1e16: `zmij`'s plain digits ("0.000123",
+    // "1234567.0"), laid out as `{:e}`: x = d₀.d₁d₂… × 10^exponent.
+    let text = shortest.format_finite(magnitude);
+    let significant = text.trim_start_matches(['0', '.']);
+    let leading = text[..text.len() - significant.len()].matches('0').count();
+    let exponent = text.find('.').unwrap_or(text.len()) as i32 - 1 - leading as i32;
+    let mut digits = significant
+        .trim_end_matches(['0', '.'])
+        .chars()
+        .filter(|&c| c != '.');
     if x < 0.0 {
-        laid.push(b'-');
+        out.push('-');
     }
-    laid.push(digits[0]);
-    if digits.len() > 1 {
-        laid.push(b'.');
-        laid.extend(&digits[1..]);
+    out.extend(digits.next());
+    if let Some(second) = digits.next() {
+        out.push('.');
+        out.push(second);
+        out.extend(digits);
     }
-    laid.exponent(exponent);
-    out.push_str(laid.as_str());
-}
-
-/// A number's text while it is laid out.
-struct Text {
-    bytes: [u8; 40],
-    len: usize,
-}
-
-impl Default for Text {
-    fn default() -> Self {
-        Text {
-            bytes: [0; 40],
-            len: 0,
-        }
-    }
-}
-
-impl Text {
-    fn push(&mut self, b: u8) {
-        self.bytes[self.len] = b;
-        self.len += 1;
-    }
-
-    fn extend(&mut self, bytes: &[u8]) {
-        self.bytes[self.len..self.len + bytes.len()].copy_from_slice(bytes);
-        self.len += bytes.len();
-    }
-
-    /// "e" and the exponent, as `{:e}` writes it: no "+", no leading zeros.
-    fn exponent(&mut self, exponent: i32) {
-        self.push(b'e');
-        if exponent < 0 {
-            self.push(b'-');
-        }
-        let e = exponent.unsigned_abs();
-        for (power, written) in [(100, e >= 100), (10, e >= 10), (1, true)] {
-            if written {
-                self.push(b'0' + (e / power % 10) as u8);
-            }
-        }
-    }
-
-    fn as_str(&self) -> &str {
-        std::str::from_utf8(&self.bytes[..self.len]).expect("digits, signs and points are ASCII")
-    }
-}
-
-/// The significant digits of a positive number (no leading or trailing zeros) and the
-/// decimal exponent of the first: x = d₀.d₁d₂… × 10^exponent.
-struct Digits {
-    bytes: [u8; 24],
-    len: usize,
-}
-
-impl Digits {
-    /// From the plain text of a positive finite number: `123.45`, `0.00012`, `1234567.0`.
-    fn of(text: &[u8]) -> (Digits, i32) {
-        let whole = text.iter().position(|&b| b == b'.').unwrap_or(text.len());
-        let mut digits = Digits {
-            bytes: [0; 24],
-            len: 0,
-        };
-        let mut leading = 0;
-        for &b in text.iter().filter(|&&b| b != b'.') {
-            if digits.len == 0 && b == b'0' {
-                leading += 1;
-            } else if digits.len < digits.bytes.len() {
-                digits.bytes[digits.len] = b;
-                digits.len += 1;
-            }
-        }
-        while digits.len > 1 && digits.bytes[digits.len - 1] == b'0' {
-            digits.len -= 1;
-        }
-        (digits, whole as i32 - 1 - leading)
-    }
-
-    fn as_slice(&self) -> &[u8] {
-        &self.bytes[..self.len]
-    }
+    // As `{:e}` writes it: no "+", no leading zeros.
+    let _ = write!(out, "e{exponent}");
 }
 
 #[cfg(test)]
@@ -174,9 +97,8 @@ mod tests {
         }
     }
 
-    /// `format_number` reads back as `x`, is as short as `format!`'s text and laid out as it
-    /// is. Where 17 digits are needed, `zmij` and the standard library may end in different
-    /// digits, both reading back as `x` (1 in about 20,000 random doubles).
+    /// `format_number` reads back as `x`, laid out as `format!` does; with 17 digits, `zmij` and
+    /// `format!` may end in different digits, both reading back as `x` (1 in 20,000 doubles).
     fn check(x: f64) -> Result<(), TestCaseError> {
         let (ours, theirs) = (format_number(x), through_format(x));
         if !x.is_nan() {

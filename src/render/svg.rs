@@ -1,12 +1,12 @@
-//! Pictures of answers as SVG, written by hand: a chart (two axes with ticks and labels in
-//! the units a person reads, a title, a legend) holding lines, markers, filled outlines,
-//! circles and heat maps. Text is left to the viewer's sans-serif font (no font files);
-//! colours are presentation attributes, not `style`, so a page with
+//! Pictures of answers as SVG, written by hand: a chart (axes in the units a person reads, a
+//! title, a legend) of lines, markers, outlines, circles and heat maps. Text is in the viewer's
+//! sans-serif font; colours are attributes, not `style`, so a page with
 //! `Content-Security-Policy: default-src 'self'` can inline the picture.
 
 use std::fmt::Write;
 
 use super::number::format_number;
+use super::table::with_unit;
 use crate::model::text::prefixed;
 
 /// Width and height of every picture (px): readable on a screen and in print.
@@ -17,51 +17,90 @@ const LEFT: f64 = 80.0;
 const TOP: f64 = 50.0;
 const RIGHT: f64 = 230.0;
 const BOTTOM: f64 = 60.0;
+const LEGEND_ROWS: usize = 14;
+const DASH: &str = r#" stroke-dasharray="6 4""#;
 
 /// Colours of successive series (a palette distinguishable by most readers).
 const PALETTE: [&str; 8] = [
     "#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2", "#17becf",
 ];
 
-/// viridis: the colours of more series than [`PALETTE`] has, in their order (a sweep's lines
-/// come in the order of the parameter that tells them apart), readable in grey and by
-/// colour-blind readers.
-const VIRIDIS: [[u8; 3]; 5] = [
-    [68, 1, 84],
-    [59, 82, 139],
-    [33, 145, 140],
-    [94, 201, 98],
-    [253, 231, 37],
-];
+/// viridis (0xRRGGBB): the colours of more series than [`PALETTE`] has, in their order (a
+/// sweep's lines come in the order of the parameter that tells them apart), readable in grey
+/// and by colour-blind readers.
+const VIRIDIS: [u32; 5] = [0x440154, 0x3b528b, 0x21918c, 0x5ec962, 0xfde725];
 
-/// The colours of a chart's series: the palette's while it has one for each group of lines;
-/// beyond it, the lines run along [`VIRIDIS`] in their order, and every other layer takes
-/// its line's colour or, past the lines, dark grey.
-struct Colours {
-    lines: usize,
-    sequential: bool,
+/// The colours of heat maps, from blue (0) to red (1).
+const HEAT: [u32; 5] = [0x313695, 0x74add1, 0xffffbf, 0xf46d43, 0xa50026];
+
+/// The colour at `t` ∈ [0, 1] along `stops`, mixed linearly between the two it falls between.
+fn ramp(stops: &[u32], t: f64) -> String {
+    let position = t.clamp(0.0, 1.0) * (stops.len() - 1) as f64;
+    let i = (position.floor() as usize).min(stops.len() - 2);
+    let f = position - i as f64;
+    let mix = |shift: u32| {
+        let (a, b) = ((stops[i] >> shift) & 0xff, (stops[i + 1] >> shift) & 0xff);
+        let (a, b) = (f64::from(a), f64::from(b));
+        (a + f * (b - a)).round() as u8
+    };
+    format!("#{:02x}{:02x}{:02x}", mix(16), mix(8), mix(0))
 }
 
-impl Colours {
-    /// The colour of the `i`th group of lines.
+/// How successive layers take their colours: lines of one group share one, along [`VIRIDIS`]
+/// when the groups outnumber [`PALETTE`]; other layers go on past the groups met so far (a
+/// fit's measured points take their curve's), dark grey past the lines along viridis.
+struct Palette<'a> {
+    /// Every group of lines, in the order the layers meet them.
+    groups: Vec<&'a str>,
+    sequential: bool,
+    next: usize,
+}
+
+impl<'a> Palette<'a> {
+    fn new(layers: &'a [Layer]) -> Palette<'a> {
+        let mut groups = Vec::new();
+        for layer in layers {
+            if let Layer::Line { group, .. } = layer {
+                if !groups.contains(&group.as_str()) {
+                    groups.push(group.as_str());
+                }
+            }
+        }
+        Palette {
+            sequential: groups.len() > PALETTE.len(),
+            groups,
+            next: 0,
+        }
+    }
+
     fn line(&self, i: usize) -> String {
         if self.sequential {
-            ramp(
-                &VIRIDIS,
-                i as f64 / self.lines.saturating_sub(1).max(1) as f64,
-            )
+            let last = self.groups.len().saturating_sub(1).max(1);
+            ramp(&VIRIDIS, i as f64 / last as f64)
         } else {
             PALETTE[i % PALETTE.len()].to_string()
         }
     }
 
-    /// The colour of the layer that is `i`th in the order of colours, not a line: that of the
-    /// `i`th group of lines when there is one (a fit's measured points beside their curve).
-    fn other(&self, i: usize) -> String {
-        if self.sequential && i >= self.lines {
-            "#444444".to_string()
-        } else {
-            self.line(i)
+    /// The colour of `layer`, the palette moved on past it.
+    fn take(&mut self, layer: &Layer) -> String {
+        match layer {
+            Layer::Line { group, .. } => {
+                let i = self.groups.iter().position(|g| g == group);
+                let i = i.expect("every group was met in new()");
+                self.next = self.next.max(i + 1);
+                self.line(i)
+            }
+            // A heat map has its own colour bar.
+            Layer::Heatmap { .. } => String::new(),
+            _ => {
+                self.next += 1;
+                if self.sequential && self.next > self.groups.len() {
+                    "#444444".to_string()
+                } else {
+                    self.line(self.next - 1)
+                }
+            }
         }
     }
 }
@@ -91,7 +130,6 @@ impl Axis {
     }
 }
 
-/// What a chart draws.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Layer {
     /// A polyline through `points`; lines of one `group` share a colour (a curve at rest
@@ -160,7 +198,6 @@ impl Layer {
     }
 }
 
-/// A chart: title, axes, layers.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Chart {
     pub title: String,
@@ -222,11 +259,11 @@ struct Scale {
 impl Scale {
     /// The values to mark on the axis: powers of ten on a log scale, round steps else.
     fn ticks(&self) -> Vec<f64> {
-        if self.log {
-            log_ticks(self.lo, self.hi)
-        } else {
-            ticks(self.lo, self.hi)
+        if !self.log {
+            return ticks(self.lo, self.hi);
         }
+        let (a, b) = (self.lo.log10().ceil(), self.hi.log10().floor());
+        (a as i32..=b as i32).map(|k| 10f64.powi(k)).collect()
     }
 
     fn at(&self, value: f64) -> f64 {
@@ -241,11 +278,10 @@ impl Scale {
 
 /// The range of `values`, padded a little (and never empty).
 fn range(values: impl Iterator<Item = f64>, log: bool) -> (f64, f64) {
-    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
-    for v in values.filter(|v| v.is_finite() && (!log || *v > 0.0)) {
-        lo = lo.min(v);
-        hi = hi.max(v);
-    }
+    let values = values.filter(|v| v.is_finite() && (!log || *v > 0.0));
+    let (lo, hi) = values.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+        (lo.min(v), hi.max(v))
+    });
     if !lo.is_finite() {
         return if log { (1.0, 10.0) } else { (0.0, 1.0) };
     }
@@ -260,30 +296,6 @@ fn range(values: impl Iterator<Item = f64>, log: bool) -> (f64, f64) {
     (lo - pad, hi + pad)
 }
 
-/// A colour from blue (0) to red (1), for heat maps.
-fn heat(t: f64) -> String {
-    const STOPS: [[u8; 3]; 5] = [
-        [49, 54, 149],
-        [116, 173, 209],
-        [255, 255, 191],
-        [244, 109, 67],
-        [165, 0, 38],
-    ];
-    ramp(&STOPS, t)
-}
-
-/// The colour at `t` ∈ [0, 1] along `stops`, mixed linearly between the two it falls between.
-fn ramp(stops: &[[u8; 3]], t: f64) -> String {
-    let position = t.clamp(0.0, 1.0) * (stops.len() - 1) as f64;
-    let i = (position.floor() as usize).min(stops.len() - 2);
-    let f = position - i as f64;
-    let mix = |k: usize| {
-        let (a, b) = (f64::from(stops[i][k]), f64::from(stops[i + 1][k]));
-        (a + f * (b - a)).round() as u8
-    };
-    format!("#{:02x}{:02x}{:02x}", mix(0), mix(1), mix(2))
-}
-
 /// Where a chart's data land on the page: each axis's scale, and the factor and prefixed unit
 /// its values are shown in (nm for 1e-9 m).
 struct Frame {
@@ -296,43 +308,8 @@ struct Frame {
 impl Frame {
     /// The page position of the data point `(x, y)`.
     fn px(&self, &(x, y): &(f64, f64)) -> (f64, f64) {
-        (
-            self.sx.at(x * self.factors.0),
-            self.sy.at(y * self.factors.1),
-        )
-    }
-}
-
-/// How successive layers take their colours: lines of one group share one, and the other
-/// layers go on through the palette past the groups met so far.
-struct Palette<'a> {
-    colours: Colours,
-    groups: Vec<&'a str>,
-    next: usize,
-}
-
-impl<'a> Palette<'a> {
-    /// The colour of `layer`, the palette moved on past it.
-    fn take(&mut self, layer: &'a Layer) -> String {
-        match layer {
-            Layer::Line { group, .. } => {
-                let i = match self.groups.iter().position(|g| g == group) {
-                    Some(i) => i,
-                    None => {
-                        self.groups.push(group);
-                        self.groups.len() - 1
-                    }
-                };
-                self.next = self.next.max(self.groups.len());
-                self.colours.line(i)
-            }
-            // A heat map has its own colour bar.
-            Layer::Heatmap { .. } => String::new(),
-            _ => {
-                self.next += 1;
-                self.colours.other(self.next - 1)
-            }
-        }
+        let (fx, fy) = self.factors;
+        (self.sx.at(x * fx), self.sy.at(y * fy))
     }
 }
 
@@ -341,44 +318,28 @@ impl<'a> Palette<'a> {
 type Entry<'a> = (&'a str, String, &'static str);
 
 impl Chart {
-    /// The chart as an SVG document.
     pub fn to_svg(&self) -> String {
         let frame = self.frame();
         let (sx, sy) = (&frame.sx, &frame.sy);
-        let mut svg = String::new();
-        let _ = write!(
-            svg,
-            r##"<svg xmlns="http://www.w3.org/2000/svg" width="{WIDTH}" height="{HEIGHT}" viewBox="0 0 {WIDTH} {HEIGHT}" font-family="sans-serif" font-size="13"><title>{}</title><rect width="100%" height="100%" fill="#ffffff"/>"##,
-            escape(&self.title)
+        let title = escape(&self.title);
+        let mut svg = format!(
+            r##"<svg xmlns="http://www.w3.org/2000/svg" width="{WIDTH}" height="{HEIGHT}" viewBox="0 0 {WIDTH} {HEIGHT}" font-family="sans-serif" font-size="13"><title>{title}</title><rect width="100%" height="100%" fill="#ffffff"/><text class="title" x="20" y="28" font-size="15" font-weight="bold">{title}</text>"##
         );
+        self.write_axes(&mut svg, &frame);
+        let (x, y, width, height) = (sx.from, sy.to, sx.to - sx.from, sy.from - sy.to);
         let _ = write!(
             svg,
-            r##"<text class="title" x="20" y="28" font-size="15" font-weight="bold">{}</text>"##,
-            escape(&self.title)
-        );
-        self.write_axes(&mut svg, sx, sy, (&frame.units.0, &frame.units.1));
-        let _ = write!(
-            svg,
-            r#"<defs><clipPath id="plot"><rect x="{}" y="{}" width="{}" height="{}"/></clipPath></defs><g clip-path="url(#plot)">"#,
-            sx.from,
-            sy.to,
-            sx.to - sx.from,
-            sy.from - sy.to
+            r#"<defs><clipPath id="plot"><rect x="{x}" y="{y}" width="{width}" height="{height}"/></clipPath></defs><g clip-path="url(#plot)">"#
         );
         let mut legend = Vec::new();
         let mut notes = self.notes.clone();
-        let mut palette = Palette {
-            colours: self.colours(),
-            groups: Vec::new(),
-            next: 0,
-        };
+        let mut palette = Palette::new(&self.layers);
         for layer in &self.layers {
             let colour = palette.take(layer);
-            legend.extend(self.write_layer(&mut svg, &frame, layer, colour, &mut notes));
+            legend.extend(write_layer(&mut svg, &frame, layer, colour, &mut notes));
         }
         svg.push_str("</g>");
-        let shown = write_legend(&mut svg, &legend);
-        write_notes(&mut svg, &notes, shown);
+        write_legend(&mut svg, &legend, &notes);
         svg.push_str("</svg>");
         svg
     }
@@ -404,117 +365,26 @@ impl Chart {
             let side = bottom - top;
             left += ((right - left) - side) / 2.0;
             right = left + side;
-            x_lo = xc - width / 2.0;
-            x_hi = xc + width / 2.0;
-            y_lo = yc - width / 2.0;
-            y_hi = yc + width / 2.0;
+            (x_lo, x_hi) = (xc - width / 2.0, xc + width / 2.0);
+            (y_lo, y_hi) = (yc - width / 2.0, yc + width / 2.0);
         }
+        let scale = |(lo, hi), (from, to), log| Scale {
+            lo,
+            hi,
+            from,
+            to,
+            log,
+        };
         Frame {
-            sx: Scale {
-                lo: x_lo,
-                hi: x_hi,
-                from: left,
-                to: right,
-                log: self.x.log,
-            },
-            sy: Scale {
-                lo: y_lo,
-                hi: y_hi,
-                from: bottom,
-                to: top,
-                log: self.y.log,
-            },
+            sx: scale((x_lo, x_hi), (left, right), self.x.log),
+            sy: scale((y_lo, y_hi), (bottom, top), self.y.log),
             factors: (x_factor, y_factor),
             units: (x_unit, y_unit),
         }
     }
 
-    /// Draws one layer in `colour`; returns its legend entry (a heat map has none: it adds
-    /// to `notes` when drawn coarser than the answer's grid).
-    fn write_layer<'a>(
-        &self,
-        svg: &mut String,
-        frame: &Frame,
-        layer: &'a Layer,
-        c: String,
-        notes: &mut Vec<String>,
-    ) -> Option<Entry<'a>> {
-        let px = |p: &(f64, f64)| frame.px(p);
-        let mark = match layer {
-            Layer::Line { points, dashed, .. } => {
-                write_line(svg, layer.name(), points.iter().map(px), *dashed, &c)
-            }
-            Layer::Markers { points, hollow, .. } => {
-                write_markers(svg, layer.name(), points.iter().map(px), *hollow, &c)
-            }
-            Layer::Area { outline, .. } => {
-                let _ = write!(
-                    svg,
-                    r#"<path class="series area" data-name="{}" d="{}" fill="{c}" fill-opacity="0.25" stroke="{c}" stroke-width="2"/>"#,
-                    escape(layer.name()),
-                    path(outline.iter().map(px), true)
-                );
-                "area"
-            }
-            Layer::Circle { centre, radius, .. } => {
-                let (cx, cy) = px(centre);
-                let r = (frame.sx.at((centre.0 + radius) * frame.factors.0) - cx).abs();
-                let _ = write!(
-                    svg,
-                    r#"<circle class="series" data-name="{}" cx="{cx:.1}" cy="{cy:.1}" r="{r:.1}" fill="none" stroke="{c}" stroke-width="2" stroke-dasharray="6 4"/>"#,
-                    escape(layer.name())
-                );
-                "dashed"
-            }
-            Layer::Heatmap {
-                name,
-                x,
-                y,
-                values,
-                unit,
-                clip,
-            } => {
-                // An outline of fewer than three points encloses nothing: no clip then.
-                let clip = if clip.len() >= 3 {
-                    path(clip.iter().map(px), true)
-                } else {
-                    String::new()
-                };
-                let drawn = self.write_heatmap(
-                    svg,
-                    (&frame.sx, &frame.sy),
-                    frame.factors,
-                    (x, y, values),
-                    unit,
-                    &clip,
-                );
-                if drawn != (x.len(), y.len()) {
-                    notes.push(format!("{name} drawn on {} × {} cells", drawn.0, drawn.1));
-                    notes.push(format!("(the answer has {} × {})", x.len(), y.len()));
-                }
-                return None;
-            }
-        };
-        Some((layer.name(), c, mark))
-    }
-
-    /// The chart's colours: sequential when its groups of lines outnumber the palette.
-    fn colours(&self) -> Colours {
-        let mut groups: Vec<&str> = Vec::new();
-        for layer in &self.layers {
-            if let Layer::Line { group, .. } = layer {
-                if !groups.contains(&group.as_str()) {
-                    groups.push(group);
-                }
-            }
-        }
-        Colours {
-            lines: groups.len(),
-            sequential: groups.len() > PALETTE.len(),
-        }
-    }
-
-    fn write_axes(&self, svg: &mut String, sx: &Scale, sy: &Scale, units: (&str, &str)) {
+    fn write_axes(&self, svg: &mut String, frame: &Frame) {
+        let (sx, sy) = (&frame.sx, &frame.sy);
         let (left, right, top, bottom) = (sx.from, sx.to, sy.to, sy.from);
         let _ = write!(
             svg,
@@ -522,16 +392,12 @@ impl Chart {
             right - left,
             bottom - top
         );
-        let x_ticks = sx.ticks();
-        let _ = write!(svg, r#"<g class="axis x">"#);
-        for t in x_ticks {
-            let x = sx.at(t);
+        svg.push_str(r#"<g class="axis x">"#);
+        let (tick, text) = (bottom + 5.0, bottom + 20.0);
+        for (x, t) in sx.ticks().into_iter().map(|t| (sx.at(t), label(t))) {
             let _ = write!(
                 svg,
-                r##"<line x1="{x:.1}" y1="{bottom}" x2="{x:.1}" y2="{:.1}" stroke="#444444"/><line x1="{x:.1}" y1="{top}" x2="{x:.1}" y2="{bottom}" stroke="#dddddd" stroke-width="0.5"/><text x="{x:.1}" y="{:.1}" text-anchor="middle">{}</text>"##,
-                bottom + 5.0,
-                bottom + 20.0,
-                label(t)
+                r##"<line x1="{x:.1}" y1="{bottom}" x2="{x:.1}" y2="{tick:.1}" stroke="#444444"/><line x1="{x:.1}" y1="{top}" x2="{x:.1}" y2="{bottom}" stroke="#dddddd" stroke-width="0.5"/><text x="{x:.1}" y="{text:.1}" text-anchor="middle">{t}</text>"##
             );
         }
         let _ = write!(
@@ -539,116 +405,189 @@ impl Chart {
             r#"<text class="label" x="{:.1}" y="{:.1}" text-anchor="middle">{}</text></g>"#,
             (left + right) / 2.0,
             HEIGHT - 15.0,
-            escape(&axis_label(&self.x, units.0))
+            escape(&with_unit(
+                self.x.quantity.replace('_', " "),
+                &frame.units.0
+            ))
         );
-        let y_ticks = sy.ticks();
-        let _ = write!(svg, r#"<g class="axis y">"#);
-        for t in y_ticks {
-            let y = sy.at(t);
+        svg.push_str(r#"<g class="axis y">"#);
+        let (tick, text) = (left - 5.0, left - 8.0);
+        for (y, t) in sy.ticks().into_iter().map(|t| (sy.at(t), label(t))) {
             let _ = write!(
                 svg,
-                r##"<line x1="{:.1}" y1="{y:.1}" x2="{left}" y2="{y:.1}" stroke="#444444"/><line x1="{left}" y1="{y:.1}" x2="{right}" y2="{y:.1}" stroke="#dddddd" stroke-width="0.5"/><text x="{:.1}" y="{:.1}" text-anchor="end">{}</text>"##,
-                left - 5.0,
-                left - 8.0,
-                y + 4.0,
-                label(t)
+                r##"<line x1="{tick:.1}" y1="{y:.1}" x2="{left}" y2="{y:.1}" stroke="#444444"/><line x1="{left}" y1="{y:.1}" x2="{right}" y2="{y:.1}" stroke="#dddddd" stroke-width="0.5"/><text x="{text:.1}" y="{:.1}" text-anchor="end">{t}</text>"##,
+                y + 4.0
             );
         }
         let (cx, cy) = (18.0, (top + bottom) / 2.0);
         let _ = write!(
             svg,
             r#"<text class="label" x="{cx}" y="{cy}" text-anchor="middle" transform="rotate(-90 {cx} {cy})">{}</text></g>"#,
-            escape(&axis_label(&self.y, units.1))
+            escape(&with_unit(
+                self.y.quantity.replace('_', " "),
+                &frame.units.1
+            ))
         );
-    }
-
-    /// Draws a heatmap and its colour bar; returns how many cells it drew along x and y.
-    fn write_heatmap(
-        &self,
-        svg: &mut String,
-        (sx, sy): (&Scale, &Scale),
-        (x_factor, y_factor): (f64, f64),
-        (x, y, values): (&[f64], &[f64], &[Vec<f64>]),
-        unit: &str,
-        clip: &str,
-    ) -> (usize, usize) {
-        let finite = values.iter().flatten().copied().filter(|v| v.is_finite());
-        let top_value = finite.fold(0.0, f64::max);
-        if x.len() < 2 || y.len() < 2 || top_value <= 0.0 {
-            return (x.len(), y.len());
-        }
-        let (factor, unit) = prefixed(unit, top_value);
-        let (columns, rows, means) = coarsened((x, y, values), HEATMAP_CELLS);
-        if clip.is_empty() {
-            svg.push_str(r#"<g class="heatmap">"#);
-        } else {
-            let _ = write!(
-                svg,
-                r#"<clipPath id="heatmap-clip"><path d="{clip}"/></clipPath><g class="heatmap" clip-path="url(#heatmap-clip)">"#
-            );
-        }
-        for (&(y0, y1), row) in rows.iter().zip(&means) {
-            for (&(x0, x1), &value) in columns.iter().zip(row) {
-                if value <= 0.0 {
-                    continue;
-                }
-                let (px0, px1) = (sx.at(x0 * x_factor), sx.at(x1 * x_factor));
-                let (py0, py1) = (sy.at(y1 * y_factor), sy.at(y0 * y_factor));
-                let _ = write!(
-                    svg,
-                    r#"<rect x="{px0:.1}" y="{py0:.1}" width="{:.2}" height="{:.2}" fill="{}"/>"#,
-                    (px1 - px0).abs() + 0.5,
-                    (py1 - py0).abs() + 0.5,
-                    heat(value / top_value)
-                );
-            }
-        }
-        svg.push_str("</g>");
-        // The colour bar, right of the plot under the legend.
-        let (bx, by, height) = (WIDTH - RIGHT + 30.0, HEIGHT - BOTTOM - 180.0, 180.0);
-        let _ = write!(svg, r#"</g><g class="colourbar">"#);
-        for k in 0..30 {
-            let t = f64::from(k) / 29.0;
-            let _ = write!(
-                svg,
-                r#"<rect x="{bx}" y="{:.1}" width="16" height="{:.1}" fill="{}"/>"#,
-                by + height * (1.0 - t) - height / 30.0,
-                height / 30.0 + 0.5,
-                heat(t)
-            );
-        }
-        for t in ticks(0.0, top_value * factor) {
-            let y = by + height * (1.0 - t / (top_value * factor));
-            let _ = write!(
-                svg,
-                r#"<text x="{}" y="{:.1}">{}</text>"#,
-                bx + 22.0,
-                y + 4.0,
-                label(t)
-            );
-        }
-        let _ = write!(
-            svg,
-            r#"<text class="label" x="{bx}" y="{:.1}">pressure [{}]</text></g><g clip-path="url(#plot)">"#,
-            by - 8.0,
-            escape(&unit)
-        );
-        (columns.len(), rows.len())
     }
 }
 
-/// The cells a heatmap draws at most along each axis: about 4 pixels each in the plot. A
-/// finer grid is drawn as blocks of its cells (each the mean of its cells), so that a
-/// picture's size does not grow with the grid asked for (a 501 × 501 pressure grid drew
-/// 12 MB of SVG cell by cell); the answer's JSON and CSV carry every value.
+/// Draws one layer in colour `c`; returns its legend entry (a heat map has none: it adds to
+/// `notes` when drawn coarser than the answer's grid).
+fn write_layer<'a>(
+    svg: &mut String,
+    frame: &Frame,
+    layer: &'a Layer,
+    c: String,
+    notes: &mut Vec<String>,
+) -> Option<Entry<'a>> {
+    let px = |p: &(f64, f64)| frame.px(p);
+    let name = escape(layer.name());
+    let mark = match layer {
+        Layer::Line { points, dashed, .. } => {
+            let dash = if *dashed { DASH } else { "" };
+            let mark = if *dashed { "dashed" } else { "line" };
+            let _ = write!(
+                svg,
+                r#"<path class="series" data-name="{name}" d="{}" fill="none" stroke="{c}" stroke-width="2"{dash}/>"#,
+                path(points.iter().map(px), false)
+            );
+            // A line of one point (a one-point sweep) has no length: its point shows.
+            if let [point] = points.as_slice() {
+                let (x, y) = px(point);
+                let _ = write!(
+                    svg,
+                    r#"<circle class="lone" cx="{x:.1}" cy="{y:.1}" r="4" fill="{c}"/>"#
+                );
+            }
+            mark
+        }
+        Layer::Markers { points, hollow, .. } => {
+            let fill = if *hollow { "#ffffff" } else { c.as_str() };
+            let mark = if *hollow { "hollow" } else { "marker" };
+            let _ = write!(svg, r#"<g class="series" data-name="{name}">"#);
+            for (x, y) in points.iter().map(px) {
+                let _ = write!(
+                    svg,
+                    r#"<circle cx="{x:.1}" cy="{y:.1}" r="4" fill="{fill}" stroke="{c}" stroke-width="1.5"/>"#
+                );
+            }
+            svg.push_str("</g>");
+            mark
+        }
+        Layer::Area { outline, .. } => {
+            let _ = write!(
+                svg,
+                r#"<path class="series area" data-name="{name}" d="{}" fill="{c}" fill-opacity="0.25" stroke="{c}" stroke-width="2"/>"#,
+                path(outline.iter().map(px), true)
+            );
+            "area"
+        }
+        Layer::Circle { centre, radius, .. } => {
+            let (cx, cy) = px(centre);
+            let r = (px(&(centre.0 + radius, centre.1)).0 - cx).abs();
+            let _ = write!(
+                svg,
+                r#"<circle class="series" data-name="{name}" cx="{cx:.1}" cy="{cy:.1}" r="{r:.1}" fill="none" stroke="{c}" stroke-width="2"{DASH}/>"#
+            );
+            "dashed"
+        }
+        Layer::Heatmap {
+            x,
+            y,
+            values,
+            unit,
+            clip,
+            ..
+        } => {
+            let drawn = write_heatmap(svg, frame, (x, y, values), unit, clip);
+            if drawn != (x.len(), y.len()) {
+                let name = layer.name();
+                notes.push(format!("{name} drawn on {} × {} cells", drawn.0, drawn.1));
+                notes.push(format!("(the answer has {} × {})", x.len(), y.len()));
+            }
+            return None;
+        }
+    };
+    Some((layer.name(), c, mark))
+}
+
+/// Draws a heatmap, only inside `clip` if it encloses anything, and its colour bar; returns
+/// how many cells it drew along x and y.
+fn write_heatmap(
+    svg: &mut String,
+    frame: &Frame,
+    (x, y, values): (&[f64], &[f64], &[Vec<f64>]),
+    unit: &str,
+    clip: &[(f64, f64)],
+) -> (usize, usize) {
+    let finite = values.iter().flatten().copied().filter(|v| v.is_finite());
+    let top_value = finite.fold(0.0, f64::max);
+    if x.len() < 2 || y.len() < 2 || top_value <= 0.0 {
+        return (x.len(), y.len());
+    }
+    let (factor, unit) = prefixed(unit, top_value);
+    let (columns, rows, means) = coarsened((x, y, values), HEATMAP_CELLS);
+    if clip.len() < 3 {
+        svg.push_str(r#"<g class="heatmap">"#);
+    } else {
+        let _ = write!(
+            svg,
+            r#"<clipPath id="heatmap-clip"><path d="{}"/></clipPath><g class="heatmap" clip-path="url(#heatmap-clip)">"#,
+            path(clip.iter().map(|p| frame.px(p)), true)
+        );
+    }
+    for (&(y0, y1), row) in rows.iter().zip(&means) {
+        for (&(x0, x1), &value) in columns.iter().zip(row) {
+            if value <= 0.0 {
+                continue;
+            }
+            let ((px0, py0), (px1, py1)) = (frame.px(&(x0, y1)), frame.px(&(x1, y0)));
+            let _ = write!(
+                svg,
+                r#"<rect x="{px0:.1}" y="{py0:.1}" width="{:.2}" height="{:.2}" fill="{}"/>"#,
+                (px1 - px0).abs() + 0.5,
+                (py1 - py0).abs() + 0.5,
+                ramp(&HEAT, value / top_value)
+            );
+        }
+    }
+    svg.push_str("</g>");
+    // The colour bar, right of the plot under the legend.
+    let (bx, by, height) = (WIDTH - RIGHT + 30.0, HEIGHT - BOTTOM - 180.0, 180.0);
+    svg.push_str(r#"</g><g class="colourbar">"#);
+    let step = height / 30.0;
+    for t in (0..30).map(|k| f64::from(k) / 29.0) {
+        let (y, colour) = (by + height * (1.0 - t) - step, ramp(&HEAT, t));
+        let _ = write!(
+            svg,
+            r#"<rect x="{bx}" y="{y:.1}" width="16" height="{:.1}" fill="{colour}"/>"#,
+            step + 0.5
+        );
+    }
+    let (x, top) = (bx + 22.0, top_value * factor);
+    for t in ticks(0.0, top) {
+        let (y, text) = (by + height * (1.0 - t / top) + 4.0, label(t));
+        let _ = write!(svg, r#"<text x="{x}" y="{y:.1}">{text}</text>"#);
+    }
+    let _ = write!(
+        svg,
+        r#"<text class="label" x="{bx}" y="{:.1}">pressure [{}]</text></g><g clip-path="url(#plot)">"#,
+        by - 8.0,
+        escape(&unit)
+    );
+    (columns.len(), rows.len())
+}
+
+/// The cells a heatmap draws at most along each axis (about 4 px each): a finer grid is drawn
+/// in blocks, each the mean of its cells, as a 501 × 501 grid drew 12 MB of SVG cell by cell;
+/// the answer's JSON and CSV carry every value.
 pub const HEATMAP_CELLS: usize = 100;
 
 /// Where a cell begins and ends along an axis.
 type Span = (f64, f64);
 
-/// The cells of a heatmap with values `values[j][i]` at (x[i], y[j]), at most `most` along
-/// each axis: each cell's extent along x and y, and the mean of the fine cells it covers
-/// (a value that is not positive, or not a number, counts as no pressure).
+/// At most `most` cells along each axis of `values[j][i]` at (x[i], y[j]): their extents and
+/// the means of the fine cells they cover (one not positive, or not a number, counts as 0).
 fn coarsened(
     (x, y, values): (&[f64], &[f64], &[Vec<f64>]),
     most: usize,
@@ -665,11 +604,8 @@ fn coarsened(
             columns
                 .iter()
                 .map(|(_, is)| {
-                    let sum: f64 = js
-                        .clone()
-                        .flat_map(|j| is.clone().map(move |i| (j, i)))
-                        .map(|(j, i)| value(j, i))
-                        .sum();
+                    let cells = js.clone().flat_map(|j| is.clone().map(move |i| (j, i)));
+                    let sum: f64 = cells.map(|(j, i)| value(j, i)).sum();
                     sum / (js.len() * is.len()) as f64
                 })
                 .collect()
@@ -681,9 +617,8 @@ fn coarsened(
     (extents(columns), extents(rows), means)
 }
 
-/// The points of `v` (a grid axis) grouped into at most `most` consecutive blocks of
-/// nearly equal size: each block's extent (from midway to the previous point to midway to
-/// the next, ending at the axis's ends) and its points' indices.
+/// The points of axis `v` in at most `most` blocks of nearly equal size: each one's extent
+/// (between midpoints, or the axis's ends) and its points' indices.
 fn blocks(v: &[f64], most: usize) -> Vec<(Span, std::ops::Range<usize>)> {
     let count = v.len().min(most.max(1));
     let edge = |i: usize| match i {
@@ -699,20 +634,6 @@ fn blocks(v: &[f64], most: usize) -> Vec<(Span, std::ops::Range<usize>)> {
         .collect()
 }
 
-fn log_ticks(lo: f64, hi: f64) -> Vec<f64> {
-    let (a, b) = (lo.log10().ceil() as i32, hi.log10().floor() as i32);
-    (a..=b).map(|k| 10f64.powi(k)).collect()
-}
-
-fn axis_label(axis: &Axis, unit: &str) -> String {
-    let name = axis.quantity.replace('_', " ");
-    if unit.is_empty() {
-        name
-    } else {
-        format!("{name} [{unit}]")
-    }
-}
-
 fn path(points: impl Iterator<Item = (f64, f64)>, closed: bool) -> String {
     let mut d = String::new();
     for (i, (x, y)) in points.enumerate() {
@@ -724,22 +645,16 @@ fn path(points: impl Iterator<Item = (f64, f64)>, closed: bool) -> String {
     d.trim_end().to_string()
 }
 
-/// The legend, right of the plot: at most [`LEGEND_ROWS`] rows (the rest counted on the
-/// last). Returns the rows written.
-fn write_legend(svg: &mut String, entries: &[Entry]) -> usize {
+/// Right of the plot, the legend (at most [`LEGEND_ROWS`] rows) and under it the notes (as
+/// many as fit above the picture's foot), each cut by [`kept`].
+fn write_legend(svg: &mut String, entries: &[Entry], notes: &[String]) {
     let x = WIDTH - RIGHT + 20.0;
     let entries: Vec<_> = entries.iter().filter(|e| !e.0.is_empty()).collect();
-    let _ = write!(svg, r#"<g class="legend">"#);
-    let (shown, more) = if entries.len() > LEGEND_ROWS {
-        (
-            &entries[..LEGEND_ROWS - 1],
-            entries.len() - (LEGEND_ROWS - 1),
-        )
-    } else {
-        (&entries[..], 0)
-    };
-    for (i, (name, colour, mark)) in shown.iter().enumerate() {
-        let y = TOP + 10.0 + 22.0 * i as f64;
+    let rows = kept(entries.len(), LEGEND_ROWS);
+    let row_y = |i: usize| TOP + 10.0 + 22.0 * i as f64;
+    svg.push_str(r#"<g class="legend">"#);
+    for (i, (name, colour, mark)) in entries[..rows].iter().enumerate() {
+        let y = row_y(i);
         let symbol = match *mark {
             "marker" | "hollow" => format!(
                 r#"<circle cx="{}" cy="{y}" r="4" fill="{}" stroke="{colour}" stroke-width="1.5"/>"#,
@@ -750,13 +665,10 @@ fn write_legend(svg: &mut String, entries: &[Entry]) -> usize {
                 r#"<rect x="{x}" y="{}" width="24" height="10" fill="{colour}" fill-opacity="0.25" stroke="{colour}"/>"#,
                 y - 5.0
             ),
-            "dashed" => format!(
-                r#"<line x1="{x}" y1="{y}" x2="{}" y2="{y}" stroke="{colour}" stroke-width="2" stroke-dasharray="6 4"/>"#,
-                x + 24.0
-            ),
             _ => format!(
-                r#"<line x1="{x}" y1="{y}" x2="{}" y2="{y}" stroke="{colour}" stroke-width="2"/>"#,
-                x + 24.0
+                r#"<line x1="{x}" y1="{y}" x2="{}" y2="{y}" stroke="{colour}" stroke-width="2"{}/>"#,
+                x + 24.0,
+                if *mark == "dashed" { DASH } else { "" }
             ),
         };
         // Long names in a smaller type, to stay within the picture.
@@ -769,94 +681,23 @@ fn write_legend(svg: &mut String, entries: &[Entry]) -> usize {
             escape(name)
         );
     }
+    let more = entries.len() - rows;
     if more > 0 {
-        let y = TOP + 10.0 + 22.0 * shown.len() as f64;
+        let y = row_y(rows) + 4.0;
         let _ = write!(
             svg,
-            r#"<text class="entry" x="{x}" y="{}">and {more} more</text>"#,
-            y + 4.0
+            r#"<text class="entry" x="{x}" y="{y}">and {more} more</text>"#
         );
     }
-    svg.push_str("</g>");
-    shown.len() + usize::from(more > 0)
-}
-
-/// A polyline in `colour` through page points; returns its legend mark.
-fn write_line(
-    svg: &mut String,
-    name: &str,
-    points: impl Iterator<Item = (f64, f64)>,
-    dashed: bool,
-    c: &str,
-) -> &'static str {
-    let points: Vec<_> = points.collect();
-    let dash = if dashed {
-        r#" stroke-dasharray="6 4""#
-    } else {
-        ""
-    };
-    let _ = write!(
-        svg,
-        r#"<path class="series" data-name="{}" d="{}" fill="none" stroke="{c}" stroke-width="2"{dash}/>"#,
-        escape(name),
-        path(points.iter().copied(), false)
-    );
-    // A line of one point (a one-point sweep) has no length: its point shows.
-    if let [(x, y)] = points.as_slice() {
-        let _ = write!(
-            svg,
-            r#"<circle class="lone" cx="{x:.1}" cy="{y:.1}" r="4" fill="{c}"/>"#
-        );
-    }
-    if dashed {
-        "dashed"
-    } else {
-        "line"
-    }
-}
-
-/// A marker in `colour` at each page point, filled or hollow; returns its legend mark.
-fn write_markers(
-    svg: &mut String,
-    name: &str,
-    points: impl Iterator<Item = (f64, f64)>,
-    hollow: bool,
-    c: &str,
-) -> &'static str {
-    let fill = if hollow { "#ffffff" } else { c };
-    let _ = write!(svg, r#"<g class="series" data-name="{}">"#, escape(name));
-    for (x, y) in points {
-        let _ = write!(
-            svg,
-            r#"<circle cx="{x:.1}" cy="{y:.1}" r="4" fill="{fill}" stroke="{c}" stroke-width="1.5"/>"#
-        );
-    }
-    svg.push_str("</g>");
-    if hollow {
-        "hollow"
-    } else {
-        "marker"
-    }
-}
-
-/// The notes under a legend of `shown` rows: as many as fit above the picture's foot, the
-/// last line then saying that more are in the answer.
-fn write_notes(svg: &mut String, notes: &[String], shown: usize) {
-    let mut y = TOP + 10.0 + 22.0 * shown as f64 + 10.0;
-    svg.push_str(r#"<g class="notes">"#);
+    let mut y = row_y(rows + usize::from(more > 0)) + 10.0;
+    svg.push_str(r#"</g><g class="notes">"#);
     let room = ((HEIGHT - 8.0 - y) / 18.0).floor().max(0.0) as usize + 1;
-    let cut = notes.len() > room;
-    let kept = if cut {
-        room.saturating_sub(1)
-    } else {
-        notes.len()
-    };
-    let more = cut.then(|| format!("… {} more in the answer", notes.len() - kept));
+    let kept = kept(notes.len(), room);
+    let more = (kept < notes.len()).then(|| format!("… {} more in the answer", notes.len() - kept));
     for note in notes[..kept].iter().chain(&more) {
         let _ = write!(
             svg,
-            r#"<text x="{}" y="{y}" font-size="11">{}</text>"#,
-            WIDTH - RIGHT + 20.0,
+            r#"<text x="{x}" y="{y}" font-size="11">{}</text>"#,
             escape(note)
         );
         y += 18.0;
@@ -864,27 +705,42 @@ fn write_notes(svg: &mut String, notes: &[String], shown: usize) {
     svg.push_str("</g>");
 }
 
-/// Rows of a legend.
-const LEGEND_ROWS: usize = 14;
+/// How many of `count` rows to write in `room`: all if they fit, else one fewer, the last row
+/// then saying how many more there are.
+fn kept(count: usize, room: usize) -> usize {
+    if count > room {
+        room.saturating_sub(1)
+    } else {
+        count
+    }
+}
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
+    /// A chart of `layers` on plain axes.
+    fn chart(layers: Vec<Layer>) -> Chart {
+        Chart {
+            title: "test".to_string(),
+            x: Axis::new("x", "m"),
+            y: Axis::new("y", ""),
+            layers,
+            equal_aspect: false,
+            notes: Vec::new(),
+        }
+    }
+
     #[test]
     fn notes_beyond_the_picture_s_height_are_counted_not_drawn_off_it() {
         let chart = Chart {
-            title: "notes".to_string(),
-            x: Axis::new("x", "m"),
-            y: Axis::new("y", ""),
-            layers: vec![Layer::Line {
+            notes: (0..40).map(|i| format!("note {i}")).collect(),
+            ..chart(vec![Layer::Line {
                 name: "line".to_string(),
                 group: "line".to_string(),
                 points: vec![(0.0, 0.0), (1.0, 1.0)],
                 dashed: false,
-            }],
-            equal_aspect: false,
-            notes: (0..40).map(|i| format!("note {i}")).collect(),
+            }])
         };
         let svg = chart.to_svg();
         let notes = &svg[svg.find(r#"<g class="notes">"#).unwrap()..];
@@ -924,15 +780,7 @@ mod tests {
             points: vec![(0.5, 0.5)],
             hollow: false,
         });
-        let chart = Chart {
-            title: "many".to_string(),
-            x: Axis::new("x", ""),
-            y: Axis::new("y", ""),
-            layers,
-            equal_aspect: false,
-            notes: Vec::new(),
-        };
-        let svg = chart.to_svg();
+        let svg = chart(layers).to_svg();
         let after = |name: &str, attribute: &str| {
             let at = svg.find(&format!(r#"data-name="{name}""#)).unwrap();
             let rest = &svg[at..];
@@ -954,26 +802,26 @@ mod tests {
 
     #[test]
     fn a_heatmap_clip_of_fewer_than_three_points_clips_nothing() {
-        let chart = |clip: Vec<(f64, f64)>| Chart {
-            title: "pressure".to_string(),
-            x: Axis::new("x", "m"),
-            y: Axis::new("y", "m"),
-            layers: vec![Layer::Heatmap {
-                name: "pressure".to_string(),
-                x: vec![0.0, 1.0],
-                y: vec![0.0, 1.0],
-                values: vec![vec![1.0, 2.0], vec![3.0, 4.0]],
-                unit: "Pa".to_string(),
-                clip,
-            }],
-            equal_aspect: true,
-            notes: Vec::new(),
+        let heatmap = |clip: Vec<(f64, f64)>| {
+            Chart {
+                y: Axis::new("y", "m"),
+                equal_aspect: true,
+                ..chart(vec![Layer::Heatmap {
+                    name: "pressure".to_string(),
+                    x: vec![0.0, 1.0],
+                    y: vec![0.0, 1.0],
+                    values: vec![vec![1.0, 2.0], vec![3.0, 4.0]],
+                    unit: "Pa".to_string(),
+                    clip,
+                }])
+            }
+            .to_svg()
         };
         for clip in [vec![], vec![(0.5, 0.5)], vec![(0.0, 0.0), (1.0, 1.0)]] {
-            let svg = chart(clip).to_svg();
+            let svg = heatmap(clip);
             assert!(svg.contains(r#"<g class="heatmap">"#) && !svg.contains("heatmap-clip"));
         }
-        let svg = chart(vec![(0.0, 0.0), (1.0, 0.0), (0.5, 1.0)]).to_svg();
+        let svg = heatmap(vec![(0.0, 0.0), (1.0, 0.0), (0.5, 1.0)]);
         assert!(svg.contains(r#"clip-path="url(#heatmap-clip)""#));
     }
 
@@ -981,18 +829,15 @@ mod tests {
     fn a_fine_heatmap_is_drawn_as_blocks_that_cover_it_and_keep_its_total() {
         let x: Vec<f64> = (0..501).map(|i| f64::from(i) * 0.5).collect();
         let y: Vec<f64> = (0..37).map(|j| f64::from(j) * 2.0 - 30.0).collect();
+        let value = |i: u32, j: u32| {
+            if (i + j) % 7 == 0 {
+                -1.0
+            } else {
+                f64::from(i * j)
+            }
+        };
         let values: Vec<Vec<f64>> = (0..37)
-            .map(|j| {
-                (0..501)
-                    .map(|i| {
-                        if (i + j) % 7 == 0 {
-                            -1.0
-                        } else {
-                            f64::from(i * j)
-                        }
-                    })
-                    .collect()
-            })
+            .map(|j| (0..501).map(|i| value(i, j)).collect())
             .collect();
         let (columns, rows, means) = coarsened((&x, &y, &values), 100);
         assert_eq!((columns.len(), rows.len()), (100, 37), "coarse in x only");

@@ -1,6 +1,5 @@
-//! Answers as tables: each output declares its columns once (name, unit, how a row gives its
-//! cell), and the header and every row are written from that one declaration, so a CSV
-//! header cannot drift from its rows.
+//! Answers as tables: the header and every row are written from one declaration of each
+//! column (name, unit, how a row gives its cell), so a CSV header cannot drift from its rows.
 
 use std::borrow::Cow;
 use std::fmt::Write;
@@ -8,7 +7,6 @@ use std::fmt::Write;
 use super::fields::Reader;
 use super::number::write_number;
 
-/// One cell of a table.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Cell {
     /// A quantity in the column's SI unit.
@@ -21,7 +19,6 @@ pub enum Cell {
     Empty,
 }
 
-/// How a column reads its cell off a row.
 enum Read<R> {
     Number(fn(&R) -> f64),
     Optional(fn(&R) -> Option<f64>),
@@ -33,7 +30,6 @@ enum Read<R> {
     Field(Reader<R>),
 }
 
-/// A column of a table whose rows are `R`s.
 pub struct Column<R> {
     pub name: Cow<'static, str>,
     /// SI unit of the column ("" for plain numbers, counts and text).
@@ -42,13 +38,14 @@ pub struct Column<R> {
 }
 
 impl<R> Column<R> {
+    const fn new(name: &'static str, unit: &'static str, read: Read<R>) -> Self {
+        let name = Cow::Borrowed(name);
+        Column { name, unit, read }
+    }
+
     /// A column of quantities in `unit` (SI; "" for a plain number).
     pub const fn number(name: &'static str, unit: &'static str, read: fn(&R) -> f64) -> Self {
-        Column {
-            name: Cow::Borrowed(name),
-            unit,
-            read: Read::Number(read),
-        }
+        Self::new(name, unit, Read::Number(read))
     }
 
     /// A column of quantities that some rows do not have (their cell is empty).
@@ -57,38 +54,28 @@ impl<R> Column<R> {
         unit: &'static str,
         read: fn(&R) -> Option<f64>,
     ) -> Self {
-        Column {
-            name: Cow::Borrowed(name),
-            unit,
-            read: Read::Optional(read),
-        }
+        Self::new(name, unit, Read::Optional(read))
     }
 
     /// A column of counts or indices.
     pub const fn count(name: &'static str, read: fn(&R) -> usize) -> Self {
-        Column {
-            name: Cow::Borrowed(name),
-            unit: "",
-            read: Read::Count(read),
-        }
+        Self::new(name, "", Read::Count(read))
     }
 
     /// A column of text, which `write` appends to the string it is given.
     pub const fn text(name: &'static str, write: fn(&R, &mut String)) -> Self {
-        Column {
-            name: Cow::Borrowed(name),
-            unit: "",
-            read: Read::Text(write),
-        }
+        Self::new(name, "", Read::Text(write))
     }
 
     /// A column of numbers named `name`, in `unit`, that `read` gives (empty where `None`).
     pub fn read(name: String, unit: &'static str, read: Reader<R>) -> Self {
-        Column {
-            name: Cow::Owned(name),
-            unit,
-            read: Read::Field(read),
-        }
+        let (name, read) = (Cow::Owned(name), Read::Field(read));
+        Column { name, unit, read }
+    }
+
+    fn heading(&self) -> Heading {
+        let (name, unit) = (self.name.to_string(), Cow::Borrowed(self.unit));
+        Heading { name, unit }
     }
 
     /// The cell of `row` as a number, if it is one (a quantity present, or a count).
@@ -100,7 +87,6 @@ impl<R> Column<R> {
         }
     }
 
-    /// The cell of `row`.
     pub fn cell(&self, row: &R) -> Cell {
         match &self.read {
             Read::Number(read) => Cell::Number(read(row)),
@@ -123,14 +109,12 @@ pub struct Heading {
     pub unit: Cow<'static, str>,
 }
 
-impl Heading {
-    /// The column's name with its unit: `radius [m]`, or `friction_coefficient`.
-    pub fn label(&self) -> String {
-        if self.unit.is_empty() {
-            self.name.clone()
-        } else {
-            format!("{} [{}]", self.name, self.unit)
-        }
+/// `name [unit]`, or `name` for a plain number (a CSV column's heading, an axis's label).
+pub(super) fn with_unit(name: String, unit: &str) -> String {
+    if unit.is_empty() {
+        name
+    } else {
+        format!("{name} [{unit}]")
     }
 }
 
@@ -142,16 +126,9 @@ pub struct Table {
 }
 
 impl Table {
-    /// The table of `rows` under `columns`.
     pub fn new<'a, R: 'a>(columns: &[Column<R>], rows: impl IntoIterator<Item = &'a R>) -> Table {
         Table {
-            headings: columns
-                .iter()
-                .map(|c| Heading {
-                    name: c.name.to_string(),
-                    unit: Cow::Borrowed(c.unit),
-                })
-                .collect(),
+            headings: columns.iter().map(Column::heading).collect(),
             rows: rows
                 .into_iter()
                 .map(|row| columns.iter().map(|c| c.cell(row)).collect())
@@ -159,8 +136,7 @@ impl Table {
         }
     }
 
-    /// Renames column `index` and gives it `unit` (a column whose quantity depends on the
-    /// rows, such as the operating point a sweep varies).
+    /// Renames column `index`, in `unit` (a quantity the rows choose: a sweep's operating point).
     pub fn rename(&mut self, index: usize, name: &str, unit: &str) {
         if let Some(heading) = self.headings.get_mut(index) {
             heading.name = name.to_string();
@@ -168,32 +144,30 @@ impl Table {
         }
     }
 
-    /// CSV (RFC 4180): one header line, each column named with its unit (`radius [m]`),
-    /// then one line per row; numbers in their shortest round-trip form, text quoted.
-    /// `None` if a number is not finite (CSV has no place for it, as JSON has none).
+    /// CSV (RFC 4180): a header line (`radius [m]`), then a line a row, text quoted; `None`
+    /// if a number is not finite (CSV has no place for it, as JSON has none).
     pub fn to_csv(&self) -> Option<String> {
-        let mut csv = Csv::new(self.headings.iter().map(Heading::label), self.rows.len());
+        let labels = self
+            .headings
+            .iter()
+            .map(|h| with_unit(h.name.clone(), &h.unit));
+        let mut csv = Csv::new(labels, self.rows.len());
         for row in &self.rows {
             for (i, cell) in row.iter().enumerate() {
                 csv.cell(i, cell);
             }
-            csv.end_line();
+            csv.text.push('\n');
         }
-        csv.finish()
+        csv.finite.then_some(csv.text)
     }
 }
 
-/// The CSV of `rows` under `columns`, as [`Table::to_csv`] writes it, straight from the rows:
-/// for an answer of many rows (a sweep's) the table's cells, a vector per row and a string
-/// per text, cost more than writing them.
+/// [`Table::to_csv`] of `rows` under `columns`, straight from the rows: for many rows (a
+/// sweep's) a table's cells, a vector a row and a string a text, cost more than the CSV.
 pub fn csv<'a, R: 'a>(columns: &[Column<R>], rows: &'a [R]) -> Option<String> {
-    let labels = columns.iter().map(|c| {
-        Heading {
-            name: c.name.to_string(),
-            unit: Cow::Borrowed(c.unit),
-        }
-        .label()
-    });
+    let labels = columns
+        .iter()
+        .map(|c| with_unit(c.name.to_string(), c.unit));
     let mut csv = Csv::new(labels, rows.len());
     let mut text = String::new();
     for row in rows {
@@ -206,34 +180,24 @@ pub fn csv<'a, R: 'a>(columns: &[Column<R>], rows: &'a [R]) -> Option<String> {
                 csv.cell(i, &column.cell(row));
             }
         }
-        csv.end_line();
+        csv.text.push('\n');
     }
-    csv.finish()
+    csv.finite.then_some(csv.text)
 }
 
 /// CSV being written: one buffer, each number straight into it.
 struct Csv {
     text: String,
     finite: bool,
-    /// Each column's last number (its bits) and its text. A number equal to the one above
-    /// it (a sweep's outer axis, its answers at rest, which depend on the load alone) is
-    /// copied, not formatted again: formatting is most of a sweep's CSV.
+    /// Each column's last number (its bits) and text: one equal to the one above (a sweep's
+    /// outer axis, its answers at rest) is copied, as formatting is most of a sweep's CSV.
     above: Vec<(u64, String)>,
 }
 
 impl Csv {
-    /// The header line of `labels`, room for `rows` rows.
     fn new(labels: impl Iterator<Item = String>, rows: usize) -> Csv {
-        let mut text = String::new();
-        let mut columns = 0;
-        for label in labels {
-            if columns > 0 {
-                text.push(',');
-            }
-            text.push_str(&label);
-            columns += 1;
-        }
-        text.push('\n');
+        let labels: Vec<String> = labels.collect();
+        let (mut text, columns) = (labels.join(",") + "\n", labels.len());
         // About 24 bytes a cell (a number of 17 digits and its exponent).
         text.reserve(24 * columns.max(1) * rows);
         Csv {
@@ -243,14 +207,12 @@ impl Csv {
         }
     }
 
-    /// The separator before cell `column`.
     fn separate(&mut self, column: usize) {
         if column > 0 {
             self.text.push(',');
         }
     }
 
-    /// `cell` as the cell of `column` of the current line.
     fn cell(&mut self, column: usize, cell: &Cell) {
         match cell {
             Cell::Number(x) => self.number(column, *x),
@@ -292,14 +254,6 @@ impl Csv {
         }
         self.text.push('"');
     }
-
-    fn end_line(&mut self) {
-        self.text.push('\n');
-    }
-
-    fn finish(self) -> Option<String> {
-        self.finite.then_some(self.text)
-    }
 }
 
 #[cfg(test)]
@@ -307,39 +261,25 @@ mod tests {
     use super::*;
     use crate::render::format_number;
 
-    struct Row {
-        x: f64,
-        label: &'static str,
-    }
+    /// A row's x and label.
+    struct Row(f64, &'static str);
 
     const COLUMNS: [Column<Row>; 3] = [
         Column::count("index", |_| 7),
-        Column::number("x", "m", |r| r.x),
-        Column::text("label", |r, text| text.push_str(r.label)),
+        Column::number("x", "m", |r| r.0),
+        Column::text("label", |r, text| text.push_str(r.1)),
     ];
 
     #[test]
     fn the_header_and_the_rows_come_from_one_declaration() {
-        let rows = [
-            Row {
-                x: 2.5e-8,
-                label: "a",
-            },
-            Row {
-                x: 0.5,
-                label: "say \"b\"",
-            },
-        ];
+        let rows = [Row(2.5e-8, "a"), Row(0.5, "say \"b\"")];
         let mut table = Table::new(&COLUMNS, &rows);
         let expected = "index,x [m],label\n7,2.5e-8,\"a\"\n7,0.5,\"say \"\"b\"\"\"\n";
         assert_eq!(table.to_csv().as_deref(), Some(expected));
         // Written from the rows, the same text.
         assert_eq!(csv(&COLUMNS, &rows).as_deref(), Some(expected));
         // A number that is not finite has no CSV.
-        let infinite = [Row {
-            x: f64::INFINITY,
-            label: "c",
-        }];
+        let infinite = [Row(f64::INFINITY, "c")];
         assert_eq!(csv(&COLUMNS, &infinite), None);
         table.rename(1, "load", "N");
         assert!(table
@@ -354,7 +294,7 @@ mod tests {
     #[test]
     fn a_number_repeated_down_a_column_is_written_as_it_was() {
         let xs = [0.1, 0.1, -0.0, 0.0, 0.0, 1e-9, 0.1, 0.1];
-        let rows: Vec<Row> = xs.iter().map(|&x| Row { x, label: "l" }).collect();
+        let rows: Vec<Row> = xs.iter().map(|&x| Row(x, "l")).collect();
         let expected: String = std::iter::once("index,x [m],label\n".to_string())
             .chain(
                 xs.iter()
@@ -364,8 +304,8 @@ mod tests {
         assert_eq!(csv(&COLUMNS, &rows).as_deref(), Some(expected.as_str()));
         assert!(expected.contains("7,-0,\"l\"\n7,0,"));
         let twice = [
-            Column::number("a", "", |r: &Row| r.x),
-            Column::number("b", "", |r| r.x / 3.0),
+            Column::number("a", "", |r: &Row| r.0),
+            Column::number("b", "", |r| r.0 / 3.0),
         ];
         assert_eq!(
             csv(&twice, &rows[..2]).as_deref(),
