@@ -1,9 +1,7 @@
-//! One Redis server in one role (the answer cache, or the jobs), as this process reaches it:
-//! a connection manager that reconnects by itself, a bound on every call, and the server's
-//! health as the last calls found it: reachable or not, full (refusing writes at its memory
-//! limit) or not, and how long a round trip takes (a ping every half second), so that callers
-//! can skip it at once while it is of no use (synchronous solves then answer from this
-//! process's memory, without waiting) and `/readyz` can say why.
+//! One Redis server in one role (the answer cache, or the jobs): a connection manager that
+//! reconnects by itself, a bound on every call, and the server's health as the last calls
+//! and pings found it (down, full, slow), so that callers skip it at once while it is of no
+//! use (synchronous solves then answer from this process alone) and `/readyz` can say why.
 
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::OnceLock;
@@ -18,7 +16,7 @@ const CALL_TIMEOUT: Duration = Duration::from_secs(1);
 /// How often an unreachable server is tried again.
 pub const RETRY_EVERY: Duration = Duration::from_millis(500);
 /// A server whose ping takes longer is slow: a synchronous solve would wait on it more than
-/// it gains (a solve costs well under a millisecond to a few).
+/// it gains.
 const SLOW: Duration = Duration::from_millis(25);
 /// How long a refusal for want of memory marks the server full, unless a write probe (every
 /// half second while it is full) finds it taking writes again sooner.
@@ -69,12 +67,12 @@ impl Health {
     }
 }
 
-/// Why a call to Redis failed, in a sentence, and the server's error code if it refused
-/// the command.
-#[derive(Clone, Debug, PartialEq, Eq)]
+/// Why a call to Redis failed, in a sentence, and the code of the server's error reply
+/// (`NOGROUP`, `BUSYGROUP`...) if it refused the command.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("{why}")]
 pub struct Failure {
     pub why: String,
-    /// The code a Redis error reply begins with (`NOGROUP`, `BUSYGROUP`...).
     code: Option<String>,
 }
 
@@ -86,15 +84,8 @@ impl Failure {
         }
     }
 
-    /// Whether Redis refused the command with error `code`.
     pub fn is(&self, code: &str) -> bool {
         self.code.as_deref() == Some(code)
-    }
-}
-
-impl std::fmt::Display for Failure {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(&self.why)
     }
 }
 
@@ -116,7 +107,7 @@ pub struct Link {
 }
 
 impl Link {
-    /// A link to the server at `url`; connects at the first call (the server may start later).
+    /// Connects at the first call (the server may start later).
     pub fn open(role: &'static str, url: &str) -> Result<Link, LinkError> {
         let failed = |source| LinkError {
             role,
@@ -155,12 +146,10 @@ impl Link {
         let _ = self.gauge.set(gauge);
     }
 
-    /// Whether the last call reached the server.
     pub fn is_up(&self) -> bool {
         self.up.load(Ordering::Relaxed)
     }
 
-    /// The server's health (see [`Health`]).
     pub fn health(&self) -> Health {
         let full_at = self.full_at.load(Ordering::Relaxed);
         let round_trip = Duration::from_micros(self.round_trip.load(Ordering::Relaxed));
@@ -186,8 +175,7 @@ impl Link {
         u64::try_from(self.opened.elapsed().as_millis()).unwrap_or(u64::MAX)
     }
 
-    /// Records whether the server was reached; `why` not (logged once, when it changes: a
-    /// refused connection, a certificate not trusted, a timeout).
+    /// Records whether the server was reached; `why` not (logged when it changes).
     fn set_up(&self, up: bool, why: &str) {
         if self.up.swap(up, Ordering::Relaxed) != up {
             if up {
@@ -201,11 +189,20 @@ impl Link {
         }
     }
 
-    /// Records what a call's outcome says of the server's reachability.
-    fn outcome<T>(
-        &self,
-        result: Result<Result<T, RedisError>, tokio::time::error::Elapsed>,
-    ) -> Result<T, Failure> {
+    /// Runs `call` on the connection, and records what its outcome says of the server; a call
+    /// cut by a lost connection is tried once more (the manager reconnects at once: the first
+    /// call after a restart of Redis succeeds).
+    async fn call<T, F, Fut>(&self, call: F) -> Result<T, Failure>
+    where
+        F: Fn(ConnectionManager) -> Fut,
+        Fut: std::future::Future<Output = Result<T, RedisError>>,
+    {
+        let mut result = tokio::time::timeout(CALL_TIMEOUT, call(self.connection.clone())).await;
+        if let Ok(Err(e)) = &result {
+            if e.is_connection_dropped() || e.is_io_error() {
+                result = tokio::time::timeout(CALL_TIMEOUT, call(self.connection.clone())).await;
+            }
+        }
         match result {
             Ok(Ok(value)) => {
                 self.denied.store(false, Ordering::Relaxed);
@@ -258,35 +255,16 @@ impl Link {
         }
     }
 
-    /// Runs `call` on the connection; a call cut by a lost connection is tried once more
-    /// (the manager reconnects at once: the first call after a restart of Redis succeeds).
-    async fn call<T, F, Fut>(&self, call: F) -> Result<T, Failure>
-    where
-        F: Fn(ConnectionManager) -> Fut,
-        Fut: std::future::Future<Output = Result<T, RedisError>>,
-    {
-        let mut result = tokio::time::timeout(CALL_TIMEOUT, call(self.connection.clone())).await;
-        if let Ok(Err(e)) = &result {
-            if e.is_connection_dropped() || e.is_io_error() {
-                result = tokio::time::timeout(CALL_TIMEOUT, call(self.connection.clone())).await;
-            }
-        }
-        self.outcome(result)
-    }
-
-    /// Runs one command.
     pub async fn query<T: FromRedisValue>(&self, cmd: &Cmd) -> Result<T, Failure> {
         self.call(|mut c| async move { cmd.query_async(&mut c).await })
             .await
     }
 
-    /// Runs a pipeline (atomic if built so).
     pub async fn pipe<T: FromRedisValue>(&self, pipe: &Pipeline) -> Result<T, Failure> {
         self.call(|mut c| async move { pipe.query_async(&mut c).await })
             .await
     }
 
-    /// Runs a Lua script with `keys` and `args`.
     pub async fn script<T: FromRedisValue>(
         &self,
         script: &Script,
@@ -305,9 +283,8 @@ impl Link {
             .await
     }
 
-    /// Pings the server every half second, so that its reachability is known (and
-    /// reported) even by a process that has no call to make, and comes back up by itself
-    /// (other calls skip a link that is down). Runs until dropped.
+    /// Pings the server every half second until dropped, so that its health is known even
+    /// by a process with no call to make, and comes back (other calls skip a link down).
     pub async fn watch(&self) {
         loop {
             tokio::time::sleep(RETRY_EVERY).await;
@@ -375,18 +352,17 @@ pub struct LinkError {
     source: RedisError,
 }
 
-/// A script run inside a transaction: `EVAL` with its text, so that it needs no loading.
-pub(super) fn eval(script: &str, keys: &[&str], args: &[&[u8]]) -> Cmd {
-    let mut cmd = redis::cmd("EVAL");
-    cmd.arg(script).arg(keys.len());
-    for key in keys {
-        cmd.arg(*key);
-    }
-    for arg in args {
-        cmd.arg(*arg);
-    }
-    cmd
+/// Adds `script` on `keys` to `pipe`, its arguments to follow: `EVAL` with its text, so that
+/// it needs no loading (inside a transaction, or not).
+pub(super) fn eval<'a>(pipe: &'a mut Pipeline, script: &str, keys: &[&str]) -> &'a mut Pipeline {
+    pipe.cmd("EVAL").arg(script).arg(keys.len()).arg(keys)
 }
+
+/// Deletes KEYS[1] only if it still holds ARGV[1] (it may have been taken over since).
+pub(super) const DELETE_IF_HELD: &str = r#"
+if redis.call('GET', KEYS[1]) == ARGV[1] then return redis.call('DEL', KEYS[1]) end
+return 0
+"#;
 
 #[cfg(test)]
 mod redaction {

@@ -1,9 +1,8 @@
-//! The fleet's workers: each takes one entry of the work stream at a time (a job, or a
-//! range of a sweep's points), solves it on a solver thread, stores the result, and only
-//! then acknowledges the entry. While it runs, a heartbeat keeps the entry its own, passes a
-//! cancel on to the solver, and counts progress; an entry whose process died goes idle and
-//! is taken over by another worker (`XAUTOCLAIM`); one delivered more than
-//! `max_deliveries` times fails its job, saying so.
+//! The fleet's workers: each takes one entry of the work stream at a time (a job, or a range
+//! of a sweep's points), solves it, stores the result, and only then acknowledges the entry.
+//! While it runs, a heartbeat keeps the entry its own, passes a cancel on and counts
+//! progress; an entry whose process died goes idle and is taken over (`XAUTOCLAIM`); one
+//! delivered more than `max_deliveries` times fails its job, saying so.
 
 use std::collections::HashMap;
 use std::ops::Range;
@@ -15,11 +14,11 @@ use redis::streams::{
     StreamAutoClaimOptions, StreamAutoClaimReply, StreamClaimOptions, StreamId, StreamReadOptions,
     StreamReadReply,
 };
-use redis::{Cmd, Value};
-use uuid::Uuid;
-
+use redis::{Cmd, Pipeline, Value};
 use tokio::sync::Semaphore;
 use tokio_util::sync::CancellationToken;
+use tokio_util::task::AbortOnDropHandle;
+use uuid::Uuid;
 
 use super::store::{RedisJobStore, Runnable};
 use super::{keys, placement, Failure, Fleet, Link};
@@ -27,8 +26,7 @@ use crate::engine::cache::Solved;
 use crate::engine::metrics as names;
 use crate::engine::pool::Pool;
 use crate::engine::solver::Solver;
-use crate::engine::store::JobResult;
-use crate::engine::store::{JobState, JobStatus};
+use crate::engine::store::{JobResult, JobState, JobStatus};
 use crate::job::parts::{self, RenderedPart};
 use crate::job::{tenant_of, Control, Job, JobError, Keyed, Unfinished, Work};
 
@@ -77,8 +75,8 @@ impl Shared {
         }
     }
 
-    /// The entries on the stream not yet finished (waiting or being solved), and the
-    /// fleet's measured cost per point of `class`, in one round trip.
+    /// The entries on the stream not yet finished, and the fleet's measured cost per point
+    /// of `class`, in one round trip.
     pub async fn backlog_and_rate(&self, class: &str) -> Result<(usize, Option<f64>), Failure> {
         let mut pipe = redis::pipe();
         pipe.xlen(keys::STREAM).hget(keys::RATES, class);
@@ -89,8 +87,7 @@ impl Shared {
         self.running.lock().unwrap_or_else(|p| p.into_inner())
     }
 
-    /// Stops every entry this process is solving; they stay unacknowledged, so that another
-    /// process takes them over.
+    /// Stops every entry this process is solving; unacknowledged, another process takes them.
     pub fn interrupt(&self) {
         for control in self.running().values() {
             control.cancel();
@@ -142,9 +139,8 @@ enum Outcome {
     Part(RenderedPart),
 }
 
-/// One worker of the fleet's stream, built from the handles it needs: the solve path, the
-/// fleet, the job slots it shares with synchronous requests (if any), and the drain's
-/// signal, at which it stops taking entries.
+/// One worker of the fleet's stream: the solve path, the fleet, the job slots it shares with
+/// synchronous requests (if any), and the drain's signal, at which it stops taking entries.
 pub struct Worker {
     solver: Arc<Solver>,
     shared: Arc<Shared>,
@@ -167,7 +163,7 @@ impl Worker {
         }
     }
 
-    /// The worker's loop: one entry at a time until the drain begins.
+    /// One entry at a time until the drain begins.
     pub async fn run(self) {
         let mut looked_for_orphans = Instant::now();
         let waiting = match self.shared.fleet.jobs.dedicated() {
@@ -203,9 +199,8 @@ impl Worker {
         shared.running().insert(entry.id.clone(), control.clone());
         // Kept until the entry is done with, assembly included (the last part's entry
         // stays pending while its job is assembled and stored).
-        let _heartbeat = AbortOnDrop(tokio::spawn(heartbeat(
-            shared.fleet.clone(),
-            store.clone(),
+        let _heartbeat = AbortOnDropHandle::new(tokio::spawn(heartbeat(
+            shared.clone(),
             entry.id.clone(),
             id,
             control.clone(),
@@ -225,8 +220,7 @@ impl Worker {
 
     /// The job of `entry` to run and how many times the entry was delivered; `None` when
     /// there is nothing to run: the job is gone or finished (the entry acknowledged), Redis
-    /// is away (the entry stays ours, and is taken over later), or the job was failed here
-    /// (delivered too many times, or not the job accepted).
+    /// is away (the entry is taken over later), or the job was failed here.
     async fn take(&self, entry: &Entry) -> Option<(Runnable, Keyed, u64)> {
         let shared = &self.shared;
         let (runnable, deliveries) = match shared.store.take(entry.job, &entry.part_name()).await {
@@ -243,37 +237,36 @@ impl Worker {
                 .counter(names::REDELIVERIES, &[])
                 .increment(1);
         }
-        let max = shared.fleet.config.max_deliveries;
-        if deliveries > u64::from(max) {
-            let times = match deliveries - 1 {
-                1 => "once".to_string(),
-                n => format!("{n} times"),
-            };
-            let error = JobError::Abandoned(format!(
-                "part {} of the job was delivered {times} and every worker that took it stopped \
-                 before finishing it (killed, or out of memory): the job is given up",
-                entry.part_name(),
-            ));
-            self.finish(entry, JobState::failed(error), None).await;
-            return None;
-        }
-        let job = match Job::from_wire(&runnable.wire) {
-            Ok(job) => job,
-            Err(e) => {
-                self.finish(entry, JobState::failed(e), None).await;
-                return None;
+        let runs = || {
+            if deliveries > u64::from(shared.fleet.config.max_deliveries) {
+                let times = match deliveries - 1 {
+                    1 => "once".to_string(),
+                    n => format!("{n} times"),
+                };
+                return Err(JobError::Abandoned(format!(
+                    "part {} of the job was delivered {times} and every worker that took it \
+                     stopped before finishing it (killed, or out of memory): the job is given up",
+                    entry.part_name(),
+                )));
             }
+            // Kept among its tenant's answers, as it was accepted ([`Keyed::scoped`]).
+            let keyed = Job::from_wire(&runnable.wire)?
+                .keyed()
+                .scoped(tenant_of(&runnable.key));
+            if keyed.key() != runnable.key {
+                return Err(JobError::Internal(
+                    "the job read back from the job store is not the job accepted".to_string(),
+                ));
+            }
+            Ok(keyed)
         };
-        // Kept among its tenant's answers, as it was accepted ([`Keyed::scoped`]).
-        let keyed = job.keyed().scoped(tenant_of(&runnable.key));
-        if keyed.key() != runnable.key {
-            let error = JobError::Internal(
-                "the job read back from the job store is not the job accepted".to_string(),
-            );
-            self.finish(entry, JobState::failed(error), None).await;
-            return None;
+        match runs() {
+            Ok(keyed) => Some((runnable, keyed, deliveries)),
+            Err(error) => {
+                self.finish(entry, JobState::failed(error), None).await;
+                None
+            }
         }
-        Some((runnable, keyed, deliveries))
     }
 
     /// Solves `entry`'s part of `keyed` (or the whole job) on a solver thread under
@@ -394,8 +387,8 @@ impl Worker {
         }
     }
 
-    /// Assembles the split `job` from all its parts, read once, and finishes it. A process
-    /// that dies here leaves the entry to the next delivery, which finds every part in.
+    /// Assembles the split job from all its parts and finishes it. A process that dies here
+    /// leaves the entry to the next delivery, which finds every part in.
     async fn assemble(&self, entry: &Entry, keyed: &Keyed, runnable: &Runnable) {
         let job = keyed.job();
         let Ok(all) = self.shared.store.parts(entry.job, runnable.parts).await else {
@@ -421,8 +414,7 @@ impl Worker {
         }
     }
 
-    /// Finishes the job of `entry` with its answer `solved`, then caches it (by reference
-    /// to the stored result where the cache shares the job store's server), unless the job
+    /// Finishes the job of `entry` with its answer `solved`, then caches it, unless the job
     /// had ended otherwise meanwhile (its stored result is then another).
     async fn succeed(&self, entry: &Entry, solved: Arc<Solved>, total: usize) {
         let state = JobState::Succeeded(JobResult::Ready(solved.clone()));
@@ -505,26 +497,36 @@ async fn create_group(fleet: &Fleet) -> Result<(), Failure> {
     }
 }
 
-/// Acknowledges `entry` and deletes it from the stream (whose length is then the backlog).
-async fn acknowledge(fleet: &Fleet, entry: &Entry) {
-    let mut pipe = redis::pipe();
+/// Adds to `pipe` the acknowledgement of `entry` and its deletion from the stream (whose
+/// length is then the backlog).
+fn acknowledged<'a>(pipe: &'a mut Pipeline, entry: &Entry) -> &'a mut Pipeline {
     let ids = [&entry.id];
     pipe.xack(keys::STREAM, keys::GROUP, &ids)
         .ignore()
         .xdel(keys::STREAM, &ids)
-        .ignore();
-    if let Err(e) = fleet.jobs.pipe::<()>(&pipe).await {
+        .ignore()
+}
+
+async fn acknowledge(fleet: &Fleet, entry: &Entry) {
+    if let Err(e) = fleet
+        .jobs
+        .pipe::<()>(acknowledged(&mut redis::pipe(), entry))
+        .await
+    {
         tracing::warn!(error = %e, "an entry was not acknowledged: it will run again");
     }
 }
 
-/// Stops a task when dropped.
-struct AbortOnDrop(tokio::task::JoinHandle<()>);
-
-impl Drop for AbortOnDrop {
-    fn drop(&mut self) {
-        self.0.abort();
+/// Adds to `pipe` a stream entry for `job`, or its part `part` (index and points): the
+/// fields [`Entry::read`] reads.
+pub(super) fn add_entry(pipe: &mut Pipeline, job: Uuid, part: Option<(usize, &Range<usize>)>) {
+    let mut fields = vec![("job", job.to_string())];
+    if let Some((index, range)) = part {
+        fields.push(("part", index.to_string()));
+        fields.push(("start", range.start.to_string()));
+        fields.push(("end", range.end.to_string()));
     }
+    pipe.xadd(keys::STREAM, "*", &fields).ignore();
 }
 
 /// Hands `entry`, stopped unfinished by a drain, back to the fleet at once: a new entry
@@ -535,22 +537,10 @@ async fn hand_back(shared: &Shared, entry: &Entry) {
         .store
         .undelivered(entry.job, &entry.part_name())
         .await;
-    let job = entry.job.to_string();
-    let mut fields = vec![("job", job)];
-    if let Some((index, range)) = &entry.part {
-        fields.push(("part", index.to_string()));
-        fields.push(("start", range.start.to_string()));
-        fields.push(("end", range.end.to_string()));
-    }
     let mut pipe = redis::pipe();
-    let ids = [&entry.id];
-    pipe.atomic()
-        .xack(keys::STREAM, keys::GROUP, &ids)
-        .ignore()
-        .xdel(keys::STREAM, &ids)
-        .ignore()
-        .xadd(keys::STREAM, "*", &fields)
-        .ignore();
+    acknowledged(pipe.atomic(), entry);
+    let part = entry.part.as_ref().map(|(index, range)| (*index, range));
+    add_entry(&mut pipe, entry.job, part);
     match shared.fleet.jobs.pipe::<()>(&pipe).await {
         Ok(()) => tracing::info!(job = %entry.job, part = entry.part_name(), "handed a part back"),
         Err(e) => tracing::warn!(error = %e, "a part was not handed back: it is taken over later"),
@@ -561,13 +551,13 @@ async fn hand_back(shared: &Shared, entry: &Entry) {
 /// bound), stops the solver if the job was cancelled or finished elsewhere, and counts the
 /// progress of a job solved whole.
 async fn heartbeat(
-    fleet: Arc<Fleet>,
-    store: Arc<RedisJobStore>,
+    shared: Arc<Shared>,
     entry: String,
     id: Uuid,
     control: Arc<Control>,
     whole: bool,
 ) {
+    let (fleet, store) = (&shared.fleet, &shared.store);
     let keep_every = (fleet.config.claim_idle / 3).max(HEARTBEAT);
     let mut kept = Instant::now();
     loop {
