@@ -25,9 +25,8 @@ use crate::job::registry::KindName;
 use crate::job::{JobError, Work};
 
 /// Moves a job to a new state unless it has finished. A finished state takes the result
-/// staged beside the record (in the same transaction, so that the bytes never pass through
-/// the script's arguments), drops the parts and starts the retention of every key of the
-/// job; a state refused drops the staged result. A success becomes its input's newest answer.
+/// staged beside the record (so that its bytes never pass through ARGV), drops the parts and
+/// starts every key's retention; a success becomes its input's newest answer.
 ///
 /// KEYS: record, result, parts, deliveries, staged result, the input's pointer. ARGV:
 /// status, done, error, retention (ms), now (Unix ms), whether a staged result is whole
@@ -58,10 +57,9 @@ end
 return 1
 "#;
 
-/// Counts once a part just stored in the parts hash (in the same transaction); acknowledges
-/// its stream entry unless the job is now whole (it then stays pending until the job is
-/// stored, so that a process that dies assembling it is replaced). Returns 1 once every
-/// part is in, 0 before, -1 if the job has finished or is gone (its parts then dropped).
+/// Counts a part just stored, once, and acknowledges its entry unless the job is now whole
+/// (pending until the job is stored, a process dying while assembling it is replaced).
+/// Returns 1 once every part is in, 0 before, -1 if the job has finished or is gone.
 ///
 /// KEYS: record, parts, stream. ARGV: part index, its points, the Unix ms at which the parts
 /// expire, the stream's group, the entry's id.
@@ -93,7 +91,6 @@ return 1
 /// The most jobs of one owner listed: the newest.
 const LISTED: isize = 10_000;
 
-/// A job as a worker needs it.
 pub struct Runnable {
     pub status: JobStatus,
     /// The job as [`crate::job::Job::to_wire`] wrote it.
@@ -105,7 +102,6 @@ pub struct Runnable {
     pub parts: usize,
 }
 
-/// The records of the fleet's jobs.
 pub struct RedisJobStore {
     fleet: Arc<Fleet>,
     retention: Duration,
@@ -123,8 +119,7 @@ impl RedisJobStore {
     }
 
     /// Records `record` (queued) and puts its work on the stream, one entry per range of
-    /// `parts` (or one for the whole job), in one transaction: a job is accepted with its
-    /// work or not at all. The record expires should no process ever finish it.
+    /// `parts`, in one transaction: a job is accepted with its work or not at all.
     pub async fn enqueue(
         &self,
         record: &JobRecord,
@@ -133,25 +128,19 @@ impl RedisJobStore {
         deadline: SystemTime,
         parts: &[Range<usize>],
     ) -> Result<(), Failure> {
-        let job = keys::job(record.id);
-        let mut pipe = redis::pipe();
-        // Borrowed where they can be: the job's text may be long (a fit's data).
         let deadline = unix_millis(deadline);
-        let deadline_text = deadline.to_string();
-        let count = parts.len().max(1).to_string();
-        let fields: [(&str, &str); 5] = [
+        let (deadline_text, count) = (deadline.to_string(), parts.len().max(1).to_string());
+        // Borrowed: the job's text may be long (a fit's data).
+        let fields = [
             ("status", JobStatus::Queued.as_str()),
             ("job", wire),
             ("key", key),
             ("deadline", &deadline_text),
             ("parts", &count),
         ];
-        pipe.atomic();
-        self.record_fields(&mut pipe, record);
-        pipe.hset_multiple(&job.record, &fields)
-            .ignore()
-            .cmd("PEXPIREAT")
-            .arg(&job.record)
+        let mut pipe = self.new_record(record, &fields);
+        pipe.cmd("PEXPIREAT")
+            .arg(keys::job(record.id).record)
             .arg(deadline + millis(self.retention))
             .ignore();
         if parts.is_empty() {
@@ -163,9 +152,9 @@ impl RedisJobStore {
         self.fleet.jobs.pipe::<()>(&pipe).await
     }
 
-    /// Adds to `pipe` the fields every new record has, and its place in its owner's list,
-    /// which lives as long as its newest job may.
-    fn record_fields(&self, pipe: &mut redis::Pipeline, record: &JobRecord) {
+    /// A transaction writing `record` with `fields` besides those every record has, and its
+    /// place in its owner's list, which lives as long as its newest job may.
+    fn new_record(&self, record: &JobRecord, fields: &[(&str, &str)]) -> redis::Pipeline {
         let key = keys::job(record.id).record;
         let submitted = unix_millis(record.submitted_at);
         let work = match record.work {
@@ -175,7 +164,7 @@ impl RedisJobStore {
         let submitted_text = submitted.to_string();
         let owner = record.owner.as_ref().map_or("", Owner::as_str);
         let bytes = record.result_bytes.to_string();
-        let fields: [(&str, &str); 7] = [
+        let common = [
             ("kind", record.kind.name()),
             ("work", &work),
             ("done", "0"),
@@ -184,11 +173,12 @@ impl RedisJobStore {
             ("submitted", &submitted_text),
             ("bytes", &bytes),
         ];
-        pipe.hset_multiple(&key, &fields).ignore();
+        let mut pipe = redis::pipe();
+        let all = [&common[..], fields].concat();
+        pipe.atomic().hset_multiple(&key, &all).ignore();
         if let Some(owner) = &record.owner {
-            // Scored in µs (exact in a double until the year 2255), so that jobs submitted in
-            // the same millisecond keep their order; ids are random past their millisecond.
-            // Jobs submitted longer ago than a job may be kept are gone: their places too.
+            // Scored in µs (exact in a double until 2255), so that jobs submitted in the same
+            // ms keep their order; places of jobs older than a job may be kept are dropped.
             let list = keys::owner(owner.as_str());
             let micros = |t: Duration| u64::try_from(t.as_micros()).unwrap_or(u64::MAX);
             let since_epoch = record
@@ -206,18 +196,19 @@ impl RedisJobStore {
                 .pexpire(&list, millis(self.lifetime) as i64)
                 .ignore();
         }
+        pipe
     }
 
-    /// The status of job `id`; `None` if it is gone (deleted or expired). A running part's
-    /// heartbeat asks it five times a second, so it reads that one field only.
+    /// The status of job `id`; `None` if it is gone. A part's heartbeat asks it five times a
+    /// second, so it reads that one field only.
     pub async fn status(&self, id: Uuid) -> Result<Option<JobStatus>, Failure> {
         let cmd = Cmd::hget(keys::job(id).record, "status");
         let status: Option<String> = self.fleet.jobs.query(&cmd).await?;
         Ok(status.as_deref().map(parse_status))
     }
 
-    /// Takes part `part` of job `id` for a worker, in one round trip: the job (`None` if it is
-    /// gone) and the part's deliveries so far, counting this one.
+    /// Takes part `part` of job `id` for a worker: the job (`None` if it is gone) and the
+    /// part's deliveries, counting this one.
     pub async fn take(&self, id: Uuid, part: &str) -> Result<(Option<Runnable>, u64), Failure> {
         let keys = keys::job(id);
         let fields = ["status", "job", "key", "deadline", "parts"];
@@ -263,8 +254,7 @@ impl RedisJobStore {
         self.fleet.jobs.pipe::<()>(&pipe).await
     }
 
-    /// Keeps part `index` (of `points` points) of `job` in its parts hash and acknowledges
-    /// its stream entry `entry` unless the job is now whole; returns whether every part is
+    /// Keeps part `index` (of `points` points) of `job` ([`PART_IN`]): whether every part is
     /// in (`None`: the job finished or is gone).
     pub async fn part_done(
         &self,
@@ -317,9 +307,8 @@ impl RedisJobStore {
             .collect()
     }
 
-    /// Moves job `id` to `state` with `done` units done (`None`: as counted so far), unless
-    /// it has finished (or is gone); returns whether it moved. A result is written once,
-    /// staged in the same transaction; one already in the store stays where it is.
+    /// Moves job `id` to `state` with `done` units done (`None`: as counted), unless it has
+    /// finished ([`UPDATE`]); returns whether it moved. A result is written once.
     pub async fn set_state(
         &self,
         id: Uuid,
@@ -349,21 +338,24 @@ impl RedisJobStore {
             pipe.hset_multiple(&job.staged, &fields).ignore();
             whole = result.form();
         }
-        let input = keys::input(key);
         let [record, result, parts, deliveries] = job.all();
-        eval(
-            &mut pipe,
-            UPDATE,
-            &[record, result, parts, deliveries, &job.staged, &input],
-        )
-        .arg(state.status().as_str())
-        .arg(done.map(|n| n.to_string()).unwrap_or_default())
-        .arg(error)
-        .arg(millis(self.retention))
-        .arg(unix_millis(SystemTime::now()))
-        .arg(whole)
-        .arg(key)
-        .arg(id.to_string());
+        let all = [
+            record,
+            result,
+            parts,
+            deliveries,
+            &job.staged,
+            &keys::input(key),
+        ];
+        eval(&mut pipe, UPDATE, &all)
+            .arg(state.status().as_str())
+            .arg(done.map(|n| n.to_string()).unwrap_or_default())
+            .arg(error)
+            .arg(millis(self.retention))
+            .arg(unix_millis(SystemTime::now()))
+            .arg(whole)
+            .arg(key)
+            .arg(id.to_string());
         let (moved,): (i64,) = self.fleet.jobs.pipe(&pipe).await?;
         Ok(moved == 1)
     }
@@ -384,20 +376,17 @@ impl RedisJobStore {
         "bytes",
     ];
 
-    /// The record of job `id`, without its result (left in Redis until a client reads it:
-    /// [`StoredResult`]); `None` if unknown or expired.
+    /// The record of job `id`, its result left in Redis ([`StoredResult`]); `None` if gone.
     pub async fn record(&self, id: Uuid) -> Result<Option<JobRecord>, Failure> {
         self.records(&[id]).await?.pop().unwrap_or(Ok(None))
     }
 
-    /// The records of jobs `ids` (`None` for those gone, an error for one this version
-    /// cannot read), read in one round trip.
+    /// The records of jobs `ids`, in one round trip (`None` for those gone).
     async fn records(
         &self,
         ids: &[Uuid],
     ) -> Result<Vec<Result<Option<JobRecord>, Failure>>, Failure> {
-        // An empty pipeline is an error to Redis's client ("empty command"): an owner with
-        // no jobs has no records to read.
+        // An empty pipeline is an error to Redis's client ("empty command").
         if ids.is_empty() {
             return Ok(Vec::new());
         }
@@ -436,10 +425,21 @@ impl RedisJobStore {
         let kind = KindName::find(&text("kind"))
             .map_err(|e| Failure::new(format!("a stored job is unreadable: {e}")))?;
         let work = text("work").parse().map_or(Work::Unknown, Work::Known);
-        // A record of the version before `result` was kept says so by its result hash.
+        let status = parse_status(&text("status"));
         let form = match fields.get("result") {
             Some(form) => String::from_utf8_lossy(form).into_owned(),
-            None => self.legacy_result_form(id, &text("status")).await?,
+            // A record of the version before `result` was kept: its result hash tells.
+            None if status.is_finished() => {
+                let cmd = Cmd::hexists(keys::job(id).result, "json");
+                let stored: bool = self.fleet.jobs.query(&cmd).await?;
+                let form = match (stored, status) {
+                    (false, _) => "",
+                    (true, JobStatus::Succeeded) => "whole",
+                    (true, _) => "partial",
+                };
+                form.to_string()
+            }
+            None => String::new(),
         };
         // A result of a cancelled or failed job is what it finished before it stopped.
         let result = || match form.as_str() {
@@ -454,7 +454,7 @@ impl RedisJobStore {
             )))),
             _ => None,
         };
-        let state = JobState::restored(parse_status(&text("status")), result(), || {
+        let state = JobState::restored(status, result(), || {
             serde_json::from_slice(fields.get("error").map_or(&[][..], Vec::as_slice))
                 .unwrap_or_else(|e| {
                     JobError::Internal(format!("the job's error is unreadable: {e}"))
@@ -470,8 +470,7 @@ impl RedisJobStore {
             done: text("done").parse().unwrap_or(0),
             input_hash: text("key"),
             owner: owner.map(Owner::stored),
-            // A record of the version before submissions were timed: its deadline, which
-            // orders it among the others all the same.
+            // A record of the version before submissions were timed: its deadline orders it.
             submitted_at: time("submitted")
                 .or_else(|| time("deadline"))
                 .unwrap_or(std::time::UNIX_EPOCH),
@@ -480,23 +479,6 @@ impl RedisJobStore {
             result_bytes: text("bytes").parse().unwrap_or(0),
             unsaved: false,
         }))
-    }
-
-    /// The form of the result of a finished job recorded by the version before records named
-    /// it: `whole` for a succeeded job's, `partial` for another's, `""` for none.
-    async fn legacy_result_form(&self, id: Uuid, status: &str) -> Result<String, Failure> {
-        let status = parse_status(status);
-        if matches!(status, JobStatus::Queued | JobStatus::Running) {
-            return Ok(String::new());
-        }
-        let cmd = Cmd::hexists(keys::job(id).result, "json");
-        let stored: bool = self.fleet.jobs.query(&cmd).await?;
-        let form = match (stored, status) {
-            (false, _) => "",
-            (true, JobStatus::Succeeded) => "whole",
-            (true, _) => "partial",
-        };
-        Ok(form.to_string())
     }
 }
 
@@ -510,10 +492,13 @@ struct InRedis {
 impl ResultPlace for InRedis {
     async fn body(&self, field: &str) -> std::io::Result<Bytes> {
         let cmd = Cmd::hget(keys::job(self.id).result, field);
-        let body: Option<Vec<u8>> = self.fleet.jobs.query(&cmd).await?;
-        body.map(Bytes::from).ok_or_else(|| {
-            std::io::Error::other("the job's result expired, or was lost from the job store")
-        })
+        let lost = "the job's result expired, or was lost from the job store";
+        match self.fleet.jobs.query::<Option<Vec<u8>>>(&cmd).await {
+            Ok(body) => body
+                .map(Bytes::from)
+                .ok_or_else(|| std::io::Error::other(lost)),
+            Err(e) => Err(std::io::Error::other(e.why)),
+        }
     }
 }
 
@@ -526,13 +511,8 @@ impl JobStore for RedisJobStore {
             ("key", &record.input_hash),
             ("parts", "1"),
         ];
-        let key = keys::job(record.id).record;
-        let mut pipe = redis::pipe();
-        pipe.atomic();
-        self.record_fields(&mut pipe, &record);
-        pipe.hset_multiple(&key, &fields)
-            .ignore()
-            .pexpire(&key, millis(self.lifetime) as i64)
+        let mut pipe = self.new_record(&record, &fields);
+        pipe.pexpire(keys::job(record.id).record, millis(self.lifetime) as i64)
             .ignore();
         if let Err(e) = self.fleet.jobs.pipe::<()>(&pipe).await {
             tracing::warn!(error = %e, id = %record.id, "a job record was not stored");
@@ -576,7 +556,6 @@ impl JobStore for RedisJobStore {
         }
     }
 
-    /// Redis forgets expired jobs by itself.
     async fn purge_expired(&self) -> usize {
         0
     }
@@ -591,28 +570,19 @@ impl JobStore for RedisJobStore {
             .query(&Cmd::zrevrange(&list, 0, LISTED - 1))
             .await?;
         let ids: Vec<Uuid> = ids.iter().filter_map(|id| id.parse().ok()).collect();
-        let records = self.records(&ids).await?;
-        let gone: Vec<String> = ids
-            .iter()
-            .zip(&records)
-            .filter(|(_, record)| matches!(record, Ok(None)))
-            .map(|(id, _)| id.to_string())
-            .collect();
+        let (mut matching, mut gone) = (Vec::new(), Vec::new());
+        for (id, record) in ids.iter().zip(self.records(&ids).await?) {
+            match record {
+                Ok(Some(record)) if record.listed_in(listing) => matching.push(record),
+                Ok(Some(_)) => {}
+                Ok(None) => gone.push(id.to_string()),
+                // One this version cannot read (another version's kind) is left out, not fatal.
+                Err(e) => tracing::warn!(error = %e, %id, "a listed job is unreadable"),
+            }
+        }
         if !gone.is_empty() {
             let _ = self.fleet.jobs.query::<i64>(&Cmd::zrem(&list, gone)).await;
         }
-        // A record this version cannot read (another version's kind) is left out, not fatal.
-        let matching = ids
-            .iter()
-            .zip(records)
-            .filter_map(|(id, record)| {
-                record
-                    .inspect_err(|e| tracing::warn!(error = %e, %id, "a listed job is unreadable"))
-                    .ok()
-                    .flatten()
-            })
-            .filter(|record| record.listed_in(listing))
-            .collect();
         Ok(Page::of(matching, listing))
     }
 
@@ -642,8 +612,7 @@ fn parse_status(text: &str) -> JobStatus {
     JobStatus::parse(text).unwrap_or(JobStatus::Failed)
 }
 
-/// The instant of this process at the Unix time `unix_ms` (the fleet's clocks are assumed
-/// in step, as NTP keeps them).
+/// The instant of this process at the Unix time `unix_ms` (clocks are in step, by NTP).
 fn instant_of(unix_ms: u64) -> Instant {
     let (now, instant) = (unix_millis(SystemTime::now()), Instant::now());
     let later = instant + Duration::from_millis(unix_ms.saturating_sub(now));
@@ -652,15 +621,8 @@ fn instant_of(unix_ms: u64) -> Instant {
         .unwrap_or(instant)
 }
 
-/// A failure to reach the fleet's Redis, as the store's readers and a result's reader see it.
 impl From<Failure> for Unreadable {
     fn from(e: Failure) -> Unreadable {
         Unreadable::Redis(e.why)
-    }
-}
-
-impl From<Failure> for std::io::Error {
-    fn from(e: Failure) -> std::io::Error {
-        std::io::Error::other(e.why)
     }
 }
