@@ -23,8 +23,7 @@ use crate::render::Format;
 const LOOK_EVERY: Duration = Duration::from_millis(5);
 
 /// Bounds the answers' bytes on a server shared with the jobs: records the answer just
-/// written, then drops the oldest while the total is over the bound. The index expires with
-/// the answers, when none is written for as long.
+/// written, then drops the oldest while the total is over the bound.
 ///
 /// KEYS: answers by age, their sizes, the answer. ARGV: now (ms), its bytes, the bound, the
 /// answers' time to live (ms).
@@ -53,22 +52,14 @@ pub struct TieredCache {
     l1: MemoryCache,
     fleet: Arc<Fleet>,
     ttl: Duration,
-    release: Script,
 }
 
 impl TieredCache {
     pub fn new(l1: MemoryCache, fleet: Arc<Fleet>, ttl: Duration) -> TieredCache {
-        let release = Script::new(DELETE_IF_HELD);
-        TieredCache {
-            l1,
-            fleet,
-            ttl,
-            release,
-        }
+        TieredCache { l1, fleet, ttl }
     }
 
-    /// The answer under `key` in Redis, if there and reachable: its texts, or the job whose
-    /// stored result it is (on the same server).
+    /// The answer under `key` in Redis: its texts, or the job whose stored result it is.
     async fn shared(&self, key: &str) -> Option<Arc<Solved>> {
         let link = &self.fleet.cache;
         if !link.is_quick() {
@@ -97,8 +88,8 @@ impl TieredCache {
         Some(solved)
     }
 
-    /// Keeps `solved` here, and in Redis if up: its texts, or where the cache shares the job
-    /// store's server and `job` stored it, a reference to the job's result, written once.
+    /// Keeps `solved` here, and in Redis if up: its texts, or a reference to the result of
+    /// `job` (on the job store's server, so that it is written once).
     async fn share(&self, solved: Arc<Solved>, job: Option<Uuid>) {
         self.l1.insert(solved.clone()).await;
         let link = &self.fleet.cache;
@@ -158,8 +149,6 @@ impl ResultCache for TieredCache {
         self.share(solved, None).await
     }
 
-    /// On one server with the job store, the answer is a reference to the job's result; on
-    /// a server of its own, a copy.
     async fn insert_result_of(&self, solved: Arc<Solved>, job: Uuid) {
         let job = self.fleet.one_server().then_some(job);
         self.share(solved, job).await
@@ -205,10 +194,9 @@ impl ResultCache for TieredCache {
     async fn release(&self, key: &str) {
         let link = &self.fleet.cache;
         if link.is_quick() {
-            let claim = keys::solving(key);
-            let _ = link
-                .script::<i64>(&self.release, &[&claim], &[self.fleet.consumer.as_bytes()])
-                .await;
+            let (release, claim) = (Script::new(DELETE_IF_HELD), keys::solving(key));
+            let consumer = self.fleet.consumer.as_bytes();
+            let _ = link.script::<i64>(&release, &[&claim], &[consumer]).await;
         }
     }
 }

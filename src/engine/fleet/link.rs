@@ -15,14 +15,11 @@ use redis::{Cmd, FromRedisValue, Pipeline, RedisError, Script};
 const CALL_TIMEOUT: Duration = Duration::from_secs(1);
 /// How often an unreachable server is tried again.
 pub const RETRY_EVERY: Duration = Duration::from_millis(500);
-/// A server whose ping takes longer is slow: a synchronous solve would wait on it more than
-/// it gains.
+/// A server whose ping takes longer is slow: a synchronous solve would wait more than it gains.
 const SLOW: Duration = Duration::from_millis(25);
-/// How long a refusal for want of memory marks the server full, unless a write probe (every
-/// half second while it is full) finds it taking writes again sooner.
+/// How long a refusal for want of memory marks the server full, unless a write probe says not.
 const FULL_FOR: Duration = Duration::from_secs(10);
 
-/// A server's health, as the last calls found it.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum Health {
     Up,
@@ -46,7 +43,6 @@ impl Health {
         }
     }
 
-    /// Why the server of `role` is not simply up, in a sentence (`None` if it is).
     pub fn reason(&self, role: &str) -> Option<String> {
         match self {
             Health::Up => None,
@@ -67,8 +63,7 @@ impl Health {
     }
 }
 
-/// Why a call to Redis failed, in a sentence, and the code of the server's error reply
-/// (`NOGROUP`, `BUSYGROUP`...) if it refused the command.
+/// Why a call to Redis failed, in a sentence, and the server's error code (`NOGROUP`...).
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
 #[error("{why}")]
 pub struct Failure {
@@ -89,7 +84,6 @@ impl Failure {
     }
 }
 
-/// A Redis server in one role.
 pub struct Link {
     /// `cache` or `jobs`, for messages and metrics.
     pub role: &'static str,
@@ -189,9 +183,8 @@ impl Link {
         }
     }
 
-    /// Runs `call` on the connection, and records what its outcome says of the server; a call
-    /// cut by a lost connection is tried once more (the manager reconnects at once: the first
-    /// call after a restart of Redis succeeds).
+    /// Runs `call`, and records what its outcome says of the server; a call cut by a lost
+    /// connection is tried once more (so that the first call after a restart succeeds).
     async fn call<T, F, Fut>(&self, call: F) -> Result<T, Failure>
     where
         F: Fn(ConnectionManager) -> Fut,
@@ -271,20 +264,15 @@ impl Link {
         keys: &[&str],
         args: &[&[u8]],
     ) -> Result<T, Failure> {
-        let mut invocation = script.prepare_invoke();
-        for key in keys {
-            invocation.key(*key);
-        }
-        for arg in args {
-            invocation.arg(*arg);
-        }
+        let mut invocation = script.key(keys);
+        invocation.arg(args);
         let invocation = &invocation;
         self.call(|mut c| async move { invocation.invoke_async(&mut c).await })
             .await
     }
 
-    /// Pings the server every half second until dropped, so that its health is known even
-    /// by a process with no call to make, and comes back (other calls skip a link down).
+    /// Pings the server until dropped, so that its health is known without calls to make,
+    /// and comes back (other calls skip a link down).
     pub async fn watch(&self) {
         loop {
             tokio::time::sleep(RETRY_EVERY).await;
@@ -316,9 +304,9 @@ impl Link {
     }
 }
 
-/// `url` with its password (AUTH, from a Secret) replaced by `***`, for messages and logs:
-/// everything between `://` and the last `@` but the user name (a password may hold `/`,
-/// `?` or `@`), and the value of a `pass` or `password` parameter (`redis+unix://`).
+/// `url` with its password replaced by `***`, for messages and logs: all between `://` and
+/// the last `@` but the user (a password may hold `/`, `?` or `@`), and a `pass` or
+/// `password` parameter (`redis+unix://`).
 pub fn redacted(url: &str) -> String {
     let Some((scheme, rest)) = url.split_once("://") else {
         return url.to_string();
@@ -353,7 +341,7 @@ pub struct LinkError {
 }
 
 /// Adds `script` on `keys` to `pipe`, its arguments to follow: `EVAL` with its text, so that
-/// it needs no loading (inside a transaction, or not).
+/// it needs no loading inside a transaction.
 pub(super) fn eval<'a>(pipe: &'a mut Pipeline, script: &str, keys: &[&str]) -> &'a mut Pipeline {
     pipe.cmd("EVAL").arg(script).arg(keys.len()).arg(keys)
 }
