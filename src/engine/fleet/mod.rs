@@ -1,10 +1,8 @@
-//! Several processes on one Redis (opt-in, `--redis-url`): a shared answer cache
-//! ([`TieredCache`]), job records any process answers for ([`RedisJobStore`]), and the work
-//! on a Redis Stream read by a consumer group ([`worker`]), taken over from a process that
-//! died. Solves are pure, so solving a part twice is harmless.
-//!
-//! Two Redis roles, one server or two: the cache (evicting) and the jobs (no eviction,
-//! persisted), so that a full cache never loses an accepted job.
+//! Several processes on one Redis (opt-in, `--redis-url`): a shared answer cache, job records
+//! any process answers for, and the work on a Redis Stream read by a consumer group, taken
+//! over from a process that died (solves are pure: solving a part twice is harmless). Two
+//! roles, one server or two: the cache (evicting) and the jobs (no eviction, persisted), so
+//! that a full cache never loses an accepted job.
 
 mod cache;
 pub mod link;
@@ -21,7 +19,6 @@ pub use link::{Failure, Health, Link, LinkError};
 pub use store::RedisJobStore;
 pub use worker::{Shared, Worker};
 
-/// How the fleet's processes share work through Redis.
 #[derive(Clone, Debug, PartialEq)]
 pub struct FleetConfig {
     /// The Redis holding answers (`allkeys-lru`).
@@ -68,8 +65,7 @@ mod keys {
 
     /// The work stream and its consumer group.
     pub const STREAM: &str = "thirdbody:work";
-    /// When the job store's data began (Unix ms): a store restarted without its data gets a
-    /// new one.
+    /// When the job store's data began (Unix ms): a store restarted without it gets a new one.
     pub const EPOCH: &str = "thirdbody:epoch";
     /// Seconds per point of each cost class, as measured by the workers.
     pub const RATES: &str = "thirdbody:rates";
@@ -79,8 +75,7 @@ mod keys {
         format!("thirdbody:answer:{key}")
     }
 
-    /// On a server shared with the jobs: the cached answers by age, and their sizes (and
-    /// `total`), which bound the cache's share of the server.
+    /// On a server shared with the jobs: the answers by age, and their sizes (and `total`).
     pub const ANSWERS_BY_AGE: &str = "thirdbody:answers:by-age";
     pub const ANSWER_SIZES: &str = "thirdbody:answers:sizes";
 
@@ -155,7 +150,6 @@ impl Fleet {
         })
     }
 
-    /// Whether the cache and the jobs are on one server.
     pub fn one_server(&self) -> bool {
         self.config.cache_url == self.config.jobs_url
     }
@@ -203,7 +197,7 @@ impl Fleet {
                 tokio::time::sleep(link::RETRY_EVERY).await; // unreachable
                 continue;
             };
-            if known != Some(maxmemory) {
+            if known.replace(maxmemory) != Some(maxmemory) {
                 let bytes = cache_share(given, maxmemory);
                 self.cache_bytes.store(bytes, Ordering::Relaxed);
                 match maxmemory {
@@ -230,13 +224,11 @@ impl Fleet {
                          server's memory"
                     ),
                 }
-                known = Some(maxmemory);
             }
             tokio::time::sleep(MAXMEMORY_EVERY).await;
         }
     }
 
-    /// When the job store's data began (Unix ms), if known.
     pub async fn epoch(&self) -> Option<u64> {
         self.jobs
             .query(&redis::Cmd::get(keys::EPOCH))
