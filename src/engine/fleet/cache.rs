@@ -1,8 +1,8 @@
 //! Answers shared by the fleet: this process's memory first (L1), then Redis (L2), by the
-//! same content key, for the same time to live. A miss is claimed in Redis before it is
-//! solved, so that identical misses on several processes solve once: the others wait for
-//! the answer to appear (or for the claim to lapse, if its holder died).
+//! same key and time to live. A miss is claimed in Redis before it is solved, so that
+//! identical misses solve once: the others wait for the answer (or for the claim to lapse).
 
+use std::sync::atomic::Ordering;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
@@ -11,6 +11,7 @@ use bytes::Bytes;
 use redis::{Cmd, ExistenceCheck, Script, SetExpiry, SetOptions};
 use uuid::Uuid;
 
+use super::link::{eval, DELETE_IF_HELD};
 use super::{keys, Fleet, Health};
 use crate::engine::cache::{Claim, MemoryCache, ResultCache, Solved};
 use crate::engine::clock::millis;
@@ -21,17 +22,8 @@ use crate::render::Format;
 /// How often a process waiting for another's solve looks for the answer.
 const LOOK_EVERY: Duration = Duration::from_millis(5);
 
-/// Deletes a claim only if it is still the caller's (it may have lapsed and been taken).
-const RELEASE: &str = r#"
-if redis.call('GET', KEYS[1]) == ARGV[1] then
-  return redis.call('DEL', KEYS[1])
-end
-return 0
-"#;
-
 /// Bounds the answers' bytes on a server shared with the jobs: records the answer just
-/// written (its key and size), then drops the oldest answers while the total is over the
-/// bound. The index itself expires with the answers, when no answer is written for as long.
+/// written, then drops the oldest while the total is over the bound.
 ///
 /// KEYS: answers by age, their sizes, the answer. ARGV: now (ms), its bytes, the bound, the
 /// answers' time to live (ms).
@@ -60,42 +52,28 @@ pub struct TieredCache {
     l1: MemoryCache,
     fleet: Arc<Fleet>,
     ttl: Duration,
-    release: Script,
 }
 
 impl TieredCache {
     pub fn new(l1: MemoryCache, fleet: Arc<Fleet>, ttl: Duration) -> TieredCache {
-        TieredCache {
-            l1,
-            fleet,
-            ttl,
-            release: Script::new(RELEASE),
-        }
+        TieredCache { l1, fleet, ttl }
     }
 
-    /// The answer under `key` in Redis, if there (and Redis reachable): its texts, or the
-    /// job whose stored result it is (on the same server).
+    /// The answer under `key` in Redis: its texts, or the job whose stored result it is.
     async fn shared(&self, key: &str) -> Option<Arc<Solved>> {
         let link = &self.fleet.cache;
         if !link.is_quick() {
             return None;
         }
         let cmd = Cmd::hmget(keys::answer(key), &["json", "csv", "kind", "job"][..]);
-        type Fields = (
-            Option<Vec<u8>>,
-            Option<Vec<u8>>,
-            Option<String>,
-            Option<String>,
-        );
-        let (json, csv, kind, job): Fields = link.query(&cmd).await.ok()?;
-        let kind = KindName::find(&kind?).ok()?;
+        let [json, csv, kind, job]: [Option<Vec<u8>>; 4] = link.query(&cmd).await.ok()?;
+        let kind = KindName::find(std::str::from_utf8(&kind?).ok()?).ok()?;
         let (json, csv) = match (json, csv, job) {
             (Some(json), Some(csv), _) => (json, csv),
             (_, _, Some(job)) => {
-                let result = keys::job(job.parse().ok()?).result;
-                let cmd = Cmd::hmget(result, &["json", "csv"][..]);
-                let (json, csv): (Option<Vec<u8>>, Option<Vec<u8>>) =
-                    link.query(&cmd).await.ok()?;
+                let id = std::str::from_utf8(&job).ok()?.parse().ok()?;
+                let cmd = Cmd::hmget(keys::job(id).result, &["json", "csv"][..]);
+                let [json, csv]: [Option<Vec<u8>>; 2] = link.query(&cmd).await.ok()?;
                 (json?, csv?)
             }
             _ => return None,
@@ -110,9 +88,51 @@ impl TieredCache {
         Some(solved)
     }
 
-    /// The answer's time to live in Redis, in ms.
-    fn ttl_millis(&self) -> i64 {
-        i64::try_from(millis(self.ttl)).unwrap_or(i64::MAX)
+    /// Keeps `solved` here, and in Redis if up: its texts, or a reference to the result of
+    /// `job` (on the job store's server, so that it is written once).
+    async fn share(&self, solved: Arc<Solved>, job: Option<Uuid>) {
+        self.l1.insert(solved.clone()).await;
+        let link = &self.fleet.cache;
+        if link.health() != Health::Up {
+            return;
+        }
+        let (key, job) = (keys::answer(&solved.key), job.map(|id| id.to_string()));
+        let ttl = i64::try_from(millis(self.ttl)).unwrap_or(i64::MAX);
+        let kind = solved.kind.name().as_bytes();
+        let csv;
+        let (fields, bytes): (Vec<(&str, &[u8])>, _) = match &job {
+            Some(job) => (vec![("kind", kind), ("job", job.as_bytes())], None),
+            None => {
+                let Ok(body) = solved.body(Format::Csv) else {
+                    return;
+                };
+                csv = body;
+                let bytes = solved.json().len() + csv.len() + key.len();
+                let fields: Vec<(&str, &[u8])> =
+                    vec![("json", solved.json()), ("csv", &csv), ("kind", kind)];
+                (fields, Some(bytes))
+            }
+        };
+        let mut pipe = redis::pipe();
+        pipe.atomic()
+            .hset_multiple(&key, &fields)
+            .ignore()
+            .pexpire(&key, ttl)
+            .ignore();
+        if let Some(bytes) = bytes.filter(|_| self.fleet.one_server()) {
+            let now = crate::engine::clock::unix_millis(std::time::SystemTime::now());
+            let bound = self.fleet.cache_bytes.load(Ordering::Relaxed);
+            let index = [keys::ANSWERS_BY_AGE, keys::ANSWER_SIZES, &key];
+            eval(&mut pipe, BOUND, &index)
+                .arg(now)
+                .arg(bytes)
+                .arg(bound)
+                .arg(ttl)
+                .ignore();
+        }
+        if let Err(e) = link.pipe::<()>(&pipe).await {
+            tracing::warn!(error = %e, "an answer was not shared");
+        }
     }
 }
 
@@ -126,71 +146,12 @@ impl ResultCache for TieredCache {
     }
 
     async fn insert(&self, solved: Arc<Solved>) {
-        self.l1.insert(solved.clone()).await;
-        let link = &self.fleet.cache;
-        if link.health() != Health::Up {
-            return;
-        }
-        let Ok(csv) = solved.body(Format::Csv) else {
-            return;
-        };
-        let key = keys::answer(&solved.key);
-        let mut pipe = redis::pipe();
-        let fields: [(&str, &[u8]); 3] = [
-            ("json", solved.json()),
-            ("csv", &csv),
-            ("kind", solved.kind.name().as_bytes()),
-        ];
-        pipe.atomic()
-            .hset_multiple(&key, &fields)
-            .ignore()
-            .pexpire(&key, self.ttl_millis())
-            .ignore();
-        if self.fleet.one_server() {
-            let bytes = (solved.json().len() + csv.len() + key.len()).to_string();
-            let now = crate::engine::clock::unix_millis(std::time::SystemTime::now()).to_string();
-            let bound = self.fleet.cache_bytes().to_string();
-            let ttl = self.ttl_millis().to_string();
-            pipe.add_command(super::link::eval(
-                BOUND,
-                &[keys::ANSWERS_BY_AGE, keys::ANSWER_SIZES, &key],
-                &[
-                    now.as_bytes(),
-                    bytes.as_bytes(),
-                    bound.as_bytes(),
-                    ttl.as_bytes(),
-                ],
-            ))
-            .ignore();
-        }
-        if let Err(e) = link.pipe::<()>(&pipe).await {
-            tracing::warn!(error = %e, "an answer was not shared");
-        }
+        self.share(solved, None).await
     }
 
-    /// On one server with the job store, the answer is a reference to the job's result,
-    /// written once there; on a server of its own, a copy.
     async fn insert_result_of(&self, solved: Arc<Solved>, job: Uuid) {
-        if !self.fleet.one_server() {
-            return self.insert(solved).await;
-        }
-        self.l1.insert(solved.clone()).await;
-        let link = &self.fleet.cache;
-        if link.health() != Health::Up {
-            return;
-        }
-        let key = keys::answer(&solved.key);
-        let job = job.to_string();
-        let fields: [(&str, &str); 2] = [("kind", solved.kind.name()), ("job", &job)];
-        let mut pipe = redis::pipe();
-        pipe.atomic()
-            .hset_multiple(&key, &fields)
-            .ignore()
-            .pexpire(&key, self.ttl_millis())
-            .ignore();
-        if let Err(e) = link.pipe::<()>(&pipe).await {
-            tracing::warn!(error = %e, "an answer was not shared");
-        }
+        let job = self.fleet.one_server().then_some(job);
+        self.share(solved, job).await
     }
 
     async fn claim(&self, key: &str, deadline: Instant) -> Result<Claim, JobError> {
@@ -233,10 +194,9 @@ impl ResultCache for TieredCache {
     async fn release(&self, key: &str) {
         let link = &self.fleet.cache;
         if link.is_quick() {
-            let claim = keys::solving(key);
-            let _ = link
-                .script::<i64>(&self.release, &[&claim], &[self.fleet.consumer.as_bytes()])
-                .await;
+            let (release, claim) = (Script::new(DELETE_IF_HELD), keys::solving(key));
+            let consumer = self.fleet.consumer.as_bytes();
+            let _ = link.script::<i64>(&release, &[&claim], &[consumer]).await;
         }
     }
 }

@@ -1,9 +1,7 @@
-//! One Redis server in one role (the answer cache, or the jobs), as this process reaches it:
-//! a connection manager that reconnects by itself, a bound on every call, and the server's
-//! health as the last calls found it: reachable or not, full (refusing writes at its memory
-//! limit) or not, and how long a round trip takes (a ping every half second), so that callers
-//! can skip it at once while it is of no use (synchronous solves then answer from this
-//! process's memory, without waiting) and `/readyz` can say why.
+//! One Redis server in one role (the answer cache, or the jobs): a connection manager that
+//! reconnects by itself, a bound on every call, and the server's health as the last calls
+//! and pings found it (down, full, slow), so that callers skip it at once while it is of no
+//! use (synchronous solves then answer from this process alone) and `/readyz` can say why.
 
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::OnceLock;
@@ -17,14 +15,11 @@ use redis::{Cmd, FromRedisValue, Pipeline, RedisError, Script};
 const CALL_TIMEOUT: Duration = Duration::from_secs(1);
 /// How often an unreachable server is tried again.
 pub const RETRY_EVERY: Duration = Duration::from_millis(500);
-/// A server whose ping takes longer is slow: a synchronous solve would wait on it more than
-/// it gains (a solve costs well under a millisecond to a few).
+/// A server whose ping takes longer is slow: a synchronous solve would wait more than it gains.
 const SLOW: Duration = Duration::from_millis(25);
-/// How long a refusal for want of memory marks the server full, unless a write probe (every
-/// half second while it is full) finds it taking writes again sooner.
+/// How long a refusal for want of memory marks the server full, unless a write probe says not.
 const FULL_FOR: Duration = Duration::from_secs(10);
 
-/// A server's health, as the last calls found it.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum Health {
     Up,
@@ -48,7 +43,6 @@ impl Health {
         }
     }
 
-    /// Why the server of `role` is not simply up, in a sentence (`None` if it is).
     pub fn reason(&self, role: &str) -> Option<String> {
         match self {
             Health::Up => None,
@@ -69,12 +63,11 @@ impl Health {
     }
 }
 
-/// Why a call to Redis failed, in a sentence, and the server's error code if it refused
-/// the command.
-#[derive(Clone, Debug, PartialEq, Eq)]
+/// Why a call to Redis failed, in a sentence, and the server's error code (`NOGROUP`...).
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("{why}")]
 pub struct Failure {
     pub why: String,
-    /// The code a Redis error reply begins with (`NOGROUP`, `BUSYGROUP`...).
     code: Option<String>,
 }
 
@@ -86,19 +79,11 @@ impl Failure {
         }
     }
 
-    /// Whether Redis refused the command with error `code`.
     pub fn is(&self, code: &str) -> bool {
         self.code.as_deref() == Some(code)
     }
 }
 
-impl std::fmt::Display for Failure {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(&self.why)
-    }
-}
-
-/// A Redis server in one role.
 pub struct Link {
     /// `cache` or `jobs`, for messages and metrics.
     pub role: &'static str,
@@ -116,7 +101,7 @@ pub struct Link {
 }
 
 impl Link {
-    /// A link to the server at `url`; connects at the first call (the server may start later).
+    /// Connects at the first call (the server may start later).
     pub fn open(role: &'static str, url: &str) -> Result<Link, LinkError> {
         let failed = |source| LinkError {
             role,
@@ -155,12 +140,10 @@ impl Link {
         let _ = self.gauge.set(gauge);
     }
 
-    /// Whether the last call reached the server.
     pub fn is_up(&self) -> bool {
         self.up.load(Ordering::Relaxed)
     }
 
-    /// The server's health (see [`Health`]).
     pub fn health(&self) -> Health {
         let full_at = self.full_at.load(Ordering::Relaxed);
         let round_trip = Duration::from_micros(self.round_trip.load(Ordering::Relaxed));
@@ -186,8 +169,7 @@ impl Link {
         u64::try_from(self.opened.elapsed().as_millis()).unwrap_or(u64::MAX)
     }
 
-    /// Records whether the server was reached; `why` not (logged once, when it changes: a
-    /// refused connection, a certificate not trusted, a timeout).
+    /// Records whether the server was reached; `why` not (logged when it changes).
     fn set_up(&self, up: bool, why: &str) {
         if self.up.swap(up, Ordering::Relaxed) != up {
             if up {
@@ -201,11 +183,19 @@ impl Link {
         }
     }
 
-    /// Records what a call's outcome says of the server's reachability.
-    fn outcome<T>(
-        &self,
-        result: Result<Result<T, RedisError>, tokio::time::error::Elapsed>,
-    ) -> Result<T, Failure> {
+    /// Runs `call`, and records what its outcome says of the server; a call cut by a lost
+    /// connection is tried once more (so that the first call after a restart succeeds).
+    async fn call<T, F, Fut>(&self, call: F) -> Result<T, Failure>
+    where
+        F: Fn(ConnectionManager) -> Fut,
+        Fut: std::future::Future<Output = Result<T, RedisError>>,
+    {
+        let mut result = tokio::time::timeout(CALL_TIMEOUT, call(self.connection.clone())).await;
+        if let Ok(Err(e)) = &result {
+            if e.is_connection_dropped() || e.is_io_error() {
+                result = tokio::time::timeout(CALL_TIMEOUT, call(self.connection.clone())).await;
+            }
+        }
         match result {
             Ok(Ok(value)) => {
                 self.denied.store(false, Ordering::Relaxed);
@@ -258,56 +248,31 @@ impl Link {
         }
     }
 
-    /// Runs `call` on the connection; a call cut by a lost connection is tried once more
-    /// (the manager reconnects at once: the first call after a restart of Redis succeeds).
-    async fn call<T, F, Fut>(&self, call: F) -> Result<T, Failure>
-    where
-        F: Fn(ConnectionManager) -> Fut,
-        Fut: std::future::Future<Output = Result<T, RedisError>>,
-    {
-        let mut result = tokio::time::timeout(CALL_TIMEOUT, call(self.connection.clone())).await;
-        if let Ok(Err(e)) = &result {
-            if e.is_connection_dropped() || e.is_io_error() {
-                result = tokio::time::timeout(CALL_TIMEOUT, call(self.connection.clone())).await;
-            }
-        }
-        self.outcome(result)
-    }
-
-    /// Runs one command.
     pub async fn query<T: FromRedisValue>(&self, cmd: &Cmd) -> Result<T, Failure> {
         self.call(|mut c| async move { cmd.query_async(&mut c).await })
             .await
     }
 
-    /// Runs a pipeline (atomic if built so).
     pub async fn pipe<T: FromRedisValue>(&self, pipe: &Pipeline) -> Result<T, Failure> {
         self.call(|mut c| async move { pipe.query_async(&mut c).await })
             .await
     }
 
-    /// Runs a Lua script with `keys` and `args`.
     pub async fn script<T: FromRedisValue>(
         &self,
         script: &Script,
         keys: &[&str],
         args: &[&[u8]],
     ) -> Result<T, Failure> {
-        let mut invocation = script.prepare_invoke();
-        for key in keys {
-            invocation.key(*key);
-        }
-        for arg in args {
-            invocation.arg(*arg);
-        }
+        let mut invocation = script.key(keys);
+        invocation.arg(args);
         let invocation = &invocation;
         self.call(|mut c| async move { invocation.invoke_async(&mut c).await })
             .await
     }
 
-    /// Pings the server every half second, so that its reachability is known (and
-    /// reported) even by a process that has no call to make, and comes back up by itself
-    /// (other calls skip a link that is down). Runs until dropped.
+    /// Pings the server until dropped, so that its health is known without calls to make,
+    /// and comes back (other calls skip a link down).
     pub async fn watch(&self) {
         loop {
             tokio::time::sleep(RETRY_EVERY).await;
@@ -339,9 +304,9 @@ impl Link {
     }
 }
 
-/// `url` with its password (AUTH, from a Secret) replaced by `***`, for messages and logs:
-/// everything between `://` and the last `@` but the user name (a password may hold `/`,
-/// `?` or `@`), and the value of a `pass` or `password` parameter (`redis+unix://`).
+/// `url` with its password replaced by `***`, for messages and logs: all between `://` and
+/// the last `@` but the user (a password may hold `/`, `?` or `@`), and a `pass` or
+/// `password` parameter (`redis+unix://`).
 pub fn redacted(url: &str) -> String {
     let Some((scheme, rest)) = url.split_once("://") else {
         return url.to_string();
@@ -375,18 +340,17 @@ pub struct LinkError {
     source: RedisError,
 }
 
-/// A script run inside a transaction: `EVAL` with its text, so that it needs no loading.
-pub(super) fn eval(script: &str, keys: &[&str], args: &[&[u8]]) -> Cmd {
-    let mut cmd = redis::cmd("EVAL");
-    cmd.arg(script).arg(keys.len());
-    for key in keys {
-        cmd.arg(*key);
-    }
-    for arg in args {
-        cmd.arg(*arg);
-    }
-    cmd
+/// Adds `script` on `keys` to `pipe`, its arguments to follow: `EVAL` with its text, so that
+/// it needs no loading inside a transaction.
+pub(super) fn eval<'a>(pipe: &'a mut Pipeline, script: &str, keys: &[&str]) -> &'a mut Pipeline {
+    pipe.cmd("EVAL").arg(script).arg(keys.len()).arg(keys)
 }
+
+/// Deletes KEYS[1] only if it still holds ARGV[1] (it may have been taken over since).
+pub(super) const DELETE_IF_HELD: &str = r#"
+if redis.call('GET', KEYS[1]) == ARGV[1] then return redis.call('DEL', KEYS[1]) end
+return 0
+"#;
 
 #[cfg(test)]
 mod redaction {

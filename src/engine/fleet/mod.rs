@@ -1,13 +1,8 @@
-//! Several processes on one Redis (opt-in, `--redis-url`): answers shared through a Redis
-//! cache behind each process's own ([`TieredCache`]), with identical misses solved once in
-//! the fleet; job records in Redis ([`RedisJobStore`]), so that any process answers for any
-//! job; and the work itself on a Redis Stream read by a consumer group ([`worker`]): a job
-//! is one entry, or a sweep one entry per range of points, taken by whichever process is
-//! free, acknowledged only once its result is stored, and taken over from a process that
-//! died after an idle bound. Solves are pure, so solving a part twice is harmless.
-//!
-//! Two Redis roles, one server or two: the cache (evicting, no persistence needed) and the
-//! jobs (no eviction, persisted), so that a full cache never loses an accepted job.
+//! Several processes on one Redis (opt-in, `--redis-url`): a shared answer cache, job records
+//! any process answers for, and the work on a Redis Stream read by a consumer group, taken
+//! over from a process that died (solves are pure: solving a part twice is harmless). Two
+//! roles, one server or two: the cache (evicting) and the jobs (no eviction, persisted), so
+//! that a full cache never loses an accepted job.
 
 mod cache;
 pub mod link;
@@ -24,27 +19,23 @@ pub use link::{Failure, Health, Link, LinkError};
 pub use store::RedisJobStore;
 pub use worker::{Shared, Worker};
 
-/// How the fleet's processes share work through Redis.
 #[derive(Clone, Debug, PartialEq)]
 pub struct FleetConfig {
     /// The Redis holding answers (`allkeys-lru`).
     pub cache_url: String,
     /// The Redis holding job records and the work stream (`noeviction`, AOF).
     pub jobs_url: String,
-    /// How long a taken part may go without its process's heartbeat before another
-    /// process takes it over.
+    /// How long a taken part may go without its heartbeat before another process takes it.
     pub claim_idle: Duration,
     /// Deliveries of one part before its job fails (its processes died on each).
     pub max_deliveries: u32,
     /// Points per part of a sweep whose cost per point is not measured yet.
     pub part_points: usize,
-    /// Bytes the cached answers may take when the cache shares the jobs' server, at most
-    /// (lowered to half the server's maxmemory where that is less: [`cache_share`]).
+    /// Bytes the cached answers may take on the jobs' server, at most ([`cache_share`]).
     pub shared_cache_bytes: u64,
 }
 
-/// How often the server's maxmemory is read again (it may be changed while running, or
-/// the server replaced by one of another size).
+/// How often the server's maxmemory is read again (it may change, or the server be replaced).
 const MAXMEMORY_EVERY: Duration = Duration::from_secs(60);
 
 /// What a Redis server says of its memory limit.
@@ -58,9 +49,8 @@ pub enum Maxmemory {
     Unknown,
 }
 
-/// The bytes the cached answers may take on a server shared with the jobs: `given`
-/// (`--redis-cache-bytes`), but at most half of the server's maxmemory, so that answers
-/// never fill a small server and leave the jobs no room (a 32 MB server under the 64 MiB
+/// The bytes cached answers may take on a server shared with the jobs: `given`, but at most
+/// half its maxmemory, so that they leave the jobs room (a 32 MB server under the 64 MiB
 /// default refused every submission once anonymous solves had filled it).
 pub fn cache_share(given: u64, maxmemory: Maxmemory) -> u64 {
     match maxmemory {
@@ -75,8 +65,7 @@ mod keys {
 
     /// The work stream and its consumer group.
     pub const STREAM: &str = "thirdbody:work";
-    /// When the job store's data began (Unix ms), set by the first process to find it
-    /// missing: a store restarted without its data gets a new one.
+    /// When the job store's data began (Unix ms): a store restarted without it gets a new one.
     pub const EPOCH: &str = "thirdbody:epoch";
     /// Seconds per point of each cost class, as measured by the workers.
     pub const RATES: &str = "thirdbody:rates";
@@ -86,8 +75,7 @@ mod keys {
         format!("thirdbody:answer:{key}")
     }
 
-    /// On a server shared with the jobs: the cached answers by age, and their sizes (with
-    /// their total under `total`), which bound the cache's share of the server.
+    /// On a server shared with the jobs: the answers by age, and their sizes (and `total`).
     pub const ANSWERS_BY_AGE: &str = "thirdbody:answers:by-age";
     pub const ANSWER_SIZES: &str = "thirdbody:answers:sizes";
 
@@ -106,7 +94,6 @@ mod keys {
         format!("thirdbody:solving:{key}")
     }
 
-    /// A job's keys.
     pub struct Job {
         pub record: String,
         pub result: String,
@@ -136,21 +123,18 @@ mod keys {
     }
 }
 
-/// This process's place in the fleet: its links to the two Redis roles and its name as a
-/// consumer of the work stream.
+/// This process's links to the two Redis roles, and its name as a consumer of the stream.
 pub struct Fleet {
     pub config: FleetConfig,
     pub cache: Link,
     pub jobs: Link,
     /// Unique to this process: host name, process id and random bits.
     pub consumer: String,
-    /// The bytes the cached answers may take on a server shared with the jobs, as last
-    /// decided from the configuration and the server ([`Fleet::size_cache`]).
+    /// The bytes cached answers may take on a server shared with the jobs ([`cache_share`]).
     cache_bytes: AtomicU64,
 }
 
 impl Fleet {
-    /// Links to the servers of `config` (connected at the first call).
     pub fn open(config: FleetConfig) -> Result<Fleet, LinkError> {
         let cache = Link::open("cache", &config.cache_url)?;
         let jobs = Link::open("jobs", &config.jobs_url)?;
@@ -166,17 +150,10 @@ impl Fleet {
         })
     }
 
-    /// The bytes the cached answers may take on a server shared with the jobs.
-    pub fn cache_bytes(&self) -> u64 {
-        self.cache_bytes.load(Ordering::Relaxed)
-    }
-
-    /// Whether the cache and the jobs are on one server.
     pub fn one_server(&self) -> bool {
         self.config.cache_url == self.config.jobs_url
     }
 
-    /// Each link's health, by role.
     pub fn health(&self) -> [(&'static str, Health); 2] {
         [
             (self.cache.role, self.cache.health()),
@@ -184,9 +161,8 @@ impl Fleet {
         ]
     }
 
-    /// Keeps trying unreachable servers until dropped (see [`Link::watch`]), and marks the
-    /// beginning of the job store's data when it finds none (within half a second of a
-    /// restart of Redis without its data).
+    /// Keeps trying unreachable servers until dropped ([`Link::watch`]), and marks the
+    /// beginning of the job store's data when it finds none (as after a restart without it).
     pub async fn watch(&self) {
         let epoch = async {
             loop {
@@ -209,8 +185,7 @@ impl Fleet {
     }
 
     /// On a server shared with the jobs, bounds the cached answers by its maxmemory
-    /// ([`cache_share`]), read at once and every minute, and logs the bound chosen whenever it
-    /// changes (with the reason, and what to do where the server does not say its limit).
+    /// ([`cache_share`]), read every minute, and logs each new bound and why.
     async fn size_cache(&self) {
         if !self.one_server() {
             return;
@@ -218,15 +193,11 @@ impl Fleet {
         let given = self.config.shared_cache_bytes;
         let mut known = None;
         loop {
-            let maxmemory = match maxmemory(&self.cache).await {
-                Some(said) => said,
-                None => {
-                    // Unreachable: try again soon.
-                    tokio::time::sleep(link::RETRY_EVERY).await;
-                    continue;
-                }
+            let Some(maxmemory) = maxmemory(&self.cache).await else {
+                tokio::time::sleep(link::RETRY_EVERY).await; // unreachable
+                continue;
             };
-            if known != Some(maxmemory) {
+            if known.replace(maxmemory) != Some(maxmemory) {
                 let bytes = cache_share(given, maxmemory);
                 self.cache_bytes.store(bytes, Ordering::Relaxed);
                 match maxmemory {
@@ -253,13 +224,11 @@ impl Fleet {
                          server's memory"
                     ),
                 }
-                known = Some(maxmemory);
             }
             tokio::time::sleep(MAXMEMORY_EVERY).await;
         }
     }
 
-    /// When the job store's data began (Unix ms), if known.
     pub async fn epoch(&self) -> Option<u64> {
         self.jobs
             .query(&redis::Cmd::get(keys::EPOCH))
@@ -269,9 +238,8 @@ impl Fleet {
     }
 }
 
-/// What the server of `link` says of its memory limit: `CONFIG GET maxmemory`, or where
-/// that is refused (managed servers often forbid CONFIG) the `maxmemory` of `INFO memory`;
-/// `None` if the server cannot be reached.
+/// What the server says of its memory limit: `CONFIG GET maxmemory`, or where that is
+/// refused (managed servers often forbid CONFIG) `INFO memory`; `None` if unreachable.
 async fn maxmemory(link: &Link) -> Option<Maxmemory> {
     let said = |bytes: u64| match bytes {
         0 => Maxmemory::Unlimited,

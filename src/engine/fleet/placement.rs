@@ -1,17 +1,14 @@
-//! Where a job's work goes: how a sweep splits into parts on the fleet's stream, by what
-//! its points were measured to cost. Each part pays a fixed cost in Redis (taken, counted,
-//! stored, acknowledged: a few round trips) and gains only when another core takes it, so
-//! a cheap sweep is one entry, solved whole by one process (an 10,000-point rolling sweep
-//! costs ~60 ms: split in 40 parts it took 4× as long), and a heavy one splits into parts
-//! of about [`PART_SECONDS`], enough of them to keep every worker busy to the end.
+//! How a sweep splits into parts on the fleet's stream, by what its points were measured to
+//! cost. Each part pays a few Redis round trips and gains only when another core takes it,
+//! so a cheap sweep is one entry (a 10,000-point rolling sweep costs ~60 ms: split in 40
+//! parts it took 4× as long), and a heavy one splits into parts of about [`PART_SECONDS`].
 
 use std::ops::Range;
 use std::time::Duration;
 
 use crate::job::parts::ranges;
 
-/// A sweep whose points together cost less is solved whole: splitting it could at best save
-/// a fraction of this, and costs a few round trips per part.
+/// A sweep whose points together cost less is solved whole: splitting could save little.
 pub const WHOLE_BELOW: Duration = Duration::from_millis(150);
 /// The solve time a part aims at: long beside its Redis round trips (~0.1 ms each on a
 /// LAN), short enough that the last parts of a sweep end close together.
@@ -21,9 +18,8 @@ pub const RATE_TTL: Duration = Duration::from_secs(24 * 3600);
 /// Weight of the latest part in a class's learned rate.
 pub const LEARNING: f64 = 0.5;
 
-/// The parts of a job of `points` points (`None`: not a sweep) whose points cost `rate`
-/// seconds each when measured (`None`: not yet measured, parts of `default_points`). An
-/// empty plan is one entry, the job solved whole.
+/// The parts of a sweep of `points` points at `rate` seconds each (`None`: not measured yet,
+/// parts of `default_points`). An empty plan is one entry, the job solved whole.
 pub fn plan(points: Option<usize>, rate: Option<f64>, default_points: usize) -> Vec<Range<usize>> {
     let Some(points) = points else {
         return Vec::new();
@@ -40,8 +36,7 @@ pub fn plan(points: Option<usize>, rate: Option<f64>, default_points: usize) -> 
     }
 }
 
-/// The rate learned from a part of `points` points solved in `took`, given the rate known
-/// before (`None`: the first).
+/// The rate learned from a part of `points` points solved in `took`, given the one before.
 pub fn learn(before: Option<f64>, took: Duration, points: usize) -> f64 {
     let now = took.as_secs_f64() / points.max(1) as f64;
     match before {

@@ -1,11 +1,10 @@
-//! Job records in Redis, so that every process answers for every job: a hash per job (its
-//! state, progress, the job itself as text, its deadline), its result once it has one, and
-//! the parts of a split job as they are solved. A finished state is final (a late worker
-//! cannot overwrite a cancel) and starts the record's retention, after which Redis forgets
-//! every key of the job.
+//! Job records in Redis, so that every process answers for every job: a hash per job, its
+//! result, and the parts of a split job as they are solved. A finished state is final (a
+//! late worker cannot overwrite a cancel) and starts the retention of every key of the job.
 
 use std::collections::HashMap;
 use std::ops::Range;
+use std::sync::Arc;
 use std::time::{Duration, Instant, SystemTime};
 
 use async_trait::async_trait;
@@ -13,8 +12,9 @@ use bytes::Bytes;
 use redis::Cmd;
 use uuid::Uuid;
 
-use super::link::eval;
-use super::{keys, Failure, Fleet};
+use super::keys::{GROUP, STREAM};
+use super::link::{eval, DELETE_IF_HELD};
+use super::{keys, worker, Failure, Fleet};
 use crate::engine::clock::{from_unix_millis, millis, unix_millis};
 use crate::engine::store::{
     JobRecord, JobResult, JobState, JobStatus, JobStore, Listing, Owner, Page, Refusal,
@@ -23,14 +23,10 @@ use crate::engine::store::{
 use crate::job::parts::RenderedPart;
 use crate::job::registry::KindName;
 use crate::job::{JobError, Work};
-use std::sync::Arc;
 
 /// Moves a job to a new state unless it has finished. A finished state takes the result
-/// staged beside the record (written in the same transaction, so that the bytes never pass
-/// through the script's arguments), drops the parts and starts the retention of every key of
-/// the job; a state refused drops the staged result.
-///
-/// A job that succeeded becomes its input's newest answer (for the input's stable link).
+/// staged beside the record (so that its bytes never pass through ARGV), drops the parts and
+/// starts every key's retention; a success becomes its input's newest answer.
 ///
 /// KEYS: record, result, parts, deliveries, staged result, the input's pointer. ARGV:
 /// status, done, error, retention (ms), now (Unix ms), whether a staged result is whole
@@ -61,12 +57,9 @@ end
 return 1
 "#;
 
-/// Counts a part just stored beside it in the parts hash (in the same transaction), once:
-/// a part solved twice counts once; acknowledges the part's stream entry unless its job is
-/// now whole (the entry then stays pending until the job is assembled and stored, so that
-/// a process that dies while assembling is replaced by the next delivery). Returns 1 once
-/// every part is in, 0 before, and -1 if the job has finished or is gone (its parts are
-/// then dropped: nobody will read them).
+/// Counts a part just stored, once, and acknowledges its entry unless the job is now whole
+/// (pending until the job is stored, a process dying while assembling it is replaced).
+/// Returns 1 once every part is in, 0 before, -1 if the job has finished or is gone.
 ///
 /// KEYS: record, parts, stream. ARGV: part index, its points, the Unix ms at which the parts
 /// expire, the stream's group, the entry's id.
@@ -95,29 +88,20 @@ end
 return 1
 "#;
 
-/// Deletes an input's pointer to a job (ARGV: its id) unless it points to another since.
-const FORGET_POINTER: &str = r#"
-if redis.call('GET', KEYS[1]) == ARGV[1] then redis.call('DEL', KEYS[1]) end
-return 0
-"#;
-
 /// The most jobs of one owner listed: the newest.
 const LISTED: isize = 10_000;
 
-/// A job as a worker needs it.
 pub struct Runnable {
     pub status: JobStatus,
     /// The job as [`crate::job::Job::to_wire`] wrote it.
     pub wire: String,
     pub key: String,
     pub deadline: Instant,
-    /// When every key of the job expires at the latest, in Unix ms: its deadline plus its
-    /// retention (a job cannot run past its deadline, nor be kept past its retention).
+    /// When every key of the job expires at the latest (Unix ms): deadline plus retention.
     pub expires: u64,
     pub parts: usize,
 }
 
-/// The records of the fleet's jobs.
 pub struct RedisJobStore {
     fleet: Arc<Fleet>,
     retention: Duration,
@@ -135,9 +119,7 @@ impl RedisJobStore {
     }
 
     /// Records `record` (queued) and puts its work on the stream, one entry per range of
-    /// `parts` (one entry for a job solved whole), in one transaction: a job is accepted
-    /// with its work or not at all. The record expires at the job's deadline plus its
-    /// retention, should no process ever finish it.
+    /// `parts`, in one transaction: a job is accepted with its work or not at all.
     pub async fn enqueue(
         &self,
         record: &JobRecord,
@@ -146,58 +128,43 @@ impl RedisJobStore {
         deadline: SystemTime,
         parts: &[Range<usize>],
     ) -> Result<(), Failure> {
-        let job = keys::job(record.id);
-        let id = record.id.to_string();
-        let mut pipe = redis::pipe();
-        // Borrowed where they can be: the job's text may be long (a fit's data).
         let deadline = unix_millis(deadline);
-        let deadline_text = deadline.to_string();
-        let count = parts.len().max(1).to_string();
-        let fields: [(&str, &str); 5] = [
+        let (deadline_text, count) = (deadline.to_string(), parts.len().max(1).to_string());
+        // Borrowed: the job's text may be long (a fit's data).
+        let fields = [
             ("status", JobStatus::Queued.as_str()),
             ("job", wire),
             ("key", key),
             ("deadline", &deadline_text),
             ("parts", &count),
         ];
-        pipe.atomic();
-        self.record_fields(&mut pipe, record);
-        pipe.hset_multiple(&job.record, &fields)
-            .ignore()
-            .cmd("PEXPIREAT")
-            .arg(&job.record)
+        let mut pipe = self.new_record(record, &fields);
+        pipe.cmd("PEXPIREAT")
+            .arg(keys::job(record.id).record)
             .arg(deadline + millis(self.retention))
             .ignore();
         if parts.is_empty() {
-            pipe.xadd(keys::STREAM, "*", &[("job", &id)]).ignore();
+            worker::add_entry(&mut pipe, record.id, None);
         }
-        for (index, range) in parts.iter().enumerate() {
-            let (part, start, end) = (
-                index.to_string(),
-                range.start.to_string(),
-                range.end.to_string(),
-            );
-            let entry: [(&str, &str); 4] = [
-                ("job", &id),
-                ("part", &part),
-                ("start", &start),
-                ("end", &end),
-            ];
-            pipe.xadd(keys::STREAM, "*", &entry).ignore();
+        for part in parts.iter().enumerate() {
+            worker::add_entry(&mut pipe, record.id, Some(part));
         }
         self.fleet.jobs.pipe::<()>(&pipe).await
     }
 
-    /// Adds to `pipe` the fields every new record has (kind, work, progress, owner, time of
-    /// submission), and its place in its owner's list, which lives as long as its newest
-    /// job may.
-    fn record_fields(&self, pipe: &mut redis::Pipeline, record: &JobRecord) {
+    /// A transaction writing `record` with `fields` besides those every record has, and its
+    /// place in its owner's list, which lives as long as its newest job may.
+    fn new_record(&self, record: &JobRecord, fields: &[(&str, &str)]) -> redis::Pipeline {
         let key = keys::job(record.id).record;
         let submitted = unix_millis(record.submitted_at);
-        let (work, submitted_text) = (work_text(record.work), submitted.to_string());
+        let work = match record.work {
+            Work::Known(n) => n.to_string(),
+            Work::Unknown => String::new(),
+        };
+        let submitted_text = submitted.to_string();
         let owner = record.owner.as_ref().map_or("", Owner::as_str);
         let bytes = record.result_bytes.to_string();
-        let fields: [(&str, &str); 7] = [
+        let common = [
             ("kind", record.kind.name()),
             ("work", &work),
             ("done", "0"),
@@ -206,13 +173,14 @@ impl RedisJobStore {
             ("submitted", &submitted_text),
             ("bytes", &bytes),
         ];
-        pipe.hset_multiple(&key, &fields).ignore();
+        let mut pipe = redis::pipe();
+        let all = [&common[..], fields].concat();
+        pipe.atomic().hset_multiple(&key, &all).ignore();
         if let Some(owner) = &record.owner {
-            // Scored in µs (exact in a double until the year 2255), so that jobs submitted in
-            // the same millisecond keep their order; ids are random past their millisecond.
-            // Jobs submitted longer ago than a job may be kept are gone: their places too.
+            // Scored in µs (exact in a double until 2255), so that jobs submitted in the same
+            // ms keep their order; places of jobs older than a job may be kept are dropped.
             let list = keys::owner(owner.as_str());
-            let micros = |t: std::time::Duration| u64::try_from(t.as_micros()).unwrap_or(u64::MAX);
+            let micros = |t: Duration| u64::try_from(t.as_micros()).unwrap_or(u64::MAX);
             let since_epoch = record
                 .submitted_at
                 .duration_since(std::time::UNIX_EPOCH)
@@ -228,27 +196,26 @@ impl RedisJobStore {
                 .pexpire(&list, millis(self.lifetime) as i64)
                 .ignore();
         }
+        pipe
     }
 
-    /// The status of job `id`; `None` if it is gone (deleted or expired). A running part's
-    /// heartbeat asks it five times a second, so it reads that one field only.
+    /// The status of job `id`; `None` if it is gone. A part's heartbeat asks it five times a
+    /// second, so it reads that one field only.
     pub async fn status(&self, id: Uuid) -> Result<Option<JobStatus>, Failure> {
         let cmd = Cmd::hget(keys::job(id).record, "status");
         let status: Option<String> = self.fleet.jobs.query(&cmd).await?;
         Ok(status.as_deref().map(parse_status))
     }
 
-    /// Takes part `part` of job `id` for a worker: the job as the worker runs it (`None` if
-    /// it is gone: deleted or expired) and the part's deliveries so far, counting this one,
-    /// in one round trip.
+    /// Takes part `part` of job `id` for a worker: the job (`None` if it is gone) and the
+    /// part's deliveries, counting this one.
     pub async fn take(&self, id: Uuid, part: &str) -> Result<(Option<Runnable>, u64), Failure> {
         let keys = keys::job(id);
         let fields = ["status", "job", "key", "deadline", "parts"];
         let mut pipe = redis::pipe();
         pipe.hmget(&keys.record, &fields[..])
             .hincr(&keys.deliveries, part, 1)
-            // Until the latest a job of this process's deadline could be kept; a job's
-            // end sets its retention.
+            // As long as a job of this process may be kept; a job's end sets its retention.
             .pexpire(&keys.deliveries, millis(self.lifetime) as i64)
             .ignore();
         type Fields = (
@@ -287,9 +254,8 @@ impl RedisJobStore {
         self.fleet.jobs.pipe::<()>(&pipe).await
     }
 
-    /// Keeps part `index` (of `points` points) of `job`, as plain fields of its parts hash,
-    /// and acknowledges its stream entry `entry` unless the job is now whole; returns
-    /// whether every part is in (`None`: the job finished or is gone).
+    /// Keeps part `index` (of `points` points) of `job` ([`PART_IN`]): whether every part is
+    /// in (`None`: the job finished or is gone).
     pub async fn part_done(
         &self,
         id: Uuid,
@@ -305,26 +271,14 @@ impl RedisJobStore {
             (format!("csv:{index}"), part.csv.as_bytes()),
             (format!("summary:{index}"), &summary),
         ];
-        let (index, points, expires) = (
-            index.to_string(),
-            points.to_string(),
-            job.expires.to_string(),
-        );
         let mut pipe = redis::pipe();
-        pipe.atomic()
-            .hset_multiple(&keys.parts, &fields)
-            .ignore()
-            .add_command(eval(
-                PART_IN,
-                &[&keys.record, &keys.parts, super::keys::STREAM],
-                &[
-                    index.as_bytes(),
-                    points.as_bytes(),
-                    expires.as_bytes(),
-                    super::keys::GROUP.as_bytes(),
-                    entry.as_bytes(),
-                ],
-            ));
+        pipe.atomic().hset_multiple(&keys.parts, &fields).ignore();
+        eval(&mut pipe, PART_IN, &[&keys.record, &keys.parts, STREAM])
+            .arg(index)
+            .arg(points)
+            .arg(job.expires)
+            .arg(GROUP)
+            .arg(entry);
         let (all,): (i64,) = self.fleet.jobs.pipe(&pipe).await?;
         Ok((all >= 0).then_some(all == 1))
     }
@@ -353,17 +307,15 @@ impl RedisJobStore {
             .collect()
     }
 
-    /// Moves job `id` to `state` with `done` units done (`None`: as counted so far), unless
-    /// it has finished (or is gone); returns whether it moved. A result is written once,
-    /// staged beside the record in the same transaction as the move; a result already in
-    /// the store stays where it is.
+    /// Moves job `id` to `state` with `done` units done (`None`: as counted), unless it has
+    /// finished ([`UPDATE`]); returns whether it moved. A result is written once.
     pub async fn set_state(
         &self,
         id: Uuid,
         state: &JobState,
         done: Option<usize>,
     ) -> Result<bool, Failure> {
-        let keys = keys::job(id);
+        let job = keys::job(id);
         let error = match state {
             JobState::Failed { error, .. } => {
                 serde_json::to_vec(error).expect("a job error is JSON")
@@ -383,31 +335,27 @@ impl RedisJobStore {
                 .await
                 .map_err(|e| Failure::new(format!("cannot render the result: {e}")))?;
             let fields: [(&str, &[u8]); 2] = [("json", &json), ("csv", &csv)];
-            pipe.hset_multiple(&keys.staged, &fields).ignore();
+            pipe.hset_multiple(&job.staged, &fields).ignore();
             whole = result.form();
         }
-        let status = state.status().as_str();
-        let done = done.map(|n| n.to_string()).unwrap_or_default();
-        let retention = millis(self.retention).to_string();
-        let now = unix_millis(SystemTime::now()).to_string();
-        let input = super::keys::input(key);
-        let id = id.to_string();
-        let mut all = keys.all().to_vec();
-        all.extend([keys.staged.as_str(), &input]);
-        pipe.add_command(eval(
-            UPDATE,
-            &all,
-            &[
-                status.as_bytes(),
-                done.as_bytes(),
-                &error,
-                retention.as_bytes(),
-                now.as_bytes(),
-                whole.as_bytes(),
-                key.as_bytes(),
-                id.as_bytes(),
-            ],
-        ));
+        let [record, result, parts, deliveries] = job.all();
+        let all = [
+            record,
+            result,
+            parts,
+            deliveries,
+            &job.staged,
+            &keys::input(key),
+        ];
+        eval(&mut pipe, UPDATE, &all)
+            .arg(state.status().as_str())
+            .arg(done.map(|n| n.to_string()).unwrap_or_default())
+            .arg(error)
+            .arg(millis(self.retention))
+            .arg(unix_millis(SystemTime::now()))
+            .arg(whole)
+            .arg(key)
+            .arg(id.to_string());
         let (moved,): (i64,) = self.fleet.jobs.pipe(&pipe).await?;
         Ok(moved == 1)
     }
@@ -428,22 +376,17 @@ impl RedisJobStore {
         "bytes",
     ];
 
-    /// The record of job `id`, without its result (which stays in Redis until a client
-    /// reads it: see [`StoredResult`]); `None` if unknown or expired.
+    /// The record of job `id`, its result left in Redis ([`StoredResult`]); `None` if gone.
     pub async fn record(&self, id: Uuid) -> Result<Option<JobRecord>, Failure> {
-        let cmd = Cmd::hmget(keys::job(id).record, &Self::FIELDS[..]);
-        let values: Vec<Option<Vec<u8>>> = self.fleet.jobs.query(&cmd).await?;
-        self.parse(id, values).await
+        self.records(&[id]).await?.pop().unwrap_or(Ok(None))
     }
 
-    /// The records of jobs `ids` (`None` for those gone, an error for one this version
-    /// cannot read), read in one round trip.
+    /// The records of jobs `ids`, in one round trip (`None` for those gone).
     async fn records(
         &self,
         ids: &[Uuid],
     ) -> Result<Vec<Result<Option<JobRecord>, Failure>>, Failure> {
-        // An empty pipeline is an error to Redis's client ("empty command"): an owner with
-        // no jobs has no records to read.
+        // An empty pipeline is an error to Redis's client ("empty command").
         if ids.is_empty() {
             return Ok(Vec::new());
         }
@@ -482,10 +425,21 @@ impl RedisJobStore {
         let kind = KindName::find(&text("kind"))
             .map_err(|e| Failure::new(format!("a stored job is unreadable: {e}")))?;
         let work = text("work").parse().map_or(Work::Unknown, Work::Known);
-        // A record of the version before `result` was kept says so by its result hash.
+        let status = parse_status(&text("status"));
         let form = match fields.get("result") {
             Some(form) => String::from_utf8_lossy(form).into_owned(),
-            None => self.legacy_result_form(id, &text("status")).await?,
+            // A record of the version before `result` was kept: its result hash tells.
+            None if status.is_finished() => {
+                let cmd = Cmd::hexists(keys::job(id).result, "json");
+                let stored: bool = self.fleet.jobs.query(&cmd).await?;
+                let form = match (stored, status) {
+                    (false, _) => "",
+                    (true, JobStatus::Succeeded) => "whole",
+                    (true, _) => "partial",
+                };
+                form.to_string()
+            }
+            None => String::new(),
         };
         // A result of a cancelled or failed job is what it finished before it stopped.
         let result = || match form.as_str() {
@@ -500,7 +454,7 @@ impl RedisJobStore {
             )))),
             _ => None,
         };
-        let state = JobState::restored(parse_status(&text("status")), result(), || {
+        let state = JobState::restored(status, result(), || {
             serde_json::from_slice(fields.get("error").map_or(&[][..], Vec::as_slice))
                 .unwrap_or_else(|e| {
                     JobError::Internal(format!("the job's error is unreadable: {e}"))
@@ -516,8 +470,7 @@ impl RedisJobStore {
             done: text("done").parse().unwrap_or(0),
             input_hash: text("key"),
             owner: owner.map(Owner::stored),
-            // A record of the version before submissions were timed: its deadline, which
-            // orders it among the others all the same.
+            // A record of the version before submissions were timed: its deadline orders it.
             submitted_at: time("submitted")
                 .or_else(|| time("deadline"))
                 .unwrap_or(std::time::UNIX_EPOCH),
@@ -526,24 +479,6 @@ impl RedisJobStore {
             result_bytes: text("bytes").parse().unwrap_or(0),
             unsaved: false,
         }))
-    }
-
-    /// The form of the result of a finished job recorded by the version before records
-    /// named it (their results are in the result hash all the same): `whole` for a
-    /// succeeded job's, `partial` for another's, `""` for none.
-    async fn legacy_result_form(&self, id: Uuid, status: &str) -> Result<String, Failure> {
-        let status = parse_status(status);
-        if matches!(status, JobStatus::Queued | JobStatus::Running) {
-            return Ok(String::new());
-        }
-        let cmd = Cmd::hexists(keys::job(id).result, "json");
-        let stored: bool = self.fleet.jobs.query(&cmd).await?;
-        let form = match (stored, status) {
-            (false, _) => "",
-            (true, JobStatus::Succeeded) => "whole",
-            (true, _) => "partial",
-        };
-        Ok(form.to_string())
     }
 }
 
@@ -557,35 +492,27 @@ struct InRedis {
 impl ResultPlace for InRedis {
     async fn body(&self, field: &str) -> std::io::Result<Bytes> {
         let cmd = Cmd::hget(keys::job(self.id).result, field);
-        let body: Option<Vec<u8>> = self
-            .fleet
-            .jobs
-            .query(&cmd)
-            .await
-            .map_err(|e| std::io::Error::other(e.why))?;
-        body.map(Bytes::from).ok_or_else(|| {
-            std::io::Error::other("the job's result expired, or was lost from the job store")
-        })
+        let lost = "the job's result expired, or was lost from the job store";
+        match self.fleet.jobs.query::<Option<Vec<u8>>>(&cmd).await {
+            Ok(body) => body
+                .map(Bytes::from)
+                .ok_or_else(|| std::io::Error::other(lost)),
+            Err(e) => Err(std::io::Error::other(e.why)),
+        }
     }
 }
 
 #[async_trait]
 impl JobStore for RedisJobStore {
-    /// The results are kept in Redis, whose memory bounds them (its `maxmemory`): no room
-    /// is made here.
+    /// The results are kept in Redis, whose `maxmemory` bounds them: no room is made here.
     async fn insert(&self, record: JobRecord) -> Result<(), Refusal> {
         let fields = [
             ("status", record.state.status().as_str()),
             ("key", &record.input_hash),
             ("parts", "1"),
         ];
-        let key = keys::job(record.id).record;
-        let mut pipe = redis::pipe();
-        pipe.atomic();
-        self.record_fields(&mut pipe, &record);
-        pipe.hset_multiple(&key, &fields)
-            .ignore()
-            .pexpire(&key, millis(self.lifetime) as i64)
+        let mut pipe = self.new_record(&record, &fields);
+        pipe.pexpire(keys::job(record.id).record, millis(self.lifetime) as i64)
             .ignore();
         if let Err(e) = self.fleet.jobs.pipe::<()>(&pipe).await {
             tracing::warn!(error = %e, id = %record.id, "a job record was not stored");
@@ -605,36 +532,30 @@ impl JobStore for RedisJobStore {
 
     /// Forgets the job's keys, its place in its owner's list, and its input's pointer to it.
     async fn remove(&self, id: Uuid) {
-        let job = keys::job(id);
-        let (owner, input): (Option<String>, Option<String>) = match self
-            .fleet
-            .jobs
-            .query(&Cmd::hmget(&job.record, &["owner", "key"][..]))
-            .await
-        {
-            Ok(fields) => fields,
-            Err(e) => {
-                tracing::warn!(error = %e, %id, "a job was not deleted");
-                return;
+        let (job, jobs) = (keys::job(id), &self.fleet.jobs);
+        let removed = async {
+            let (owner, input): (Option<String>, Option<String>) = jobs
+                .query(&Cmd::hmget(&job.record, &["owner", "key"][..]))
+                .await?;
+            let id_text = id.to_string();
+            let mut pipe = redis::pipe();
+            pipe.atomic().del(&job.all()[..]).ignore();
+            if let Some(owner) = owner.filter(|o| !o.is_empty()) {
+                pipe.zrem(keys::owner(&owner), &id_text).ignore();
             }
+            if let Some(input) = input {
+                // Unless the input's pointer points to another job since.
+                eval(&mut pipe, DELETE_IF_HELD, &[&keys::input(&input)])
+                    .arg(&id_text)
+                    .ignore();
+            }
+            jobs.pipe::<()>(&pipe).await
         };
-        let id_text = id.to_string();
-        let mut pipe = redis::pipe();
-        pipe.atomic().del(&job.all()[..]).ignore();
-        if let Some(owner) = owner.filter(|o| !o.is_empty()) {
-            pipe.zrem(keys::owner(&owner), &id_text).ignore();
-        }
-        if let Some(input) = input {
-            let pointer = keys::input(&input);
-            pipe.add_command(eval(FORGET_POINTER, &[&pointer], &[id_text.as_bytes()]))
-                .ignore();
-        }
-        if let Err(e) = self.fleet.jobs.pipe::<()>(&pipe).await {
+        if let Err(e) = removed.await {
             tracing::warn!(error = %e, %id, "a job was not deleted");
         }
     }
 
-    /// Redis forgets expired jobs by itself.
     async fn purge_expired(&self) -> usize {
         0
     }
@@ -647,53 +568,34 @@ impl JobStore for RedisJobStore {
             .fleet
             .jobs
             .query(&Cmd::zrevrange(&list, 0, LISTED - 1))
-            .await
-            .map_err(|e| Unreadable::Redis(e.why))?;
+            .await?;
         let ids: Vec<Uuid> = ids.iter().filter_map(|id| id.parse().ok()).collect();
-        let records = self
-            .records(&ids)
-            .await
-            .map_err(|e| Unreadable::Redis(e.why))?;
-        let gone: Vec<String> = ids
-            .iter()
-            .zip(&records)
-            .filter(|(_, record)| matches!(record, Ok(None)))
-            .map(|(id, _)| id.to_string())
-            .collect();
+        let (mut matching, mut gone) = (Vec::new(), Vec::new());
+        for (id, record) in ids.iter().zip(self.records(&ids).await?) {
+            match record {
+                Ok(Some(record)) if record.listed_in(listing) => matching.push(record),
+                Ok(Some(_)) => {}
+                Ok(None) => gone.push(id.to_string()),
+                // One this version cannot read (another version's kind) is left out, not fatal.
+                Err(e) => tracing::warn!(error = %e, %id, "a listed job is unreadable"),
+            }
+        }
         if !gone.is_empty() {
             let _ = self.fleet.jobs.query::<i64>(&Cmd::zrem(&list, gone)).await;
         }
-        // A record this version cannot read (another version's kind) is left out, not fatal.
-        let matching = ids
-            .iter()
-            .zip(records)
-            .filter_map(|(id, record)| {
-                record
-                    .inspect_err(|e| tracing::warn!(error = %e, %id, "a listed job is unreadable"))
-                    .ok()
-                    .flatten()
-            })
-            .filter(|record| record.listed_in(listing))
-            .collect();
         Ok(Page::of(matching, listing))
     }
 
     async fn with_input(&self, input_hash: &str) -> Result<Option<JobRecord>, Unreadable> {
         let cmd = Cmd::get(keys::input(input_hash));
-        let id: Option<String> = self
-            .fleet
-            .jobs
-            .query(&cmd)
-            .await
-            .map_err(|e| Unreadable::Redis(e.why))?;
+        let id: Option<String> = self.fleet.jobs.query(&cmd).await?;
         let Some(id) = id.and_then(|id| id.parse().ok()) else {
             return Ok(None);
         };
-        let record = self
+        Ok(self
             .record(id)
-            .await
-            .map_err(|e| Unreadable::Redis(e.why))?;
-        Ok(record.filter(|r| matches!(r.state, JobState::Succeeded(_))))
+            .await?
+            .filter(|r| matches!(r.state, JobState::Succeeded(_))))
     }
 
     fn shared(&self) -> bool {
@@ -705,27 +607,22 @@ impl JobStore for RedisJobStore {
     }
 }
 
-fn work_text(work: Work) -> String {
-    match work {
-        Work::Known(n) => n.to_string(),
-        Work::Unknown => String::new(),
-    }
-}
-
 /// The status stored as `text`; failed for one this version does not know.
 fn parse_status(text: &str) -> JobStatus {
     JobStatus::parse(text).unwrap_or(JobStatus::Failed)
 }
 
-/// The instant of this process at the Unix time `unix_ms` (clocks of the fleet's machines
-/// are assumed in step, as NTP keeps them).
+/// The instant of this process at the Unix time `unix_ms` (clocks are in step, by NTP).
 fn instant_of(unix_ms: u64) -> Instant {
-    let now = unix_millis(SystemTime::now());
-    let nowi = Instant::now();
-    if unix_ms >= now {
-        nowi + Duration::from_millis(unix_ms - now)
-    } else {
-        nowi.checked_sub(Duration::from_millis(now - unix_ms))
-            .unwrap_or(nowi)
+    let (now, instant) = (unix_millis(SystemTime::now()), Instant::now());
+    let later = instant + Duration::from_millis(unix_ms.saturating_sub(now));
+    later
+        .checked_sub(Duration::from_millis(now.saturating_sub(unix_ms)))
+        .unwrap_or(instant)
+}
+
+impl From<Failure> for Unreadable {
+    fn from(e: Failure) -> Unreadable {
+        Unreadable::Redis(e.why)
     }
 }

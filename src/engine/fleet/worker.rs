@@ -1,9 +1,7 @@
-//! The fleet's workers: each takes one entry of the work stream at a time (a job, or a
-//! range of a sweep's points), solves it on a solver thread, stores the result, and only
-//! then acknowledges the entry. While it runs, a heartbeat keeps the entry its own, passes a
-//! cancel on to the solver, and counts progress; an entry whose process died goes idle and
-//! is taken over by another worker (`XAUTOCLAIM`); one delivered more than
-//! `max_deliveries` times fails its job, saying so.
+//! The fleet's workers: each takes one entry of the work stream at a time (a job, or a range
+//! of a sweep's points), solves it, stores the result, and only then acknowledges the entry,
+//! kept its own by a heartbeat meanwhile. An entry whose process died is taken over
+//! (`XAUTOCLAIM`); one delivered more than `max_deliveries` times fails its job.
 
 use std::collections::HashMap;
 use std::ops::Range;
@@ -11,15 +9,16 @@ use std::sync::{Arc, Mutex, MutexGuard};
 use std::time::{Duration, Instant};
 
 use bytes::Bytes;
+use futures_util::future::OptionFuture;
 use redis::streams::{
     StreamAutoClaimOptions, StreamAutoClaimReply, StreamClaimOptions, StreamId, StreamReadOptions,
     StreamReadReply,
 };
-use redis::{Cmd, Value};
-use uuid::Uuid;
-
+use redis::{Cmd, Pipeline, Value};
 use tokio::sync::Semaphore;
 use tokio_util::sync::CancellationToken;
+use tokio_util::task::AbortOnDropHandle;
+use uuid::Uuid;
 
 use super::store::{RedisJobStore, Runnable};
 use super::{keys, placement, Failure, Fleet, Link};
@@ -27,19 +26,16 @@ use crate::engine::cache::Solved;
 use crate::engine::metrics as names;
 use crate::engine::pool::Pool;
 use crate::engine::solver::Solver;
-use crate::engine::store::JobResult;
-use crate::engine::store::{JobState, JobStatus};
+use crate::engine::store::{JobResult, JobState, JobStatus};
 use crate::job::parts::{self, RenderedPart};
 use crate::job::{tenant_of, Control, Job, JobError, Keyed, Unfinished, Work};
 
-/// How long a worker's read of the stream waits for an entry (well within a call's bound);
-/// an entry added meanwhile is taken at once.
+/// How long a worker's read of the stream waits for an entry (well within a call's bound).
 const WAIT: Duration = Duration::from_millis(250);
 /// How often a running entry's heartbeat looks for a cancel and counts progress.
 const HEARTBEAT: Duration = Duration::from_millis(200);
 
-/// What an engine in a fleet holds: the fleet, its job store, and the entries this process
-/// is solving (so that a drain that runs out of time can stop them).
+/// What an engine in a fleet holds, and the entries it is solving (for a late drain to stop).
 pub struct Shared {
     pub fleet: Arc<Fleet>,
     pub store: Arc<RedisJobStore>,
@@ -58,8 +54,7 @@ impl Shared {
         }
     }
 
-    /// Learns the cost per point of `class` from `points` solved in `took`, and tells the
-    /// fleet (whose processes split the next jobs of the class by it).
+    /// Learns the cost per point of `class`, and tells the fleet, which splits jobs by it.
     async fn learn(&self, class: &'static str, took: Duration, points: usize) {
         let rate = {
             let mut rates = self.rates.lock().unwrap_or_else(|p| p.into_inner());
@@ -77,8 +72,7 @@ impl Shared {
         }
     }
 
-    /// The entries on the stream not yet finished (waiting or being solved), and the
-    /// fleet's measured cost per point of `class`, in one round trip.
+    /// The entries on the stream not yet finished, and the fleet's cost per point of `class`.
     pub async fn backlog_and_rate(&self, class: &str) -> Result<(usize, Option<f64>), Failure> {
         let mut pipe = redis::pipe();
         pipe.xlen(keys::STREAM).hget(keys::RATES, class);
@@ -89,8 +83,7 @@ impl Shared {
         self.running.lock().unwrap_or_else(|p| p.into_inner())
     }
 
-    /// Stops every entry this process is solving; they stay unacknowledged, so that another
-    /// process takes them over.
+    /// Stops every entry this process is solving; unacknowledged, another process takes them.
     pub fn interrupt(&self) {
         for control in self.running().values() {
             control.cancel();
@@ -98,7 +91,7 @@ impl Shared {
     }
 }
 
-/// One entry of the work stream.
+#[derive(Clone)]
 struct Entry {
     /// The stream entry's id.
     id: String,
@@ -109,19 +102,14 @@ struct Entry {
 
 impl Entry {
     fn read(entry: &StreamId) -> Option<Entry> {
-        let text = |name: &str| match entry.map.get(name) {
-            Some(Value::BulkString(bytes)) => String::from_utf8(bytes.clone()).ok(),
-            Some(Value::SimpleString(text)) => Some(text.clone()),
-            _ => None,
-        };
-        let number = |name: &str| text(name).and_then(|t| t.parse::<usize>().ok());
+        let number = |name: &str| entry.get::<usize>(name);
         let part = match (number("part"), number("start"), number("end")) {
             (Some(index), Some(start), Some(end)) => Some((index, start..end)),
             _ => None,
         };
         Some(Entry {
             id: entry.id.clone(),
-            job: text("job")?.parse().ok()?,
+            job: entry.get::<String>("job")?.parse().ok()?,
             part,
         })
     }
@@ -134,7 +122,6 @@ impl Entry {
     }
 }
 
-/// What a solver thread gives back.
 enum Outcome {
     Whole(Arc<Solved>),
     /// A job solved whole that stopped before its end, and what it finished.
@@ -142,9 +129,8 @@ enum Outcome {
     Part(RenderedPart),
 }
 
-/// One worker of the fleet's stream, built from the handles it needs: the solve path, the
-/// fleet, the job slots it shares with synchronous requests (if any), and the drain's
-/// signal, at which it stops taking entries.
+/// One worker of the fleet's stream: the solve path, the fleet, the job slots it shares with
+/// synchronous requests (if any), and the drain's signal, at which it stops taking entries.
 pub struct Worker {
     solver: Arc<Solver>,
     shared: Arc<Shared>,
@@ -167,7 +153,6 @@ impl Worker {
         }
     }
 
-    /// The worker's loop: one entry at a time until the drain begins.
     pub async fn run(self) {
         let mut looked_for_orphans = Instant::now();
         let waiting = match self.shared.fleet.jobs.dedicated() {
@@ -175,10 +160,7 @@ impl Worker {
             Err(e) => return tracing::error!(error = %e, "a worker cannot reach Redis"),
         };
         while !self.draining.is_cancelled() {
-            let slot = match &self.slots {
-                Some(slots) => Some(slots.clone().acquire_owned().await),
-                None => None,
-            };
+            let slot = OptionFuture::from(self.slots.clone().map(Semaphore::acquire_owned)).await;
             match next_entry(&self.shared.fleet, &waiting, &mut looked_for_orphans).await {
                 Ok(Some(entry)) => self.process(entry).await,
                 Ok(None) => {}
@@ -193,27 +175,18 @@ impl Worker {
 
     /// Solves `entry` and stores its result; acknowledges it unless it should run again.
     async fn process(&self, entry: Entry) {
-        let shared = &self.shared;
-        let store = &shared.store;
-        let id = entry.job;
+        let (shared, id) = (&self.shared, entry.job);
         let Some((runnable, keyed, deliveries)) = self.take(&entry).await else {
             return;
         };
         let control = Arc::new(self.solver.control(runnable.deadline));
         shared.running().insert(entry.id.clone(), control.clone());
-        // Kept until the entry is done with, assembly included (the last part's entry
-        // stays pending while its job is assembled and stored).
-        let _heartbeat = AbortOnDrop(tokio::spawn(heartbeat(
-            shared.fleet.clone(),
-            store.clone(),
-            entry.id.clone(),
-            id,
-            control.clone(),
-            entry.part.is_none(),
-        )));
+        // Kept through assembly: the last part's entry stays pending until its job is stored.
+        let beat = heartbeat(shared.clone(), entry.clone(), control.clone());
+        let _heartbeat = AbortOnDropHandle::new(tokio::spawn(beat));
         tracing::info!(entry = entry.id, job = %id, part = entry.part_name(), deliveries, "solving a part");
         if runnable.status == JobStatus::Queued {
-            let _ = store.set_state(id, &JobState::Running, None).await;
+            let _ = shared.store.set_state(id, &JobState::Running, None).await;
         }
         let started = Instant::now();
         let result = self.solve(&entry, &keyed, &control).await;
@@ -223,10 +196,8 @@ impl Worker {
             .await;
     }
 
-    /// The job of `entry` to run and how many times the entry was delivered; `None` when
-    /// there is nothing to run: the job is gone or finished (the entry acknowledged), Redis
-    /// is away (the entry stays ours, and is taken over later), or the job was failed here
-    /// (delivered too many times, or not the job accepted).
+    /// The job of `entry` and the entry's deliveries; `None` if the job is gone or finished
+    /// (the entry acknowledged), Redis is away (taken over later), or it was failed here.
     async fn take(&self, entry: &Entry) -> Option<(Runnable, Keyed, u64)> {
         let shared = &self.shared;
         let (runnable, deliveries) = match shared.store.take(entry.job, &entry.part_name()).await {
@@ -243,41 +214,39 @@ impl Worker {
                 .counter(names::REDELIVERIES, &[])
                 .increment(1);
         }
-        let max = shared.fleet.config.max_deliveries;
-        if deliveries > u64::from(max) {
-            let times = match deliveries - 1 {
-                1 => "once".to_string(),
-                n => format!("{n} times"),
-            };
-            let error = JobError::Abandoned(format!(
-                "part {} of the job was delivered {times} and every worker that took it stopped \
-                 before finishing it (killed, or out of memory): the job is given up",
-                entry.part_name(),
-            ));
-            self.finish(entry, JobState::failed(error), None).await;
-            return None;
-        }
-        let job = match Job::from_wire(&runnable.wire) {
-            Ok(job) => job,
-            Err(e) => {
-                self.finish(entry, JobState::failed(e), None).await;
-                return None;
+        let runs = || {
+            if deliveries > u64::from(shared.fleet.config.max_deliveries) {
+                let times = match deliveries - 1 {
+                    1 => "once".to_string(),
+                    n => format!("{n} times"),
+                };
+                return Err(JobError::Abandoned(format!(
+                    "part {} of the job was delivered {times} and every worker that took it \
+                     stopped before finishing it (killed, or out of memory): the job is given up",
+                    entry.part_name(),
+                )));
             }
+            // Kept among its tenant's answers, as it was accepted ([`Keyed::scoped`]).
+            let keyed = Job::from_wire(&runnable.wire)?
+                .keyed()
+                .scoped(tenant_of(&runnable.key));
+            if keyed.key() != runnable.key {
+                return Err(JobError::Internal(
+                    "the job read back from the job store is not the job accepted".to_string(),
+                ));
+            }
+            Ok(keyed)
         };
-        // Kept among its tenant's answers, as it was accepted ([`Keyed::scoped`]).
-        let keyed = job.keyed().scoped(tenant_of(&runnable.key));
-        if keyed.key() != runnable.key {
-            let error = JobError::Internal(
-                "the job read back from the job store is not the job accepted".to_string(),
-            );
-            self.finish(entry, JobState::failed(error), None).await;
-            return None;
+        match runs() {
+            Ok(keyed) => Some((runnable, keyed, deliveries)),
+            Err(error) => {
+                self.finish(entry, JobState::failed(error), None).await;
+                None
+            }
         }
-        Some((runnable, keyed, deliveries))
     }
 
-    /// Solves `entry`'s part of `keyed` (or the whole job) on a solver thread under
-    /// `control`; the CSV is rendered there too, not on an async thread.
+    /// Solves `entry`'s part (or the whole job) on a solver thread, the CSV rendered there too.
     async fn solve(
         &self,
         entry: &Entry,
@@ -318,8 +287,7 @@ impl Worker {
         .await
     }
 
-    /// Counts the part's outcome, and tells the fleet what a point of its kind cost when it
-    /// was solved (in the background: the part's answer does not wait for it).
+    /// Counts the part's outcome, and tells the fleet what a point of its kind cost.
     fn count(
         &self,
         entry: &Entry,
@@ -346,8 +314,8 @@ impl Worker {
         }
     }
 
-    /// Stores what solving `entry` gave: the job's end, or its part (and the whole job once
-    /// every part is in); a part the drain stopped is handed back.
+    /// Stores the job's end, or its part (and the job once every part is in); a part the
+    /// drain stopped is handed back.
     async fn settle(
         &self,
         entry: &Entry,
@@ -358,13 +326,7 @@ impl Worker {
     ) {
         let shared = &self.shared;
         match result {
-            Ok(Outcome::Whole(solved)) => {
-                let total = match keyed.job().work() {
-                    Work::Known(total) => total,
-                    Work::Unknown => control.done(),
-                };
-                self.succeed(entry, solved, total).await;
-            }
+            Ok(Outcome::Whole(solved)) => self.succeed(entry, keyed, solved, control.done()).await,
             Ok(Outcome::Stopped(error, partial)) => {
                 let state = JobState::Failed {
                     error,
@@ -394,10 +356,9 @@ impl Worker {
         }
     }
 
-    /// Assembles the split `job` from all its parts, read once, and finishes it. A process
-    /// that dies here leaves the entry to the next delivery, which finds every part in.
+    /// Assembles the split job from all its parts and finishes it. A process that dies here
+    /// leaves the entry to the next delivery, which finds every part in.
     async fn assemble(&self, entry: &Entry, keyed: &Keyed, runnable: &Runnable) {
-        let job = keyed.job();
         let Ok(all) = self.shared.store.parts(entry.job, runnable.parts).await else {
             return; // taken over later
         };
@@ -405,15 +366,11 @@ impl Worker {
             Ok(assembled) => {
                 let solved = Arc::new(Solved::rendered(
                     keyed.key().to_string(),
-                    job.kind(),
+                    keyed.job().kind(),
                     Bytes::from(assembled.json),
                     Bytes::from(assembled.csv),
                 ));
-                let total = match job.work() {
-                    Work::Known(n) => n,
-                    Work::Unknown => runnable.parts,
-                };
-                self.succeed(entry, solved, total).await;
+                self.succeed(entry, keyed, solved, runnable.parts).await;
             }
             Err(e) => {
                 self.finish(entry, JobState::failed(e), None).await;
@@ -421,19 +378,21 @@ impl Worker {
         }
     }
 
-    /// Finishes the job of `entry` with its answer `solved`, then caches it (by reference
-    /// to the stored result where the cache shares the job store's server), unless the job
-    /// had ended otherwise meanwhile (its stored result is then another).
-    async fn succeed(&self, entry: &Entry, solved: Arc<Solved>, total: usize) {
+    /// Finishes the job of `entry` with its answer `solved` (its work done, or `counted` if
+    /// unknown), then caches it, unless the job had ended otherwise meanwhile.
+    async fn succeed(&self, entry: &Entry, keyed: &Keyed, solved: Arc<Solved>, counted: usize) {
+        let total = match keyed.job().work() {
+            Work::Known(total) => total,
+            Work::Unknown => counted,
+        };
         let state = JobState::Succeeded(JobResult::Ready(solved.clone()));
         if self.finish(entry, state, Some(total)).await {
             self.solver.keep_result_of(solved, entry.job).await;
         }
     }
 
-    /// Stores the job's final `state`, then acknowledges the entry (left for another worker
-    /// if the state could not be stored); returns whether the job ended so (not if it had
-    /// ended otherwise before, a cancel say).
+    /// Stores the job's final `state`, then acknowledges the entry (unless the state could
+    /// not be stored); returns whether the job ended so (not if it ended otherwise first).
     async fn finish(&self, entry: &Entry, state: JobState, done: Option<usize>) -> bool {
         state.log_end(entry.job);
         let shared = &self.shared;
@@ -450,8 +409,8 @@ impl Worker {
     }
 }
 
-/// The next entry for this worker: one whose worker went silent for the idle bound (looked
-/// for every half of it), else a new one, waited for on the worker's own link `waiting`.
+/// The next entry: one whose worker went silent for the idle bound (looked for every half of
+/// it), else a new one, waited for on the worker's own link `waiting`.
 async fn next_entry(
     fleet: &Fleet,
     waiting: &Link,
@@ -496,7 +455,7 @@ async fn next_entry(
     }
 }
 
-/// Creates the stream and its consumer group (once in the fleet; later calls find it).
+/// Creates the stream and its consumer group, once in the fleet.
 async fn create_group(fleet: &Fleet) -> Result<(), Failure> {
     let create = Cmd::xgroup_create_mkstream(keys::STREAM, keys::GROUP, "0");
     match fleet.jobs.query::<()>(&create).await {
@@ -505,79 +464,63 @@ async fn create_group(fleet: &Fleet) -> Result<(), Failure> {
     }
 }
 
-/// Acknowledges `entry` and deletes it from the stream (whose length is then the backlog).
-async fn acknowledge(fleet: &Fleet, entry: &Entry) {
-    let mut pipe = redis::pipe();
+/// Acknowledges `entry` in `pipe`, and deletes it from the stream (whose length is then the
+/// backlog).
+fn acknowledged<'a>(pipe: &'a mut Pipeline, entry: &Entry) -> &'a mut Pipeline {
     let ids = [&entry.id];
     pipe.xack(keys::STREAM, keys::GROUP, &ids)
         .ignore()
         .xdel(keys::STREAM, &ids)
-        .ignore();
-    if let Err(e) = fleet.jobs.pipe::<()>(&pipe).await {
+        .ignore()
+}
+
+async fn acknowledge(fleet: &Fleet, entry: &Entry) {
+    let mut pipe = redis::pipe();
+    if let Err(e) = fleet.jobs.pipe::<()>(acknowledged(&mut pipe, entry)).await {
         tracing::warn!(error = %e, "an entry was not acknowledged: it will run again");
     }
 }
 
-/// Stops a task when dropped.
-struct AbortOnDrop(tokio::task::JoinHandle<()>);
-
-impl Drop for AbortOnDrop {
-    fn drop(&mut self) {
-        self.0.abort();
+/// Adds to `pipe` a stream entry for `job` or its part (index and points): [`Entry::read`].
+pub(super) fn add_entry(pipe: &mut Pipeline, job: Uuid, part: Option<(usize, &Range<usize>)>) {
+    let mut fields = vec![("job", job.to_string())];
+    if let Some((index, range)) = part {
+        fields.push(("part", index.to_string()));
+        fields.push(("start", range.start.to_string()));
+        fields.push(("end", range.end.to_string()));
     }
+    pipe.xadd(keys::STREAM, "*", &fields).ignore();
 }
 
-/// Hands `entry`, stopped unfinished by a drain, back to the fleet at once: a new entry
-/// with the same work replaces it (no wait for the idle bound) and its delivery is taken
-/// back. The parts already in stay: the job resumes where it was.
+/// Hands `entry`, stopped by a drain, back at once: a new entry with the same work replaces
+/// it (no wait for the idle bound) and its delivery is taken back; the parts in stay.
 async fn hand_back(shared: &Shared, entry: &Entry) {
     let _ = shared
         .store
         .undelivered(entry.job, &entry.part_name())
         .await;
-    let job = entry.job.to_string();
-    let mut fields = vec![("job", job)];
-    if let Some((index, range)) = &entry.part {
-        fields.push(("part", index.to_string()));
-        fields.push(("start", range.start.to_string()));
-        fields.push(("end", range.end.to_string()));
-    }
     let mut pipe = redis::pipe();
-    let ids = [&entry.id];
-    pipe.atomic()
-        .xack(keys::STREAM, keys::GROUP, &ids)
-        .ignore()
-        .xdel(keys::STREAM, &ids)
-        .ignore()
-        .xadd(keys::STREAM, "*", &fields)
-        .ignore();
+    acknowledged(pipe.atomic(), entry);
+    let part = entry.part.as_ref().map(|(index, range)| (*index, range));
+    add_entry(&mut pipe, entry.job, part);
     match shared.fleet.jobs.pipe::<()>(&pipe).await {
         Ok(()) => tracing::info!(job = %entry.job, part = entry.part_name(), "handed a part back"),
         Err(e) => tracing::warn!(error = %e, "a part was not handed back: it is taken over later"),
     }
 }
 
-/// While an entry runs: keeps it this worker's (resetting its idle time well within the
-/// bound), stops the solver if the job was cancelled or finished elsewhere, and counts the
-/// progress of a job solved whole.
-async fn heartbeat(
-    fleet: Arc<Fleet>,
-    store: Arc<RedisJobStore>,
-    entry: String,
-    id: Uuid,
-    control: Arc<Control>,
-    whole: bool,
-) {
+/// While an entry runs: keeps it this worker's (well within the idle bound), stops the solver
+/// if the job was cancelled or finished elsewhere, and counts a whole job's progress.
+async fn heartbeat(shared: Arc<Shared>, entry: Entry, control: Arc<Control>) {
+    let (fleet, store, id) = (&shared.fleet, &shared.store, entry.job);
     let keep_every = (fleet.config.claim_idle / 3).max(HEARTBEAT);
     let mut kept = Instant::now();
     loop {
         tokio::time::sleep(HEARTBEAT).await;
-        match store.status(id).await {
-            Ok(Some(status)) if !status.is_finished() => {}
-            Ok(_) => control.cancel(),
-            Err(_) => {}
+        if matches!(store.status(id).await, Ok(s) if s.is_none_or(JobStatus::is_finished)) {
+            control.cancel();
         }
-        if whole {
+        if entry.part.is_none() {
             let _ = store
                 .set_state(id, &JobState::Running, Some(control.done()))
                 .await;
@@ -588,7 +531,7 @@ async fn heartbeat(
                 keys::GROUP,
                 &fleet.consumer,
                 0,
-                &[&entry],
+                &[&entry.id],
                 StreamClaimOptions::default().with_justid(),
             );
             if fleet.jobs.query::<Value>(&keep).await.is_ok() {
