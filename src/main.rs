@@ -64,7 +64,8 @@ enum Command {
     /// Print the OpenAPI description of the HTTP API.
     Openapi,
     /// Make an API key: prints the key on the first line (give it to its holder: it is kept
-    /// nowhere) and, on the second, its entry for the keys file of `serve --api-keys`.
+    /// nowhere) and, on the second, its entry for the keys file of `serve --api-keys` (or,
+    /// with `--append FILE`, adds the entry to that file and prints the key alone).
     NewKey {
         /// The key's tenant: jobs submitted with it belong to this name (keys of one name
         /// share them: add a new key under the old name to rotate it).
@@ -76,6 +77,10 @@ enum Command {
         /// When it stops being accepted (RFC 3339, e.g. 2027-06-30T00:00:00Z); never if absent.
         #[arg(long)]
         expires: Option<String>,
+        /// The keys file to add the entry to (made if absent; a running `serve` reads it
+        /// again within a second).
+        #[arg(long, value_name = "FILE")]
+        append: Option<std::path::PathBuf>,
     },
     /// Exit 0 if the service on THIRDBODY_BIND answers /healthz (a container's health check:
     /// the image has no curl).
@@ -173,7 +178,8 @@ fn main() -> ExitCode {
             name,
             scopes,
             expires,
-        } => return new_key(&name, &scopes, expires.as_deref()),
+            append,
+        } => return new_key(&name, &scopes, expires.as_deref(), append.as_deref()),
         Command::Healthcheck { bind } => return healthcheck(bind),
     };
     let result = job.and_then(|job| {
@@ -278,10 +284,22 @@ fn healthcheck(mut bind: std::net::SocketAddr) -> ExitCode {
     }
 }
 
-/// `thirdbody new-key`: a key and its entry, or why not (exit 2).
-fn new_key(name: &str, scopes: &str, expires: Option<&str>) -> ExitCode {
-    match http::access::keys::issue(name, scopes, expires) {
-        Ok((key, entry)) => print(&format!("{key}\n{entry}\n")),
+/// `thirdbody new-key`: a key and its entry (or the entry added to the keys file `append`),
+/// or why not (exit 2).
+fn new_key(name: &str, scopes: &str, expires: Option<&str>, append: Option<&Path>) -> ExitCode {
+    use http::access::keys;
+    let issued = keys::issue(name, scopes, expires).and_then(|(key, entry)| match append {
+        Some(file) => keys::append(file, &entry).map(|()| {
+            eprintln!(
+                "thirdbody new-key: its entry is added to {}",
+                file.display()
+            );
+            format!("{key}\n")
+        }),
+        None => Ok(format!("{key}\n{entry}\n")),
+    });
+    match issued {
+        Ok(text) => print(&text),
         Err(e) => {
             eprintln!("thirdbody new-key: {e}");
             ExitCode::from(INVALID_JOB)

@@ -92,6 +92,54 @@ fn new_key_refuses_what_the_service_would_refuse() {
     }
 }
 
+#[test]
+fn new_key_appends_its_entry_to_the_keys_file_and_prints_the_key_alone() {
+    use sha2::{Digest, Sha256};
+    let dir = scratch("append");
+    let file = dir.join("keys.json");
+    let append = |name: &str| {
+        let out = thirdbody()
+            .args([
+                "new-key",
+                "--name",
+                name,
+                "--append",
+                file.to_str().unwrap(),
+            ])
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let text = String::from_utf8(out.stdout).unwrap();
+        assert_eq!(text.lines().count(), 1, "{text}");
+        text.trim().to_string()
+    };
+    // Made when absent, then added to.
+    let keys = [append("lab-a"), append("lab-b")];
+    let written: Value = serde_json::from_str(&std::fs::read_to_string(&file).unwrap()).unwrap();
+    let entries = written["keys"].as_array().unwrap();
+    assert_eq!(entries.len(), 2);
+    for ((entry, key), name) in entries.iter().zip(&keys).zip(["lab-a", "lab-b"]) {
+        assert_eq!(entry["name"], name);
+        let hash: String = Sha256::digest(key.as_bytes())
+            .iter()
+            .map(|b| format!("{b:02x}"))
+            .collect();
+        assert_eq!(entry["sha256"], hash.as_str());
+    }
+    // A file `serve` would refuse is left as it is.
+    std::fs::write(&file, "{\"keys\": 3}").unwrap();
+    let out = thirdbody()
+        .args(["new-key", "--name", "c", "--append", file.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    assert_eq!(std::fs::read_to_string(&file).unwrap(), "{\"keys\": 3}");
+}
+
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn keys_are_added_rotated_and_revoked_without_a_restart() {
     let dir = scratch("keys");

@@ -153,6 +153,12 @@ pub enum KeysError {
         path: String,
         source: std::io::Error,
     },
+    /// The file cannot be written (`new-key --append`).
+    #[error("cannot write {path}: {source}")]
+    Unwritable {
+        path: String,
+        source: std::io::Error,
+    },
 }
 
 impl Ring {
@@ -257,6 +263,38 @@ pub fn issue(
     let entry = entry.to_string();
     Ring::parse(&format!("{{\"keys\": [{entry}]}}"))?;
     Ok((key, entry))
+}
+
+/// Adds `entry` (as [`issue`] made it) to the keys file at `path`, made if it does not exist:
+/// the whole file is checked as `serve` reads it, then written beside it and renamed over it,
+/// so that a running service never reads half of it.
+pub fn append(path: &std::path::Path, entry: &str) -> Result<(), KeysError> {
+    let shown = path.display().to_string();
+    let text = match std::fs::read_to_string(path) {
+        Ok(text) => text,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => "{\"keys\": []}".to_string(),
+        Err(source) => {
+            return Err(KeysError::Unreadable {
+                path: shown,
+                source,
+            })
+        }
+    };
+    Ring::parse(&text)?;
+    let mut file: serde_json::Value = serde_json::from_str(&text).map_err(KeysError::Json)?;
+    let entry: serde_json::Value = serde_json::from_str(entry).map_err(KeysError::Json)?;
+    if let Some(keys) = file["keys"].as_array_mut() {
+        keys.push(entry);
+    }
+    let text = serde_json::to_string_pretty(&file).map_err(KeysError::Json)?;
+    Ring::parse(&text)?;
+    let partial = path.with_extension("partial");
+    let unwritable = |source| KeysError::Unwritable {
+        path: shown.clone(),
+        source,
+    };
+    std::fs::write(&partial, text + "\n").map_err(unwritable)?;
+    std::fs::rename(&partial, path).map_err(unwritable)
 }
 
 /// Where the keys come from: a file (read again when it changes) or the JSON itself (an
