@@ -140,6 +140,13 @@ try {
   await page.waitForFunction((s) => (document.querySelector(`${s} svg title`) || {}).textContent?.startsWith("Three-body"), area("three-body", "picture"));
   await page.screenshot({ path: `${shots}/three-body.png`, fullPage: true });
   const localMu = await page.locator(`${area("three-body", "table")} tr`, { hasText: "friction_coefficient" }).first().textContent();
+  // Each quantity in the unit of its magnitude: W = 0.99999…e-3 N is 1 mN (not 1000 µN), and
+  // a zero area is in the unit of the other areas (not m²).
+  const bodyRow = async (name) => page.locator(`${area("three-body", "table")} tr`, { hasText: name }).first().textContent();
+  if ((await bodyRow("loads.total")) !== "loads.total1mN") fail(`the total load reads ${await bodyRow("loads.total")}`);
+  if ((await bodyRow("areas.surface_surface")) !== "areas.surface_surface0µm²") fail(`a zero area reads ${await bodyRow("areas.surface_surface")}`);
+  // The form says which modulus the layer's is.
+  if (!(await page.locator("#form-three-body label[data-field='elastic_modulus']").textContent()).includes("constrained")) fail("the three-body form does not say which modulus E_L is");
 
   // The same system on the continuum layer contact: its μ several times lower, its error said.
   await page.selectOption("#form-three-body select[name='layer_contact']", "continuum");
@@ -406,6 +413,18 @@ try {
   // The newest job is the fit measured on the three-body system: E_L back at 3 GPa.
   if (!/(^|[^\d.])(2\.99\d*|3(\.00\d*)?)\s*GPa/.test(reopened)) fail(`the reopened fit's modulus reads ${reopened}`);
   if (await page.locator("#panel-history").isHidden()) fail("a job's link does not show the history");
+  // Shared with another browser (no token of this one): the answer with the inputs that made
+  // it, and no empty history table under it.
+  const elsewhere = await browser.newPage({ viewport: { width: 1366, height: 900 } });
+  elsewhere.on("pageerror", (error) => errors.push(String(error)));
+  await elsewhere.goto(`${base}/#job=${listed[0].id}`);
+  await elsewhere.waitForSelector(`${area("history")} .inputs tr`, { timeout: 30000 });
+  const inputs = await elsewhere.locator(`${area("history")} .inputs`).textContent();
+  if (!inputs.includes("Inputs of this answer") || !/series|parameters/.test(inputs)) fail(`a shared link shows the inputs ${inputs.slice(0, 200)}`);
+  await elsewhere.waitForFunction(() => document.querySelector("#history-count").textContent !== "");
+  if (!(await elsewhere.locator("#history-jobs").isHidden())) fail("a shared link shows an empty history table");
+  await elsewhere.screenshot({ path: `${shots}/shared-link.png`, fullPage: true });
+  await elsewhere.close();
   await page.waitForFunction((n) => document.querySelectorAll("#history-jobs tbody tr").length === n, listed.length);
   const relisted = await listedRows();
   if (relisted.map((r) => r.id).join() !== listed.map((r) => r.id).join()) fail("the history after the restart is not the one before");

@@ -182,7 +182,8 @@ function scaleFor(value, unit) {
   const [name, power] = base;
   for (const [size, prefix] of [[1, ""], [1e-3, "m"], [1e-6, "µ"], [1e-9, "n"], [1e-12, "p"]]) {
     const scale = size ** power;
-    const least = power === 2 ? 1e-2 : 1;
+    // A hair below a round value (0.999999… mN, a sum's rounding) is read at that value.
+    const least = (power === 2 ? 1e-2 : 1) * (1 - 1e-9);
     if (Math.abs(value) >= least * scale || prefix === "p") {
       return [scale, name === "m/s" ? `${prefix}m/s` : prefix + name];
     }
@@ -231,6 +232,7 @@ class Area {
   /** Everything but the status line emptied. */
   clear() {
     for (const name of ["warnings", "picture", "table", "downloads"]) this.part(name).replaceChildren();
+    for (const inputs of this.root.querySelectorAll(".inputs")) inputs.remove();
   }
 
   /** An error in place of the answer it replaces: an old table never stands under it. */
@@ -312,12 +314,19 @@ function unitsOf(answer, prefix = "") {
  *  as the range it is, other lists left out. */
 function rows(answer, units, prefix = "") {
   const out = [];
+  // A zero has no magnitude of its own: it is shown in the unit of its siblings of the same
+  // unit (areas.surface_surface 0 µm² beside the other areas, not 0 m²).
+  const largest = {};
+  for (const [key, value] of Object.entries(answer)) {
+    const unit = units[prefix + key];
+    if (typeof value === "number") largest[unit] = Math.max(largest[unit] || 0, Math.abs(value));
+  }
   for (const [key, value] of Object.entries(answer)) {
     if (key === "meta") continue;
     const path = prefix + key;
     if (typeof value === "number") {
-      const [shown, unit] = readable(value, units[path]);
-      out.push([path, Number(shown.toPrecision(6)), unit]);
+      const [size, unit] = scaleFor(value || largest[units[path]], units[path]);
+      out.push([path, Number((value / size).toPrecision(6)), unit]);
     } else if (Array.isArray(value) && value.length === 2 && value.every((v) => typeof v === "number")) {
       // A range (a fit's 95 % interval, its bounds): both ends in the unit of the larger.
       // A list's unit is named by its path with `[]`.
@@ -525,6 +534,30 @@ async function showAnswer(area, token, answer, picture, downloads, name) {
     }
   }
   showDownloads(area, downloads, name);
+  if (area === $("#panel-history").area) showInputs(area, answer);
+}
+
+/** The inputs that made an answer opened from the history or a link (its canonical input,
+ *  every default filled in, in SI units), under its table: the form that asked is elsewhere. */
+function showInputs(area, answer) {
+  const input = answer.meta && answer.meta.input;
+  if (!input || typeof input !== "object") return;
+  const box = Object.assign(document.createElement("details"), { className: "inputs", open: true });
+  box.append(Object.assign(document.createElement("summary"), { textContent: "Inputs of this answer (SI units, every default filled in)" }));
+  const table = box.appendChild(document.createElement("table"));
+  const body = table.createTBody();
+  const flat = (value, path) => {
+    if (value && typeof value === "object" && !Array.isArray(value)) {
+      for (const [key, inner] of Object.entries(value)) flat(inner, path ? `${path}.${key}` : key);
+    } else {
+      const row = body.insertRow();
+      row.insertCell().textContent = path;
+      const listed = Array.isArray(value) && value.some((v) => v && typeof v === "object");
+      row.insertCell().textContent = listed ? `${value.length} items (in the JSON download)` : Array.isArray(value) ? value.join(", ") : String(value);
+    }
+  };
+  flat(input, "");
+  area.part("downloads").after(box);
 }
 
 /** What a continuum answer's verification says of its accuracy, in a sentence. */
@@ -992,6 +1025,7 @@ async function loadHistory(more = false) {
   for (const view of read.body.jobs) rows.append(historyRow(view));
   listing.next = read.body.next || null;
   $("#history-more").hidden = !listing.next;
+  $("#history-jobs").closest(".table-box").hidden = rows.rows.length === 0;
   $("#history-count").textContent = read.body.total
     ? `${rows.rows.length} of ${read.body.total} jobs shown.`
     : "No jobs here yet: the sweeps and fits run in this browser are listed.";
