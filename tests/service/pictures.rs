@@ -160,7 +160,7 @@ fn more_lines_than_the_palette_has_run_along_a_sequential_map_in_their_order() {
     };
     // viridis from its dark end towards its light one, in the order of the loads: its green
     // grows all along it.
-    assert_eq!(stroke("P = 250 pN"), "#440154");
+    assert_eq!(stroke("P = 0.25 nN"), "#440154");
     let names = &series[..12];
     let greens: Vec<u8> = names
         .iter()
@@ -197,9 +197,15 @@ fn a_sweep_has_a_curve_per_other_value_and_marks_points_at_rest() {
     let (series, legend) = parts(&svg);
     assert_eq!(
         series,
-        ["P = 500 pN", "P = 1 nN", "P = 2 nN", "at rest, V = 0"]
+        ["P = 0.5 nN", "P = 1 nN", "P = 2 nN", "at rest, V = 0"]
     );
     assert_eq!(legend, series);
+    // One condition, one unit in the legend: its largest value's (issue 52: "P = 500 pN"
+    // beside "P = 2 nN", "V = 0 m/s" beside "V = 4 nm/s").
+    let (_, at_rest) = solve(json!({"kind": "sweep", "input": {"vary": {
+        "load": ["0.5 nN", "1 nN", "2 nN"], "velocity": ["0 nm/s", "4 nm/s"]}}}));
+    let (series, _) = parts(&at_rest);
+    assert_eq!(series, ["V = 0 nm/s", "V = 4 nm/s", "at rest, V = 0"]);
     let chart = chart::<SweepPicture>(&answer);
     let Layer::Line { points, .. } = &chart.layers[1] else {
         panic!()

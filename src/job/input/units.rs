@@ -135,7 +135,7 @@ pub enum UnitError {
         expected: Dimension,
     },
     /// A mass where a force is expected (a load typed in kg, as on a balance).
-    #[error("is a mass, not a force: it weighs {} under standard gravity", with_prefix(*.weight, "N"))]
+    #[error("is a mass, not a force: it weighs {} under standard gravity", crate::model::text::quantity(*.weight, "N"))]
     MassForForce {
         /// Its weight (N).
         weight: f64,
@@ -241,35 +241,6 @@ pub fn parse_quantity(text: &str, expected: Dimension) -> Result<f64, UnitError>
 
 /// g₀ (m/s²), by definition (CGPM 1901): what a mass given for a load weighs.
 const STANDARD_GRAVITY: f64 = 9.806_65;
-
-/// `value` of the SI unit `symbol` in the prefixed unit that puts its number between 1 and
-/// 1000, to three significant digits (`9.81 mN`), for messages.
-pub fn with_prefix(value: f64, symbol: &str) -> String {
-    const NAMES: [(&str, i32); 9] = [
-        ("G", 9),
-        ("M", 6),
-        ("k", 3),
-        ("", 0),
-        ("m", -3),
-        ("µ", -6),
-        ("n", -9),
-        ("p", -12),
-        ("f", -15),
-    ];
-    let (prefix, power) = NAMES
-        .into_iter()
-        .find(|(_, p)| value.abs() >= 10f64.powi(*p) * (1.0 - 5e-4))
-        .filter(|_| value != 0.0)
-        .unwrap_or(("", 0));
-    let x = value / 10f64.powi(power);
-    let decimals = 2 - (x.abs().log10().floor() as usize).min(2);
-    let number = format!("{x:.decimals$}");
-    let number = match number.contains('.') {
-        true => number.trim_end_matches('0').trim_end_matches('.'),
-        false => &number,
-    };
-    format!("{number} {prefix}{symbol}")
-}
 
 /// Whether `text` is a number in degrees Celsius (`"25 °C"`).
 pub fn names_celsius(text: &str) -> bool {
@@ -508,10 +479,6 @@ mod tests {
                 .to_string(),
             "is a mass"
         );
-        assert_eq!(with_prefix(1.0e-3, "N"), "1 mN");
-        assert_eq!(with_prefix(0.9996, "N"), "1 N");
-        assert_eq!(with_prefix(12.345e-9, "m"), "12.3 nm");
-        assert_eq!(with_prefix(0.0, "N"), "0 N");
     }
 
     #[test]

@@ -13,7 +13,6 @@ use serde::{Deserialize, Serialize};
 use serde_json::{json, Value};
 use utoipa::ToSchema;
 
-use super::input::units::with_prefix;
 use super::input::LayerModel;
 use super::input::{self, field, Checker, Field, Quantity};
 use super::kind::SMALL_ANSWER;
@@ -27,6 +26,7 @@ use super::{
     Control, Cost, JobError, Kind, Limits, Meta, OnRefusal, References, Swept, Validated, Work,
 };
 use crate::model::tables::Use;
+use crate::model::text::quantity;
 use crate::model::three_body::{
     Diameters, LayerContact, OperatingPoint, ThreeBody, ThreeBodySolution,
 };
@@ -295,9 +295,9 @@ impl Kind for SweepJob {
                     let p = &contacts[i];
                     format!(
                         "R = {}, P = {}, V = {}",
-                        with_prefix(p.radius, "m"),
-                        with_prefix(p.load, "N"),
-                        with_prefix(p.velocity, "m/s")
+                        quantity(p.radius, "m"),
+                        quantity(p.load, "N"),
+                        quantity(p.velocity, "m/s")
                     )
                 };
                 let swept = refused_at(swept, first, on_refusal, name);
@@ -325,11 +325,11 @@ impl Kind for SweepJob {
                 let name = |i: usize| {
                     let system = &systems[i];
                     let operating = match system.operating {
-                        OperatingPoint::Separation(d) => format!("d = {}", with_prefix(d, "m")),
-                        OperatingPoint::TotalLoad(w) => format!("W = {}", with_prefix(w, "N")),
-                        OperatingPoint::ParticleLoad(p) => format!("P = {}", with_prefix(p, "N")),
+                        OperatingPoint::Separation(d) => format!("d = {}", quantity(d, "m")),
+                        OperatingPoint::TotalLoad(w) => format!("W = {}", quantity(w, "N")),
+                        OperatingPoint::ParticleLoad(p) => format!("P = {}", quantity(p, "N")),
                     };
-                    format!("{operating}, V = {}", with_prefix(system.velocity, "m/s"))
+                    format!("{operating}, V = {}", quantity(system.velocity, "m/s"))
                 };
                 let swept = refused_at(swept, first, on_refusal, name);
                 let stop = swept.stopped.clone();

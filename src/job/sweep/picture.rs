@@ -10,6 +10,7 @@ use crate::job::picture::{shown, symbol, Picture, PictureError};
 use crate::job::points::PointStatus;
 use crate::job::rolling::ContactOutput;
 use crate::job::three_body::{operating_units, ThreeBodyResult};
+use crate::model::text::prefixed;
 use crate::model::Parameter;
 use crate::render::svg::{Axis, Chart, Layer};
 
@@ -108,29 +109,52 @@ fn condition(name: &str, parameter: Parameter, value: f64) -> Condition {
     (name.to_string(), parameter.unit(), value)
 }
 
-/// The conditions that vary over `rows`, each with its number of distinct values.
-fn varied(rows: &[Drawn], first: &Drawn) -> Vec<(usize, usize)> {
+/// A condition that varies over the rows: its index, its number of distinct values, and the
+/// unit its legend labels are written in (that of its largest value, with its factor from
+/// SI), so that one condition reads in one unit: "V = 0 nm/s" beside "V = 4 nm/s", and
+/// "P = 0.5 nN" beside "P = 2 nN" (not "500 pN").
+struct Varied {
+    index: usize,
+    values: usize,
+    unit: (f64, String),
+}
+
+/// The conditions that vary over `rows`.
+fn varied(rows: &[Drawn], first: &Drawn) -> Vec<Varied> {
     let values =
         |i: usize| -> Vec<u64> { rows.iter().map(|r| r.conditions[i].2.to_bits()).collect() };
     (0..first.conditions.len())
-        .filter_map(|i| {
-            let mut seen = values(i);
+        .filter_map(|index| {
+            let mut seen = values(index);
             seen.sort_unstable();
             seen.dedup();
-            (seen.len() > 1).then_some((i, seen.len()))
+            let largest = rows
+                .iter()
+                .map(|r| r.conditions[index].2.abs())
+                .fold(0.0, f64::max);
+            let unit = prefixed(first.conditions[index].1, largest);
+            (seen.len() > 1).then_some(Varied {
+                index,
+                values: seen.len(),
+                unit,
+            })
         })
         .collect()
 }
 
 /// The label of `row`'s curve: the values of the `varied` conditions other than the one
 /// drawn `along`, or `sweep` when there are none.
-fn label(row: &Drawn, varied: &[(usize, usize)], along: usize) -> String {
+fn label(row: &Drawn, varied: &[Varied], along: usize) -> String {
     let label: Vec<String> = varied
         .iter()
-        .filter(|v| v.0 != along)
+        .filter(|v| v.index != along)
         .map(|v| {
-            let (name, unit, value) = &row.conditions[v.0];
-            format!("{} = {}", symbol(name), shown(*value, unit))
+            let (name, _, value) = &row.conditions[v.index];
+            let (factor, unit) = &v.unit;
+            let number = shown(value * factor, "");
+            format!("{} = {number} {unit}", symbol(name))
+                .trim_end()
+                .to_string()
         })
         .collect();
     if label.is_empty() {
@@ -171,7 +195,11 @@ impl Picture for SweepPicture {
             .ok_or_else(|| PictureError::new("the sweep has no point"))?;
         let varied = varied(&rows, first);
         // The longest list; of equal ones, the first (`max_by_key` keeps the last).
-        let along = varied.iter().rev().max_by_key(|v| v.1).map_or(0, |v| v.0);
+        let along = varied
+            .iter()
+            .rev()
+            .max_by_key(|v| v.values)
+            .map_or(0, |v| v.index);
         let (along_name, along_unit, _) = &first.conditions[along];
         // Curves by the values of the other varied lists, in order of first appearance.
         let mut curves: Vec<Curve> = Vec::new();
