@@ -206,6 +206,15 @@ fn a_sweep_has_a_curve_per_other_value_and_marks_points_at_rest() {
         "load": ["0.5 nN", "1 nN", "2 nN"], "velocity": ["0 nm/s", "4 nm/s"]}}}));
     let (series, _) = parts(&at_rest);
     assert_eq!(series, ["V = 0 nm/s", "V = 4 nm/s", "at rest, V = 0"]);
+    // Which law of the layer answered is said (issue 52), and on the continuum its error.
+    assert!(svg.contains("layer: local law (the paper's)"), "{svg}");
+    let (solved, continuum) = solve(json!({"kind": "sweep", "input": {
+        "base": {"layer": {"model": "continuum"}}, "vary": {"load": ["0.5 nN", "1 nN"]}}}));
+    let error = solved["meta"]["verification"]["contact_area_error"]
+        .as_f64()
+        .unwrap();
+    let said = format!("layer: continuum, A within ±{:.2} %", 100.0 * error);
+    assert!(continuum.contains(&said), "{said}: {continuum}");
     let chart = chart::<SweepPicture>(&answer);
     let Layer::Line { points, .. } = &chart.layers[1] else {
         panic!()
@@ -233,7 +242,11 @@ fn a_sweep_draws_the_points_it_answered_and_counts_those_it_did_not() {
         .collect();
     assert_eq!(
         notes,
-        ["1 of 3 points not drawn:", "refused, or not solved"]
+        [
+            "layer: local law (the paper's)",
+            "1 of 3 points not drawn:",
+            "refused, or not solved"
+        ]
     );
 }
 

@@ -6,6 +6,7 @@ use std::collections::BTreeMap;
 
 use serde::Deserialize;
 
+use crate::job::input::LayerModel;
 use crate::job::picture::{shown, symbol, Picture, PictureError};
 use crate::job::points::PointStatus;
 use crate::job::rolling::ContactOutput;
@@ -14,10 +15,55 @@ use crate::model::text::prefixed;
 use crate::model::Parameter;
 use crate::render::svg::{Axis, Chart, Layer};
 
-/// What the picture shows of a sweep: its rows.
+/// What the picture shows of a sweep: its rows, and which law of the layer answered them
+/// with what error.
 #[derive(Deserialize)]
 pub struct SweepPicture {
     points: Rows,
+    meta: Option<SweepMeta>,
+}
+
+/// What the picture says of a sweep's `meta`: a rolling sweep's layer law, and on the
+/// continuum its worst error in the area.
+#[derive(Deserialize)]
+struct SweepMeta {
+    input: Option<SweepAsked>,
+    verification: Option<Verified>,
+}
+
+#[derive(Deserialize)]
+struct SweepAsked {
+    base: Option<BaseAsked>,
+}
+
+#[derive(Deserialize)]
+struct BaseAsked {
+    layer: Option<LayerAsked>,
+}
+
+#[derive(Deserialize)]
+struct LayerAsked {
+    model: Option<LayerModel>,
+}
+
+#[derive(Deserialize)]
+struct Verified {
+    contact_area_error: Option<f64>,
+}
+
+impl SweepMeta {
+    /// The note naming the law of a rolling sweep's layer (and the continuum's error in A).
+    fn law(&self) -> Option<String> {
+        // A three-body system's layer names no model (its contact law is its own field).
+        let model = self.input.as_ref()?.base.as_ref()?.layer.as_ref()?.model?;
+        Some(match model {
+            LayerModel::Local => "layer: local law (the paper's)".to_string(),
+            LayerModel::Continuum => match self.verification.as_ref()?.contact_area_error {
+                Some(error) => format!("layer: continuum, A within ±{:.2} %", 100.0 * error),
+                None => "layer: continuum".to_string(),
+            },
+        })
+    }
 }
 
 /// The rows of either kind, as the output writes them.
@@ -225,13 +271,11 @@ impl Picture for SweepPicture {
         }
         let layers = layers(curves);
         // Short lines: they stand under the legend.
-        let notes = match unanswered {
-            0 => Vec::new(),
-            n => vec![
-                format!("{n} of {} points not drawn:", rows.len()),
-                "refused, or not solved".to_string(),
-            ],
-        };
+        let mut notes: Vec<String> = self.meta.and_then(|m| m.law()).into_iter().collect();
+        if unanswered > 0 {
+            notes.push(format!("{unanswered} of {} points not drawn:", rows.len()));
+            notes.push("refused, or not solved".to_string());
+        }
         Ok(Chart {
             title: format!("Sweep: {y_name} against {}", along_name.replace('_', " ")),
             x: Axis::new(along_name, along_unit),
