@@ -177,6 +177,13 @@ pub trait Kind: fmt::Debug + Send + Sync + Sized + 'static {
         None
     }
 
+    /// The unit table of this job's answer (its `meta.units`): the output's, unless an answer
+    /// holds only some of the output's fields (a rolling sweep's rows are not a three-body
+    /// sweep's).
+    fn answer_units(&self) -> &'static UnitTable {
+        Self::Output::UNITS
+    }
+
     /// Whether the job is certain to take no more than about a hundred microseconds: the
     /// engine then runs it on the request's own thread, which is cheaper than handing it to
     /// a solver thread and back (BENCHMARKS.md). No by default.
@@ -447,7 +454,7 @@ impl<K: Kind> Dispatch for K {
     }
 
     fn units(&self) -> &'static crate::render::UnitTable {
-        K::Output::UNITS
+        self.answer_units()
     }
 
     fn as_any(&self) -> &dyn Any {

@@ -10,7 +10,7 @@ use thirdbody::job::{Control, FieldError, Job, JobError, Limits, RollingJob, Wor
 use thirdbody::model::limits::relaxed;
 use thirdbody::model::tables::{self, Use};
 use thirdbody::model::{solve, Layer, Quadrature, Rolling, SolveOptions};
-use thirdbody::render::Output;
+use thirdbody::render::{Format, Output};
 
 fn job(value: Value) -> Result<Job, JobError> {
     Job::from_value(value, &Limits::default())
@@ -447,4 +447,36 @@ fn the_room_made_for_a_result_holds_it() {
             job.result_bytes()
         );
     }
+}
+
+/// A sweep's `meta.units` lists its own rows' fields: a rolling sweep's none of a three-body
+/// sweep's, and the other way round (issue 52: a rolling sweep listed 17 of them).
+#[test]
+fn a_sweep_lists_the_units_of_its_own_rows_only() {
+    let units = |job: Value| -> Vec<String> {
+        let job = Job::from_value(job, &Limits::default()).unwrap();
+        let answer = engine::run(&job, &Control::default()).unwrap();
+        let text: Value = serde_json::from_slice(&answer.render(Format::Json).unwrap()).unwrap();
+        let units = text["meta"]["units"].as_object().unwrap();
+        units
+            .keys()
+            .filter(|k| k.starts_with("points[]"))
+            .cloned()
+            .collect()
+    };
+    let rolling = units(json!({"kind": "sweep", "input": {"vary": {"load": ["1 nN", "2 nN"]}}}));
+    assert!(rolling.contains(&"points[].contact_area".to_string()));
+    assert!(
+        !rolling.iter().any(|k| k.starts_with("points[].areas")),
+        "{rolling:?}"
+    );
+    assert!(!rolling.contains(&"points[].mean_diameter".to_string()));
+    let systems = units(json!({"kind": "sweep", "input": {"kind": "three_body",
+        "base": {"operating": {"total_load": "1 mN"}},
+        "vary": {"total_load": ["1 mN", "2 mN"]}}}));
+    assert!(systems.contains(&"points[].areas.total".to_string()));
+    assert!(
+        !systems.contains(&"points[].contact_area".to_string()),
+        "{systems:?}"
+    );
 }

@@ -7,6 +7,7 @@ mod rows;
 pub use picture::SweepPicture;
 pub use rows::{PointCounts, SweepSummary, SweepVerification};
 
+use std::collections::BTreeMap;
 use std::ops::Range;
 
 use serde::{Deserialize, Serialize};
@@ -219,6 +220,13 @@ impl Kind for SweepJob {
                     .map(|p| system_cost(p, &mut counted))
                     .fold(Cost::default(), Cost::then)
             }
+        }
+    }
+
+    fn answer_units(&self) -> &'static UnitTable {
+        match &self.points {
+            SweepOfPoints::Rolling(_) => &ROLLING_UNITS,
+            SweepOfPoints::ThreeBody(_) => &THREE_BODY_UNITS,
         }
     }
 
@@ -665,8 +673,37 @@ described! {
     }
 }
 
+/// The unit table of a sweep of one kind of point: a sweep's, without the fields of the other
+/// kind's rows (`rows` and `other` are the two kinds' fields, by path within a row).
+fn units_of(
+    rows: BTreeMap<String, &'static str>,
+    other: BTreeMap<String, &'static str>,
+) -> BTreeMap<String, &'static str> {
+    let mut units = render::fields::units::<SweepOutput>();
+    units.retain(|path, _| match path.strip_prefix("points[].") {
+        Some(field) => rows.contains_key(field) || !other.contains_key(field),
+        None => true,
+    });
+    units
+}
+
+/// The unit tables of a rolling sweep's answer and of a three-body sweep's.
+static ROLLING_UNITS: UnitTable = render::Fixed::new(render::UnitGroups::new(|| {
+    units_of(
+        render::fields::units::<SweepPoint>(),
+        render::fields::units::<ThreeBodySweepPoint>(),
+    )
+}));
+static THREE_BODY_UNITS: UnitTable = render::Fixed::new(render::UnitGroups::new(|| {
+    units_of(
+        render::fields::units::<ThreeBodySweepPoint>(),
+        render::fields::units::<SweepPoint>(),
+    )
+}));
+
 impl Output for SweepOutput {
-    /// The points of a rolling sweep or of a three-body sweep.
+    /// The points of a rolling sweep or of a three-body sweep (a sweep's own answer lists
+    /// its kind's alone: [`Kind::answer_units`]).
     const UNITS: &'static UnitTable = unit_table!(SweepOutput);
 
     /// How many points the model refused, and how to fail the sweep instead.
