@@ -144,6 +144,21 @@ impl Table {
         }
     }
 
+    /// The table with a column `name` in `unit` holding `value` on every row (a quantity the
+    /// whole answer has, such as a fitted parameter beside each residual).
+    pub fn with_constant(mut self, name: &str, unit: &'static str, value: Option<f64>) -> Table {
+        let unit = Cow::Borrowed(unit);
+        self.headings.push(Heading {
+            name: name.to_string(),
+            unit,
+        });
+        let cell = value.map_or(Cell::Empty, Cell::Number);
+        for row in &mut self.rows {
+            row.push(cell.clone());
+        }
+        self
+    }
+
     /// CSV (RFC 4180): a header line (`radius [m]`), then a line a row, text quoted; `None`
     /// if a number is not finite (CSV has no place for it, as JSON has none).
     pub fn to_csv(&self) -> Option<String> {

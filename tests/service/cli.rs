@@ -95,7 +95,7 @@ fn figures_print_as_json_or_csv() {
     let text = String::from_utf8_lossy(&csv.stdout);
     assert_eq!(
         text.lines().next(),
-        Some("series,label,radius [m],friction_coefficient")
+        Some("series,label,radius [m],friction_coefficient,load [N],velocity [m/s]")
     );
     assert_eq!(text.lines().count(), 1 + 10 * 14);
 }
@@ -724,4 +724,26 @@ fn the_help_and_the_readme_name_every_kind_of_the_registry() {
         .collect();
     assert_eq!(listed(&help), registry, "{help}");
     assert_eq!(listed(job_line), registry, "{job_line}");
+}
+
+/// A fit's CSV carries what was fitted: each parameter and its standard error beside every
+/// residual (issue 52: the CSV had the residuals alone).
+#[test]
+fn a_fit_s_csv_says_what_was_fitted() {
+    let answer = json(&thirdbody(&["solve", "examples/fit.json"], None));
+    let out = thirdbody(&["solve", "examples/fit.json", "--format", "csv"], None);
+    assert!(out.status.success());
+    let text = String::from_utf8_lossy(&out.stdout);
+    let header: Vec<&str> = text.lines().next().unwrap().split(',').collect();
+    let row: Vec<&str> = text.lines().nth(1).unwrap().split(',').collect();
+    for name in answer["parameter_names"].as_array().unwrap() {
+        let name = name.as_str().unwrap();
+        let column = header
+            .iter()
+            .position(|h| h.starts_with(&format!("fitted_{name} [")))
+            .unwrap_or_else(|| panic!("no column for {name}: {header:?}"));
+        let value: f64 = row[column].parse().unwrap();
+        assert_eq!(value, answer["parameters"][name]["value"].as_f64().unwrap());
+        assert!(header[column + 1].starts_with(&format!("fitted_{name}_standard_error [")));
+    }
 }

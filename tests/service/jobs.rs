@@ -373,7 +373,12 @@ fn figures_3_to_9_hold_the_series_of_model_section_5() {
         assert_eq!(s.points.first(), s.points.last());
     }
     let csv = f.table().to_csv().unwrap();
-    assert_eq!(csv.lines().next(), Some("series,label,x [m],y [m]"));
+    // The conditions each contour holds fixed are columns of their own (issue 52).
+    assert_eq!(
+        csv.lines().next(),
+        Some("series,label,x [m],y [m],radius [m],load [N],velocity [m/s]")
+    );
+    assert!(csv.lines().nth(1).unwrap().ends_with(",2.5e-8,1e-9,0"));
     assert_eq!(csv.lines().count(), 1 + 4 * 202);
 }
 

@@ -175,7 +175,7 @@ impl FigureOutput {
 /// One point of a figure, as a CSV row.
 struct FigureRow<'a> {
     series: usize,
-    label: &'a str,
+    of: &'a SeriesOutput,
     point: [f64; 2],
 }
 
@@ -183,14 +183,18 @@ impl Output for FigureOutput {
     /// The points are in the units of the axes, which the answer names.
     const UNITS: &'static UnitTable = unit_table!(FigureOutput);
 
-    /// One row per point: the series' index and legend, then x and y in the axes' units.
+    /// One row per point: the series' index and legend, then x and y in the axes' units, then
+    /// the conditions its series holds fixed (R, P, V) as columns of their own.
     fn table(&self) -> Table {
-        fn columns<'a>() -> [Column<FigureRow<'a>>; 4] {
+        fn columns<'a>() -> [Column<FigureRow<'a>>; 7] {
             [
                 Column::count("series", |r| r.series),
-                Column::text("label", |r, text| text.push_str(r.label)),
+                Column::text("label", |r, text| text.push_str(&r.of.label)),
                 Column::number("x", "", |r| r.point[0]),
                 Column::number("y", "", |r| r.point[1]),
+                Column::optional("radius", "m", |r| r.of.radius),
+                Column::optional("load", "N", |r| r.of.load),
+                Column::number("velocity", "m/s", |r| r.of.velocity),
             ]
         }
         let rows: Vec<FigureRow> = self
@@ -200,12 +204,25 @@ impl Output for FigureOutput {
             .flat_map(|(series, s)| {
                 s.points.iter().map(move |&point| FigureRow {
                     series,
-                    label: &s.label,
+                    of: s,
                     point,
                 })
             })
             .collect();
-        let mut table = Table::new(&columns(), &rows);
+        // A condition that varies along the curves (the x axis's) is in the x column alone.
+        let fixed =
+            |read: fn(&SeriesOutput) -> Option<f64>| self.series.iter().all(|s| read(s).is_some());
+        let columns: Vec<Column<FigureRow>> = columns()
+            .into_iter()
+            .enumerate()
+            .filter(|(i, _)| match i {
+                4 => fixed(|s| s.radius),
+                5 => fixed(|s| s.load),
+                _ => true,
+            })
+            .map(|(_, c)| c)
+            .collect();
+        let mut table = Table::new(&columns, &rows);
         table.rename(2, &self.x.quantity, &self.x.unit);
         table.rename(3, &self.y.quantity, &self.y.unit);
         table

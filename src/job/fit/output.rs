@@ -308,6 +308,26 @@ impl Output for FitOutput {
             }),
             Column::number("normalized_residual", "", |r| r.normalized_residual),
         ];
-        Table::new(&COLUMNS, &self.residuals)
+        // Each fitted parameter and its standard error beside every residual: a CSV alone
+        // says what was fitted.
+        let fitted = self.parameter_names.iter().filter_map(|&name| {
+            let unit = FitParameter::ALL
+                .iter()
+                .find(|p| p.name() == name)
+                .map_or("", |p| p.parameter().unit());
+            Some((name, unit, self.parameters.get(name)?))
+        });
+        fitted.fold(
+            Table::new(&COLUMNS, &self.residuals),
+            |table, (name, unit, e)| {
+                table
+                    .with_constant(&format!("fitted_{name}"), unit, Some(e.value))
+                    .with_constant(
+                        &format!("fitted_{name}_standard_error"),
+                        unit,
+                        e.standard_error,
+                    )
+            },
+        )
     }
 }
