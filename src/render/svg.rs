@@ -240,6 +240,31 @@ fn label(value: f64) -> String {
     }
 }
 
+/// The labels of an axis's ticks: short decimals, or, where those would not tell every tick
+/// apart (ticks a millionth apart or less: a continuum μ at a slow speed read "0.000001"
+/// twice), powers of ten with the digits the step needs ("1.2e-6").
+fn labels(ticks: &[f64]) -> Vec<String> {
+    let plain: Vec<String> = ticks.iter().map(|&t| label(t)).collect();
+    if plain.windows(2).all(|w| w[0] != w[1]) {
+        return plain;
+    }
+    let step = ticks
+        .windows(2)
+        .map(|w| w[1] - w[0])
+        .fold(f64::INFINITY, f64::min);
+    let power = |x: f64| (x.abs().log10() + 1e-9).floor();
+    ticks
+        .iter()
+        .map(|&t| match t.abs() < step * 1e-9 {
+            true => "0".to_string(),
+            false => {
+                let digits = (power(t) - power(step)).max(0.0) as usize;
+                format!("{t:.digits$e}")
+            }
+        })
+        .collect()
+}
+
 fn escape(text: &str) -> String {
     text.replace('&', "&amp;")
         .replace('<', "&lt;")
@@ -394,7 +419,8 @@ impl Chart {
         );
         svg.push_str(r#"<g class="axis x">"#);
         let (tick, text) = (bottom + 5.0, bottom + 20.0);
-        for (x, t) in sx.ticks().into_iter().map(|t| (sx.at(t), label(t))) {
+        let ticks = sx.ticks();
+        for (x, t) in ticks.iter().map(|&t| sx.at(t)).zip(labels(&ticks)) {
             let _ = write!(
                 svg,
                 r##"<line x1="{x:.1}" y1="{bottom}" x2="{x:.1}" y2="{tick:.1}" stroke="#444444"/><line x1="{x:.1}" y1="{top}" x2="{x:.1}" y2="{bottom}" stroke="#dddddd" stroke-width="0.5"/><text x="{x:.1}" y="{text:.1}" text-anchor="middle">{t}</text>"##
@@ -412,7 +438,8 @@ impl Chart {
         );
         svg.push_str(r#"<g class="axis y">"#);
         let (tick, text) = (left - 5.0, left - 8.0);
-        for (y, t) in sy.ticks().into_iter().map(|t| (sy.at(t), label(t))) {
+        let ticks = sy.ticks();
+        for (y, t) in ticks.iter().map(|&t| sy.at(t)).zip(labels(&ticks)) {
             let _ = write!(
                 svg,
                 r##"<line x1="{tick:.1}" y1="{y:.1}" x2="{left}" y2="{y:.1}" stroke="#444444"/><line x1="{left}" y1="{y:.1}" x2="{right}" y2="{y:.1}" stroke="#dddddd" stroke-width="0.5"/><text x="{text:.1}" y="{:.1}" text-anchor="end">{t}</text>"##,
@@ -872,5 +899,15 @@ mod tests {
         );
         let t = ticks(-5.6, 5.6);
         assert!(t.contains(&0.0) && t.len() >= 4 && t.len() <= 8, "{t:?}");
+    }
+
+    #[test]
+    fn tick_labels_tell_every_tick_apart() {
+        assert_eq!(labels(&[0.02, 0.022, 0.024]), ["0.02", "0.022", "0.024"]);
+        let small = ticks(1.05e-6, 1.65e-6);
+        let said = labels(&small);
+        assert_eq!(said[..3], ["1.1e-6", "1.2e-6", "1.3e-6"]);
+        assert!(said.windows(2).all(|w| w[0] != w[1]), "{said:?}");
+        assert_eq!(labels(&[0.0, 2e-7, 4e-7]), ["0", "2e-7", "4e-7"]);
     }
 }
