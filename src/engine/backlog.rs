@@ -10,8 +10,10 @@
 //! first jobs have run. The estimate of a job stays in the backlog until the job ends.
 
 use std::collections::HashMap;
-use std::sync::{Arc, Mutex, MutexGuard};
+use std::sync::{Arc, Mutex};
 use std::time::Duration;
+
+use super::lock;
 
 /// Weight of the latest job in a class's learned rate.
 const LEARNING: f64 = 0.5;
@@ -57,10 +59,6 @@ impl Backlog {
         })
     }
 
-    fn accepted(&self) -> MutexGuard<'_, Accepted> {
-        self.accepted.lock().unwrap_or_else(|p| p.into_inner())
-    }
-
     /// Accepts a job of `class` with `units` of work if it can end within its deadline
     /// behind the work accepted already; the ticket keeps its estimate in the backlog until
     /// dropped. A job with nothing ahead of it is always accepted (its deadline tells).
@@ -69,7 +67,7 @@ impl Backlog {
         class: &'static str,
         units: usize,
     ) -> Result<Ticket, Backlogged> {
-        let mut accepted = self.accepted();
+        let mut accepted = lock(&self.accepted);
         let rate = accepted.rates.get(class).copied().unwrap_or(0.0);
         let needs = rate * units as f64;
         let ahead = accepted.seconds / self.threads;
@@ -113,7 +111,7 @@ impl Ticket {
             return;
         }
         let observed = took.as_secs_f64() / units as f64;
-        let mut accepted = self.backlog.accepted();
+        let mut accepted = lock(&self.backlog.accepted);
         let rate = accepted.rates.entry(self.class).or_insert(observed);
         *rate += LEARNING * (observed - *rate);
     }
@@ -121,7 +119,7 @@ impl Ticket {
 
 impl Drop for Ticket {
     fn drop(&mut self) {
-        let mut accepted = self.backlog.accepted();
+        let mut accepted = lock(&self.backlog.accepted);
         accepted.seconds = (accepted.seconds - self.estimate).max(0.0);
     }
 }

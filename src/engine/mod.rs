@@ -40,8 +40,16 @@ pub use service::Engine;
 pub use solver::{CacheStatus, CacheUse, Solver};
 pub use storage::Storage;
 
+use std::sync::{Mutex, MutexGuard, PoisonError};
+
 use crate::job::{Control, Job, JobError};
 use crate::render::Answer;
+
+/// Locks `mutex`, even if a holder panicked: every holder leaves what it guards whole, and
+/// one failed request must not wedge the engine.
+pub(crate) fn lock<T>(mutex: &Mutex<T>) -> MutexGuard<'_, T> {
+    mutex.lock().unwrap_or_else(PoisonError::into_inner)
+}
 
 /// Runs `job` to its answer, or until `control` stops it.
 pub fn run(job: &Job, control: &Control) -> Result<Answer, JobError> {
