@@ -146,7 +146,7 @@ impl Lifecycle {
             tracker: TaskTracker::new(),
             draining: CancellationToken::new(),
             queued: AtomicUsize::new(0),
-            jobs_queued: metrics.gauge(names::JOBS_QUEUED),
+            jobs_queued: metrics.gauge(names::JOBS_QUEUED, &[]),
             config,
         }
     }

@@ -60,13 +60,12 @@ impl Metrics {
         self.describe_counter(REJECTIONS, "Work refused, by reason");
     }
 
-    /// Gives a counter its help text.
     pub fn describe_counter(&self, name: &'static str, help: &'static str) {
         self.recorder
             .describe_counter(name.into(), None, help.into());
     }
 
-    /// Gives a histogram of durations its help text.
+    /// Describes a histogram of durations.
     pub fn describe_seconds(&self, name: &'static str, help: &'static str) {
         let unit = Some(metrics::Unit::Seconds);
         self.recorder
@@ -78,11 +77,7 @@ impl Metrics {
             .register_counter(&key(name, labels), &METADATA)
     }
 
-    pub fn gauge(&self, name: &'static str) -> Gauge {
-        self.labelled_gauge(name, &[])
-    }
-
-    pub fn labelled_gauge(&self, name: &'static str, labels: &[(&'static str, &str)]) -> Gauge {
+    pub fn gauge(&self, name: &'static str, labels: &[(&'static str, &str)]) -> Gauge {
         self.recorder.register_gauge(&key(name, labels), &METADATA)
     }
 
@@ -110,7 +105,7 @@ impl SolveDurations {
 
     /// Records that a job of `kind` took `elapsed` to end with `outcome`.
     pub fn record(&self, kind: &'static str, outcome: &'static str, elapsed: Duration) {
-        let mut seen = self.seen.lock().unwrap_or_else(|e| e.into_inner());
+        let mut seen = super::lock(&self.seen);
         let found = seen.iter().find(|(k, o, _)| *k == kind && *o == outcome);
         let histogram = match found {
             Some((.., histogram)) => histogram.clone(),

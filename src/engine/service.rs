@@ -51,7 +51,7 @@ impl Engine {
     pub fn with_storage(config: EngineConfig, metrics: Metrics, storage: Storage) -> Arc<Engine> {
         if let Some(shared) = &storage.fleet {
             for link in [&shared.fleet.cache, &shared.fleet.jobs] {
-                link.report_to(metrics.labelled_gauge(names::REDIS_UP, &[("role", link.role)]));
+                link.report_to(metrics.gauge(names::REDIS_UP, &[("role", link.role)]));
             }
         }
         let solver = Arc::new(Solver::new(&config, metrics.clone(), storage.cache));

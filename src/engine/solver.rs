@@ -109,7 +109,7 @@ impl Solver {
             points: Arc::new(PointMemo::new(budget.points, config.cache_ttl)),
             cache_hits: metrics.counter(names::CACHE_HITS, &[]),
             cache_misses: metrics.counter(names::CACHE_MISSES, &[]),
-            jobs_running: metrics.gauge(names::JOBS_RUNNING),
+            jobs_running: metrics.gauge(names::JOBS_RUNNING, &[]),
             solve_durations: SolveDurations::new(metrics.clone()),
             metrics,
         }
