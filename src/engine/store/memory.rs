@@ -4,13 +4,14 @@
 //! when it is submitted, never after its work.
 
 use std::collections::{HashMap, VecDeque};
-use std::sync::{Mutex, MutexGuard};
+use std::sync::Mutex;
 use std::time::{Duration, SystemTime};
 
 use uuid::Uuid;
 
 use super::record::{JobRecord, JobResult, JobState, Refusal};
 use crate::engine::clock::age;
+use crate::engine::lock;
 
 /// Where a job's result will be kept.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -19,13 +20,6 @@ pub enum Place {
     /// The database of saved analyses (every finished job's result is saved there; one kept
     /// there only is read from there).
     Database,
-}
-
-/// Room made for a result not in yet.
-#[derive(Clone, Copy, Debug)]
-struct Reservation {
-    bytes: u64,
-    place: Place,
 }
 
 /// The records of one process's jobs, at most `max_jobs` of them, with the results of those
@@ -45,8 +39,8 @@ pub struct MemoryJobStore {
 #[derive(Debug, Default)]
 struct Records {
     jobs: HashMap<Uuid, JobRecord>,
-    /// Room made for the results of jobs not finished yet.
-    reserved: HashMap<Uuid, Reservation>,
+    /// Room made (bytes, and where) for the results of jobs not finished yet.
+    reserved: HashMap<Uuid, (u64, Place)>,
     /// Finished jobs, oldest first (ids may have been forgotten since).
     finished: VecDeque<Uuid>,
     /// Bytes held and made room for in memory.
@@ -74,8 +68,8 @@ impl Records {
                 self.free(Place::Memory, result.weight());
             }
         }
-        if let Some(r) = self.reserved.remove(id) {
-            self.free(r.place, r.bytes);
+        if let Some((bytes, place)) = self.reserved.remove(id) {
+            self.free(place, bytes);
         }
     }
 
@@ -121,10 +115,6 @@ impl MemoryJobStore {
         }
     }
 
-    fn records(&self) -> MutexGuard<'_, Records> {
-        self.records.lock().unwrap_or_else(|p| p.into_inner())
-    }
-
     /// Room for a result of `bytes` in `records`: in memory if it fits there, else in the
     /// database, if it is a file.
     fn room(&self, records: &Records, bytes: u64) -> Result<Place, Refusal> {
@@ -156,7 +146,7 @@ impl MemoryJobStore {
 
     /// Keeps job `id`'s result as `stored` (in the database) instead of in memory.
     pub fn store_result(&self, id: Uuid, stored: JobResult) {
-        let mut records = self.records();
+        let mut records = lock(&self.records);
         let Some(record) = records.jobs.get_mut(&id) else {
             return;
         };
@@ -164,29 +154,11 @@ impl MemoryJobStore {
         record.state = record.state.clone().with_result(stored);
         records.free(Place::Memory, held);
     }
-}
 
-/// What [`MemoryJobStore::update`] did.
-#[derive(Clone, Copy, Debug)]
-pub struct Updated {
-    /// When the job finished, once it has (now, if memory forgot the job).
-    pub finished_at: Option<SystemTime>,
-    /// Where room was made for its result.
-    pub place: Place,
-}
-
-/// `n` bytes in MB, for people.
-fn megabytes(n: u64) -> String {
-    format!("{:.1} MB", n as f64 / 1e6)
-}
-
-/// The in-memory half of [`super::local::LocalJobStore`]: the [`JobStore`] calls that it
-/// answers alone.
-impl MemoryJobStore {
     pub async fn insert(&self, record: JobRecord) -> Result<(), Refusal> {
         let result_bytes = record.result_bytes;
         let now = SystemTime::now();
-        let mut records = self.records();
+        let mut records = lock(&self.records);
         records.purge(self.retention, now);
         if records.jobs.len() >= self.max_jobs {
             return Err(Refusal::Full {
@@ -200,19 +172,13 @@ impl MemoryJobStore {
         }
         let place = self.room(&records, result_bytes)?;
         records.hold(place, result_bytes);
-        records.reserved.insert(
-            record.id,
-            Reservation {
-                bytes: result_bytes,
-                place,
-            },
-        );
+        records.reserved.insert(record.id, (result_bytes, place));
         records.jobs.insert(record.id, record);
         Ok(())
     }
 
     pub async fn get(&self, id: Uuid) -> Option<JobRecord> {
-        let mut records = self.records();
+        let mut records = lock(&self.records);
         let record = records.jobs.get(&id)?;
         if record.expired(self.retention, SystemTime::now()) {
             records.forget(&id);
@@ -221,41 +187,29 @@ impl MemoryJobStore {
         Some(record.clone())
     }
 
-    /// Moves job `id` to `state`; returns, once finished, when it finished (now, if memory
-    /// forgot the job), and where room was made for its result (the database: the caller
-    /// moves it there, [`MemoryJobStore::store_result`], once saved).
-    pub async fn update(&self, id: Uuid, state: JobState, done: usize) -> Updated {
-        self.update_at(id, state, done, SystemTime::now()).await
-    }
-
-    /// [`MemoryJobStore::update`], a job finishing now taken to have finished at `now`.
-    pub async fn update_at(
-        &self,
-        id: Uuid,
-        state: JobState,
-        done: usize,
-        now: SystemTime,
-    ) -> Updated {
+    /// Moves job `id` to `state`, a job finishing now taken to have finished at `now`;
+    /// returns where room was made for its result (the database: the caller moves it there,
+    /// [`MemoryJobStore::store_result`], once saved).
+    pub async fn update(&self, id: Uuid, state: JobState, done: usize, now: SystemTime) -> Place {
         let finishing = state.status().is_finished();
-        let mut records = self.records();
+        let mut records = lock(&self.records);
         // The room made for the result, taken once: by the update that finishes the job.
         let reservation = finishing.then(|| records.reserved.remove(&id)).flatten();
-        if let Some(r) = reservation {
-            records.free(r.place, r.bytes);
+        if let Some((bytes, place)) = reservation {
+            records.free(place, bytes);
             if let Some(result) = state.result() {
                 records.hold(Place::Memory, result.weight());
-                if result.weight() > r.bytes {
+                if result.weight() > bytes {
                     tracing::warn!(
-                        %id, estimate = r.bytes, weight = result.weight(),
+                        %id, estimate = bytes, weight = result.weight(),
                         "a result weighs more than the room made for it"
                     );
                 }
             }
         }
-        let place = reservation.map_or(Place::Memory, |r| r.place);
+        let place = reservation.map_or(Place::Memory, |(_, place)| place);
         let Some(record) = records.jobs.get_mut(&id) else {
-            let finished_at = finishing.then_some(now);
-            return Updated { finished_at, place };
+            return place;
         };
         let finished = finishing && record.finished_at.is_none();
         if finished {
@@ -263,28 +217,32 @@ impl MemoryJobStore {
         }
         record.state = state;
         record.done = done;
-        let finished_at = record.finished_at;
         if finished {
             records.finished.push_back(id);
         }
-        Updated { finished_at, place }
+        place
     }
 
     pub async fn remove(&self, id: Uuid) {
-        self.records().forget(&id);
+        lock(&self.records).forget(&id);
     }
 
     /// Marks job `id` as kept in memory only (its end could not be saved for good), or no
     /// longer.
     pub fn mark_unsaved(&self, id: Uuid, unsaved: bool) {
-        if let Some(record) = self.records().jobs.get_mut(&id) {
+        if let Some(record) = lock(&self.records).jobs.get_mut(&id) {
             record.unsaved = unsaved;
         }
     }
 
     pub async fn purge_expired(&self) -> usize {
-        self.records().purge(self.retention, SystemTime::now())
+        lock(&self.records).purge(self.retention, SystemTime::now())
     }
+}
+
+/// `n` bytes in MB, for people.
+fn megabytes(n: u64) -> String {
+    format!("{:.1} MB", n as f64 / 1e6)
 }
 
 #[cfg(test)]
@@ -295,41 +253,15 @@ mod tests {
     use crate::engine::cache::Solved;
     use crate::job::registry::KindName;
     use crate::job::Work;
-    use crate::render::{Answer, Column, Output, Table, UnitTable};
-    use crate::{described, unit_table};
-    use serde::Serialize;
 
-    described! {
-        #[derive(Debug, PartialEq, Serialize)]
-        struct Blob {
-            text: String => [],
-        }
-    }
-
-    impl Output for Blob {
-        const UNITS: &'static UnitTable = unit_table!(Blob);
-        fn table(&self) -> Table {
-            Table::new(
-                &[Column::text("text", |b: &Blob, text| {
-                    text.push_str(&b.text)
-                })],
-                [self],
-            )
-        }
-    }
-
-    /// A result whose JSON and CSV take about `bytes` together, as a job keeps it.
+    /// A result whose JSON and CSV take `bytes` together, as a job keeps it.
     fn kept(key: &str, bytes: usize) -> JobResult {
-        let blob = Blob {
-            text: "x".repeat(bytes / 2),
-        };
-        let solved = Solved::new(
-            key.to_string(),
+        let (kind, half) = (
             KindName::of::<crate::job::RollingJob>(),
-            Answer::new(blob),
-        )
-        .unwrap();
-        JobResult::Ready(Arc::new(solved.kept().unwrap()))
+            vec![b'x'; bytes / 2],
+        );
+        let solved = Solved::rendered(key.to_string(), kind, half.clone().into(), half.into());
+        JobResult::Ready(Arc::new(solved))
     }
 
     fn record() -> JobRecord {
@@ -343,9 +275,8 @@ mod tests {
 
     /// Finishes job `id` with a result of `bytes`.
     async fn succeed(store: &MemoryJobStore, id: Uuid, bytes: usize) {
-        store
-            .update(id, JobState::Succeeded(kept("k", bytes)), 1)
-            .await;
+        let end = JobState::Succeeded(kept("k", bytes));
+        store.update(id, end, 1, SystemTime::now()).await;
     }
 
     #[tokio::test]
@@ -401,12 +332,16 @@ mod tests {
         store.insert(large.holding(100_000)).await.unwrap();
         let small_end = JobState::Succeeded(kept("k", 2_000));
         assert_eq!(
-            store.update(small_id, small_end, 1).await.place,
+            store
+                .update(small_id, small_end, 1, SystemTime::now())
+                .await,
             Place::Memory
         );
         let large_end = JobState::Succeeded(kept("k", 90_000));
         assert_eq!(
-            store.update(large_id, large_end, 1).await.place,
+            store
+                .update(large_id, large_end, 1, SystemTime::now())
+                .await,
             Place::Database
         );
         // Once saved there, memory holds the small result alone: room for another.
@@ -418,7 +353,11 @@ mod tests {
             store.get(large_id).await.unwrap().state,
             JobState::Succeeded(JobResult::Stored(_))
         ));
-        assert!(store.records().memory < 4_000, "{}", store.records().memory);
+        assert!(
+            lock(&store.records).memory < 4_000,
+            "{}",
+            lock(&store.records).memory
+        );
         store.insert(record().holding(1_500)).await.unwrap();
     }
 
@@ -449,7 +388,9 @@ mod tests {
             ids.push(r.id);
             store.insert(r.holding(100)).await.unwrap();
             let cancelled = JobState::Cancelled { partial: None };
-            store.update(ids[ids.len() - 1], cancelled, 0).await;
+            store
+                .update(ids[ids.len() - 1], cancelled, 0, SystemTime::now())
+                .await;
         }
         assert!(matches!(
             store.insert(record().holding(100)).await,
