@@ -4,7 +4,7 @@
 
 use std::collections::{HashMap, HashSet, VecDeque};
 use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
-use std::sync::{Arc, Mutex, MutexGuard};
+use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 use metrics::Gauge;
@@ -20,8 +20,9 @@ use super::config::EngineConfig;
 use super::error::EngineError;
 use super::fleet::{placement, Health, Shared, Worker};
 use super::ids::{self, JobIds, Unknown};
+use super::lock;
 use super::metrics::{self as names, Metrics};
-use super::solver::Solver;
+use super::solver::{Solver, Stopped};
 use super::store::{JobRecord, JobResult, JobState, JobStatus, JobStore, Listing, Owner, Page};
 use crate::job::{Control, JobError, Keyed, Work};
 
@@ -79,12 +80,10 @@ impl Uncollected {
         self.ids.insert(id);
         self.order.push_back(id);
         while self.ids.len() > max {
-            match self.order.pop_front() {
-                Some(old) => {
-                    self.ids.remove(&old);
-                }
-                None => break,
-            }
+            let Some(old) = self.order.pop_front() else {
+                break;
+            };
+            self.ids.remove(&old);
         }
         // Ids read since are still in `order`: drop them when they outnumber the rest.
         if self.order.len() > 2 * self.ids.len() + 16 {
@@ -149,10 +148,6 @@ impl Lifecycle {
             jobs_queued: metrics.gauge(names::JOBS_QUEUED, &[]),
             config,
         }
-    }
-
-    fn live(&self) -> MutexGuard<'_, HashMap<Uuid, Arc<LiveJob>>> {
-        self.live.lock().unwrap_or_else(|p| p.into_inner())
     }
 
     /// Starts `loops` workers on the fleet's stream (none without a fleet). With
@@ -226,13 +221,10 @@ impl Lifecycle {
             Work::Known(total) => total,
             Work::Unknown => 0,
         };
-        self.jobs
-            .insert(record.clone())
-            .await
-            .map_err(EngineError::from)?;
+        self.jobs.insert(record.clone()).await?;
         let state = JobState::Succeeded(JobResult::Ready(solved));
         self.jobs.update(record.id, state.clone(), done).await;
-        self.uncollected().insert(record.id, self.config.max_jobs);
+        lock(&self.uncollected).insert(record.id, self.config.max_jobs);
         record.state = state;
         record.done = done;
         Ok(record)
@@ -279,7 +271,7 @@ impl Lifecycle {
             anonymous,
             solved_in: AtomicU64::new(0),
         });
-        self.live().insert(id, live.clone());
+        lock(&self.live).insert(id, live.clone());
         let span = tracing::info_span!("job", id = %id, kind = %kind);
         let lifecycle = self.clone();
         self.tracker.spawn(
@@ -298,10 +290,8 @@ impl Lifecycle {
                 // Owed to its client, and no longer running, before anyone can read it
                 // finished: a drain begun in between would otherwise count it owed (as
                 // running, or unread) after its client had read it, and wait for it forever.
-                lifecycle
-                    .uncollected()
-                    .insert(id, lifecycle.config.max_jobs);
-                lifecycle.live().remove(&id);
+                lock(&lifecycle.uncollected).insert(id, lifecycle.config.max_jobs);
+                lock(&lifecycle.live).remove(&id);
                 lifecycle.jobs.update(id, state, done).await;
                 live.status.send_replace(status);
             }
@@ -353,7 +343,10 @@ impl Lifecycle {
 
     /// The jobs no tenant owns that this process runs or queues.
     pub fn unfinished_anonymous(&self) -> usize {
-        self.live().values().filter(|job| job.anonymous).count()
+        lock(&self.live)
+            .values()
+            .filter(|job| job.anonymous)
+            .count()
     }
 
     /// Why the job store cannot keep new jobs now, if it cannot.
@@ -372,11 +365,8 @@ impl Lifecycle {
         let mut record = self.jobs.get(id).await?;
         if record.state.status().is_finished() {
             self.collected(id);
-        }
-        if let Some(live) = self.live().get(&id) {
-            if !record.state.status().is_finished() {
-                record.done = live.control.done();
-            }
+        } else if let Some(live) = lock(&self.live).get(&id) {
+            record.done = live.control.done();
         }
         Some(record)
     }
@@ -385,12 +375,8 @@ impl Lifecycle {
     /// runs has its progress counted up to now.
     pub async fn list(&self, listing: &Listing) -> Result<Page, EngineError> {
         self.store_reachable()?;
-        let mut page = self
-            .jobs
-            .list(listing)
-            .await
-            .map_err(|e| EngineError::Unavailable(e.to_string()))?;
-        let live = self.live();
+        let mut page = self.jobs.list(listing).await?;
+        let live = lock(&self.live);
         for record in &mut page.jobs {
             if let Some(job) = live.get(&record.id) {
                 record.done = job.control.done();
@@ -402,10 +388,7 @@ impl Lifecycle {
     /// The newest job that succeeded on the input whose hash is `input_hash`.
     pub async fn with_input(&self, input_hash: &str) -> Result<Option<JobRecord>, EngineError> {
         self.store_reachable()?;
-        self.jobs
-            .with_input(input_hash)
-            .await
-            .map_err(|e| EngineError::Unavailable(e.to_string()))
+        Ok(self.jobs.with_input(input_hash).await?)
     }
 
     /// What can be told of a job `id` that the job store does not know.
@@ -427,14 +410,16 @@ impl Lifecycle {
 
     /// A receiver of the status changes of the job `id`, if this process runs it.
     pub fn watch(&self, id: Uuid) -> Option<watch::Receiver<JobStatus>> {
-        self.live().get(&id).map(|live| live.status.subscribe())
+        lock(&self.live)
+            .get(&id)
+            .map(|live| live.status.subscribe())
     }
 
     /// Cancels the job `id`: a queued job at once, a running one at the solver's next check;
     /// waits a little for it to stop and returns it then. A finished job is left as it is.
     pub async fn cancel(&self, id: Uuid) -> Option<JobRecord> {
         let before = self.job(id).await?;
-        let live = self.live().get(&id).cloned();
+        let live = lock(&self.live).get(&id).cloned();
         if live.is_none() && self.jobs.shared() && !before.state.status().is_finished() {
             // Run by a worker of the fleet: it sees the cancel at its next heartbeat.
             let state = JobState::Cancelled { partial: None };
@@ -463,7 +448,7 @@ impl Lifecycle {
     }
 
     /// Stops taking work: new solves and jobs are refused. The jobs accepted, queued or
-    /// running, go on; [`Lifecycle::jobs_finished`] waits for them to finish and
+    /// running, go on; [`Lifecycle::finish_jobs`] waits for them to finish and
     /// [`Lifecycle::jobs_collected`] for their clients to read them.
     ///
     /// The jobs that finished before the drain and were not read are owed to their clients
@@ -472,54 +457,46 @@ impl Lifecycle {
     /// never comes back made every drain wait its whole timeout.
     pub fn begin_drain(&self) {
         self.draining.cancel();
-        let unfinished: Vec<Uuid> = self.live().keys().copied().collect();
+        let unfinished: Vec<Uuid> = lock(&self.live).keys().copied().collect();
         let kept = self.jobs.durable() && self.jobs.problem().is_none();
         let uncollected: Vec<Uuid> = match kept {
             true => Vec::new(),
-            false => self.uncollected().ids.iter().copied().collect(),
+            false => lock(&self.uncollected).ids.iter().copied().collect(),
         };
-        self.owed()
-            .extend(unfinished.into_iter().chain(uncollected));
-    }
-
-    fn owed(&self) -> MutexGuard<'_, HashSet<Uuid>> {
-        self.owed.lock().unwrap_or_else(|p| p.into_inner())
-    }
-
-    fn uncollected(&self) -> MutexGuard<'_, Uncollected> {
-        self.uncollected.lock().unwrap_or_else(|p| p.into_inner())
+        lock(&self.owed).extend(unfinished.into_iter().chain(uncollected));
     }
 
     /// A client read the job `id` finished: it owes its client nothing more.
     fn collected(&self, id: Uuid) {
-        self.uncollected().ids.remove(&id);
-        self.owed().remove(&id);
+        lock(&self.uncollected).ids.remove(&id);
+        lock(&self.owed).remove(&id);
     }
 
     /// Resolves when every job unfinished at the start of the drain has been read finished
     /// by its client (polled, or followed to its completion event), so that none of their
     /// answers is lost with the process.
     pub async fn jobs_collected(&self) {
-        /// How often the drain looks.
-        const LOOK: Duration = Duration::from_millis(20);
-        while !self.owed().is_empty() {
-            tokio::time::sleep(LOOK).await;
+        while !lock(&self.owed).is_empty() {
+            tokio::time::sleep(Duration::from_millis(20)).await;
         }
     }
 
     /// Asynchronous jobs of this process queued or running: those a drain waits to finish.
     pub fn unfinished_jobs(&self) -> usize {
-        self.live().len()
+        lock(&self.live).len()
     }
 
     /// Jobs finished that no client has read yet: those a drain waits for clients to read
     /// (once it has begun, the jobs it owes that are finished; before, every one unread).
     pub fn unread_jobs(&self) -> usize {
         if self.is_draining() {
-            let live: HashSet<Uuid> = self.live().keys().copied().collect();
-            self.owed().iter().filter(|id| !live.contains(id)).count()
+            let live: HashSet<Uuid> = lock(&self.live).keys().copied().collect();
+            lock(&self.owed)
+                .iter()
+                .filter(|id| !live.contains(id))
+                .count()
         } else {
-            self.uncollected().ids.len()
+            lock(&self.uncollected).ids.len()
         }
     }
 
@@ -527,42 +504,30 @@ impl Lifecycle {
         self.draining.is_cancelled()
     }
 
-    /// Resolves when every asynchronous job has finished (call after `begin_drain`).
-    async fn jobs_finished(&self) {
-        self.tracker.close();
-        self.tracker.wait().await;
-    }
-
     /// Waits (after `begin_drain`) for the jobs to finish until `end`; what is still running
-    /// then is interrupted ([`Lifecycle::interrupt_unfinished_jobs`]) and given a second to stop.
-    /// Returns whether every job finished in time.
-    /// Whatever the store could not save before is saved then, if it now can.
+    /// then is interrupted (it ends `interrupted`) and given a second to stop. Returns
+    /// whether every job finished in time. Whatever the store could not save before is saved
+    /// then, if it now can.
     pub async fn finish_jobs(&self, end: tokio::time::Instant) -> bool {
-        let finished = tokio::time::timeout_at(end, self.jobs_finished())
+        self.tracker.close();
+        let finished = tokio::time::timeout_at(end, self.tracker.wait())
             .await
             .is_ok();
         if !finished {
-            self.interrupt_unfinished_jobs();
+            if let Some(shared) = &self.fleet {
+                shared.interrupt();
+            }
+            for live in lock(&self.live).values() {
+                live.interrupted.store(true, Ordering::SeqCst);
+                live.cancel();
+            }
             // They stop at their next check, microseconds to milliseconds away.
-            let _ = tokio::time::timeout(Duration::from_secs(1), self.jobs_finished()).await;
+            let _ = tokio::time::timeout(Duration::from_secs(1), self.tracker.wait()).await;
         }
         self.jobs.settle().await;
         finished
     }
 
-    /// Stops every job not finished yet (the drain ran out of time): they end
-    /// `interrupted`.
-    fn interrupt_unfinished_jobs(&self) {
-        if let Some(shared) = &self.fleet {
-            shared.interrupt();
-        }
-        for live in self.live().values() {
-            live.interrupted.store(true, Ordering::SeqCst);
-            live.cancel();
-        }
-    }
-
-    /// The life of an asynchronous job after its submission; returns its final state.
     /// Runs an accepted job to its end state; its solve time teaches `ticket`'s class.
     async fn run_job(&self, live: &LiveJob, id: Uuid, keyed: Keyed, ticket: &Ticket) -> JobState {
         let permit = match self.solver.cached(keyed.key()).await {
@@ -610,8 +575,7 @@ impl Lifecycle {
                 self.solver.keep(solved.clone()).await;
                 JobState::Succeeded(JobResult::Ready(solved))
             }
-            Err(stopped) => {
-                let (error, partial) = stopped.into_parts();
+            Err(Stopped { error, partial }) => {
                 let partial = partial.map(JobResult::Ready);
                 match error {
                     JobError::Cancelled => live.stopped(partial),

@@ -51,15 +51,9 @@ pub enum CacheUse {
 /// A solve that did not answer: why, and the partial answer of a job that keeps what it
 /// finished ([`crate::job::Unfinished`]).
 pub(super) struct Stopped {
-    error: JobError,
-    partial: Option<Arc<Solved>>,
-}
-
-impl Stopped {
-    /// Why the solve stopped, and what it finished (kept for an asynchronous job only).
-    pub(super) fn into_parts(self) -> (JobError, Option<Arc<Solved>>) {
-        (self.error, self.partial)
-    }
+    pub error: JobError,
+    /// What it finished (kept for an asynchronous job only).
+    pub partial: Option<Arc<Solved>>,
 }
 
 impl From<JobError> for Stopped {
@@ -207,7 +201,7 @@ impl Solver {
         let solved = self
             .execute(permit, keyed, control, false)
             .await
-            .map_err(|stopped| stopped.into_parts().0)?;
+            .map_err(|stopped| stopped.error)?;
         if cache == CacheUse::Keep {
             self.keep(solved.clone()).await;
         }
@@ -273,16 +267,10 @@ impl Solver {
             Pool::run(permit, control, solve).await
         }
         .unwrap_or_else(|e| Err(Stopped::from(e)));
-        let outcome = match &result {
+        let outcome = match result.as_ref().map_err(|stopped| &stopped.error) {
             Ok(_) => "succeeded",
-            Err(Stopped {
-                error: JobError::Cancelled,
-                ..
-            }) => "cancelled",
-            Err(Stopped {
-                error: JobError::DeadlineExceeded,
-                ..
-            }) => "deadline_exceeded",
+            Err(JobError::Cancelled) => "cancelled",
+            Err(JobError::DeadlineExceeded) => "deadline_exceeded",
             Err(_) => "failed",
         };
         self.solve_durations
