@@ -38,7 +38,8 @@ impl Solved {
     /// Renders `answer` as JSON; an answer that cannot be rendered (a non-finite number)
     /// is an internal error, never a silent `null` for the client.
     pub fn new(key: String, kind: KindName, answer: Answer) -> Result<Solved, JobError> {
-        let json = answer.render(Format::Json).map_err(internal)?;
+        let json = answer.render(Format::Json);
+        let json = json.map_err(|e| JobError::Internal(e.to_string()))?;
         Ok(Solved {
             key,
             kind,
@@ -75,14 +76,10 @@ impl Solved {
     /// The same answer as it is kept for a long time: its CSV rendered now and the typed
     /// answer let go, so that it weighs its two texts and no more.
     pub fn kept(&self) -> Result<Solved, RenderError> {
+        let (key, csv) = (self.key.clone(), self.body(Format::Csv)?);
         Ok(Solved {
-            key: self.key.clone(),
-            kind: self.kind,
             complete: self.complete,
-            json: self.json.clone(),
-            csv: OnceLock::from(self.body(Format::Csv)?),
-            svg: OnceLock::new(),
-            answer: None,
+            ..Solved::rendered(key, self.kind, self.json.clone(), csv)
         })
     }
 
@@ -95,23 +92,13 @@ impl Solved {
     pub fn body(&self, format: Format) -> Result<Bytes, RenderError> {
         match format {
             Format::Json => Ok(self.json.clone()),
-            Format::Csv => {
-                if let Some(csv) = self.csv.get() {
-                    return Ok(csv.clone());
-                }
+            Format::Csv => once(&self.csv, || {
                 let answer = self.answer.as_ref().ok_or_else(|| {
                     RenderError::new("an answer rendered elsewhere came without its CSV")
                 })?;
-                let csv = Bytes::from(answer.render(Format::Csv)?);
-                Ok(self.csv.get_or_init(|| csv).clone())
-            }
-            Format::Svg => {
-                if let Some(svg) = self.svg.get() {
-                    return Ok(svg.clone());
-                }
-                let svg = picture(self.kind, &self.json)?;
-                Ok(self.svg.get_or_init(|| svg).clone())
-            }
+                Ok(answer.render(Format::Csv)?.into())
+            }),
+            Format::Svg => once(&self.svg, || picture(self.kind, &self.json)),
         }
     }
 
@@ -126,13 +113,21 @@ impl Solved {
     }
 }
 
+/// What `cell` holds, made by `make` the first time.
+fn once(
+    cell: &OnceLock<Bytes>,
+    make: impl FnOnce() -> Result<Bytes, RenderError>,
+) -> Result<Bytes, RenderError> {
+    if let Some(bytes) = cell.get() {
+        return Ok(bytes.clone());
+    }
+    let bytes = make()?;
+    Ok(cell.get_or_init(|| bytes).clone())
+}
+
 /// The picture of an answer of `kind` from its JSON.
 pub fn picture(kind: KindName, json: &[u8]) -> Result<Bytes, RenderError> {
     draw_svg(kind.picture(), json).map(Bytes::from)
-}
-
-fn internal(e: RenderError) -> JobError {
-    JobError::Internal(e.to_string())
 }
 
 /// Who solves a key no cache holds yet.
@@ -153,23 +148,19 @@ pub trait ResultCache: Send + Sync {
 
     /// Keeps `solved`, which is also the result of job `job` in the fleet's job store: a
     /// cache on that same server refers to it there rather than hold it twice.
-    async fn insert_result_of(&self, solved: Arc<Solved>, job: uuid::Uuid) {
-        let _ = job;
+    async fn insert_result_of(&self, solved: Arc<Solved>, _job: uuid::Uuid) {
         self.insert(solved).await;
     }
 
     /// Claims the solve of `key` among the processes sharing the cache, waiting (until
     /// `deadline`) while another holds it. One process's cache needs no claim: the engine
     /// already shares one solve among its own callers.
-    async fn claim(&self, key: &str, deadline: Instant) -> Result<Claim, JobError> {
-        let _ = (key, deadline);
+    async fn claim(&self, _key: &str, _deadline: Instant) -> Result<Claim, JobError> {
         Ok(Claim::Mine)
     }
 
     /// Gives up the claim on `key` (its answer kept, or its solve failed).
-    async fn release(&self, key: &str) {
-        let _ = key;
-    }
+    async fn release(&self, _key: &str) {}
 }
 
 /// The cache of one process, bounded in bytes and in time.

@@ -88,26 +88,20 @@ impl Pool {
         T: Send + 'static,
         F: FnOnce(&Control) -> Result<T, JobError> + Send + 'static,
     {
-        let guard = CancelOnDrop(Some(control.clone()));
+        let mut guard = CancelOnDrop(Some(control.clone()));
         let span = tracing::Span::current();
         let result = super::heavy::run(move || {
             let _permit = permit;
             span.in_scope(|| work(&control))
         })
         .await;
-        guard.disarm();
+        guard.0 = None;
         result.map_err(|e| JobError::Internal(format!("the solver thread failed: {e}")))?
     }
 }
 
 /// Cancels a job when the future waiting for it is dropped before it finished.
 struct CancelOnDrop(Option<Arc<Control>>);
-
-impl CancelOnDrop {
-    fn disarm(mut self) {
-        self.0 = None;
-    }
-}
 
 impl Drop for CancelOnDrop {
     fn drop(&mut self) {

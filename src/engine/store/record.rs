@@ -60,13 +60,7 @@ impl JobStatus {
     }
 
     pub fn is_finished(self) -> bool {
-        matches!(
-            self,
-            JobStatus::Succeeded
-                | JobStatus::Failed
-                | JobStatus::Cancelled
-                | JobStatus::Interrupted
-        )
+        !matches!(self, JobStatus::Queued | JobStatus::Running)
     }
 }
 
