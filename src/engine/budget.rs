@@ -39,11 +39,6 @@ impl Budget {
 /// kept as an upper bound for the maps of [`super::bounded`]).
 pub const ENTRY_OVERHEAD: u64 = 256;
 
-/// The weight of an entry holding `bytes`: with its overhead.
-pub fn weight(bytes: u64) -> u64 {
-    bytes.saturating_add(ENTRY_OVERHEAD)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
