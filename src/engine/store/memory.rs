@@ -1,7 +1,4 @@
-//! One process's job records in memory, bounded in count and in the bytes of their results:
-//! a result beyond its share of the memory budget is kept in the database of saved analyses
-//! instead (when that is a file), and a job for whose result there is no room is refused
-//! when it is submitted, never after its work.
+//! One process's job records in memory, bounded in count and in the bytes of their results.
 
 use std::collections::{HashMap, VecDeque};
 use std::sync::Mutex;
@@ -48,14 +45,12 @@ struct Records {
 }
 
 impl Records {
-    /// Adds `bytes` held in `place` (nothing, in the database).
     fn hold(&mut self, place: Place, bytes: u64) {
         if place == Place::Memory {
             self.memory += bytes;
         }
     }
 
-    /// Takes `bytes` held in `place` back.
     fn free(&mut self, place: Place, bytes: u64) {
         if place == Place::Memory {
             self.memory = self.memory.saturating_sub(bytes);
@@ -73,7 +68,6 @@ impl Records {
         }
     }
 
-    /// Forgets the jobs past their retention.
     fn purge(&mut self, retention: Duration, now: SystemTime) -> usize {
         let expired: Vec<Uuid> = self
             .jobs
@@ -89,8 +83,7 @@ impl Records {
         expired.len()
     }
 
-    /// How long until the oldest finished job expires (and makes room), at most
-    /// `retention`.
+    /// How long until the oldest finished job expires (and makes room), at most `retention`.
     fn next_expiry(&self, retention: Duration, now: SystemTime) -> Duration {
         self.finished
             .iter()
@@ -102,9 +95,6 @@ impl Records {
 }
 
 impl MemoryJobStore {
-    /// A store that forgets a job `retention` after it finished, keeps at most `max_jobs`
-    /// records and `result_bytes` of their results in memory, and leaves results beyond that
-    /// to the database if `database` (a file) can hold them.
     pub fn new(retention: Duration, max_jobs: usize, result_bytes: u64, database: bool) -> Self {
         MemoryJobStore {
             records: Mutex::default(),
@@ -115,8 +105,7 @@ impl MemoryJobStore {
         }
     }
 
-    /// Room for a result of `bytes` in `records`: in memory if it fits there, else in the
-    /// database, if it is a file.
+    /// Room for a result of `bytes`: in memory if it fits there, else in a file database.
     fn room(&self, records: &Records, bytes: u64) -> Result<Place, Refusal> {
         if records.memory.saturating_add(bytes) <= self.result_bytes {
             return Ok(Place::Memory);
@@ -227,8 +216,7 @@ impl MemoryJobStore {
         lock(&self.records).forget(&id);
     }
 
-    /// Marks job `id` as kept in memory only (its end could not be saved for good), or no
-    /// longer.
+    /// Marks job `id` as kept in memory only (its end could not be saved), or no longer.
     pub fn mark_unsaved(&self, id: Uuid, unsaved: bool) {
         if let Some(record) = lock(&self.records).jobs.get_mut(&id) {
             record.unsaved = unsaved;
@@ -250,47 +238,52 @@ mod tests {
     use std::sync::Arc;
 
     use super::*;
+    use crate::engine::archive::{Archive, IN_MEMORY};
     use crate::engine::cache::Solved;
     use crate::job::registry::KindName;
-    use crate::job::Work;
+    use crate::job::{RollingJob, Work};
 
     /// A result whose JSON and CSV take `bytes` together, as a job keeps it.
-    fn kept(key: &str, bytes: usize) -> JobResult {
-        let (kind, half) = (
-            KindName::of::<crate::job::RollingJob>(),
-            vec![b'x'; bytes / 2],
-        );
-        let solved = Solved::rendered(key.to_string(), kind, half.clone().into(), half.into());
-        JobResult::Ready(Arc::new(solved))
+    fn kept(bytes: usize) -> JobState {
+        let (kind, half) = (KindName::of::<RollingJob>(), vec![b'x'; bytes / 2]);
+        let solved = Solved::rendered("k".into(), kind, half.clone().into(), half.into());
+        JobState::Succeeded(JobResult::Ready(Arc::new(solved)))
     }
 
-    fn record() -> JobRecord {
-        JobRecord::queued(
-            Uuid::new_v4(),
-            KindName::of::<crate::job::RollingJob>(),
-            Work::Known(1),
-            "k",
-        )
+    /// A job just accepted whose result may take `bytes`.
+    fn record(bytes: u64) -> JobRecord {
+        let kind = KindName::of::<RollingJob>();
+        JobRecord::queued(Uuid::new_v4(), kind, Work::Known(1), "k").holding(bytes)
     }
 
-    /// Finishes job `id` with a result of `bytes`.
-    async fn succeed(store: &MemoryJobStore, id: Uuid, bytes: usize) {
-        let end = JobState::Succeeded(kept("k", bytes));
-        store.update(id, end, 1, SystemTime::now()).await;
+    /// Inserts `n` jobs whose results may take `bytes`, ending each in `end` if given.
+    async fn admit(
+        store: &MemoryJobStore,
+        n: usize,
+        bytes: u64,
+        end: Option<JobState>,
+    ) -> Vec<Uuid> {
+        let mut ids = Vec::new();
+        for _ in 0..n {
+            let record = record(bytes);
+            ids.push(record.id);
+            store.insert(record).await.unwrap();
+            if let Some(end) = end.clone() {
+                store
+                    .update(ids[ids.len() - 1], end, 1, SystemTime::now())
+                    .await;
+            }
+        }
+        ids
     }
 
     #[tokio::test]
     async fn a_result_is_kept_whole_for_its_retention_and_a_job_without_room_is_refused_before_its_work(
     ) {
         let store = MemoryJobStore::new(Duration::from_secs(60), 100, 10_000, false);
-        let mut ids = Vec::new();
-        for _ in 0..3 {
-            let r = record();
-            ids.push(r.id);
-            store.insert(r.holding(3_000)).await.unwrap();
-        }
+        let ids = admit(&store, 3, 3_000, None).await;
         // Room for three results of 3 kB is made: a fourth does not fit, now.
-        match store.insert(record().holding(3_000)).await {
+        match store.insert(record(3_000)).await {
             Err(Refusal::Full { what, retry_after }) => {
                 assert!(
                     what.contains("in memory (the database is in memory too"),
@@ -302,14 +295,14 @@ mod tests {
         }
         // Too large for an empty store: said so, with both numbers.
         assert_eq!(
-            store.insert(record().holding(20_000)).await,
+            store.insert(record(20_000)).await,
             Err(Refusal::TooLarge {
                 needed: 20_000,
                 limit: 10_000
             })
         );
         for id in &ids {
-            succeed(&store, *id, 2_500).await;
+            store.update(*id, kept(2_500), 1, SystemTime::now()).await;
         }
         // Every result is still there, whole.
         for id in &ids {
@@ -317,102 +310,62 @@ mod tests {
             assert!(matches!(state, JobState::Succeeded(JobResult::Ready(_))));
         }
         // A result that weighs less than its room gives the rest back: one more 1 kB job fits.
-        store.insert(record().holding(1_000)).await.unwrap();
+        store.insert(record(1_000)).await.unwrap();
         // Forgetting a job makes room.
         store.remove(ids[0]).await;
-        store.insert(record().holding(3_000)).await.unwrap();
+        store.insert(record(3_000)).await.unwrap();
     }
 
     #[tokio::test]
     async fn results_beyond_the_memory_budget_are_left_to_a_file_database() {
         let store = MemoryJobStore::new(Duration::from_secs(60), 100, 4_000, true);
-        let (small, large) = (record(), record());
+        let (small, large) = (record(3_000), record(100_000));
         let (small_id, large_id) = (small.id, large.id);
-        store.insert(small.holding(3_000)).await.unwrap();
-        store.insert(large.holding(100_000)).await.unwrap();
-        let small_end = JobState::Succeeded(kept("k", 2_000));
-        assert_eq!(
-            store
-                .update(small_id, small_end, 1, SystemTime::now())
-                .await,
-            Place::Memory
-        );
-        let large_end = JobState::Succeeded(kept("k", 90_000));
-        assert_eq!(
-            store
-                .update(large_id, large_end, 1, SystemTime::now())
-                .await,
-            Place::Database
-        );
+        store.insert(small).await.unwrap();
+        store.insert(large).await.unwrap();
+        let now = SystemTime::now();
+        let small_end = store.update(small_id, kept(2_000), 1, now).await;
+        assert_eq!(small_end, Place::Memory);
+        let large_end = store.update(large_id, kept(90_000), 1, now).await;
+        assert_eq!(large_end, Place::Database);
         // Once saved there, memory holds the small result alone: room for another.
         let JobState::Succeeded(large) = store.get(large_id).await.unwrap().state else {
             panic!("the large job did not succeed");
         };
-        store.store_result(large_id, stored(&large));
+        let archive = Archive::open(IN_MEMORY, Duration::from_secs(60)).unwrap();
+        store.store_result(large_id, archive.saved(large_id, &large));
         assert!(matches!(
             store.get(large_id).await.unwrap().state,
             JobState::Succeeded(JobResult::Stored(_))
         ));
-        assert!(
-            lock(&store.records).memory < 4_000,
-            "{}",
-            lock(&store.records).memory
-        );
-        store.insert(record().holding(1_500)).await.unwrap();
-    }
-
-    /// `result` as a store outside memory keeps it.
-    fn stored(result: &JobResult) -> JobResult {
-        struct Nowhere;
-        #[async_trait::async_trait]
-        impl super::super::ResultPlace for Nowhere {
-            async fn body(&self, _: &str) -> std::io::Result<bytes::Bytes> {
-                Ok(bytes::Bytes::new())
-            }
-        }
-        let stored = super::super::StoredResult::new(
-            result.key().to_string(),
-            KindName::of::<crate::job::RollingJob>(),
-            result.complete(),
-            Arc::new(Nowhere),
-        );
-        JobResult::Stored(Arc::new(stored))
+        let memory = lock(&store.records).memory;
+        assert!(memory < 4_000, "{memory}");
+        store.insert(record(1_500)).await.unwrap();
     }
 
     #[tokio::test]
     async fn at_most_max_jobs_records_are_kept_and_more_are_refused_until_one_is_forgotten() {
         let store = MemoryJobStore::new(Duration::from_secs(60), 3, 1 << 20, false);
-        let mut ids = Vec::new();
-        for _ in 0..3 {
-            let r = record();
-            ids.push(r.id);
-            store.insert(r.holding(100)).await.unwrap();
-            let cancelled = JobState::Cancelled { partial: None };
-            store
-                .update(ids[ids.len() - 1], cancelled, 0, SystemTime::now())
-                .await;
-        }
+        let cancelled = JobState::Cancelled { partial: None };
+        let ids = admit(&store, 3, 100, Some(cancelled)).await;
         assert!(matches!(
-            store.insert(record().holding(100)).await,
+            store.insert(record(100)).await,
             Err(Refusal::Full { .. })
         ));
         for id in &ids {
             assert!(store.get(*id).await.is_some());
         }
         store.remove(ids[0]).await;
-        store.insert(record().holding(100)).await.unwrap();
+        store.insert(record(100)).await.unwrap();
     }
 
     #[tokio::test]
     async fn expired_jobs_make_room() {
         let store = MemoryJobStore::new(Duration::from_millis(20), 1, 1 << 20, false);
-        let first = record();
-        let id = first.id;
-        store.insert(first.holding(100)).await.unwrap();
-        succeed(&store, id, 50).await;
-        assert!(store.insert(record().holding(100)).await.is_err());
+        let id = admit(&store, 1, 100, Some(kept(50))).await[0];
+        assert!(store.insert(record(100)).await.is_err());
         tokio::time::sleep(Duration::from_millis(30)).await;
-        store.insert(record().holding(100)).await.unwrap();
+        store.insert(record(100)).await.unwrap();
         assert!(store.get(id).await.is_none());
     }
 }
