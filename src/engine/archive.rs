@@ -1,14 +1,11 @@
-//! Saved analyses: every job this process accepts, recorded in an embedded SQLite database
-//! (a file by default) from its acceptance, with its result once it finishes, and kept for
-//! the history's retention, across restarts. Its owner's list of jobs, a job's stable link
-//! and an input's newest answer are read from here once the job has left memory.
+//! Saved analyses: every job this process accepts, in an embedded SQLite database (a file
+//! by default) from its acceptance, with its result once it finishes, kept for the
+//! history's retention across restarts. The calls block: [`super::local::LocalJobStore`]
+//! makes them off the async threads.
 //!
 //! One process per file: the database is locked for the process's life (SQLite's exclusive
 //! locking mode), so that a second `serve` on the same file fails at start-up rather than
 //! marking the first one's running jobs interrupted. A fleet keeps its history in Redis.
-//!
-//! The calls block (SQLite is synchronous): [`super::local::LocalJobStore`] makes them off
-//! the async threads.
 
 use std::path::Path;
 use std::sync::{Arc, Mutex};
@@ -67,7 +64,6 @@ const ADDED_COLUMN: &str = "result_bytes INTEGER NOT NULL DEFAULT 0";
 const COLUMNS: &str = "id, owner, kind, status, done, total, input_hash, submitted, finished, \
                        error, result, result_bytes";
 
-/// The database of saved analyses.
 pub struct Archive {
     db: Mutex<Connection>,
     retention: Duration,
@@ -83,8 +79,8 @@ fn identity(path: &str) -> std::io::Result<(u64, u64)> {
 }
 
 impl Archive {
-    /// Opens (or creates) the database at `path` (a file, or [`IN_MEMORY`]), keeping finished
-    /// jobs for `retention` ([`prepare`]s it: a damaged file is refused, saying how to go on).
+    /// Opens (or creates) and [`prepare`]s the database at `path` (a file, or [`IN_MEMORY`]),
+    /// keeping finished jobs for `retention`.
     pub fn open(path: &str, retention: Duration) -> Result<Arc<Archive>, ArchiveError> {
         let error = |why: String| ArchiveError {
             path: path.to_string(),
@@ -113,7 +109,6 @@ impl Archive {
         self.stored(id, key, kind, result.complete())
     }
 
-    /// The result of job `id`, read from the database when asked for.
     fn stored(self: &Arc<Self>, id: Uuid, key: String, kind: KindName, whole: bool) -> JobResult {
         let saved = Arc::new(Saved {
             archive: self.clone(),
@@ -128,8 +123,7 @@ impl Archive {
     }
 
     /// Why what is written now would be lost at a restart, if it would: the file opened was
-    /// removed or replaced while the process runs (it writes to the file it opened, which no
-    /// path names any more).
+    /// removed or replaced while the process runs.
     pub fn moved(&self) -> Option<String> {
         let (path, opened) = self.file.as_ref()?;
         let now = identity(path);
@@ -149,8 +143,7 @@ impl Archive {
         millis(SystemTime::now()).saturating_sub(retention)
     }
 
-    /// Records the job `record`, just accepted (a row written once: its end is
-    /// [`Archive::finish`]'s).
+    /// Records a job just accepted (its end is [`Archive::finish`]'s).
     pub fn insert(&self, record: &JobRecord) -> rusqlite::Result<()> {
         let total = match record.work {
             Work::Known(n) => Some(n as i64),
@@ -174,9 +167,8 @@ impl Archive {
         Ok(())
     }
 
-    /// Ends the job `id` in `state` with `done` units done at `finished`, with its result's
-    /// JSON and CSV (`bodies`) if it has one that could be read; a job deleted meanwhile (no
-    /// row) or already ended stays as it is.
+    /// Ends the job `id`, with its result's JSON and CSV (`bodies`) if they could be read; a
+    /// job deleted meanwhile or already ended stays as it is.
     pub fn finish(
         &self,
         id: Uuid,
@@ -246,8 +238,7 @@ impl Archive {
         Ok(row.flatten())
     }
 
-    /// The jobs of `listing`'s owner within their retention, newest first, filtered and
-    /// paged.
+    /// The jobs of `listing`'s owner within their retention, newest first, filtered, paged.
     pub fn list(self: &Arc<Self>, listing: &Listing) -> rusqlite::Result<Page> {
         let filter = "owner = ?1 AND (?2 IS NULL OR kind = ?2) AND (?3 IS NULL OR status = ?3) \
                       AND (finished IS NULL OR finished > ?4)";
@@ -291,8 +282,7 @@ impl Archive {
         })
     }
 
-    /// The newest job within its retention that succeeded on the input whose hash is
-    /// `input_hash`.
+    /// The newest job within its retention that succeeded on the input `input_hash`.
     pub fn with_input(self: &Arc<Self>, input_hash: &str) -> rusqlite::Result<Option<JobRecord>> {
         let sql = format!(
             "SELECT {COLUMNS} FROM jobs WHERE input_hash = ?1 AND status = 'succeeded' \
@@ -301,7 +291,6 @@ impl Archive {
         self.one(&sql, params![input_hash, self.cutoff()])
     }
 
-    /// Forgets the job `id` and its result.
     pub fn remove(&self, id: Uuid) -> rusqlite::Result<()> {
         let mut db = lock(&self.db);
         let tx = db.transaction()?;
@@ -310,7 +299,7 @@ impl Archive {
         tx.commit()
     }
 
-    /// Forgets the jobs past their retention; returns how many.
+    /// Forgets the jobs past their retention; how many.
     pub fn purge(&self) -> rusqlite::Result<usize> {
         let cutoff = self.cutoff();
         let mut db = lock(&self.db);
@@ -336,8 +325,7 @@ impl Archive {
             .optional()
     }
 
-    /// The record of a row of `COLUMNS`; `None` for a row this version cannot read (a kind
-    /// it does not know).
+    /// The record of a row of `COLUMNS`; `None` for one this version cannot read.
     fn record(self: &Arc<Self>, row: &Row<'_>) -> rusqlite::Result<Option<JobRecord>> {
         let text = |i: usize| row.get::<_, String>(i);
         let Ok(id) = Uuid::parse_str(&text(0)?) else {
@@ -440,12 +428,10 @@ fn millis(time: SystemTime) -> i64 {
     i64::try_from(unix_millis(time)).unwrap_or(i64::MAX)
 }
 
-/// The time stored as `unix_ms`.
 fn time(unix_ms: i64) -> SystemTime {
     from_unix_millis(u64::try_from(unix_ms).unwrap_or(0))
 }
 
-/// Why the database of saved analyses cannot be opened.
 #[derive(Debug, thiserror::Error)]
 #[error("--database {path}: {why}")]
 pub struct ArchiveError {

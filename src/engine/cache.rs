@@ -19,7 +19,6 @@ use bytes::Bytes;
 /// kept for that; or both renderings as another process made them (Redis, assembled parts).
 #[derive(Debug)]
 pub struct Solved {
-    /// The job's cache key.
     pub key: String,
     /// The job's kind (which draws its picture).
     pub kind: KindName,
@@ -28,7 +27,6 @@ pub struct Solved {
     pub complete: bool,
     json: Bytes,
     csv: OnceLock<Bytes>,
-    /// The picture, drawn the first time a client asks for it.
     svg: OnceLock<Bytes>,
     /// The typed answer, while the CSV is still to render.
     answer: Option<Answer>,
@@ -51,8 +49,7 @@ impl Solved {
         })
     }
 
-    /// An answer of `kind` already rendered as JSON and CSV (its picture is drawn from the
-    /// JSON).
+    /// An answer already rendered as JSON and CSV.
     pub fn rendered(key: String, kind: KindName, json: Bytes, csv: Bytes) -> Solved {
         Solved {
             key,
@@ -83,7 +80,6 @@ impl Solved {
         })
     }
 
-    /// The answer as compact JSON.
     pub fn json(&self) -> &Bytes {
         &self.json
     }
@@ -102,9 +98,8 @@ impl Solved {
         }
     }
 
-    /// Bytes held in memory, roughly: the JSON text, the CSV (counted ahead, at the JSON's
-    /// size, while it is still to render from the typed answer), the typed answer while it
-    /// is kept (about the JSON's size), and the key.
+    /// Bytes held in memory, roughly: the CSV still to render, and the typed answer kept for
+    /// it, are counted at the JSON's size.
     pub fn weight(&self) -> u64 {
         let json = self.json.len();
         let csv = self.csv.get().map_or(json, Bytes::len);
@@ -125,7 +120,6 @@ fn once(
     Ok(cell.get_or_init(|| bytes).clone())
 }
 
-/// The picture of an answer of `kind` from its JSON.
 pub fn picture(kind: KindName, json: &[u8]) -> Result<Bytes, RenderError> {
     draw_svg(kind.picture(), json).map(Bytes::from)
 }
@@ -141,9 +135,7 @@ pub enum Claim {
 /// Where solved jobs are kept.
 #[async_trait]
 pub trait ResultCache: Send + Sync {
-    /// The answer under `key`, if kept.
     async fn get(&self, key: &str) -> Option<Arc<Solved>>;
-    /// Keeps `solved` under its key.
     async fn insert(&self, solved: Arc<Solved>);
 
     /// Keeps `solved`, which is also the result of job `job` in the fleet's job store: a
@@ -178,7 +170,6 @@ impl MemoryCache {
         )
     }
 
-    /// Holds at most about `max_bytes` of answers, each for at most `ttl`.
     pub fn new(max_bytes: u64, ttl: Duration) -> Self {
         // A rolling answer, the commonest, weighs about 16 kB.
         let weigh = |solved: &Arc<Solved>| solved.weight();

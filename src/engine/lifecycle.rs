@@ -1,6 +1,5 @@
 //! The life of asynchronous jobs: their records, the handles of those this process runs,
-//! their ids, the drain that waits for them, and the fleet's work stream when the engine
-//! works in one. Their solving goes through the [`Solver`], the one solve path.
+//! their ids, the drain, and the fleet's work stream. They solve through the [`Solver`].
 
 use std::collections::{HashMap, HashSet, VecDeque};
 use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
@@ -36,9 +35,8 @@ struct LiveJob {
     /// Wakes a job still waiting for a permit when it is cancelled (the solver itself
     /// watches `control`).
     cancel: CancellationToken,
-    /// Whether the job is being stopped by the shutdown rather than by its client.
+    /// Whether the shutdown, not its client, stops it.
     interrupted: AtomicBool,
-    /// The job's status, for those who wait for a change.
     status: watch::Sender<JobStatus>,
     /// Whether no API key's tenant owns it (callers without a key share one quota of jobs).
     anonymous: bool,
@@ -51,13 +49,11 @@ struct LiveJob {
 pub type OnEnd = Box<dyn FnOnce(Duration) + Send>;
 
 impl LiveJob {
-    /// Asks the job to stop: at once if it is queued, at the solver's next check if it runs.
     fn cancel(&self) {
         self.cancel.cancel();
         self.control.cancel();
     }
 
-    /// The state of a job that stopped on a cancel: interrupted if the shutdown asked.
     fn stopped(&self, partial: Option<JobResult>) -> JobState {
         if self.interrupted.load(Ordering::SeqCst) {
             JobState::Interrupted
@@ -98,12 +94,10 @@ pub struct Lifecycle {
     config: EngineConfig,
     solver: Arc<Solver>,
     jobs: Arc<dyn JobStore>,
-    /// The fleet, when the engine works in one: jobs then run on its work stream.
+    /// The fleet, if any: jobs then run on its work stream.
     fleet: Option<Arc<Shared>>,
-    /// The jobs this process runs, by id.
     live: Mutex<HashMap<Uuid, Arc<LiveJob>>>,
-    /// Jobs finished that no client has read finished yet (at most `max_jobs`, the oldest
-    /// given up first).
+    /// At most `max_jobs`, the oldest given up first.
     uncollected: Mutex<Uncollected>,
     /// The jobs unfinished or uncollected when the drain began, whose clients have not yet
     /// read them finished: the drain waits for them (see [`Lifecycle::jobs_collected`]).
@@ -112,13 +106,12 @@ pub struct Lifecycle {
     /// Solver threads asynchronous jobs may hold at once: all but one, so that synchronous
     /// requests always find one that no job holds.
     job_slots: Arc<Semaphore>,
-    /// The tasks of asynchronous jobs (and the fleet's workers), waited for on shutdown.
+    /// The tasks of jobs (and the fleet's workers), waited for on shutdown.
     tracker: TaskTracker,
-    /// Cancelled when the drain begins: no new work is taken from then on.
+    /// Cancelled when the drain begins.
     draining: CancellationToken,
     /// Asynchronous jobs waiting for a permit.
     queued: AtomicUsize,
-    /// The estimated work of the asynchronous jobs accepted and not ended.
     backlog: Arc<Backlog>,
     jobs_queued: Gauge,
 }
@@ -150,10 +143,9 @@ impl Lifecycle {
         }
     }
 
-    /// Starts `loops` workers on the fleet's stream (none without a fleet). With
-    /// `share_with_requests` (a process that also serves HTTP) they take the job slots, so
-    /// that a synchronous request always finds a solver thread. They stop when the drain
-    /// begins.
+    /// Starts `loops` workers on the fleet's stream (none without a fleet), until the drain.
+    /// With `share_with_requests` (a process that also serves HTTP) they take the job slots,
+    /// so that a synchronous request always finds a solver thread.
     pub fn start_workers(&self, loops: usize, share_with_requests: bool) {
         let Some(shared) = self.fleet.clone() else {
             return;
@@ -173,9 +165,8 @@ impl Lifecycle {
     }
 
     /// Queues `keyed` to run in the background; returns its record. Refused when the queue
-    /// is full, the service is draining, or there is no room to keep the job's result.
-    /// `on_end` is told what the job cost when it ends here (a job the fleet's workers run
-    /// ends elsewhere: it is dropped).
+    /// is full or there is no room to keep the job's result. `on_end` is told what the job
+    /// cost if it ends here (not a job the fleet's workers run).
     pub(super) async fn submit(
         self: &Arc<Self>,
         keyed: Keyed,
@@ -230,8 +221,7 @@ impl Lifecycle {
         Ok(record)
     }
 
-    /// A place in this process's queue for `keyed`, and its turn in the backlog; refused
-    /// when the queue is full, or when the work before it would keep it past its deadline.
+    /// A place in this process's queue for `keyed`, and its turn in the backlog.
     fn take_place(&self, keyed: &Keyed) -> Result<Ticket, EngineError> {
         let max = self.config.max_queued_jobs;
         if self
@@ -252,7 +242,7 @@ impl Lifecycle {
             })
     }
 
-    /// Runs job `id` in this process, on its task, until it ends; then records its end.
+    /// Runs job `id` on a task of its own, then records its end.
     fn spawn(
         self: &Arc<Self>,
         id: Uuid,
@@ -299,8 +289,8 @@ impl Lifecycle {
         );
     }
 
-    /// Puts `job` on the fleet's work stream (in parts, if it splits into more than a part's
-    /// points); refused when the stream holds more than 64 entries per queued job allowed.
+    /// Puts `job` on the fleet's work stream, in parts; refused when the stream holds more
+    /// than 64 entries per queued job allowed.
     async fn enqueue(
         &self,
         shared: &Shared,
@@ -359,8 +349,7 @@ impl Lifecycle {
         self.fleet.as_ref().map(|shared| shared.fleet.health())
     }
 
-    /// The asynchronous job `id`, unless unknown or expired; a job this process runs has
-    /// its progress counted up to now.
+    /// The job `id`, unless unknown or expired, with its progress up to now if it runs here.
     pub async fn job(&self, id: Uuid) -> Option<JobRecord> {
         let mut record = self.jobs.get(id).await?;
         if record.state.status().is_finished() {
@@ -371,8 +360,7 @@ impl Lifecycle {
         Some(record)
     }
 
-    /// The jobs of `listing`'s owner, newest first, filtered and paged; a job this process
-    /// runs has its progress counted up to now.
+    /// The jobs of `listing`'s owner, newest first, filtered and paged (progress as `job`).
     pub async fn list(&self, listing: &Listing) -> Result<Page, EngineError> {
         self.store_reachable()?;
         let mut page = self.jobs.list(listing).await?;
@@ -434,8 +422,7 @@ impl Lifecycle {
         Some(self.job(id).await.unwrap_or(before))
     }
 
-    /// Cancels the job `id` if it has not finished (see [`Lifecycle::cancel`]) and forgets it;
-    /// returns it as it ended.
+    /// Cancels the job `id` ([`Lifecycle::cancel`]) and forgets it; returns it as it ended.
     pub async fn delete(&self, id: Uuid) -> Option<JobRecord> {
         let record = self.cancel(id).await?;
         self.jobs.remove(id).await;
@@ -472,9 +459,8 @@ impl Lifecycle {
         lock(&self.owed).remove(&id);
     }
 
-    /// Resolves when every job unfinished at the start of the drain has been read finished
-    /// by its client (polled, or followed to its completion event), so that none of their
-    /// answers is lost with the process.
+    /// Resolves when every job owed at the start of the drain has been read finished by its
+    /// client, so that none of their answers is lost with the process.
     pub async fn jobs_collected(&self) {
         while !lock(&self.owed).is_empty() {
             tokio::time::sleep(Duration::from_millis(20)).await;
@@ -486,8 +472,7 @@ impl Lifecycle {
         lock(&self.live).len()
     }
 
-    /// Jobs finished that no client has read yet: those a drain waits for clients to read
-    /// (once it has begun, the jobs it owes that are finished; before, every one unread).
+    /// Jobs finished that no client has read yet (once the drain has begun, those it owes).
     pub fn unread_jobs(&self) -> usize {
         if self.is_draining() {
             let live: HashSet<Uuid> = lock(&self.live).keys().copied().collect();
@@ -504,10 +489,9 @@ impl Lifecycle {
         self.draining.is_cancelled()
     }
 
-    /// Waits (after `begin_drain`) for the jobs to finish until `end`; what is still running
-    /// then is interrupted (it ends `interrupted`) and given a second to stop. Returns
-    /// whether every job finished in time. Whatever the store could not save before is saved
-    /// then, if it now can.
+    /// Waits (after `begin_drain`) for the jobs to finish until `end`, then interrupts the rest
+    /// and gives them a second to stop; whether every job finished in time. What the store
+    /// could not save before is saved then, if it now can.
     pub async fn finish_jobs(&self, end: tokio::time::Instant) -> bool {
         self.tracker.close();
         let finished = tokio::time::timeout_at(end, self.tracker.wait())

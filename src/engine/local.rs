@@ -50,8 +50,7 @@ impl LocalJobStore {
         }
     }
 
-    /// Writes with `call` (as [`LocalJobStore::db`] does), remembering whether writes fail:
-    /// the reason, for the client, if this one did.
+    /// [`LocalJobStore::db`], remembering whether writes fail.
     async fn write(
         &self,
         what: &'static str,
@@ -81,8 +80,7 @@ impl LocalJobStore {
             .ok()
     }
 
-    /// Saves the end of job `id`: its final state as memory `kept` it, its work `done`,
-    /// when it `finished`.
+    /// Saves the end of job `id`, its final state as memory `kept` it.
     async fn save_end(
         &self,
         id: Uuid,
@@ -106,9 +104,8 @@ impl LocalJobStore {
         .await
     }
 
-    /// Saves the ends not saved before (a disk that was full has room again) of the jobs
-    /// memory still holds: after this they are not lost at a restart. Tried after every
-    /// write that succeeds, and at every purge.
+    /// Saves the ends not saved before, of the jobs memory still holds (a full disk may have
+    /// room again). Tried after every write that succeeds, and at every purge.
     async fn save_unsaved(&self) {
         let pending = std::mem::take(&mut *lock(&self.unsaved));
         for id in pending {
@@ -164,8 +161,7 @@ impl JobStore for LocalJobStore {
         }
         // The end is saved before memory shows it: a client told that the job finished
         // finds it finished after a restart too (shown first, a kill between the two left
-        // it `interrupted`).
-        // (A job ends once: an end already kept keeps its time.)
+        // it `interrupted`). A job ends once: an end already kept keeps its time.
         let ended = self.memory.get(id).await.and_then(|job| job.finished_at);
         let now = ended.unwrap_or_else(SystemTime::now);
         let result = state.result().cloned();
@@ -216,7 +212,6 @@ impl JobStore for LocalJobStore {
         self.archive.durable()
     }
 
-    /// The ends not saved, saved now if the disk has room again.
     async fn settle(&self) {
         self.save_unsaved().await;
     }
