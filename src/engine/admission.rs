@@ -25,7 +25,6 @@ const PATIENCE: Duration = Duration::from_secs(5);
 const RELEASE: &str = "if redis.call('GET', KEYS[1]) == ARGV[1] then \
                        return redis.call('DEL', KEYS[1]) else return 0 end";
 
-/// The tenants' locks.
 #[derive(Default)]
 pub struct Admissions {
     local: Mutex<HashMap<String, Arc<tokio::sync::Mutex<()>>>>,
@@ -40,21 +39,20 @@ pub struct Turn {
 impl Drop for Turn {
     fn drop(&mut self) {
         // Outside a runtime (none to free it on) the lease runs out by itself.
-        let Ok(runtime) = tokio::runtime::Handle::try_current() else {
+        let runtime = tokio::runtime::Handle::try_current();
+        let (Ok(runtime), Some((fleet, key, token))) = (runtime, self.fleet.take()) else {
             return;
         };
-        if let Some((fleet, key, token)) = self.fleet.take() {
-            runtime.spawn(async move {
-                let script = redis::Script::new(RELEASE);
-                let released = fleet
-                    .jobs
-                    .script::<i64>(&script, &[&key], &[token.as_bytes()])
-                    .await;
-                if let Err(e) = released {
-                    tracing::warn!(error = %e.why, "a tenant's admission lock waits out its lease");
-                }
-            });
-        }
+        runtime.spawn(async move {
+            let script = redis::Script::new(RELEASE);
+            let released = fleet
+                .jobs
+                .script::<i64>(&script, &[&key], &[token.as_bytes()])
+                .await;
+            if let Err(e) = released {
+                tracing::warn!(error = %e.why, "a tenant's admission lock waits out its lease");
+            }
+        });
     }
 }
 

@@ -79,8 +79,8 @@ fn identity(path: &str) -> std::io::Result<(u64, u64)> {
 }
 
 impl Archive {
-    /// Opens (or creates) and [`prepare`]s the database at `path` (a file, or [`IN_MEMORY`]),
-    /// keeping finished jobs for `retention`.
+    /// Opens (or creates) and readies (`prepare`) the database at `path` (a file, or
+    /// [`IN_MEMORY`]), keeping finished jobs for `retention`.
     pub fn open(path: &str, retention: Duration) -> Result<Arc<Archive>, ArchiveError> {
         let error = |why: String| ArchiveError {
             path: path.to_string(),
@@ -243,17 +243,15 @@ impl Archive {
         let filter = "owner = ?1 AND (?2 IS NULL OR kind = ?2) AND (?3 IS NULL OR status = ?3) \
                       AND (finished IS NULL OR finished > ?4)";
         let db = lock(&self.db);
-        let (owner, kind, status, cutoff) = (
+        let (owner, kind, status) = (
             listing.owner.as_str(),
             listing.kind.map(|k| k.name()),
             listing.status.map(JobStatus::as_str),
-            self.cutoff(),
         );
-        let total: i64 = db.query_row(
-            &format!("SELECT COUNT(*) FROM jobs WHERE {filter}"),
-            params![owner, kind, status, cutoff],
-            |row| row.get(0),
-        )?;
+        let (cutoff, limit, offset) = (self.cutoff(), listing.limit as i64, listing.offset as i64);
+        let all = params![owner, kind, status, cutoff, limit, offset];
+        let count = format!("SELECT COUNT(*) FROM jobs WHERE {filter}");
+        let total: i64 = db.query_row(&count, &all[..4], |row| row.get(0))?;
         // Jobs accepted in the same millisecond are in the order they were accepted (the
         // row id grows with each insert; ids are random past their millisecond).
         let sql = format!(
@@ -261,23 +259,10 @@ impl Archive {
              LIMIT ?5 OFFSET ?6"
         );
         let mut statement = db.prepare(&sql)?;
-        let rows = statement.query_map(
-            params![
-                owner,
-                kind,
-                status,
-                cutoff,
-                listing.limit as i64,
-                listing.offset as i64
-            ],
-            |row| self.record(row),
-        )?;
-        let mut jobs = Vec::new();
-        for row in rows {
-            jobs.extend(row?);
-        }
+        let rows = statement.query_map(all, |row| self.record(row))?;
+        let jobs: Vec<Option<JobRecord>> = rows.collect::<rusqlite::Result<_>>()?;
         Ok(Page {
-            jobs,
+            jobs: jobs.into_iter().flatten().collect(),
             total: total as usize,
         })
     }
@@ -439,7 +424,6 @@ pub struct ArchiveError {
     why: String,
 }
 
-/// A result in the database.
 struct Saved {
     archive: Arc<Archive>,
     id: Uuid,

@@ -39,13 +39,9 @@ impl Solved {
         let json = answer.render(Format::Json);
         let json = json.map_err(|e| JobError::Internal(e.to_string()))?;
         Ok(Solved {
-            key,
-            kind,
-            complete: true,
-            json: json.into(),
             csv: OnceLock::new(),
-            svg: OnceLock::new(),
             answer: Some(answer),
+            ..Solved::rendered(key, kind, json.into(), Bytes::new())
         })
     }
 
@@ -70,8 +66,7 @@ impl Solved {
         })
     }
 
-    /// The same answer as it is kept for a long time: its CSV rendered now and the typed
-    /// answer let go, so that it weighs its two texts and no more.
+    /// The same answer as kept for long: its CSV rendered now, the typed answer let go.
     pub fn kept(&self) -> Result<Solved, RenderError> {
         let (key, csv) = (self.key.clone(), self.body(Format::Csv)?);
         Ok(Solved {
@@ -145,8 +140,7 @@ pub trait ResultCache: Send + Sync {
     }
 
     /// Claims the solve of `key` among the processes sharing the cache, waiting (until
-    /// `deadline`) while another holds it. One process's cache needs no claim: the engine
-    /// already shares one solve among its own callers.
+    /// `deadline`) while another holds it. One process's cache needs none (see `coalesce`).
     async fn claim(&self, _key: &str, _deadline: Instant) -> Result<Claim, JobError> {
         Ok(Claim::Mine)
     }

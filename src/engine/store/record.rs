@@ -166,8 +166,7 @@ pub struct JobRecord {
     pub kind: KindName,
     pub work: Work,
     pub state: JobState,
-    /// Work done when the record was last written (a running job's own count is live in
-    /// the process that runs it).
+    /// Work done when last written (a running job's own count is live where it runs).
     pub done: usize,
     /// The hash of the job's canonical input (its cache key): equal inputs, equal answers.
     pub input_hash: String,
@@ -176,11 +175,9 @@ pub struct JobRecord {
     /// When it was accepted (wall clock: it is shown, and compared across processes).
     pub submitted_at: SystemTime,
     pub finished_at: Option<SystemTime>,
-    /// Bytes its answer may take, at most: the room made for it when it was accepted, held
-    /// for its retention.
+    /// Bytes its answer may take, at most: room made at its acceptance, held for its retention.
     pub result_bytes: u64,
-    /// Whether its end could not be saved where the store keeps jobs for good (a database
-    /// that cannot be written): it is then kept in memory only, and says so.
+    /// Whether its end could not be saved for good (then memory alone keeps it, and says so).
     pub unsaved: bool,
 }
 
@@ -234,18 +231,15 @@ impl JobRecord {
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]
 pub struct Owner(String);
 
-/// The prefix of a tenant's stored form.
 const TENANT: &str = "key:";
 
 impl Owner {
-    /// The owner holding `token` (checked by the caller).
     pub fn of_token(token: &str) -> Owner {
         use sha2::{Digest, Sha256};
         let digest = Sha256::digest(token.as_bytes());
         Owner(digest.iter().map(|b| format!("{b:02x}")).collect())
     }
 
-    /// The tenant of the API keys named `name`.
     pub fn of_tenant(name: &str) -> Owner {
         Owner(format!("{TENANT}{name}"))
     }
@@ -380,10 +374,7 @@ pub enum Unreadable {
 
 impl JobResult {
     pub fn complete(&self) -> bool {
-        match self {
-            JobResult::Ready(solved) => solved.complete,
-            JobResult::Stored(stored) => stored.complete,
-        }
+        self.about().2
     }
 
     /// How stores name the result's completeness: `whole` or `partial`.
@@ -395,8 +386,7 @@ impl JobResult {
         }
     }
 
-    /// The answer's JSON and CSV (a CSV rendered now is rendered off the async threads: a
-    /// large sweep's takes tens of milliseconds).
+    /// The answer's JSON and CSV (a CSV is rendered off the async threads: tens of ms).
     pub async fn bodies(&self) -> io::Result<(Bytes, Bytes)> {
         match self {
             JobResult::Ready(solved) => {
@@ -414,16 +404,18 @@ impl JobResult {
     }
 
     pub fn kind(&self) -> KindName {
-        match self {
-            JobResult::Ready(solved) => solved.kind,
-            JobResult::Stored(stored) => stored.kind,
-        }
+        self.about().1
     }
 
     pub fn key(&self) -> &str {
+        self.about().0
+    }
+
+    /// The answer's cache key, its kind, and whether it is whole.
+    fn about(&self) -> (&str, KindName, bool) {
         match self {
-            JobResult::Ready(solved) => &solved.key,
-            JobResult::Stored(stored) => &stored.key,
+            JobResult::Ready(s) => (&s.key, s.kind, s.complete),
+            JobResult::Stored(s) => (&s.key, s.kind, s.complete),
         }
     }
 
