@@ -27,9 +27,7 @@ const TEACHES: Duration = Duration::from_millis(50);
 pub struct Backlogged {
     /// The wait for the work accepted before it, shared by the job threads.
     pub ahead: Duration,
-    /// Its own estimated solve.
     pub needs: Duration,
-    /// Its deadline, from submission.
     pub deadline: Duration,
 }
 
@@ -41,7 +39,6 @@ struct Accepted {
     rates: HashMap<&'static str, f64>,
 }
 
-/// The estimated work accepted and not ended.
 #[derive(Debug)]
 pub struct Backlog {
     threads: f64,
@@ -50,7 +47,6 @@ pub struct Backlog {
 }
 
 impl Backlog {
-    /// A backlog worked by `threads` job threads, for jobs given `deadline` each.
     pub fn new(threads: usize, deadline: Duration) -> Arc<Self> {
         Arc::new(Backlog {
             threads: threads.max(1) as f64,
@@ -59,9 +55,9 @@ impl Backlog {
         })
     }
 
-    /// Accepts a job of `class` with `units` of work if it can end within its deadline
-    /// behind the work accepted already; the ticket keeps its estimate in the backlog until
-    /// dropped. A job with nothing ahead of it is always accepted (its deadline tells).
+    /// Accepts a job of `class` if it can end within its deadline behind the work accepted
+    /// already (always, with nothing ahead: its deadline tells); its ticket keeps its
+    /// estimate in the backlog until dropped.
     pub fn admit(
         self: &Arc<Self>,
         class: &'static str,
@@ -88,12 +84,10 @@ impl Backlog {
     }
 }
 
-/// An accepted job's place in the backlog.
 #[derive(Debug)]
 pub struct Ticket {
     backlog: Arc<Backlog>,
     class: &'static str,
-    /// Its units of work, as admitted.
     units: usize,
     estimate: f64,
 }
@@ -104,8 +98,7 @@ impl Ticket {
         self.units
     }
 
-    /// The job ran for `took` and did `units` of work (counted as admitted: all of them if
-    /// it ended well): its class's rate learns from it.
+    /// The job ran for `took` and did `units` of work: its class's rate learns from it.
     pub fn ran(&self, units: usize, took: Duration) {
         if units == 0 || took < TEACHES {
             return;

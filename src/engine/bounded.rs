@@ -99,7 +99,7 @@ impl<V: Clone> Bounded<V> {
         self.map.insert(key, Timed { value, expires });
     }
 
-    /// Entries held (expired ones included until they are read or pushed out).
+    /// Entries held, expired ones included.
     pub fn len(&self) -> usize {
         self.map.len()
     }

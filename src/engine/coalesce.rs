@@ -12,7 +12,6 @@ use super::cache::Solved;
 use super::error::EngineError;
 use super::lock;
 
-/// A solve in flight.
 pub type Solving = BoxFuture<'static, Result<Arc<Solved>, EngineError>>;
 
 /// The solves in flight, by cache key. Entries are weak: when every caller waiting for a
@@ -54,8 +53,7 @@ impl Coalescer {
     }
 }
 
-/// Forgets a key's entry once its solve is finished or abandoned (whichever waiter leaves
-/// last, normally or by being dropped).
+/// Forgets a key's entry once its solve is done or abandoned (by whichever waiter leaves last).
 struct Forget<'a> {
     coalescer: &'a Coalescer,
     key: &'a str,

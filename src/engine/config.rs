@@ -12,8 +12,7 @@ pub struct EngineConfig {
     pub job_deadline: Duration,
     /// Asynchronous jobs that may wait for a solver thread.
     pub max_queued_jobs: usize,
-    /// Memory for everything kept between requests (bytes, estimated): cached answers, the
-    /// results of finished jobs, the input memo, solved points ([`Budget`]).
+    /// Memory for everything kept between requests (bytes, estimated; see `budget`).
     pub memory_budget: u64,
     /// Records of asynchronous jobs kept at most (the oldest finished are forgotten first).
     pub max_jobs: usize,

@@ -1,5 +1,3 @@
-//! Why the engine did not answer.
-
 use std::time::Duration;
 
 use super::backlog::Backlogged;

@@ -1,8 +1,5 @@
-//! Ids of asynchronous jobs, which say where they came from, so that a job no store knows
-//! can be told truly: an id no run of the service gave out (mistyped, or from elsewhere), a
-//! job deleted or expired, one accepted by an earlier run of a process that kept its jobs
-//! in memory (interrupted by its shutdown), or one lost with a job store (Redis) that
-//! restarted without its data.
+//! Ids of asynchronous jobs, which say where they came from, so that what became of a job no
+//! store knows can be told truly ([`Unknown`]).
 //!
 //! An id is a UUID (version 7: its first 48 bits are the Unix time in ms of its issue), with
 //! a tag of the process that issued it and a 16-bit check over the rest: a random or
@@ -47,7 +44,6 @@ impl Default for JobIds {
 }
 
 impl JobIds {
-    /// A new id.
     pub fn next(&self) -> Uuid {
         let now = unix_millis(SystemTime::now());
         let mut bytes = *Uuid::new_v4().as_bytes();
@@ -59,7 +55,6 @@ impl JobIds {
         Uuid::from_bytes(bytes)
     }
 
-    /// Whether this process issued `id`.
     pub fn issued_here(&self, id: Uuid) -> bool {
         is_ours(id) && id.as_bytes()[TAG] == self.tag
     }

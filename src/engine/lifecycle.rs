@@ -25,27 +25,24 @@ use super::solver::{Solver, Stopped};
 use super::store::{JobRecord, JobResult, JobState, JobStatus, JobStore, Listing, Owner, Page};
 use crate::job::{Control, JobError, Keyed, Work};
 
-/// How long a cancel waits for the job to stop (it checks between units of work, which take
-/// microseconds to milliseconds).
+/// How long a cancel waits for the job to stop (it checks between units of work, ≤ ms).
 const CANCEL_WAIT: Duration = Duration::from_secs(5);
 
 /// The handles of an asynchronous job this process runs: what its record cannot hold.
 struct LiveJob {
     control: Arc<Control>,
-    /// Wakes a job still waiting for a permit when it is cancelled (the solver itself
-    /// watches `control`).
+    /// Wakes a job still waiting for a permit (the solver itself watches `control`).
     cancel: CancellationToken,
     /// Whether the shutdown, not its client, stops it.
     interrupted: AtomicBool,
     status: watch::Sender<JobStatus>,
-    /// Whether no API key's tenant owns it (callers without a key share one quota of jobs).
+    /// Whether no tenant owns it (callers without a key share one quota of jobs).
     anonymous: bool,
     /// How long it held a solver thread (ns; 0 until it ran): what it really cost.
     solved_in: AtomicU64,
 }
 
-/// Called with what a job really cost (its time on a solver thread) when it ends: a quota
-/// trues up the estimate it charged (the engine's `submit`).
+/// Told a job's time on a solver thread when it ends, to true up its quota's estimate.
 pub type OnEnd = Box<dyn FnOnce(Duration) + Send>;
 
 impl LiveJob {
@@ -99,12 +96,11 @@ pub struct Lifecycle {
     live: Mutex<HashMap<Uuid, Arc<LiveJob>>>,
     /// At most `max_jobs`, the oldest given up first.
     uncollected: Mutex<Uncollected>,
-    /// The jobs unfinished or uncollected when the drain began, whose clients have not yet
-    /// read them finished: the drain waits for them (see [`Lifecycle::jobs_collected`]).
+    /// The jobs unfinished or uncollected when the drain began, until their clients read
+    /// them finished ([`Lifecycle::jobs_collected`]).
     owed: Mutex<HashSet<Uuid>>,
     ids: JobIds,
-    /// Solver threads asynchronous jobs may hold at once: all but one, so that synchronous
-    /// requests always find one that no job holds.
+    /// Solver threads jobs may hold at once: all but one, kept for synchronous requests.
     job_slots: Arc<Semaphore>,
     /// The tasks of jobs (and the fleet's workers), waited for on shutdown.
     tracker: TaskTracker,
@@ -201,7 +197,7 @@ impl Lifecycle {
         Ok(record)
     }
 
-    /// Records `record`, whose answer `solved` was cached, as succeeded at once.
+    /// Records `record`, whose answer was cached, as succeeded at once.
     async fn answered(
         &self,
         mut record: JobRecord,
@@ -339,7 +335,7 @@ impl Lifecycle {
             .count()
     }
 
-    /// Why the job store cannot keep new jobs now, if it cannot.
+    /// See [`JobStore::problem`].
     pub fn store_problem(&self) -> Option<String> {
         self.jobs.problem()
     }
@@ -403,8 +399,8 @@ impl Lifecycle {
             .map(|live| live.status.subscribe())
     }
 
-    /// Cancels the job `id`: a queued job at once, a running one at the solver's next check;
-    /// waits a little for it to stop and returns it then. A finished job is left as it is.
+    /// Cancels the job `id` (a running one stops at the solver's next check), and returns it
+    /// after waiting a little for it to stop. A finished job is left as it is.
     pub async fn cancel(&self, id: Uuid) -> Option<JobRecord> {
         let before = self.job(id).await?;
         let live = lock(&self.live).get(&id).cloned();
@@ -429,19 +425,15 @@ impl Lifecycle {
         Some(record)
     }
 
-    /// Forgets the finished jobs past their retention.
     pub async fn purge_expired_jobs(&self) -> usize {
         self.jobs.purge_expired().await
     }
 
-    /// Stops taking work: new solves and jobs are refused. The jobs accepted, queued or
-    /// running, go on; [`Lifecycle::finish_jobs`] waits for them to finish and
-    /// [`Lifecycle::jobs_collected`] for their clients to read them.
-    ///
-    /// The jobs that finished before the drain and were not read are owed to their clients
-    /// only if the store would lose them with the process (in memory, or a database that
-    /// cannot be written): a durable store gives them to the next process, and a client that
-    /// never comes back made every drain wait its whole timeout.
+    /// Stops taking work; the jobs accepted go on ([`Lifecycle::finish_jobs`],
+    /// [`Lifecycle::jobs_collected`]). The jobs finished before the drain and not read are
+    /// owed to their clients only if the store would lose them with the process (in memory,
+    /// or a database that cannot be written): a durable store gives them to the next
+    /// process, and a client that never comes back made every drain wait its whole timeout.
     pub fn begin_drain(&self) {
         self.draining.cancel();
         let unfinished: Vec<Uuid> = lock(&self.live).keys().copied().collect();

@@ -30,7 +30,6 @@ use super::store::{
 )]
 struct Unwritable;
 
-/// A process's jobs: in memory, and in its database.
 pub struct LocalJobStore {
     memory: MemoryJobStore,
     archive: Arc<Archive>,
@@ -61,8 +60,8 @@ impl LocalJobStore {
         outcome
     }
 
-    /// Runs `call` on the database off the async threads; an error is logged with `what`
-    /// was being done, and read as `None` (the record in memory still answers).
+    /// Runs `call` on the database off the async threads; an error is logged (with `what`)
+    /// and read as `None` (the record in memory still answers).
     async fn db<T: Send + 'static>(
         &self,
         what: &'static str,

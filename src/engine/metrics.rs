@@ -29,7 +29,6 @@ pub const REDELIVERIES: &str = "thirdbody_redeliveries_total";
 static METADATA: Metadata<'static> =
     Metadata::new(module_path!(), metrics::Level::INFO, Some(module_path!()));
 
-/// A handle on a recorder, shared by the engine and the HTTP layer.
 #[derive(Clone)]
 pub struct Metrics {
     recorder: Arc<dyn Recorder + Send + Sync>,
@@ -39,7 +38,13 @@ impl Metrics {
     /// Records on `recorder`, and describes the engine's metrics there.
     pub fn new(recorder: Arc<dyn Recorder + Send + Sync>) -> Self {
         let metrics = Metrics { recorder };
-        metrics.describe();
+        metrics.describe_seconds(SOLVE_DURATION, "Time spent solving jobs");
+        metrics.describe_counter(CACHE_HITS, "Results served from the cache");
+        metrics.describe_counter(CACHE_MISSES, "Results that were solved");
+        let r = &metrics.recorder;
+        r.describe_gauge(JOBS_QUEUED.into(), None, "Async jobs waiting".into());
+        r.describe_gauge(JOBS_RUNNING.into(), None, "Async jobs being solved".into());
+        metrics.describe_counter(REJECTIONS, "Work refused, by reason");
         metrics
     }
 
@@ -48,16 +53,6 @@ impl Metrics {
         Metrics {
             recorder: Arc::new(NoopRecorder),
         }
-    }
-
-    fn describe(&self) {
-        self.describe_seconds(SOLVE_DURATION, "Time spent solving jobs");
-        self.describe_counter(CACHE_HITS, "Results served from the cache");
-        self.describe_counter(CACHE_MISSES, "Results that were solved");
-        let r = &self.recorder;
-        r.describe_gauge(JOBS_QUEUED.into(), None, "Async jobs waiting".into());
-        r.describe_gauge(JOBS_RUNNING.into(), None, "Async jobs being solved".into());
-        self.describe_counter(REJECTIONS, "Work refused, by reason");
     }
 
     pub fn describe_counter(&self, name: &'static str, help: &'static str) {
@@ -103,7 +98,6 @@ impl SolveDurations {
         }
     }
 
-    /// Records that a job of `kind` took `elapsed` to end with `outcome`.
     pub fn record(&self, kind: &'static str, outcome: &'static str, elapsed: Duration) {
         let mut seen = super::lock(&self.seen);
         let found = seen.iter().find(|(k, o, _)| *k == kind && *o == outcome);

@@ -12,11 +12,10 @@ use super::fleet::Fleet;
 use super::lock;
 use crate::job::Cost;
 
-/// The length of a window.
 const WINDOW: Duration = Duration::from_secs(60);
 
-/// A charge refused: what the tenant used in the window already, and when the window ends
-/// (none if the charge alone is over the limit: waiting cannot help).
+/// A charge refused: what the tenant used in the window, and when the window ends (none if
+/// the charge alone is over the limit: waiting cannot help).
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Exceeded {
     pub used: u64,
@@ -29,17 +28,15 @@ pub struct Exceeded {
 pub struct Charge {
     pub tenant: String,
     pub points: u64,
-    /// The window they were charged in.
     pub window: u64,
     /// Whether the points guessed at an iterative job's work (a fit's), which its time then
-    /// settles; else they are the work's own measure (a point a local answer, a continuum
-    /// answer's grid), the same whatever the machine.
+    /// settles; else they are the work's own measure, the same whatever the machine.
     pub guessed: bool,
 }
 
 /// The points charged to each tenant in the current window.
 pub struct PointCounts {
-    /// Tenant → (window, points), when there is no fleet (or its Redis cannot be reached).
+    /// Tenant → (window, points), without a fleet (or its Redis).
     local: Mutex<HashMap<String, (u64, u64)>>,
     fleet: Option<Arc<Fleet>>,
 }
@@ -52,8 +49,7 @@ impl PointCounts {
         }
     }
 
-    /// Charges `points` to `tenant` in the window of `now`, unless its points there would
-    /// pass `limit`; the window charged.
+    /// Charges `points` to `tenant` in the window of `now` within `limit`; the window.
     pub async fn charge(
         &self,
         tenant: &str,
@@ -86,8 +82,7 @@ impl PointCounts {
         }
     }
 
-    /// Trues up `charge`, made before the work, by what the work really `took` on a solver
-    /// thread ([`crate::job::Cost::of_time`]), if it was a guess.
+    /// Trues up `charge`, if it was a guess, by what the work `took` ([`Cost::of_time`]).
     pub async fn true_up(&self, charge: &Charge, took: Duration) {
         if !charge.guessed {
             return;
@@ -98,15 +93,14 @@ impl PointCounts {
             .await;
     }
 
-    /// Gives back `charge`: the work it was for was refused after all.
+    /// Gives back `charge`: its work was refused after all.
     pub async fn refund(&self, charge: &Charge) {
         let charged = i64::try_from(charge.points).unwrap_or(i64::MAX);
         self.adjust(&charge.tenant, -charged, charge.window).await;
     }
 
-    /// Trues up a charge made before the work: `delta` more points (fewer, if negative) for
-    /// `tenant` in the window it was charged in, `window`, whatever its limit (the work is
-    /// done); never below nought.
+    /// Adds `delta` points (fewer, if negative) to `tenant`'s charge in `window`, whatever
+    /// its limit (the work is done).
     pub async fn adjust(&self, tenant: &str, delta: i64, window: u64) {
         if delta == 0 {
             return;
@@ -123,7 +117,7 @@ impl PointCounts {
         }
     }
 
-    /// In this process: the points used before, if the charge is refused.
+    /// In this process; the points used before, if refused.
     fn charge_here(&self, tenant: &str, window: u64, points: u64, limit: u64) -> Result<(), u64> {
         let mut counts = lock(&self.local);
         let count = counts.entry(tenant.to_string()).or_insert((window, 0));
@@ -162,7 +156,6 @@ impl PointCounts {
     }
 }
 
-/// The fleet's count of `tenant`'s points in `window`.
 fn key(tenant: &str, window: u64) -> String {
     format!("thirdbody:quota:{tenant}:{window}")
 }

@@ -29,20 +29,17 @@ pub struct Engine {
     solve_deadline: Duration,
     pub solver: Arc<Solver>,
     pub jobs: Arc<Lifecycle>,
-    /// The points each tenant asked for in the current minute (its quota's count).
     points: Arc<PointCounts>,
     admissions: Admissions,
     fleet: Option<Arc<Fleet>>,
 }
 
 impl Engine {
-    /// An engine that keeps everything in this process.
     pub fn new(config: EngineConfig, metrics: Metrics) -> Result<Arc<Engine>, ArchiveError> {
         let storage = Storage::in_process(&config)?;
         Ok(Engine::with_storage(config, metrics, storage))
     }
 
-    /// An engine that keeps answers and job records in `storage`.
     pub fn with_storage(config: EngineConfig, metrics: Metrics, storage: Storage) -> Arc<Engine> {
         if let Some(shared) = &storage.fleet {
             for link in [&shared.fleet.cache, &shared.fleet.jobs] {
@@ -174,12 +171,10 @@ impl Engine {
         record.map_err(|e| self.refused(e))
     }
 
-    /// Trues up `charge` by what its work really `took` on a solver thread.
     pub async fn true_up(&self, charge: &Charge, took: Duration) {
         self.points.true_up(charge, took).await;
     }
 
-    /// Gives back `charge`: its work was refused after all (no thread, no room).
     pub async fn refund(&self, charge: &Charge) {
         self.points.refund(charge).await;
     }

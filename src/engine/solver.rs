@@ -67,8 +67,7 @@ pub struct Solver {
     pool: Pool,
     cache: Arc<dyn ResultCache>,
     coalescer: Coalescer,
-    /// The text of valid inputs (their kind and compact JSON with sorted keys) → their
-    /// cache key, so that a repeated request is answered without being validated again.
+    /// Valid inputs' text (kind and compact JSON) → cache key: a repeat is not validated again.
     input_keys: Bounded<Arc<str>>,
     doorkeeper: Doorkeeper,
     points: Arc<PointMemo>,
@@ -80,7 +79,6 @@ pub struct Solver {
 }
 
 impl Solver {
-    /// A solve path of `config.pool_size` threads whose answers are kept in `cache`.
     pub fn new(config: &EngineConfig, metrics: Metrics, cache: Arc<dyn ResultCache>) -> Self {
         let budget = Budget::split(config.memory_budget);
         Solver {
@@ -132,7 +130,6 @@ impl Solver {
         solved
     }
 
-    /// Keeps `solved` in the cache.
     pub(super) async fn keep(&self, solved: Arc<Solved>) {
         self.cache.insert(solved).await;
     }
@@ -270,7 +267,6 @@ impl Solver {
     }
 }
 
-/// A job counted as running ([`Solver::running`]) until dropped.
 pub(super) struct Running(Gauge);
 
 impl Drop for Running {

@@ -14,8 +14,7 @@ use crate::engine::lock;
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Place {
     Memory,
-    /// The database of saved analyses (every finished job's result is saved there; one kept
-    /// there only is read from there).
+    /// The database of saved analyses (which saves every finished job's result anyway).
     Database,
 }
 
@@ -38,7 +37,7 @@ struct Records {
     jobs: HashMap<Uuid, JobRecord>,
     /// Room made (bytes, and where) for the results of jobs not finished yet.
     reserved: HashMap<Uuid, (u64, Place)>,
-    /// Finished jobs, oldest first (ids may have been forgotten since).
+    /// Finished jobs, oldest first (some may be forgotten since).
     finished: VecDeque<Uuid>,
     /// Bytes held and made room for in memory.
     memory: u64,
@@ -133,7 +132,7 @@ impl MemoryJobStore {
         })
     }
 
-    /// Keeps job `id`'s result as `stored` (in the database) instead of in memory.
+    /// Keeps job `id`'s result as `stored` in the database instead of in memory.
     pub fn store_result(&self, id: Uuid, stored: JobResult) {
         let mut records = lock(&self.records);
         let Some(record) = records.jobs.get_mut(&id) else {

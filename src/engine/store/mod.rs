@@ -22,8 +22,7 @@ pub trait JobStore: Send + Sync {
     async fn insert(&self, record: JobRecord) -> Result<(), Refusal>;
     /// The job `id`, unless unknown or expired.
     async fn get(&self, id: Uuid) -> Option<JobRecord>;
-    /// Moves the job `id` to `state` with `done` units of work done; a finished state
-    /// starts its retention.
+    /// Moves the job `id` to `state`; a finished state starts its retention.
     async fn update(&self, id: Uuid, state: JobState, done: usize);
     async fn remove(&self, id: Uuid);
     /// Forgets the jobs past their retention; returns how many.
@@ -33,8 +32,8 @@ pub trait JobStore: Send + Sync {
     /// The newest job that succeeded on the input whose hash is `input_hash`.
     async fn with_input(&self, input_hash: &str) -> Result<Option<JobRecord>, Unreadable>;
 
-    /// Whether every process of the fleet shares the store (so any of them answers for any
-    /// job, and a job unknown to it is unknown to all).
+    /// Whether every process of the fleet shares the store (a job unknown to it is unknown
+    /// to all).
     fn shared(&self) -> bool {
         false
     }
