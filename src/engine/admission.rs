@@ -12,6 +12,7 @@ use tokio::sync::OwnedMutexGuard;
 
 use super::error::EngineError;
 use super::fleet::Fleet;
+use super::lock;
 
 /// The longest a fleet's lock is held if its holder dies: far longer than a count and an
 /// insert take.
@@ -24,7 +25,6 @@ const PATIENCE: Duration = Duration::from_secs(5);
 const RELEASE: &str = "if redis.call('GET', KEYS[1]) == ARGV[1] then \
                        return redis.call('DEL', KEYS[1]) else return 0 end";
 
-/// The tenants' locks.
 #[derive(Default)]
 pub struct Admissions {
     local: Mutex<HashMap<String, Arc<tokio::sync::Mutex<()>>>>,
@@ -39,21 +39,20 @@ pub struct Turn {
 impl Drop for Turn {
     fn drop(&mut self) {
         // Outside a runtime (none to free it on) the lease runs out by itself.
-        let Ok(runtime) = tokio::runtime::Handle::try_current() else {
+        let runtime = tokio::runtime::Handle::try_current();
+        let (Ok(runtime), Some((fleet, key, token))) = (runtime, self.fleet.take()) else {
             return;
         };
-        if let Some((fleet, key, token)) = self.fleet.take() {
-            runtime.spawn(async move {
-                let script = redis::Script::new(RELEASE);
-                let released = fleet
-                    .jobs
-                    .script::<i64>(&script, &[&key], &[token.as_bytes()])
-                    .await;
-                if let Err(e) = released {
-                    tracing::warn!(error = %e.why, "a tenant's admission lock waits out its lease");
-                }
-            });
-        }
+        runtime.spawn(async move {
+            let script = redis::Script::new(RELEASE);
+            let released = fleet
+                .jobs
+                .script::<i64>(&script, &[&key], &[token.as_bytes()])
+                .await;
+            if let Err(e) = released {
+                tracing::warn!(error = %e.why, "a tenant's admission lock waits out its lease");
+            }
+        });
     }
 }
 
@@ -64,41 +63,36 @@ impl Admissions {
         tenant: &str,
         fleet: Option<&Arc<Fleet>>,
     ) -> Result<Turn, EngineError> {
-        let lock = self
-            .local
-            .lock()
-            .unwrap_or_else(|p| p.into_inner())
+        let mutex = lock(&self.local)
             .entry(tenant.to_string())
             .or_default()
             .clone();
-        let local = lock.lock_owned().await;
-        self.forget_idle();
+        let mut turn = Turn {
+            _local: mutex.lock_owned().await,
+            fleet: None,
+        };
+        forget_idle(&mut lock(&self.local));
         let Some(fleet) = fleet else {
-            return Ok(Turn {
-                _local: local,
-                fleet: None,
-            });
+            return Ok(turn);
         };
         let key = format!("thirdbody:admitting:{tenant}");
         let token = uuid::Uuid::new_v4().to_string();
+        let mut set = redis::cmd("SET");
+        set.arg(&key)
+            .arg(&token)
+            .arg("NX")
+            .arg("PX")
+            .arg(LEASE.as_millis() as u64);
         let start = Instant::now();
         loop {
-            let mut set = redis::cmd("SET");
-            set.arg(&key)
-                .arg(&token)
-                .arg("NX")
-                .arg("PX")
-                .arg(LEASE.as_millis() as u64);
             let taken: Option<String> = fleet
                 .jobs
                 .query(&set)
                 .await
                 .map_err(|e| EngineError::Unavailable(e.why))?;
             if taken.is_some() {
-                return Ok(Turn {
-                    _local: local,
-                    fleet: Some((fleet.clone(), key, token)),
-                });
+                turn.fleet = Some((fleet.clone(), key, token));
+                return Ok(turn);
             }
             if start.elapsed() > PATIENCE {
                 return Err(EngineError::Unavailable(format!(
@@ -110,13 +104,12 @@ impl Admissions {
             tokio::time::sleep(Duration::from_millis(5)).await;
         }
     }
+}
 
-    /// Forgets the locks nobody holds or waits for, so that the map stays as small as the
-    /// tenants admitting now.
-    fn forget_idle(&self) {
-        let mut local = self.local.lock().unwrap_or_else(|p| p.into_inner());
-        if local.len() > 64 {
-            local.retain(|_, lock| Arc::strong_count(lock) > 1);
-        }
+/// Forgets the locks nobody holds or waits for, so that the map stays as small as the
+/// tenants admitting now.
+fn forget_idle(locks: &mut HashMap<String, Arc<tokio::sync::Mutex<()>>>) {
+    if locks.len() > 64 {
+        locks.retain(|_, mutex| Arc::strong_count(mutex) > 1);
     }
 }

@@ -1,25 +1,23 @@
-//! Saved analyses: every job this process accepts, recorded in an embedded SQLite database
-//! (a file by default) from its acceptance, with its result once it finishes, and kept for
-//! the history's retention, across restarts. Its owner's list of jobs, a job's stable link
-//! and an input's newest answer are read from here once the job has left memory.
+//! Saved analyses: every job this process accepts, in an embedded SQLite database (a file
+//! by default) from its acceptance, with its result once it finishes, kept for the
+//! history's retention across restarts. The calls block: [`super::local::LocalJobStore`]
+//! makes them off the async threads.
 //!
 //! One process per file: the database is locked for the process's life (SQLite's exclusive
 //! locking mode), so that a second `serve` on the same file fails at start-up rather than
 //! marking the first one's running jobs interrupted. A fleet keeps its history in Redis.
-//!
-//! The calls block (SQLite is synchronous): [`super::local::LocalJobStore`] makes them off
-//! the async threads.
 
 use std::path::Path;
-use std::sync::{Arc, Mutex, MutexGuard};
+use std::sync::{Arc, Mutex};
 use std::time::{Duration, SystemTime};
 
 use async_trait::async_trait;
 use bytes::Bytes;
-use rusqlite::{params, Connection, OptionalExtension, Row};
+use rusqlite::{params, Connection, OptionalExtension, Params, Row};
 use uuid::Uuid;
 
 use super::clock::{from_unix_millis, unix_millis};
+use super::lock;
 use super::store::{JobRecord, JobState, JobStatus, Listing, Owner, Page};
 use super::store::{JobResult, ResultPlace, StoredResult};
 use crate::job::registry::KindName;
@@ -66,7 +64,6 @@ const ADDED_COLUMN: &str = "result_bytes INTEGER NOT NULL DEFAULT 0";
 const COLUMNS: &str = "id, owner, kind, status, done, total, input_hash, submitted, finished, \
                        error, result, result_bytes";
 
-/// The database of saved analyses.
 pub struct Archive {
     db: Mutex<Connection>,
     retention: Duration,
@@ -82,112 +79,42 @@ fn identity(path: &str) -> std::io::Result<(u64, u64)> {
 }
 
 impl Archive {
-    /// Opens (or creates) the database at `path` (a file, or [`IN_MEMORY`]), keeping finished
-    /// jobs for `retention`, after a quick check of its integrity (a damaged file is refused,
-    /// saying how to go on). Jobs an earlier run left unfinished are marked interrupted:
-    /// that run stopped before they ended.
+    /// Opens (or creates) and readies (`prepare`) the database at `path` (a file, or
+    /// [`IN_MEMORY`]), keeping finished jobs for `retention`.
     pub fn open(path: &str, retention: Duration) -> Result<Arc<Archive>, ArchiveError> {
         let error = |why: String| ArchiveError {
             path: path.to_string(),
             why,
         };
-        let failed = |e: rusqlite::Error| {
-            let hint = match e.sqlite_error_code() {
-                Some(rusqlite::ErrorCode::DatabaseBusy | rusqlite::ErrorCode::DatabaseLocked) => {
-                    ": another thirdbody process has it open (give each process its own \
-                     --database; a fleet keeps its history in Redis)"
-                }
-                Some(rusqlite::ErrorCode::DatabaseCorrupt | rusqlite::ErrorCode::NotADatabase) => {
-                    DAMAGED
-                }
-                _ => "",
-            };
-            error(format!("{e}{hint}"))
-        };
         let durable = path != IN_MEMORY;
-        if durable {
-            if let Some(dir) = Path::new(path)
-                .parent()
-                .filter(|d| !d.as_os_str().is_empty())
-            {
-                std::fs::create_dir_all(dir).map_err(|e| error(e.to_string()))?;
-            }
+        let parent = Path::new(path).parent();
+        if let Some(dir) = parent.filter(|d| durable && !d.as_os_str().is_empty()) {
+            std::fs::create_dir_all(dir).map_err(|e| error(e.to_string()))?;
         }
-        let db = Connection::open(path).map_err(failed)?;
-        // WAL with synchronous NORMAL: a transaction committed is in the file's log before
-        // the call returns, so a killed process loses nothing; the log is synced to the disk
-        // at each checkpoint, so a power cut may lose the last transactions (RELIABILITY.md).
-        db.execute_batch(
-            "PRAGMA locking_mode = EXCLUSIVE;
-             PRAGMA journal_mode = WAL;
-             PRAGMA synchronous = NORMAL;",
-        )
-        .map_err(failed)?;
-        let check: String = db
-            .query_row("PRAGMA quick_check", [], |row| row.get(0))
-            .map_err(failed)?;
-        if check != "ok" {
-            return Err(error(format!("{check}{DAMAGED}")));
-        }
-        db.execute_batch(SCHEMA).map_err(failed)?;
-        let added: i64 = db
-            .query_row(
-                "SELECT COUNT(*) FROM pragma_table_info('jobs') WHERE name = 'result_bytes'",
-                [],
-                |row| row.get(0),
-            )
-            .map_err(failed)?;
-        if added == 0 {
-            db.execute_batch(&format!("ALTER TABLE jobs ADD COLUMN {ADDED_COLUMN}"))
-                .map_err(failed)?;
-        }
-        let now = millis(SystemTime::now());
-        let interrupted = db
-            .execute(
-                "UPDATE jobs SET status = 'interrupted', finished = ?1 WHERE finished IS NULL",
-                [now],
-            )
-            .map_err(failed)?;
-        if interrupted > 0 {
-            tracing::warn!(
-                jobs = interrupted,
-                "jobs left unfinished by the last run are marked interrupted"
-            );
-        }
-        let file = match durable {
-            true => Some((
-                path.to_string(),
-                identity(path).map_err(|e| error(e.to_string()))?,
-            )),
-            false => None,
-        };
+        let db = Connection::open(path).map_err(hint).map_err(error)?;
+        prepare(&db).map_err(error)?;
+        let file = durable.then(|| identity(path).map(|id| (path.to_string(), id)));
         let archive = Arc::new(Archive {
             db: Mutex::new(db),
             retention,
-            file,
+            file: file.transpose().map_err(|e| error(e.to_string()))?,
         });
-        archive.purge().map_err(failed)?;
+        archive.purge().map_err(hint).map_err(error)?;
         Ok(archive)
     }
 
-    /// `result` of job `id` as the database keeps it (once its end is saved): read from
-    /// there when asked for.
+    /// `result` of job `id` as the database keeps it (once its end is saved).
     pub fn saved(self: &Arc<Self>, id: Uuid, result: &JobResult) -> JobResult {
+        let (key, kind) = (result.key().to_string(), result.kind());
+        self.stored(id, key, kind, result.complete())
+    }
+
+    fn stored(self: &Arc<Self>, id: Uuid, key: String, kind: KindName, whole: bool) -> JobResult {
         let saved = Arc::new(Saved {
             archive: self.clone(),
             id,
         });
-        let stored = StoredResult::new(
-            result.key().to_string(),
-            result.kind(),
-            result.complete(),
-            saved,
-        );
-        JobResult::Stored(Arc::new(stored))
-    }
-
-    fn db(&self) -> MutexGuard<'_, Connection> {
-        self.db.lock().unwrap_or_else(|p| p.into_inner())
+        JobResult::Stored(Arc::new(StoredResult::new(key, kind, whole, saved)))
     }
 
     /// Whether the database is a file (it outlives the process).
@@ -196,8 +123,7 @@ impl Archive {
     }
 
     /// Why what is written now would be lost at a restart, if it would: the file opened was
-    /// removed or replaced while the process runs (it writes to the file it opened, which no
-    /// path names any more).
+    /// removed or replaced while the process runs.
     pub fn moved(&self) -> Option<String> {
         let (path, opened) = self.file.as_ref()?;
         let now = identity(path);
@@ -217,14 +143,13 @@ impl Archive {
         millis(SystemTime::now()).saturating_sub(retention)
     }
 
-    /// Records the job `record`, just accepted (a row written once: its end is
-    /// [`Archive::finish`]'s).
+    /// Records a job just accepted (its end is [`Archive::finish`]'s).
     pub fn insert(&self, record: &JobRecord) -> rusqlite::Result<()> {
         let total = match record.work {
             Work::Known(n) => Some(n as i64),
             Work::Unknown => None,
         };
-        self.db().execute(
+        lock(&self.db).execute(
             "INSERT OR IGNORE INTO jobs (id, owner, kind, status, done, total, input_hash, \
              submitted, result_bytes) VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9)",
             params![
@@ -242,9 +167,8 @@ impl Archive {
         Ok(())
     }
 
-    /// Ends the job `id` in `state` with `done` units done at `finished`, with its result's
-    /// JSON and CSV (`bodies`) if it has one that could be read; a job deleted meanwhile (no
-    /// row) or already ended stays as it is.
+    /// Ends the job `id`, with its result's JSON and CSV (`bodies`) if they could be read; a
+    /// job deleted meanwhile or already ended stays as it is.
     pub fn finish(
         &self,
         id: Uuid,
@@ -253,7 +177,7 @@ impl Archive {
         finished: SystemTime,
         bodies: Option<(Bytes, Bytes)>,
     ) -> rusqlite::Result<()> {
-        let mut db = self.db();
+        let mut db = lock(&self.db);
         let tx = db.transaction()?;
         let error = match state {
             JobState::Failed { error, .. } => serde_json::to_string(error).ok(),
@@ -287,7 +211,7 @@ impl Archive {
 
     /// Moves the job `id` to `status` (a job started), unless it has finished.
     pub fn set_status(&self, id: Uuid, status: JobStatus) -> rusqlite::Result<()> {
-        self.db().execute(
+        lock(&self.db).execute(
             "UPDATE jobs SET status = ?2 WHERE id = ?1 AND finished IS NULL",
             params![id.to_string(), status.as_str()],
         )?;
@@ -299,32 +223,35 @@ impl Archive {
         let sql = format!(
             "SELECT {COLUMNS} FROM jobs WHERE id = ?1 AND (finished IS NULL OR finished > ?2)"
         );
-        let db = self.db();
-        let row = db
-            .query_row(&sql, params![id.to_string(), self.cutoff()], |row| {
-                self.record(row)
-            })
+        self.one(&sql, params![id.to_string(), self.cutoff()])
+    }
+
+    /// The record that `sql` finds with `params`, if any (and readable).
+    fn one(
+        self: &Arc<Self>,
+        sql: &str,
+        params: impl Params,
+    ) -> rusqlite::Result<Option<JobRecord>> {
+        let row = lock(&self.db)
+            .query_row(sql, params, |row| self.record(row))
             .optional()?;
         Ok(row.flatten())
     }
 
-    /// The jobs of `listing`'s owner within their retention, newest first, filtered and
-    /// paged.
+    /// The jobs of `listing`'s owner within their retention, newest first, filtered, paged.
     pub fn list(self: &Arc<Self>, listing: &Listing) -> rusqlite::Result<Page> {
         let filter = "owner = ?1 AND (?2 IS NULL OR kind = ?2) AND (?3 IS NULL OR status = ?3) \
                       AND (finished IS NULL OR finished > ?4)";
-        let db = self.db();
-        let (owner, kind, status, cutoff) = (
+        let db = lock(&self.db);
+        let (owner, kind, status) = (
             listing.owner.as_str(),
             listing.kind.map(|k| k.name()),
             listing.status.map(JobStatus::as_str),
-            self.cutoff(),
         );
-        let total: i64 = db.query_row(
-            &format!("SELECT COUNT(*) FROM jobs WHERE {filter}"),
-            params![owner, kind, status, cutoff],
-            |row| row.get(0),
-        )?;
+        let (cutoff, limit, offset) = (self.cutoff(), listing.limit as i64, listing.offset as i64);
+        let all = params![owner, kind, status, cutoff, limit, offset];
+        let count = format!("SELECT COUNT(*) FROM jobs WHERE {filter}");
+        let total: i64 = db.query_row(&count, &all[..4], |row| row.get(0))?;
         // Jobs accepted in the same millisecond are in the order they were accepted (the
         // row id grows with each insert; ids are random past their millisecond).
         let sql = format!(
@@ -332,56 +259,35 @@ impl Archive {
              LIMIT ?5 OFFSET ?6"
         );
         let mut statement = db.prepare(&sql)?;
-        let rows = statement.query_map(
-            params![
-                owner,
-                kind,
-                status,
-                cutoff,
-                listing.limit as i64,
-                listing.offset as i64
-            ],
-            |row| self.record(row),
-        )?;
-        let mut jobs = Vec::new();
-        for row in rows {
-            jobs.extend(row?);
-        }
+        let rows = statement.query_map(all, |row| self.record(row))?;
+        let jobs: Vec<Option<JobRecord>> = rows.collect::<rusqlite::Result<_>>()?;
         Ok(Page {
-            jobs,
+            jobs: jobs.into_iter().flatten().collect(),
             total: total as usize,
         })
     }
 
-    /// The newest job within its retention that succeeded on the input whose hash is
-    /// `input_hash`.
+    /// The newest job within its retention that succeeded on the input `input_hash`.
     pub fn with_input(self: &Arc<Self>, input_hash: &str) -> rusqlite::Result<Option<JobRecord>> {
         let sql = format!(
             "SELECT {COLUMNS} FROM jobs WHERE input_hash = ?1 AND status = 'succeeded' \
              AND finished > ?2 ORDER BY finished DESC LIMIT 1"
         );
-        let db = self.db();
-        let row = db
-            .query_row(&sql, params![input_hash, self.cutoff()], |row| {
-                self.record(row)
-            })
-            .optional()?;
-        Ok(row.flatten())
+        self.one(&sql, params![input_hash, self.cutoff()])
     }
 
-    /// Forgets the job `id` and its result.
     pub fn remove(&self, id: Uuid) -> rusqlite::Result<()> {
-        let mut db = self.db();
+        let mut db = lock(&self.db);
         let tx = db.transaction()?;
         tx.execute("DELETE FROM results WHERE id = ?1", [id.to_string()])?;
         tx.execute("DELETE FROM jobs WHERE id = ?1", [id.to_string()])?;
         tx.commit()
     }
 
-    /// Forgets the jobs past their retention; returns how many.
+    /// Forgets the jobs past their retention; how many.
     pub fn purge(&self) -> rusqlite::Result<usize> {
         let cutoff = self.cutoff();
-        let mut db = self.db();
+        let mut db = lock(&self.db);
         let tx = db.transaction()?;
         tx.execute(
             "DELETE FROM results WHERE id IN (SELECT id FROM jobs WHERE finished <= ?1)",
@@ -395,7 +301,7 @@ impl Archive {
     /// The result of job `id` as JSON (`json`) or CSV (`csv`).
     fn body(&self, id: Uuid, field: &str) -> rusqlite::Result<Option<Vec<u8>>> {
         let column = if field == "csv" { "csv" } else { "json" };
-        self.db()
+        lock(&self.db)
             .query_row(
                 &format!("SELECT {column} FROM results WHERE id = ?1"),
                 [id.to_string()],
@@ -404,8 +310,7 @@ impl Archive {
             .optional()
     }
 
-    /// The record of a row of `COLUMNS`; `None` for a row this version cannot read (a kind
-    /// it does not know).
+    /// The record of a row of `COLUMNS`; `None` for one this version cannot read.
     fn record(self: &Arc<Self>, row: &Row<'_>) -> rusqlite::Result<Option<JobRecord>> {
         let text = |i: usize| row.get::<_, String>(i);
         let Ok(id) = Uuid::parse_str(&text(0)?) else {
@@ -415,14 +320,8 @@ impl Archive {
             return Ok(None);
         };
         let input_hash = text(6)?;
-        let result = row.get::<_, Option<String>>(10)?.map(|form| {
-            let saved = Arc::new(Saved {
-                archive: self.clone(),
-                id,
-            });
-            let stored = StoredResult::new(input_hash.clone(), kind, form == "whole", saved);
-            JobResult::Stored(Arc::new(stored))
-        });
+        let result = row.get::<_, Option<String>>(10)?;
+        let result = result.map(|form| self.stored(id, input_hash.clone(), kind, form == "whole"));
         let error = || -> JobError {
             row.get::<_, Option<String>>(9)
                 .ok()
@@ -450,17 +349,74 @@ impl Archive {
     }
 }
 
+/// Readies the connection `db`: its locking and journal, a quick check of its integrity,
+/// its tables (as this version has them); jobs an earlier run left unfinished are marked
+/// interrupted, as that run stopped before they ended. The reason, if it cannot be used.
+fn prepare(db: &Connection) -> Result<(), String> {
+    // WAL with synchronous NORMAL: a transaction committed is in the file's log before the
+    // call returns, so a killed process loses nothing; the log is synced to the disk at each
+    // checkpoint, so a power cut may lose the last transactions (RELIABILITY.md).
+    db.execute_batch(
+        "PRAGMA locking_mode = EXCLUSIVE;
+         PRAGMA journal_mode = WAL;
+         PRAGMA synchronous = NORMAL;",
+    )
+    .map_err(hint)?;
+    let check: String = db
+        .query_row("PRAGMA quick_check", [], |row| row.get(0))
+        .map_err(hint)?;
+    if check != "ok" {
+        return Err(format!("{check}{DAMAGED}"));
+    }
+    db.execute_batch(SCHEMA).map_err(hint)?;
+    let added: i64 = db
+        .query_row(
+            "SELECT COUNT(*) FROM pragma_table_info('jobs') WHERE name = 'result_bytes'",
+            [],
+            |row| row.get(0),
+        )
+        .map_err(hint)?;
+    if added == 0 {
+        db.execute_batch(&format!("ALTER TABLE jobs ADD COLUMN {ADDED_COLUMN}"))
+            .map_err(hint)?;
+    }
+    let interrupted = db
+        .execute(
+            "UPDATE jobs SET status = 'interrupted', finished = ?1 WHERE finished IS NULL",
+            [millis(SystemTime::now())],
+        )
+        .map_err(hint)?;
+    if interrupted > 0 {
+        tracing::warn!(
+            jobs = interrupted,
+            "jobs left unfinished by the last run are marked interrupted"
+        );
+    }
+    Ok(())
+}
+
+/// `e`, with how to go on from it when that is known.
+fn hint(e: rusqlite::Error) -> String {
+    let hint = match e.sqlite_error_code() {
+        Some(rusqlite::ErrorCode::DatabaseBusy | rusqlite::ErrorCode::DatabaseLocked) => {
+            ": another thirdbody process has it open (give each process its own --database; a \
+             fleet keeps its history in Redis)"
+        }
+        Some(rusqlite::ErrorCode::DatabaseCorrupt | rusqlite::ErrorCode::NotADatabase) => DAMAGED,
+        _ => "",
+    };
+    format!("{e}{hint}")
+}
+
 /// `time` as stored: Unix ms (SQLite's integers are signed).
 fn millis(time: SystemTime) -> i64 {
     i64::try_from(unix_millis(time)).unwrap_or(i64::MAX)
 }
 
-/// The time stored as `unix_ms`.
 fn time(unix_ms: i64) -> SystemTime {
     from_unix_millis(u64::try_from(unix_ms).unwrap_or(0))
 }
 
-/// Why the database of saved analyses cannot be opened.
 #[derive(Debug, thiserror::Error)]
 #[error("--database {path}: {why}")]
 pub struct ArchiveError {
@@ -468,7 +424,6 @@ pub struct ArchiveError {
     why: String,
 }
 
-/// A result in the database.
 struct Saved {
     archive: Arc<Archive>,
     id: Uuid,

@@ -10,8 +10,10 @@
 //! first jobs have run. The estimate of a job stays in the backlog until the job ends.
 
 use std::collections::HashMap;
-use std::sync::{Arc, Mutex, MutexGuard};
+use std::sync::{Arc, Mutex};
 use std::time::Duration;
+
+use super::lock;
 
 /// Weight of the latest job in a class's learned rate.
 const LEARNING: f64 = 0.5;
@@ -25,9 +27,7 @@ const TEACHES: Duration = Duration::from_millis(50);
 pub struct Backlogged {
     /// The wait for the work accepted before it, shared by the job threads.
     pub ahead: Duration,
-    /// Its own estimated solve.
     pub needs: Duration,
-    /// Its deadline, from submission.
     pub deadline: Duration,
 }
 
@@ -39,7 +39,6 @@ struct Accepted {
     rates: HashMap<&'static str, f64>,
 }
 
-/// The estimated work accepted and not ended.
 #[derive(Debug)]
 pub struct Backlog {
     threads: f64,
@@ -48,7 +47,6 @@ pub struct Backlog {
 }
 
 impl Backlog {
-    /// A backlog worked by `threads` job threads, for jobs given `deadline` each.
     pub fn new(threads: usize, deadline: Duration) -> Arc<Self> {
         Arc::new(Backlog {
             threads: threads.max(1) as f64,
@@ -57,19 +55,15 @@ impl Backlog {
         })
     }
 
-    fn accepted(&self) -> MutexGuard<'_, Accepted> {
-        self.accepted.lock().unwrap_or_else(|p| p.into_inner())
-    }
-
-    /// Accepts a job of `class` with `units` of work if it can end within its deadline
-    /// behind the work accepted already; the ticket keeps its estimate in the backlog until
-    /// dropped. A job with nothing ahead of it is always accepted (its deadline tells).
+    /// Accepts a job of `class` if it can end within its deadline behind the work accepted
+    /// already (always, with nothing ahead: its deadline tells); its ticket keeps its
+    /// estimate in the backlog until dropped.
     pub fn admit(
         self: &Arc<Self>,
         class: &'static str,
         units: usize,
     ) -> Result<Ticket, Backlogged> {
-        let mut accepted = self.accepted();
+        let mut accepted = lock(&self.accepted);
         let rate = accepted.rates.get(class).copied().unwrap_or(0.0);
         let needs = rate * units as f64;
         let ahead = accepted.seconds / self.threads;
@@ -90,12 +84,10 @@ impl Backlog {
     }
 }
 
-/// An accepted job's place in the backlog.
 #[derive(Debug)]
 pub struct Ticket {
     backlog: Arc<Backlog>,
     class: &'static str,
-    /// Its units of work, as admitted.
     units: usize,
     estimate: f64,
 }
@@ -106,14 +98,13 @@ impl Ticket {
         self.units
     }
 
-    /// The job ran for `took` and did `units` of work (counted as admitted: all of them if
-    /// it ended well): its class's rate learns from it.
+    /// The job ran for `took` and did `units` of work: its class's rate learns from it.
     pub fn ran(&self, units: usize, took: Duration) {
         if units == 0 || took < TEACHES {
             return;
         }
         let observed = took.as_secs_f64() / units as f64;
-        let mut accepted = self.backlog.accepted();
+        let mut accepted = lock(&self.backlog.accepted);
         let rate = accepted.rates.entry(self.class).or_insert(observed);
         *rate += LEARNING * (observed - *rate);
     }
@@ -121,7 +112,7 @@ impl Ticket {
 
 impl Drop for Ticket {
     fn drop(&mut self) {
-        let mut accepted = self.backlog.accepted();
+        let mut accepted = lock(&self.backlog.accepted);
         accepted.seconds = (accepted.seconds - self.estimate).max(0.0);
     }
 }

@@ -56,7 +56,7 @@ impl<V> Clone for Weigh<V> {
 
 impl<V> Weighter<String, Timed<V>> for Weigh<V> {
     fn weight(&self, key: &String, timed: &Timed<V>) -> u64 {
-        budget::weight(key.len() as u64 + (self.0)(&timed.value))
+        (key.len() as u64 + (self.0)(&timed.value)).saturating_add(budget::ENTRY_OVERHEAD)
     }
 }
 
@@ -99,7 +99,7 @@ impl<V: Clone> Bounded<V> {
         self.map.insert(key, Timed { value, expires });
     }
 
-    /// Entries held (expired ones included until they are read or pushed out).
+    /// Entries held, expired ones included.
     pub fn len(&self) -> usize {
         self.map.len()
     }

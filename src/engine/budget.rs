@@ -9,8 +9,7 @@
 pub struct Budget {
     /// Cached answers (9/16).
     pub answers: u64,
-    /// The working memory of the solves running (3/16): each sets aside its estimate
-    /// before it allocates ([`crate::job::Cost::bytes`], [`super::pool::Pool`]).
+    /// The working memory of the solves running (3/16), set aside before they allocate.
     pub solves: u64,
     /// Results kept by finished asynchronous jobs beyond the cache (3/16).
     pub job_results: u64,
@@ -21,7 +20,6 @@ pub struct Budget {
 }
 
 impl Budget {
-    /// Splits `total` bytes.
     pub fn split(total: u64) -> Budget {
         let part = |numerator: u64, denominator: u64| total / denominator * numerator;
         Budget {
@@ -38,11 +36,6 @@ impl Budget {
 /// allocations' headers, the eviction policy's records (measured for moka at ~200 bytes, and
 /// kept as an upper bound for the maps of [`super::bounded`]).
 pub const ENTRY_OVERHEAD: u64 = 256;
-
-/// The weight of an entry holding `bytes`: with its overhead.
-pub fn weight(bytes: u64) -> u64 {
-    bytes.saturating_add(ENTRY_OVERHEAD)
-}
 
 #[cfg(test)]
 mod tests {

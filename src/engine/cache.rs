@@ -19,7 +19,6 @@ use bytes::Bytes;
 /// kept for that; or both renderings as another process made them (Redis, assembled parts).
 #[derive(Debug)]
 pub struct Solved {
-    /// The job's cache key.
     pub key: String,
     /// The job's kind (which draws its picture).
     pub kind: KindName,
@@ -28,7 +27,6 @@ pub struct Solved {
     pub complete: bool,
     json: Bytes,
     csv: OnceLock<Bytes>,
-    /// The picture, drawn the first time a client asks for it.
     svg: OnceLock<Bytes>,
     /// The typed answer, while the CSV is still to render.
     answer: Option<Answer>,
@@ -38,20 +36,16 @@ impl Solved {
     /// Renders `answer` as JSON; an answer that cannot be rendered (a non-finite number)
     /// is an internal error, never a silent `null` for the client.
     pub fn new(key: String, kind: KindName, answer: Answer) -> Result<Solved, JobError> {
-        let json = answer.render(Format::Json).map_err(internal)?;
+        let json = answer.render(Format::Json);
+        let json = json.map_err(|e| JobError::Internal(e.to_string()))?;
         Ok(Solved {
-            key,
-            kind,
-            complete: true,
-            json: json.into(),
             csv: OnceLock::new(),
-            svg: OnceLock::new(),
             answer: Some(answer),
+            ..Solved::rendered(key, kind, json.into(), Bytes::new())
         })
     }
 
-    /// An answer of `kind` already rendered as JSON and CSV (its picture is drawn from the
-    /// JSON).
+    /// An answer already rendered as JSON and CSV.
     pub fn rendered(key: String, kind: KindName, json: Bytes, csv: Bytes) -> Solved {
         Solved {
             key,
@@ -72,21 +66,15 @@ impl Solved {
         })
     }
 
-    /// The same answer as it is kept for a long time: its CSV rendered now and the typed
-    /// answer let go, so that it weighs its two texts and no more.
+    /// The same answer as kept for long: its CSV rendered now, the typed answer let go.
     pub fn kept(&self) -> Result<Solved, RenderError> {
+        let (key, csv) = (self.key.clone(), self.body(Format::Csv)?);
         Ok(Solved {
-            key: self.key.clone(),
-            kind: self.kind,
             complete: self.complete,
-            json: self.json.clone(),
-            csv: OnceLock::from(self.body(Format::Csv)?),
-            svg: OnceLock::new(),
-            answer: None,
+            ..Solved::rendered(key, self.kind, self.json.clone(), csv)
         })
     }
 
-    /// The answer as compact JSON.
     pub fn json(&self) -> &Bytes {
         &self.json
     }
@@ -95,29 +83,18 @@ impl Solved {
     pub fn body(&self, format: Format) -> Result<Bytes, RenderError> {
         match format {
             Format::Json => Ok(self.json.clone()),
-            Format::Csv => {
-                if let Some(csv) = self.csv.get() {
-                    return Ok(csv.clone());
-                }
+            Format::Csv => once(&self.csv, || {
                 let answer = self.answer.as_ref().ok_or_else(|| {
                     RenderError::new("an answer rendered elsewhere came without its CSV")
                 })?;
-                let csv = Bytes::from(answer.render(Format::Csv)?);
-                Ok(self.csv.get_or_init(|| csv).clone())
-            }
-            Format::Svg => {
-                if let Some(svg) = self.svg.get() {
-                    return Ok(svg.clone());
-                }
-                let svg = picture(self.kind, &self.json)?;
-                Ok(self.svg.get_or_init(|| svg).clone())
-            }
+                Ok(answer.render(Format::Csv)?.into())
+            }),
+            Format::Svg => once(&self.svg, || picture(self.kind, &self.json)),
         }
     }
 
-    /// Bytes held in memory, roughly: the JSON text, the CSV (counted ahead, at the JSON's
-    /// size, while it is still to render from the typed answer), the typed answer while it
-    /// is kept (about the JSON's size), and the key.
+    /// Bytes held in memory, roughly: the CSV still to render, and the typed answer kept for
+    /// it, are counted at the JSON's size.
     pub fn weight(&self) -> u64 {
         let json = self.json.len();
         let csv = self.csv.get().map_or(json, Bytes::len);
@@ -126,13 +103,20 @@ impl Solved {
     }
 }
 
-/// The picture of an answer of `kind` from its JSON.
-pub fn picture(kind: KindName, json: &[u8]) -> Result<Bytes, RenderError> {
-    draw_svg(kind.picture(), json).map(Bytes::from)
+/// What `cell` holds, made by `make` the first time.
+fn once(
+    cell: &OnceLock<Bytes>,
+    make: impl FnOnce() -> Result<Bytes, RenderError>,
+) -> Result<Bytes, RenderError> {
+    if let Some(bytes) = cell.get() {
+        return Ok(bytes.clone());
+    }
+    let bytes = make()?;
+    Ok(cell.get_or_init(|| bytes).clone())
 }
 
-fn internal(e: RenderError) -> JobError {
-    JobError::Internal(e.to_string())
+pub fn picture(kind: KindName, json: &[u8]) -> Result<Bytes, RenderError> {
+    draw_svg(kind.picture(), json).map(Bytes::from)
 }
 
 /// Who solves a key no cache holds yet.
@@ -146,30 +130,23 @@ pub enum Claim {
 /// Where solved jobs are kept.
 #[async_trait]
 pub trait ResultCache: Send + Sync {
-    /// The answer under `key`, if kept.
     async fn get(&self, key: &str) -> Option<Arc<Solved>>;
-    /// Keeps `solved` under its key.
     async fn insert(&self, solved: Arc<Solved>);
 
     /// Keeps `solved`, which is also the result of job `job` in the fleet's job store: a
     /// cache on that same server refers to it there rather than hold it twice.
-    async fn insert_result_of(&self, solved: Arc<Solved>, job: uuid::Uuid) {
-        let _ = job;
+    async fn insert_result_of(&self, solved: Arc<Solved>, _job: uuid::Uuid) {
         self.insert(solved).await;
     }
 
     /// Claims the solve of `key` among the processes sharing the cache, waiting (until
-    /// `deadline`) while another holds it. One process's cache needs no claim: the engine
-    /// already shares one solve among its own callers.
-    async fn claim(&self, key: &str, deadline: Instant) -> Result<Claim, JobError> {
-        let _ = (key, deadline);
+    /// `deadline`) while another holds it. One process's cache needs none (see `coalesce`).
+    async fn claim(&self, _key: &str, _deadline: Instant) -> Result<Claim, JobError> {
         Ok(Claim::Mine)
     }
 
     /// Gives up the claim on `key` (its answer kept, or its solve failed).
-    async fn release(&self, key: &str) {
-        let _ = key;
-    }
+    async fn release(&self, _key: &str) {}
 }
 
 /// The cache of one process, bounded in bytes and in time.
@@ -187,7 +164,6 @@ impl MemoryCache {
         )
     }
 
-    /// Holds at most about `max_bytes` of answers, each for at most `ttl`.
     pub fn new(max_bytes: u64, ttl: Duration) -> Self {
         // A rolling answer, the commonest, weighs about 16 kB.
         let weigh = |solved: &Arc<Solved>| solved.weight();

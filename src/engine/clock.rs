@@ -1,6 +1,5 @@
-//! Times as the engine stores and shares them: whole milliseconds, since the Unix epoch for
-//! instants. One file for them, so that the database, the fleet's Redis and the memory store
-//! count time the same way.
+//! Times as the engine stores and shares them, in whole milliseconds (since the Unix epoch):
+//! one way for the database, the fleet's Redis and the memory store.
 
 use std::time::{Duration, SystemTime};
 

@@ -3,33 +3,27 @@
 //! request solves once.
 
 use std::collections::HashMap;
-use std::sync::{Arc, Mutex, MutexGuard};
+use std::sync::{Arc, Mutex};
 
 use futures_util::future::{BoxFuture, FutureExt, Shared, WeakShared};
 
 use super::bounded::KeyHasher;
 use super::cache::Solved;
 use super::error::EngineError;
+use super::lock;
 
-/// A solve in flight.
 pub type Solving = BoxFuture<'static, Result<Arc<Solved>, EngineError>>;
 
 /// The solves in flight, by cache key. Entries are weak: when every caller waiting for a
 /// solve has gone (clients hung up), the solve is dropped, and with it cancelled.
 #[derive(Default)]
 pub struct Coalescer {
-    in_flight: Mutex<InFlight>,
+    /// Hashed as the engine's other maps are ([`KeyHasher`]: SipHash was 1,300 of an
+    /// uncached request's instructions here).
+    in_flight: Mutex<HashMap<String, WeakShared<Solving>, KeyHasher>>,
 }
 
-/// The solves in flight, by key, hashed as the engine's other maps are ([`KeyHasher`]:
-/// SipHash was 1,300 of an uncached request's instructions here).
-type InFlight = HashMap<String, WeakShared<Solving>, KeyHasher>;
-
 impl Coalescer {
-    fn in_flight(&self) -> MutexGuard<'_, InFlight> {
-        self.in_flight.lock().unwrap_or_else(|p| p.into_inner())
-    }
-
     /// The result of the solve of `key`: one already in flight, or `start()`. The flag says
     /// whether this call started it.
     pub async fn run(
@@ -43,7 +37,7 @@ impl Coalescer {
             key,
         };
         let (solving, started) = {
-            let mut in_flight = self.in_flight();
+            let mut in_flight = lock(&self.in_flight);
             match in_flight.get(key).and_then(WeakShared::upgrade) {
                 Some(solving) => (solving, false),
                 None => {
@@ -59,8 +53,7 @@ impl Coalescer {
     }
 }
 
-/// Forgets a key's entry once its solve is finished or abandoned (whichever waiter leaves
-/// last, normally or by being dropped).
+/// Forgets a key's entry once its solve is done or abandoned (by whichever waiter leaves last).
 struct Forget<'a> {
     coalescer: &'a Coalescer,
     key: &'a str,
@@ -68,7 +61,7 @@ struct Forget<'a> {
 
 impl Drop for Forget<'_> {
     fn drop(&mut self) {
-        let mut in_flight = self.coalescer.in_flight();
+        let mut in_flight = lock(&self.coalescer.in_flight);
         let done = in_flight
             .get(self.key)
             .is_some_and(|weak| weak.upgrade().is_none_or(|s| Shared::peek(&s).is_some()));
@@ -102,7 +95,7 @@ mod tests {
         assert!(results
             .iter()
             .all(|(r, _)| matches!(r, Err(EngineError::Overloaded))));
-        assert!(coalescer.in_flight().is_empty());
+        assert!(lock(&coalescer.in_flight).is_empty());
     }
 
     #[tokio::test]
@@ -131,6 +124,6 @@ mod tests {
         .await;
         assert!(waited.is_err());
         assert_eq!(dropped.load(Ordering::SeqCst), 1);
-        assert!(coalescer.in_flight().is_empty());
+        assert!(lock(&coalescer.in_flight).is_empty());
     }
 }

@@ -2,7 +2,6 @@
 
 use std::time::Duration;
 
-/// The limits of an engine.
 #[derive(Clone, Debug, PartialEq)]
 pub struct EngineConfig {
     /// Solver threads, and so jobs solved at once.
@@ -13,19 +12,16 @@ pub struct EngineConfig {
     pub job_deadline: Duration,
     /// Asynchronous jobs that may wait for a solver thread.
     pub max_queued_jobs: usize,
-    /// Memory for everything kept between requests (bytes, estimated): cached answers, the
-    /// results of finished jobs, the input memo, solved points ([`Budget`]).
+    /// Memory for everything kept between requests (bytes, estimated; see `budget`).
     pub memory_budget: u64,
     /// Records of asynchronous jobs kept at most (the oldest finished are forgotten first).
     pub max_jobs: usize,
     /// How long an answer stays cached.
     pub cache_ttl: Duration,
-    /// How long a finished asynchronous job's record and result stay in memory for its
-    /// client to collect.
+    /// How long a finished job's record and result stay in memory for its client.
     pub job_retention: Duration,
-    /// The database of saved analyses, which also keeps the results of finished jobs
-    /// beyond the memory budget: a file, or [`super::archive::IN_MEMORY`] (then such
-    /// results are refused, as memory would hold them).
+    /// The database of saved analyses (which keeps results beyond the memory budget too): a
+    /// file, or [`super::archive::IN_MEMORY`] (such results are then refused).
     pub database: String,
     /// How long finished jobs are kept in the history (the database, or the fleet's Redis).
     pub history_retention: Duration,

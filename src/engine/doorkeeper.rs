@@ -14,7 +14,6 @@ use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
 
 use super::bounded::KeyHasher;
 
-/// The sightings of inputs, as bits set.
 pub struct Doorkeeper {
     bits: Box<[AtomicU64]>,
     /// First sightings since the last reset.
@@ -23,8 +22,8 @@ pub struct Doorkeeper {
 }
 
 impl Doorkeeper {
-    /// A doorkeeper for a memo that holds about `entries` inputs: `8 × entries` bits (at
-    /// least 4,096), rounded up to a power of two.
+    /// For a memo of about `entries` inputs: `8 × entries` bits (at least 4,096), rounded up
+    /// to a power of two.
     pub fn new(entries: u64) -> Doorkeeper {
         let bits = usize::try_from(entries.saturating_mul(8))
             .unwrap_or(usize::MAX)

@@ -1,9 +1,7 @@
-//! Why the engine did not answer.
-
 use std::time::Duration;
 
 use super::backlog::Backlogged;
-use super::store::Refusal;
+use super::store::{Refusal, Unreadable};
 use crate::job::JobError;
 
 /// Why the engine did not answer.
@@ -41,5 +39,11 @@ impl From<Refusal> for EngineError {
 impl From<JobError> for EngineError {
     fn from(e: JobError) -> Self {
         EngineError::Job(e)
+    }
+}
+
+impl From<Unreadable> for EngineError {
+    fn from(e: Unreadable) -> Self {
+        EngineError::Unavailable(e.to_string())
     }
 }

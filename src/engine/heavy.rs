@@ -10,6 +10,7 @@ use tokio::task::JoinError;
 
 /// How much lower than the async threads heavy work runs (a nice value: 10 gives the async
 /// threads about ten times the heavy threads' share when both want a core).
+#[cfg_attr(not(target_os = "linux"), allow(dead_code))]
 const NICENESS: i32 = 10;
 
 /// Runs `work` on a blocking thread below the async threads' priority.
@@ -24,33 +25,24 @@ pub async fn run<T: Send + 'static>(
 }
 
 /// Lowers the calling thread's priority, once per thread (a thread cannot raise it again
-/// without privileges, and need not).
-pub fn lower_priority() {
+/// without privileges, and need not). On Linux the nice value is the calling thread's own
+/// (NPTL), not the process's; a thread starts with its creator's.
+fn lower_priority() {
     thread_local! {
         static LOWERED: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
     }
-    LOWERED.with(|lowered| {
-        if !lowered.replace(true) {
-            lower_by(NICENESS);
-        }
-    });
-}
-
-/// On Linux the nice value is the calling thread's own (NPTL), not the process's; a thread
-/// starts with its creator's.
-#[cfg(target_os = "linux")]
-fn lower_by(niceness: i32) {
+    if LOWERED.with(|lowered| lowered.replace(true)) {
+        return;
+    }
     // SAFETY: gettid, getpriority and setpriority take no pointers; a failure only leaves
     // the priority as it was.
+    #[cfg(target_os = "linux")]
     unsafe {
         let thread = libc::gettid() as libc::id_t;
         let now = libc::getpriority(libc::PRIO_PROCESS, thread);
-        libc::setpriority(libc::PRIO_PROCESS, thread, (now + niceness).min(19));
+        libc::setpriority(libc::PRIO_PROCESS, thread, (now + NICENESS).min(19));
     }
 }
-
-#[cfg(not(target_os = "linux"))]
-fn lower_by(_niceness: i32) {}
 
 #[cfg(test)]
 mod tests {
@@ -58,7 +50,7 @@ mod tests {
 
     #[cfg(target_os = "linux")]
     fn own_niceness() -> i32 {
-        // SAFETY: as in lower_by.
+        // SAFETY: as in lower_priority.
         unsafe { libc::getpriority(libc::PRIO_PROCESS, libc::gettid() as libc::id_t) }
     }
 

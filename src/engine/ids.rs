@@ -1,16 +1,15 @@
-//! Ids of asynchronous jobs, which say where they came from, so that a job no store knows
-//! can be told truly: an id no run of the service gave out (mistyped, or from elsewhere), a
-//! job deleted or expired, one accepted by an earlier run of a process that kept its jobs
-//! in memory (interrupted by its shutdown), or one lost with a job store (Redis) that
-//! restarted without its data.
+//! Ids of asynchronous jobs, which say where they came from, so that what became of a job no
+//! store knows can be told truly ([`Unknown`]).
 //!
 //! An id is a UUID (version 7: its first 48 bits are the Unix time in ms of its issue), with
 //! a tag of the process that issued it and a 16-bit check over the rest: a random or
 //! mistyped id passes the check once in 65,536.
 
-use std::time::{SystemTime, UNIX_EPOCH};
+use std::time::SystemTime;
 
 use uuid::Uuid;
+
+use super::clock::unix_millis;
 
 /// Where the tag of the issuing process is, and where the check is.
 const TAG: std::ops::Range<usize> = 9..12;
@@ -45,11 +44,8 @@ impl Default for JobIds {
 }
 
 impl JobIds {
-    /// A new id.
     pub fn next(&self) -> Uuid {
-        let now = SystemTime::now()
-            .duration_since(UNIX_EPOCH)
-            .map_or(0, |d| d.as_millis() as u64);
+        let now = unix_millis(SystemTime::now());
         let mut bytes = *Uuid::new_v4().as_bytes();
         bytes[..6].copy_from_slice(&now.to_be_bytes()[2..]);
         bytes[6] = 0x70 | (bytes[6] & 0x0f);
@@ -59,7 +55,6 @@ impl JobIds {
         Uuid::from_bytes(bytes)
     }
 
-    /// Whether this process issued `id`.
     pub fn issued_here(&self, id: Uuid) -> bool {
         is_ours(id) && id.as_bytes()[TAG] == self.tag
     }
@@ -93,31 +88,21 @@ fn check(bytes: &[u8; 16]) -> [u8; 2] {
 mod tests {
     use super::*;
 
+    /// Another process's id is ours too, but not issued here.
     #[test]
     fn an_id_is_a_version_7_uuid_with_its_time_tag_and_check() {
-        let ids = JobIds::default();
-        let before = SystemTime::now()
-            .duration_since(UNIX_EPOCH)
-            .unwrap()
-            .as_millis() as u64;
+        let (ids, other) = (JobIds::default(), JobIds::default());
+        let before = unix_millis(SystemTime::now());
         let id = ids.next();
-        let after = SystemTime::now()
-            .duration_since(UNIX_EPOCH)
-            .unwrap()
-            .as_millis() as u64;
+        let after = unix_millis(SystemTime::now());
         assert_eq!(id.get_version_num(), 7);
         assert_eq!(id.get_variant(), uuid::Variant::RFC4122);
         assert!((before..=after).contains(&issued_at(id)));
         assert!(is_ours(id) && ids.issued_here(id));
         assert_ne!(id, ids.next());
-    }
-
-    #[test]
-    fn another_process_s_id_is_ours_but_not_issued_here() {
-        let (a, b) = (JobIds::default(), JobIds::default());
-        let id = b.next();
+        let id = other.next();
         assert!(is_ours(id));
-        assert!(!a.issued_here(id));
+        assert!(!ids.issued_here(id));
     }
 
     #[test]

@@ -1,10 +1,9 @@
 //! The life of asynchronous jobs: their records, the handles of those this process runs,
-//! their ids, the drain that waits for them, and the fleet's work stream when the engine
-//! works in one. Their solving goes through the [`Solver`], the one solve path.
+//! their ids, the drain, and the fleet's work stream. They solve through the [`Solver`].
 
 use std::collections::{HashMap, HashSet, VecDeque};
 use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
-use std::sync::{Arc, Mutex, MutexGuard};
+use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 use metrics::Gauge;
@@ -20,43 +19,38 @@ use super::config::EngineConfig;
 use super::error::EngineError;
 use super::fleet::{placement, Health, Shared, Worker};
 use super::ids::{self, JobIds, Unknown};
+use super::lock;
 use super::metrics::{self as names, Metrics};
-use super::solver::Solver;
+use super::solver::{Solver, Stopped};
 use super::store::{JobRecord, JobResult, JobState, JobStatus, JobStore, Listing, Owner, Page};
 use crate::job::{Control, JobError, Keyed, Work};
 
-/// How long a cancel waits for the job to stop (it checks between units of work, which take
-/// microseconds to milliseconds).
+/// How long a cancel waits for the job to stop (it checks between units of work, ≤ ms).
 const CANCEL_WAIT: Duration = Duration::from_secs(5);
 
 /// The handles of an asynchronous job this process runs: what its record cannot hold.
 struct LiveJob {
     control: Arc<Control>,
-    /// Wakes a job still waiting for a permit when it is cancelled (the solver itself
-    /// watches `control`).
+    /// Wakes a job still waiting for a permit (the solver itself watches `control`).
     cancel: CancellationToken,
-    /// Whether the job is being stopped by the shutdown rather than by its client.
+    /// Whether the shutdown, not its client, stops it.
     interrupted: AtomicBool,
-    /// The job's status, for those who wait for a change.
     status: watch::Sender<JobStatus>,
-    /// Whether no API key's tenant owns it (callers without a key share one quota of jobs).
+    /// Whether no tenant owns it (callers without a key share one quota of jobs).
     anonymous: bool,
     /// How long it held a solver thread (ns; 0 until it ran): what it really cost.
     solved_in: AtomicU64,
 }
 
-/// Called with what a job really cost (its time on a solver thread) when it ends: a quota
-/// trues up the estimate it charged (the engine's `submit`).
+/// Told a job's time on a solver thread when it ends, to true up its quota's estimate.
 pub type OnEnd = Box<dyn FnOnce(Duration) + Send>;
 
 impl LiveJob {
-    /// Asks the job to stop: at once if it is queued, at the solver's next check if it runs.
     fn cancel(&self) {
         self.cancel.cancel();
         self.control.cancel();
     }
 
-    /// The state of a job that stopped on a cancel: interrupted if the shutdown asked.
     fn stopped(&self, partial: Option<JobResult>) -> JobState {
         if self.interrupted.load(Ordering::SeqCst) {
             JobState::Interrupted
@@ -79,12 +73,10 @@ impl Uncollected {
         self.ids.insert(id);
         self.order.push_back(id);
         while self.ids.len() > max {
-            match self.order.pop_front() {
-                Some(old) => {
-                    self.ids.remove(&old);
-                }
-                None => break,
-            }
+            let Some(old) = self.order.pop_front() else {
+                break;
+            };
+            self.ids.remove(&old);
         }
         // Ids read since are still in `order`: drop them when they outnumber the rest.
         if self.order.len() > 2 * self.ids.len() + 16 {
@@ -99,27 +91,23 @@ pub struct Lifecycle {
     config: EngineConfig,
     solver: Arc<Solver>,
     jobs: Arc<dyn JobStore>,
-    /// The fleet, when the engine works in one: jobs then run on its work stream.
+    /// The fleet, if any: jobs then run on its work stream.
     fleet: Option<Arc<Shared>>,
-    /// The jobs this process runs, by id.
     live: Mutex<HashMap<Uuid, Arc<LiveJob>>>,
-    /// Jobs finished that no client has read finished yet (at most `max_jobs`, the oldest
-    /// given up first).
+    /// At most `max_jobs`, the oldest given up first.
     uncollected: Mutex<Uncollected>,
-    /// The jobs unfinished or uncollected when the drain began, whose clients have not yet
-    /// read them finished: the drain waits for them (see [`Lifecycle::jobs_collected`]).
+    /// The jobs unfinished or uncollected when the drain began, until their clients read
+    /// them finished ([`Lifecycle::jobs_collected`]).
     owed: Mutex<HashSet<Uuid>>,
     ids: JobIds,
-    /// Solver threads asynchronous jobs may hold at once: all but one, so that synchronous
-    /// requests always find one that no job holds.
+    /// Solver threads jobs may hold at once: all but one, kept for synchronous requests.
     job_slots: Arc<Semaphore>,
-    /// The tasks of asynchronous jobs (and the fleet's workers), waited for on shutdown.
+    /// The tasks of jobs (and the fleet's workers), waited for on shutdown.
     tracker: TaskTracker,
-    /// Cancelled when the drain begins: no new work is taken from then on.
+    /// Cancelled when the drain begins.
     draining: CancellationToken,
     /// Asynchronous jobs waiting for a permit.
     queued: AtomicUsize,
-    /// The estimated work of the asynchronous jobs accepted and not ended.
     backlog: Arc<Backlog>,
     jobs_queued: Gauge,
 }
@@ -146,19 +134,14 @@ impl Lifecycle {
             tracker: TaskTracker::new(),
             draining: CancellationToken::new(),
             queued: AtomicUsize::new(0),
-            jobs_queued: metrics.gauge(names::JOBS_QUEUED),
+            jobs_queued: metrics.gauge(names::JOBS_QUEUED, &[]),
             config,
         }
     }
 
-    fn live(&self) -> MutexGuard<'_, HashMap<Uuid, Arc<LiveJob>>> {
-        self.live.lock().unwrap_or_else(|p| p.into_inner())
-    }
-
-    /// Starts `loops` workers on the fleet's stream (none without a fleet). With
-    /// `share_with_requests` (a process that also serves HTTP) they take the job slots, so
-    /// that a synchronous request always finds a solver thread. They stop when the drain
-    /// begins.
+    /// Starts `loops` workers on the fleet's stream (none without a fleet), until the drain.
+    /// With `share_with_requests` (a process that also serves HTTP) they take the job slots,
+    /// so that a synchronous request always finds a solver thread.
     pub fn start_workers(&self, loops: usize, share_with_requests: bool) {
         let Some(shared) = self.fleet.clone() else {
             return;
@@ -178,9 +161,8 @@ impl Lifecycle {
     }
 
     /// Queues `keyed` to run in the background; returns its record. Refused when the queue
-    /// is full, the service is draining, or there is no room to keep the job's result.
-    /// `on_end` is told what the job cost when it ends here (a job the fleet's workers run
-    /// ends elsewhere: it is dropped).
+    /// is full or there is no room to keep the job's result. `on_end` is told what the job
+    /// cost if it ends here (not a job the fleet's workers run).
     pub(super) async fn submit(
         self: &Arc<Self>,
         keyed: Keyed,
@@ -215,7 +197,7 @@ impl Lifecycle {
         Ok(record)
     }
 
-    /// Records `record`, whose answer `solved` was cached, as succeeded at once.
+    /// Records `record`, whose answer was cached, as succeeded at once.
     async fn answered(
         &self,
         mut record: JobRecord,
@@ -226,20 +208,16 @@ impl Lifecycle {
             Work::Known(total) => total,
             Work::Unknown => 0,
         };
-        self.jobs
-            .insert(record.clone())
-            .await
-            .map_err(EngineError::from)?;
+        self.jobs.insert(record.clone()).await?;
         let state = JobState::Succeeded(JobResult::Ready(solved));
         self.jobs.update(record.id, state.clone(), done).await;
-        self.uncollected().insert(record.id, self.config.max_jobs);
+        lock(&self.uncollected).insert(record.id, self.config.max_jobs);
         record.state = state;
         record.done = done;
         Ok(record)
     }
 
-    /// A place in this process's queue for `keyed`, and its turn in the backlog; refused
-    /// when the queue is full, or when the work before it would keep it past its deadline.
+    /// A place in this process's queue for `keyed`, and its turn in the backlog.
     fn take_place(&self, keyed: &Keyed) -> Result<Ticket, EngineError> {
         let max = self.config.max_queued_jobs;
         if self
@@ -260,7 +238,7 @@ impl Lifecycle {
             })
     }
 
-    /// Runs job `id` in this process, on its task, until it ends; then records its end.
+    /// Runs job `id` on a task of its own, then records its end.
     fn spawn(
         self: &Arc<Self>,
         id: Uuid,
@@ -279,7 +257,7 @@ impl Lifecycle {
             anonymous,
             solved_in: AtomicU64::new(0),
         });
-        self.live().insert(id, live.clone());
+        lock(&self.live).insert(id, live.clone());
         let span = tracing::info_span!("job", id = %id, kind = %kind);
         let lifecycle = self.clone();
         self.tracker.spawn(
@@ -298,10 +276,8 @@ impl Lifecycle {
                 // Owed to its client, and no longer running, before anyone can read it
                 // finished: a drain begun in between would otherwise count it owed (as
                 // running, or unread) after its client had read it, and wait for it forever.
-                lifecycle
-                    .uncollected()
-                    .insert(id, lifecycle.config.max_jobs);
-                lifecycle.live().remove(&id);
+                lock(&lifecycle.uncollected).insert(id, lifecycle.config.max_jobs);
+                lock(&lifecycle.live).remove(&id);
                 lifecycle.jobs.update(id, state, done).await;
                 live.status.send_replace(status);
             }
@@ -309,8 +285,8 @@ impl Lifecycle {
         );
     }
 
-    /// Puts `job` on the fleet's work stream (in parts, if it splits into more than a part's
-    /// points); refused when the stream holds more than 64 entries per queued job allowed.
+    /// Puts `job` on the fleet's work stream, in parts; refused when the stream holds more
+    /// than 64 entries per queued job allowed.
     async fn enqueue(
         &self,
         shared: &Shared,
@@ -353,10 +329,13 @@ impl Lifecycle {
 
     /// The jobs no tenant owns that this process runs or queues.
     pub fn unfinished_anonymous(&self) -> usize {
-        self.live().values().filter(|job| job.anonymous).count()
+        lock(&self.live)
+            .values()
+            .filter(|job| job.anonymous)
+            .count()
     }
 
-    /// Why the job store cannot keep new jobs now, if it cannot.
+    /// See [`JobStore::problem`].
     pub fn store_problem(&self) -> Option<String> {
         self.jobs.problem()
     }
@@ -366,31 +345,22 @@ impl Lifecycle {
         self.fleet.as_ref().map(|shared| shared.fleet.health())
     }
 
-    /// The asynchronous job `id`, unless unknown or expired; a job this process runs has
-    /// its progress counted up to now.
+    /// The job `id`, unless unknown or expired, with its progress up to now if it runs here.
     pub async fn job(&self, id: Uuid) -> Option<JobRecord> {
         let mut record = self.jobs.get(id).await?;
         if record.state.status().is_finished() {
             self.collected(id);
-        }
-        if let Some(live) = self.live().get(&id) {
-            if !record.state.status().is_finished() {
-                record.done = live.control.done();
-            }
+        } else if let Some(live) = lock(&self.live).get(&id) {
+            record.done = live.control.done();
         }
         Some(record)
     }
 
-    /// The jobs of `listing`'s owner, newest first, filtered and paged; a job this process
-    /// runs has its progress counted up to now.
+    /// The jobs of `listing`'s owner, newest first, filtered and paged (progress as `job`).
     pub async fn list(&self, listing: &Listing) -> Result<Page, EngineError> {
         self.store_reachable()?;
-        let mut page = self
-            .jobs
-            .list(listing)
-            .await
-            .map_err(|e| EngineError::Unavailable(e.to_string()))?;
-        let live = self.live();
+        let mut page = self.jobs.list(listing).await?;
+        let live = lock(&self.live);
         for record in &mut page.jobs {
             if let Some(job) = live.get(&record.id) {
                 record.done = job.control.done();
@@ -402,10 +372,7 @@ impl Lifecycle {
     /// The newest job that succeeded on the input whose hash is `input_hash`.
     pub async fn with_input(&self, input_hash: &str) -> Result<Option<JobRecord>, EngineError> {
         self.store_reachable()?;
-        self.jobs
-            .with_input(input_hash)
-            .await
-            .map_err(|e| EngineError::Unavailable(e.to_string()))
+        Ok(self.jobs.with_input(input_hash).await?)
     }
 
     /// What can be told of a job `id` that the job store does not know.
@@ -427,14 +394,16 @@ impl Lifecycle {
 
     /// A receiver of the status changes of the job `id`, if this process runs it.
     pub fn watch(&self, id: Uuid) -> Option<watch::Receiver<JobStatus>> {
-        self.live().get(&id).map(|live| live.status.subscribe())
+        lock(&self.live)
+            .get(&id)
+            .map(|live| live.status.subscribe())
     }
 
-    /// Cancels the job `id`: a queued job at once, a running one at the solver's next check;
-    /// waits a little for it to stop and returns it then. A finished job is left as it is.
+    /// Cancels the job `id` (a running one stops at the solver's next check), and returns it
+    /// after waiting a little for it to stop. A finished job is left as it is.
     pub async fn cancel(&self, id: Uuid) -> Option<JobRecord> {
         let before = self.job(id).await?;
-        let live = self.live().get(&id).cloned();
+        let live = lock(&self.live).get(&id).cloned();
         if live.is_none() && self.jobs.shared() && !before.state.status().is_finished() {
             // Run by a worker of the fleet: it sees the cancel at its next heartbeat.
             let state = JobState::Cancelled { partial: None };
@@ -449,77 +418,62 @@ impl Lifecycle {
         Some(self.job(id).await.unwrap_or(before))
     }
 
-    /// Cancels the job `id` if it has not finished (see [`Lifecycle::cancel`]) and forgets it;
-    /// returns it as it ended.
+    /// Cancels the job `id` ([`Lifecycle::cancel`]) and forgets it; returns it as it ended.
     pub async fn delete(&self, id: Uuid) -> Option<JobRecord> {
         let record = self.cancel(id).await?;
         self.jobs.remove(id).await;
         Some(record)
     }
 
-    /// Forgets the finished jobs past their retention.
     pub async fn purge_expired_jobs(&self) -> usize {
         self.jobs.purge_expired().await
     }
 
-    /// Stops taking work: new solves and jobs are refused. The jobs accepted, queued or
-    /// running, go on; [`Lifecycle::jobs_finished`] waits for them to finish and
-    /// [`Lifecycle::jobs_collected`] for their clients to read them.
-    ///
-    /// The jobs that finished before the drain and were not read are owed to their clients
-    /// only if the store would lose them with the process (in memory, or a database that
-    /// cannot be written): a durable store gives them to the next process, and a client that
-    /// never comes back made every drain wait its whole timeout.
+    /// Stops taking work; the jobs accepted go on ([`Lifecycle::finish_jobs`],
+    /// [`Lifecycle::jobs_collected`]). The jobs finished before the drain and not read are
+    /// owed to their clients only if the store would lose them with the process (in memory,
+    /// or a database that cannot be written): a durable store gives them to the next
+    /// process, and a client that never comes back made every drain wait its whole timeout.
     pub fn begin_drain(&self) {
         self.draining.cancel();
-        let unfinished: Vec<Uuid> = self.live().keys().copied().collect();
+        let unfinished: Vec<Uuid> = lock(&self.live).keys().copied().collect();
         let kept = self.jobs.durable() && self.jobs.problem().is_none();
         let uncollected: Vec<Uuid> = match kept {
             true => Vec::new(),
-            false => self.uncollected().ids.iter().copied().collect(),
+            false => lock(&self.uncollected).ids.iter().copied().collect(),
         };
-        self.owed()
-            .extend(unfinished.into_iter().chain(uncollected));
-    }
-
-    fn owed(&self) -> MutexGuard<'_, HashSet<Uuid>> {
-        self.owed.lock().unwrap_or_else(|p| p.into_inner())
-    }
-
-    fn uncollected(&self) -> MutexGuard<'_, Uncollected> {
-        self.uncollected.lock().unwrap_or_else(|p| p.into_inner())
+        lock(&self.owed).extend(unfinished.into_iter().chain(uncollected));
     }
 
     /// A client read the job `id` finished: it owes its client nothing more.
     fn collected(&self, id: Uuid) {
-        self.uncollected().ids.remove(&id);
-        self.owed().remove(&id);
+        lock(&self.uncollected).ids.remove(&id);
+        lock(&self.owed).remove(&id);
     }
 
-    /// Resolves when every job unfinished at the start of the drain has been read finished
-    /// by its client (polled, or followed to its completion event), so that none of their
-    /// answers is lost with the process.
+    /// Resolves when every job owed at the start of the drain has been read finished by its
+    /// client, so that none of their answers is lost with the process.
     pub async fn jobs_collected(&self) {
-        /// How often the drain looks.
-        const LOOK: Duration = Duration::from_millis(20);
-        while !self.owed().is_empty() {
-            tokio::time::sleep(LOOK).await;
+        while !lock(&self.owed).is_empty() {
+            tokio::time::sleep(Duration::from_millis(20)).await;
         }
     }
 
     /// Asynchronous jobs of this process queued or running: those a drain waits to finish.
     pub fn unfinished_jobs(&self) -> usize {
-        self.live().len()
+        lock(&self.live).len()
     }
 
-    /// Jobs finished that no client has read yet: those a drain waits for clients to read
-    /// (once it has begun, the jobs it owes that are finished; before, every one unread).
+    /// Jobs finished that no client has read yet (once the drain has begun, those it owes).
     pub fn unread_jobs(&self) -> usize {
         if self.is_draining() {
-            let live: HashSet<Uuid> = self.live().keys().copied().collect();
-            self.owed().iter().filter(|id| !live.contains(id)).count()
+            let live: HashSet<Uuid> = lock(&self.live).keys().copied().collect();
+            lock(&self.owed)
+                .iter()
+                .filter(|id| !live.contains(id))
+                .count()
         } else {
-            self.uncollected().ids.len()
+            lock(&self.uncollected).ids.len()
         }
     }
 
@@ -527,42 +481,29 @@ impl Lifecycle {
         self.draining.is_cancelled()
     }
 
-    /// Resolves when every asynchronous job has finished (call after `begin_drain`).
-    async fn jobs_finished(&self) {
-        self.tracker.close();
-        self.tracker.wait().await;
-    }
-
-    /// Waits (after `begin_drain`) for the jobs to finish until `end`; what is still running
-    /// then is interrupted ([`Lifecycle::interrupt_unfinished_jobs`]) and given a second to stop.
-    /// Returns whether every job finished in time.
-    /// Whatever the store could not save before is saved then, if it now can.
+    /// Waits (after `begin_drain`) for the jobs to finish until `end`, then interrupts the rest
+    /// and gives them a second to stop; whether every job finished in time. What the store
+    /// could not save before is saved then, if it now can.
     pub async fn finish_jobs(&self, end: tokio::time::Instant) -> bool {
-        let finished = tokio::time::timeout_at(end, self.jobs_finished())
+        self.tracker.close();
+        let finished = tokio::time::timeout_at(end, self.tracker.wait())
             .await
             .is_ok();
         if !finished {
-            self.interrupt_unfinished_jobs();
+            if let Some(shared) = &self.fleet {
+                shared.interrupt();
+            }
+            for live in lock(&self.live).values() {
+                live.interrupted.store(true, Ordering::SeqCst);
+                live.cancel();
+            }
             // They stop at their next check, microseconds to milliseconds away.
-            let _ = tokio::time::timeout(Duration::from_secs(1), self.jobs_finished()).await;
+            let _ = tokio::time::timeout(Duration::from_secs(1), self.tracker.wait()).await;
         }
         self.jobs.settle().await;
         finished
     }
 
-    /// Stops every job not finished yet (the drain ran out of time): they end
-    /// `interrupted`.
-    fn interrupt_unfinished_jobs(&self) {
-        if let Some(shared) = &self.fleet {
-            shared.interrupt();
-        }
-        for live in self.live().values() {
-            live.interrupted.store(true, Ordering::SeqCst);
-            live.cancel();
-        }
-    }
-
-    /// The life of an asynchronous job after its submission; returns its final state.
     /// Runs an accepted job to its end state; its solve time teaches `ticket`'s class.
     async fn run_job(&self, live: &LiveJob, id: Uuid, keyed: Keyed, ticket: &Ticket) -> JobState {
         let permit = match self.solver.cached(keyed.key()).await {
@@ -610,8 +551,7 @@ impl Lifecycle {
                 self.solver.keep(solved.clone()).await;
                 JobState::Succeeded(JobResult::Ready(solved))
             }
-            Err(stopped) => {
-                let (error, partial) = stopped.into_parts();
+            Err(Stopped { error, partial }) => {
                 let partial = partial.map(JobResult::Ready);
                 match error {
                     JobError::Cancelled => live.stopped(partial),

@@ -9,13 +9,14 @@
 //! failure was only logged: after a restart 235 of 250 jobs accepted on a full disk were
 //! unknown.) A job whose end cannot be saved stays in memory, marked unsaved.
 
-use std::sync::{Arc, Mutex, MutexGuard};
+use std::sync::{Arc, Mutex};
 use std::time::SystemTime;
 
 use async_trait::async_trait;
 use uuid::Uuid;
 
 use super::archive::Archive;
+use super::lock;
 use super::store::memory::Place;
 use super::store::{
     JobRecord, JobState, JobStore, Listing, MemoryJobStore, Page, Refusal, Unreadable,
@@ -29,7 +30,6 @@ use super::store::{
 )]
 struct Unwritable;
 
-/// A process's jobs: in memory, and in its database.
 pub struct LocalJobStore {
     memory: MemoryJobStore,
     archive: Arc<Archive>,
@@ -49,24 +49,19 @@ impl LocalJobStore {
         }
     }
 
-    /// Writes with `call` (as [`LocalJobStore::db`] does), remembering whether writes fail:
-    /// the reason, for the client, if this one did.
+    /// [`LocalJobStore::db`], remembering whether writes fail.
     async fn write(
         &self,
         what: &'static str,
         call: impl FnOnce(&Arc<Archive>) -> rusqlite::Result<()> + Send + 'static,
     ) -> Result<(), Unwritable> {
-        let outcome = match self.db(what, call).await {
-            Some(()) => Ok(()),
-            None => Err(Unwritable),
-        };
-        let mut failing = self.failing.lock().unwrap_or_else(|p| p.into_inner());
-        *failing = outcome.as_ref().err().map(Unwritable::to_string);
+        let outcome = self.db(what, call).await.ok_or(Unwritable);
+        *lock(&self.failing) = outcome.as_ref().err().map(Unwritable::to_string);
         outcome
     }
 
-    /// Runs `call` on the database off the async threads; an error is logged with `what`
-    /// was being done, and read as `None` (the record in memory still answers).
+    /// Runs `call` on the database off the async threads; an error is logged (with `what`)
+    /// and read as `None` (the record in memory still answers).
     async fn db<T: Send + 'static>(
         &self,
         what: &'static str,
@@ -84,8 +79,7 @@ impl LocalJobStore {
             .ok()
     }
 
-    /// Saves the end of job `id`: its final state as memory `kept` it, its work `done`,
-    /// when it `finished`.
+    /// Saves the end of job `id`, its final state as memory `kept` it.
     async fn save_end(
         &self,
         id: Uuid,
@@ -109,19 +103,10 @@ impl LocalJobStore {
         .await
     }
 
-    /// The jobs whose end could not be saved, to save once writes succeed again.
-    fn unsaved(&self) -> MutexGuard<'_, Vec<Uuid>> {
-        self.unsaved.lock().unwrap_or_else(|p| p.into_inner())
-    }
-
-    /// Saves the ends not saved before (a disk that was full has room again) of the jobs
-    /// memory still holds: after this they are not lost at a restart. Tried after every
-    /// write that succeeds, and at every purge.
+    /// Saves the ends not saved before, of the jobs memory still holds (a full disk may have
+    /// room again). Tried after every write that succeeds, and at every purge.
     async fn save_unsaved(&self) {
-        let pending = std::mem::take(&mut *self.unsaved());
-        if pending.is_empty() {
-            return;
-        }
+        let pending = std::mem::take(&mut *lock(&self.unsaved));
         for id in pending {
             let Some(record) = self.memory.get(id).await else {
                 continue;
@@ -131,7 +116,7 @@ impl LocalJobStore {
             };
             match self.save_end(id, record.state, record.done, finished).await {
                 Ok(()) => self.memory.mark_unsaved(id, false),
-                Err(_) => self.unsaved().push(id),
+                Err(_) => lock(&self.unsaved).push(id),
             }
         }
     }
@@ -166,7 +151,7 @@ impl JobStore for LocalJobStore {
     async fn update(&self, id: Uuid, state: JobState, done: usize) {
         let status = state.status();
         if !status.is_finished() {
-            self.memory.update(id, state, done).await;
+            self.memory.update(id, state, done, SystemTime::now()).await;
             // A start not recorded reads as the job queued: it is not lost for that.
             let _ = self
                 .write("record a job's start", move |db| db.set_status(id, status))
@@ -175,19 +160,16 @@ impl JobStore for LocalJobStore {
         }
         // The end is saved before memory shows it: a client told that the job finished
         // finds it finished after a restart too (shown first, a kill between the two left
-        // it `interrupted`).
-        // (A job ends once: an end already kept keeps its time.)
-        let now = match self.memory.get(id).await.and_then(|job| job.finished_at) {
-            Some(ended) => ended,
-            None => SystemTime::now(),
-        };
+        // it `interrupted`). A job ends once: an end already kept keeps its time.
+        let ended = self.memory.get(id).await.and_then(|job| job.finished_at);
+        let now = ended.unwrap_or_else(SystemTime::now);
         let result = state.result().cloned();
         let saved = self.save_end(id, state.clone(), done, now).await;
-        let updated = self.memory.update_at(id, state, done, now).await;
+        let place = self.memory.update(id, state, done, now).await;
         match saved {
             Ok(()) => {
                 // A result beyond the memory budget is read from the database from now on.
-                if let Some(result) = result.filter(|_| updated.place == Place::Database) {
+                if let Some(result) = result.filter(|_| place == Place::Database) {
                     self.memory
                         .store_result(id, self.archive.saved(id, &result));
                 }
@@ -195,7 +177,7 @@ impl JobStore for LocalJobStore {
             }
             Err(_) => {
                 self.memory.mark_unsaved(id, true);
-                self.unsaved().push(id);
+                lock(&self.unsaved).push(id);
             }
         }
     }
@@ -229,25 +211,21 @@ impl JobStore for LocalJobStore {
         self.archive.durable()
     }
 
-    /// The ends not saved, saved now if the disk has room again.
     async fn settle(&self) {
         self.save_unsaved().await;
     }
 
     fn problem(&self) -> Option<String> {
-        let failing = self.failing.lock().unwrap_or_else(|p| p.into_inner());
-        let unsaved = self.unsaved().len();
-        self.archive
-            .moved()
-            .or_else(|| failing.clone())
-            .or_else(|| {
-                (unsaved > 0).then(|| {
-                    format!(
-                        "{unsaved} finished jobs could not be saved in the database of saved \
+        let failing = lock(&self.failing).clone();
+        let unsaved = lock(&self.unsaved).len();
+        self.archive.moved().or(failing).or_else(|| {
+            (unsaved > 0).then(|| {
+                format!(
+                    "{unsaved} finished jobs could not be saved in the database of saved \
                          analyses (the log says why): they are kept in memory until a write \
                          succeeds"
-                    )
-                })
+                )
             })
+        })
     }
 }

@@ -21,7 +21,6 @@ impl std::fmt::Debug for PointMemo {
 }
 
 impl PointMemo {
-    /// Holds about `max_bytes` of points, each for at most `ttl`.
     pub fn new(max_bytes: u64, ttl: Duration) -> Self {
         // A point of a rolling sweep, the commonest, weighs about 1 kB.
         let weigh = |(_, bytes): &(Kept, u32)| u64::from(*bytes);

@@ -29,7 +29,6 @@ pub const REDELIVERIES: &str = "thirdbody_redeliveries_total";
 static METADATA: Metadata<'static> =
     Metadata::new(module_path!(), metrics::Level::INFO, Some(module_path!()));
 
-/// A handle on a recorder, shared by the engine and the HTTP layer.
 #[derive(Clone)]
 pub struct Metrics {
     recorder: Arc<dyn Recorder + Send + Sync>,
@@ -39,7 +38,13 @@ impl Metrics {
     /// Records on `recorder`, and describes the engine's metrics there.
     pub fn new(recorder: Arc<dyn Recorder + Send + Sync>) -> Self {
         let metrics = Metrics { recorder };
-        metrics.describe();
+        metrics.describe_seconds(SOLVE_DURATION, "Time spent solving jobs");
+        metrics.describe_counter(CACHE_HITS, "Results served from the cache");
+        metrics.describe_counter(CACHE_MISSES, "Results that were solved");
+        let r = &metrics.recorder;
+        r.describe_gauge(JOBS_QUEUED.into(), None, "Async jobs waiting".into());
+        r.describe_gauge(JOBS_RUNNING.into(), None, "Async jobs being solved".into());
+        metrics.describe_counter(REJECTIONS, "Work refused, by reason");
         metrics
     }
 
@@ -50,23 +55,12 @@ impl Metrics {
         }
     }
 
-    fn describe(&self) {
-        self.describe_seconds(SOLVE_DURATION, "Time spent solving jobs");
-        self.describe_counter(CACHE_HITS, "Results served from the cache");
-        self.describe_counter(CACHE_MISSES, "Results that were solved");
-        let r = &self.recorder;
-        r.describe_gauge(JOBS_QUEUED.into(), None, "Async jobs waiting".into());
-        r.describe_gauge(JOBS_RUNNING.into(), None, "Async jobs being solved".into());
-        self.describe_counter(REJECTIONS, "Work refused, by reason");
-    }
-
-    /// Gives a counter its help text.
     pub fn describe_counter(&self, name: &'static str, help: &'static str) {
         self.recorder
             .describe_counter(name.into(), None, help.into());
     }
 
-    /// Gives a histogram of durations its help text.
+    /// Describes a histogram of durations.
     pub fn describe_seconds(&self, name: &'static str, help: &'static str) {
         let unit = Some(metrics::Unit::Seconds);
         self.recorder
@@ -78,11 +72,7 @@ impl Metrics {
             .register_counter(&key(name, labels), &METADATA)
     }
 
-    pub fn gauge(&self, name: &'static str) -> Gauge {
-        self.labelled_gauge(name, &[])
-    }
-
-    pub fn labelled_gauge(&self, name: &'static str, labels: &[(&'static str, &str)]) -> Gauge {
+    pub fn gauge(&self, name: &'static str, labels: &[(&'static str, &str)]) -> Gauge {
         self.recorder.register_gauge(&key(name, labels), &METADATA)
     }
 
@@ -108,9 +98,8 @@ impl SolveDurations {
         }
     }
 
-    /// Records that a job of `kind` took `elapsed` to end with `outcome`.
     pub fn record(&self, kind: &'static str, outcome: &'static str, elapsed: Duration) {
-        let mut seen = self.seen.lock().unwrap_or_else(|e| e.into_inner());
+        let mut seen = super::lock(&self.seen);
         let found = seen.iter().find(|(k, o, _)| *k == kind && *o == outcome);
         let histogram = match found {
             Some((.., histogram)) => histogram.clone(),

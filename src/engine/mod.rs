@@ -1,11 +1,8 @@
-//! Runs validated jobs. The command line calls [`run`] directly: the job's kind does its own
-//! work under a [`Control`]. The HTTP service goes through an [`Engine`]: admission control
-//! on a pool of permits sized to the cores ([`pool`]), a result cache ([`cache`]) in front
-//! of which identical misses share one solve ([`coalesce`]), and a store of asynchronous
-//! jobs ([`store`]). The cache and the store are traits, so that a shared backend can take
-//! the place of the in-process ones. Inside, the engine is two parts: the solve path
-//! ([`Solver`]) and the life of asynchronous jobs (`lifecycle`); the fleet's workers
-//! ([`fleet::Worker`]) solve through the same [`Solver`].
+//! Runs validated jobs. The command line calls [`run`] directly. The HTTP service goes
+//! through an [`Engine`]: admission on a pool of permits sized to the cores ([`pool`]), a
+//! result cache ([`cache`]) in front of which identical misses share one solve, and a store
+//! of asynchronous jobs ([`store`]); the cache and the store are traits, so that a shared
+//! backend (the [`fleet`]'s) can take the place of the in-process ones.
 
 pub mod admission;
 pub mod archive;
@@ -40,8 +37,16 @@ pub use service::Engine;
 pub use solver::{CacheStatus, CacheUse, Solver};
 pub use storage::Storage;
 
+use std::sync::{Mutex, MutexGuard, PoisonError};
+
 use crate::job::{Control, Job, JobError};
 use crate::render::Answer;
+
+/// Locks `mutex`, even if a holder panicked: every holder leaves what it guards whole, and
+/// one failed request must not wedge the engine.
+pub(crate) fn lock<T>(mutex: &Mutex<T>) -> MutexGuard<'_, T> {
+    mutex.lock().unwrap_or_else(PoisonError::into_inner)
+}
 
 /// Runs `job` to its answer, or until `control` stops it.
 pub fn run(job: &Job, control: &Control) -> Result<Answer, JobError> {

@@ -16,7 +16,6 @@ use crate::job::{Control, JobError};
 pub struct Pool {
     permits: Arc<Semaphore>,
     memory: Arc<Semaphore>,
-    /// The memory's permits in all.
     memory_kib: u32,
 }
 
@@ -28,7 +27,6 @@ pub struct Permit {
 }
 
 impl Pool {
-    /// A pool of `size` thread permits (at least one) and `memory` bytes of working memory.
     pub fn new(size: usize, memory: u64) -> Self {
         let memory_kib = u32::try_from(memory >> 10).unwrap_or(u32::MAX).max(1);
         Pool {
@@ -38,15 +36,13 @@ impl Pool {
         }
     }
 
-    /// The memory permits a solve of `bytes` takes: all of them for a solve larger than the
-    /// whole share, which then runs alone.
+    /// The memory permits for `bytes`: all of them for a solve larger than the share (alone).
     fn kib(&self, bytes: u64) -> u32 {
         u32::try_from(bytes.div_ceil(1024))
             .unwrap_or(u32::MAX)
             .min(self.memory_kib)
     }
 
-    /// A thread and `bytes` of working memory if both are free now.
     pub fn try_acquire(&self, bytes: u64) -> Option<Permit> {
         let thread = self.permits.clone().try_acquire_owned().ok()?;
         let memory = match self.kib(bytes) {
@@ -63,15 +59,10 @@ impl Pool {
     pub async fn acquire(&self, bytes: u64) -> Permit {
         let closed = "the pool's semaphores are never closed";
         let thread = self.permits.clone().acquire_owned().await.expect(closed);
+        let memory = self.memory.clone();
         let memory = match self.kib(bytes) {
             0 => None,
-            kib => Some(
-                self.memory
-                    .clone()
-                    .acquire_many_owned(kib)
-                    .await
-                    .expect(closed),
-            ),
+            kib => Some(memory.acquire_many_owned(kib).await.expect(closed)),
         };
         Permit {
             _thread: thread,
@@ -79,35 +70,28 @@ impl Pool {
         }
     }
 
-    /// Runs `work` on a blocking thread (below the async threads, [`super::heavy`]) that holds `permit` until it returns, inside the
-    /// caller's tracing span. If the caller stops waiting (a client hung up, a request timed
-    /// out), `control` is cancelled: the solver stops at its next check instead of burning a
-    /// core for nobody.
+    /// Runs `work` holding `permit` on a [`super::heavy`] thread, in the caller's span. If the
+    /// caller stops waiting (a client hung up, a request timed out), `control` is cancelled:
+    /// the solver stops at its next check instead of burning a core for nobody.
     pub async fn run<T, F>(permit: Permit, control: Arc<Control>, work: F) -> Result<T, JobError>
     where
         T: Send + 'static,
         F: FnOnce(&Control) -> Result<T, JobError> + Send + 'static,
     {
-        let guard = CancelOnDrop(Some(control.clone()));
+        let mut guard = CancelOnDrop(Some(control.clone()));
         let span = tracing::Span::current();
         let result = super::heavy::run(move || {
             let _permit = permit;
             span.in_scope(|| work(&control))
         })
         .await;
-        guard.disarm();
+        guard.0 = None;
         result.map_err(|e| JobError::Internal(format!("the solver thread failed: {e}")))?
     }
 }
 
 /// Cancels a job when the future waiting for it is dropped before it finished.
 struct CancelOnDrop(Option<Arc<Control>>);
-
-impl CancelOnDrop {
-    fn disarm(mut self) {
-        self.0 = None;
-    }
-}
 
 impl Drop for CancelOnDrop {
     fn drop(&mut self) {

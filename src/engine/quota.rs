@@ -7,26 +7,15 @@ use std::collections::HashMap;
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, SystemTime};
 
+use super::clock::unix_millis;
 use super::fleet::Fleet;
+use super::lock;
 use crate::job::Cost;
 
-/// The length of a window.
 const WINDOW: Duration = Duration::from_secs(60);
 
-/// Seconds since the epoch of `now`.
-fn seconds(now: SystemTime) -> u64 {
-    now.duration_since(std::time::UNIX_EPOCH)
-        .unwrap_or_default()
-        .as_secs()
-}
-
-/// The window `now` falls in.
-fn window_of(now: SystemTime) -> u64 {
-    seconds(now) / WINDOW.as_secs()
-}
-
-/// A charge refused: what the tenant used in the window already, and when the window ends
-/// (none if the charge alone is over the limit: waiting cannot help).
+/// A charge refused: what the tenant used in the window, and when the window ends (none if
+/// the charge alone is over the limit: waiting cannot help).
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Exceeded {
     pub used: u64,
@@ -39,17 +28,15 @@ pub struct Exceeded {
 pub struct Charge {
     pub tenant: String,
     pub points: u64,
-    /// The window they were charged in.
     pub window: u64,
     /// Whether the points guessed at an iterative job's work (a fit's), which its time then
-    /// settles; else they are the work's own measure (a point a local answer, a continuum
-    /// answer's grid), the same whatever the machine.
+    /// settles; else they are the work's own measure, the same whatever the machine.
     pub guessed: bool,
 }
 
 /// The points charged to each tenant in the current window.
 pub struct PointCounts {
-    /// Tenant → (window, points), when there is no fleet (or its Redis cannot be reached).
+    /// Tenant → (window, points), without a fleet (or its Redis).
     local: Mutex<HashMap<String, (u64, u64)>>,
     fleet: Option<Arc<Fleet>>,
 }
@@ -62,8 +49,7 @@ impl PointCounts {
         }
     }
 
-    /// Charges `points` to `tenant` in the window of `now`, unless its points there would
-    /// pass `limit`; the window charged.
+    /// Charges `points` to `tenant` in the window of `now` within `limit`; the window.
     pub async fn charge(
         &self,
         tenant: &str,
@@ -71,8 +57,8 @@ impl PointCounts {
         limit: u64,
         now: SystemTime,
     ) -> Result<u64, Exceeded> {
-        let since = seconds(now);
-        let window = window_of(now);
+        let since = unix_millis(now) / 1000;
+        let window = since / WINDOW.as_secs();
         let retry_after = Duration::from_secs(WINDOW.as_secs() - since % WINDOW.as_secs());
         if points > limit {
             return Err(Exceeded {
@@ -96,8 +82,7 @@ impl PointCounts {
         }
     }
 
-    /// Trues up `charge`, made before the work, by what the work really `took` on a solver
-    /// thread ([`crate::job::Cost::of_time`]), if it was a guess.
+    /// Trues up `charge`, if it was a guess, by what the work `took` ([`Cost::of_time`]).
     pub async fn true_up(&self, charge: &Charge, took: Duration) {
         if !charge.guessed {
             return;
@@ -108,41 +93,33 @@ impl PointCounts {
             .await;
     }
 
-    /// Gives back `charge`: the work it was for was refused after all.
+    /// Gives back `charge`: its work was refused after all.
     pub async fn refund(&self, charge: &Charge) {
         let charged = i64::try_from(charge.points).unwrap_or(i64::MAX);
         self.adjust(&charge.tenant, -charged, charge.window).await;
     }
 
-    /// Trues up a charge made before the work: `delta` more points (fewer, if negative) for
-    /// `tenant` in the window it was charged in, `window`, whatever its limit (the work is
-    /// done); never below nought.
+    /// Adds `delta` points (fewer, if negative) to `tenant`'s charge in `window`, whatever
+    /// its limit (the work is done).
     pub async fn adjust(&self, tenant: &str, delta: i64, window: u64) {
         if delta == 0 {
             return;
         }
         if let Some(fleet) = &self.fleet {
-            let key = format!("thirdbody:quota:{tenant}:{window}");
-            let mut pipe = redis::pipe();
-            pipe.atomic()
-                .incr(&key, delta)
-                .ignore()
-                .expire(&key, 2 * WINDOW.as_secs() as i64)
-                .ignore();
-            if fleet.jobs.pipe::<()>(&pipe).await.is_ok() {
+            if add(fleet, &key(tenant, window), delta).await.is_some() {
                 return;
             }
         }
-        let mut counts = self.local.lock().unwrap_or_else(|p| p.into_inner());
+        let mut counts = lock(&self.local);
         // A window gone by is not counted any more: nothing to true up there.
         if let Some(count) = counts.get_mut(tenant).filter(|c| c.0 == window) {
             count.1 = count.1.saturating_add_signed(delta);
         }
     }
 
-    /// In this process: the points used before, if the charge is refused.
+    /// In this process; the points used before, if refused.
     fn charge_here(&self, tenant: &str, window: u64, points: u64, limit: u64) -> Result<(), u64> {
-        let mut counts = self.local.lock().unwrap_or_else(|p| p.into_inner());
+        let mut counts = lock(&self.local);
         let count = counts.entry(tenant.to_string()).or_insert((window, 0));
         if count.0 != window {
             *count = (window, 0);
@@ -164,14 +141,9 @@ impl PointCounts {
         points: u64,
         limit: u64,
     ) -> Option<Result<(), u64>> {
-        let key = format!("thirdbody:quota:{tenant}:{window}");
-        let mut pipe = redis::pipe();
-        pipe.atomic()
-            .incr(&key, points)
-            .expire(&key, 2 * WINDOW.as_secs() as i64)
-            .ignore();
+        let key = key(tenant, window);
+        let used = add(fleet, &key, i64::try_from(points).unwrap_or(i64::MAX)).await?;
         // A count trued up below nought (a refund that passed a later charge) is nought.
-        let (used,): (i64,) = fleet.jobs.pipe(&pipe).await.ok()?;
         let used = u64::try_from(used).unwrap_or(0);
         if used <= limit {
             return Some(Ok(()));
@@ -184,12 +156,31 @@ impl PointCounts {
     }
 }
 
+fn key(tenant: &str, window: u64) -> String {
+    format!("thirdbody:quota:{tenant}:{window}")
+}
+
+/// Adds `delta` to the count under `key` in the fleet's Redis, which keeps it two windows:
+/// the count then, or `None` if Redis cannot be reached.
+async fn add(fleet: &Fleet, key: &str, delta: i64) -> Option<i64> {
+    let mut pipe = redis::pipe();
+    pipe.atomic()
+        .incr(key, delta)
+        .expire(key, 2 * WINDOW.as_secs() as i64)
+        .ignore();
+    let (count,): (i64,) = fleet.jobs.pipe(&pipe).await.ok()?;
+    Some(count)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
+    /// A charge is trued up in the window it was charged in: a refund makes room, work beyond
+    /// the estimate takes it (past the limit, even: the work is done); a window gone by is
+    /// not counted any more.
     #[tokio::test]
-    async fn a_tenant_gets_its_points_per_window_and_no_more() {
+    async fn a_tenant_gets_its_points_per_window_and_a_charge_is_trued_up_in_it() {
         let counts = PointCounts::new(None);
         let at = |s: u64| std::time::UNIX_EPOCH + Duration::from_secs(s);
         // 60 000 s is the start of a window; 10 points a window.
@@ -208,31 +199,17 @@ mod tests {
         // More than the limit at once: waiting cannot help.
         let alone = counts.charge("c", 11, 10, at(60_000)).await;
         assert_eq!(alone.unwrap_err().retry_after, None);
-    }
 
-    /// A charge is trued up in the window it was charged in: a refund makes room, work beyond
-    /// the estimate takes it (past the limit, even: the work is done); a window gone by is
-    /// not counted any more.
-    #[tokio::test]
-    async fn a_charge_is_trued_up_in_its_window() {
-        let counts = PointCounts::new(None);
-        let at = |s: u64| std::time::UNIX_EPOCH + Duration::from_secs(s);
-        let window = counts.charge("a", 8, 10, at(60_000)).await.unwrap();
-        counts.adjust("a", -6, window).await;
-        assert_eq!(counts.charge("a", 8, 10, at(60_002)).await, Ok(window));
-        counts.adjust("a", 5, window).await;
-        let over = counts.charge("a", 1, 10, at(60_004)).await.unwrap_err();
+        let window = counts.charge("d", 8, 10, at(60_000)).await.unwrap();
+        counts.adjust("d", -6, window).await;
+        assert_eq!(counts.charge("d", 8, 10, at(60_002)).await, Ok(window));
+        counts.adjust("d", 5, window).await;
+        let over = counts.charge("d", 1, 10, at(60_004)).await.unwrap_err();
         assert_eq!(over.used, 15);
-        counts.adjust("a", -100, window - 1).await;
-        assert_eq!(
-            counts
-                .charge("a", 1, 10, at(60_005))
-                .await
-                .unwrap_err()
-                .used,
-            15
-        );
-        counts.adjust("b", -5, window).await;
-        assert_eq!(counts.charge("b", 10, 10, at(60_006)).await, Ok(window));
+        counts.adjust("d", -100, window - 1).await;
+        let over = counts.charge("d", 1, 10, at(60_005)).await.unwrap_err();
+        assert_eq!(over.used, 15);
+        counts.adjust("e", -5, window).await;
+        assert_eq!(counts.charge("e", 10, 10, at(60_006)).await, Ok(window));
     }
 }

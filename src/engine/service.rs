@@ -1,8 +1,6 @@
-//! The engine: what the service asks of the compute side, behind one type. It is two parts
-//! with one job each: the solve path ([`Solver`]: cache → one solve per key → permit →
-//! solver thread) and the life of asynchronous jobs ([`Lifecycle`]: records, live handles,
-//! ids, the drain, the fleet's stream). The engine admits or refuses new work (and counts
-//! refusals) and hands each call to its part.
+//! The engine: what the service asks of the compute side, behind one type. It admits or
+//! refuses new work (and counts refusals) and hands each call to its part: the solve path
+//! ([`Solver`]) or the life of asynchronous jobs ([`Lifecycle`]).
 
 use std::collections::HashSet;
 use std::future::Future;
@@ -29,29 +27,23 @@ const UNFINISHED_COUNTED: usize = 10_000;
 /// The compute service: the solve path and the asynchronous jobs.
 pub struct Engine {
     solve_deadline: Duration,
-    /// The solve path: cache, one solve per key, permits, solver threads.
     pub solver: Arc<Solver>,
-    /// The asynchronous jobs: their records, the drain, the fleet's workers.
     pub jobs: Arc<Lifecycle>,
-    /// The points each tenant asked for in the current minute (its quota's count).
     points: Arc<PointCounts>,
-    /// One admission at a time per tenant (its quotas counted, then its job stored).
     admissions: Admissions,
     fleet: Option<Arc<Fleet>>,
 }
 
 impl Engine {
-    /// An engine that keeps everything in this process.
     pub fn new(config: EngineConfig, metrics: Metrics) -> Result<Arc<Engine>, ArchiveError> {
         let storage = Storage::in_process(&config)?;
         Ok(Engine::with_storage(config, metrics, storage))
     }
 
-    /// An engine that keeps answers and job records in `storage`.
     pub fn with_storage(config: EngineConfig, metrics: Metrics, storage: Storage) -> Arc<Engine> {
         if let Some(shared) = &storage.fleet {
             for link in [&shared.fleet.cache, &shared.fleet.jobs] {
-                link.report_to(metrics.labelled_gauge(names::REDIS_UP, &[("role", link.role)]));
+                link.report_to(metrics.gauge(names::REDIS_UP, &[("role", link.role)]));
             }
         }
         let solver = Arc::new(Solver::new(&config, metrics.clone(), storage.cache));
@@ -74,15 +66,14 @@ impl Engine {
         })
     }
 
-    /// `tenant`'s turn to admit a job (whose quotas are counted, then the job stored), after
-    /// its admissions before, in this process and across a fleet ([`Admissions`]).
+    /// `tenant`'s turn to admit a job (its quotas counted, then the job stored), after its
+    /// admissions before, in this process and across a fleet ([`Admissions`]).
     pub async fn turn(&self, tenant: &str) -> Result<Turn, EngineError> {
         self.admissions.turn(tenant, self.fleet.as_ref()).await
     }
 
-    /// Charges `points` of work to `tenant`, unless its points this minute would pass
-    /// `limit` (counted fleet-wide in a fleet).
-    /// The window charged, for a later true-up or refund ([`Charge`]).
+    /// Charges `points` to `tenant`, unless its points this minute (fleet-wide in a fleet)
+    /// would pass `limit`; the window charged, for a later true-up or refund ([`Charge`]).
     pub async fn charge(&self, tenant: &str, points: u64, limit: u64) -> Result<u64, Exceeded> {
         self.points
             .charge(tenant, points, limit, std::time::SystemTime::now())
@@ -112,11 +103,10 @@ impl Engine {
         self.solver.metrics()
     }
 
-    /// Answers the input `text` (its kind and compact JSON, as the client sent it): an input
-    /// seen before whose answer is cached is answered at once, without validating it again
-    /// (validation and the cache key cost more than the look-up); otherwise `validate` makes
-    /// its job, which is solved ([`Engine::solve`]). The caller decides where `validate`
-    /// runs (a large input is read on a blocking thread).
+    /// Answers the input `text` (its kind and compact JSON, as sent): one seen before whose
+    /// answer is cached at once, without validating it again (validation and the cache key
+    /// cost more than the look-up); else `validate` makes its job, which is solved. The
+    /// caller decides where `validate` runs (a large input is read on a blocking thread).
     pub async fn answer<E: From<EngineError>>(
         self: &Arc<Self>,
         text: String,
@@ -141,9 +131,8 @@ impl Engine {
         self.solve_by(keyed, deadline, CacheUse::Keep).await
     }
 
-    /// [`Engine::solve`] with a deadline of the caller's (shared by several solves, as a
-    /// checks suite's), never later than the solve deadline from now, and its own use of
-    /// the cache (a check's answer is not kept).
+    /// [`Engine::solve`] by the caller's deadline (shared by several solves, as a checks
+    /// suite's; never later than the solve deadline), using the cache as `cache` says.
     pub async fn solve_by(
         self: &Arc<Self>,
         keyed: Keyed,
@@ -156,12 +145,9 @@ impl Engine {
         solved.map_err(|e| self.refused(e))
     }
 
-    /// Queues `keyed` to run in the background; returns its record. Refused when the
-    /// queue is full, the service is draining, or there is no room to keep the job's
-    /// result.
-    /// `charged`: the points a quota charged for it, trued up by what it really took when it
-    /// ends if they were a guess (in this process; a fleet's workers run jobs elsewhere, and
-    /// the guess stands).
+    /// Queues `keyed` to run in the background ([`Lifecycle::submit`]). `charged`: the points
+    /// a quota charged for it, trued up when it ends if they were a guess (in this process;
+    /// a fleet's workers run jobs elsewhere, and the guess stands), refunded if refused.
     pub async fn submit(
         &self,
         keyed: Keyed,
@@ -185,12 +171,10 @@ impl Engine {
         record.map_err(|e| self.refused(e))
     }
 
-    /// Trues up `charge` by what its work really `took` on a solver thread.
     pub async fn true_up(&self, charge: &Charge, took: Duration) {
         self.points.true_up(charge, took).await;
     }
 
-    /// Gives back `charge`: its work was refused after all (no thread, no room).
     pub async fn refund(&self, charge: &Charge) {
         self.points.refund(charge).await;
     }

@@ -1,7 +1,6 @@
 //! The solve path: keyed job → cache → one solve per key in flight → a permit (or a refusal)
 //! → a blocking thread with a deadline and a cancel flag → the answer rendered and kept.
-//! Synchronous solves, asynchronous jobs ([`super::lifecycle`]) and the fleet's workers
-//! ([`super::fleet::Worker`]) all solve through it; it knows nothing of job records.
+//! Synchronous solves, asynchronous jobs and the fleet's workers all solve through it.
 
 use std::sync::Arc;
 use std::time::Instant;
@@ -43,23 +42,15 @@ pub enum CacheUse {
     /// Keeps the answer for the next caller (a client's solve).
     Keep,
     /// Lets the answer go once the caller has it (a large answer solved for a check, which
-    /// nobody else asks for). Identical concurrent solves share this one, so theirs is not
-    /// kept either.
+    /// nobody else asks for; identical concurrent solves share it, unkept).
     ReadOnly,
 }
 
-/// A solve that did not answer: why, and the partial answer of a job that keeps what it
-/// finished ([`crate::job::Unfinished`]).
+/// A solve that did not answer ([`crate::job::Unfinished`]).
 pub(super) struct Stopped {
-    error: JobError,
-    partial: Option<Arc<Solved>>,
-}
-
-impl Stopped {
-    /// Why the solve stopped, and what it finished (kept for an asynchronous job only).
-    pub(super) fn into_parts(self) -> (JobError, Option<Arc<Solved>>) {
-        (self.error, self.partial)
-    }
+    pub error: JobError,
+    /// What it finished (kept for an asynchronous job only).
+    pub partial: Option<Arc<Solved>>,
 }
 
 impl From<JobError> for Stopped {
@@ -76,12 +67,9 @@ pub struct Solver {
     pool: Pool,
     cache: Arc<dyn ResultCache>,
     coalescer: Coalescer,
-    /// The text of valid inputs (their kind and compact JSON with sorted keys) → their
-    /// cache key, so that a repeated request is answered without being validated again.
+    /// Valid inputs' text (kind and compact JSON) → cache key: a repeat is not validated again.
     input_keys: Bounded<Arc<str>>,
-    /// Which inputs were seen once: the memo takes an input on its second sighting.
     doorkeeper: Doorkeeper,
-    /// Solved points of sweeps, for a retry after a deadline.
     points: Arc<PointMemo>,
     metrics: Metrics,
     solve_durations: SolveDurations,
@@ -91,7 +79,6 @@ pub struct Solver {
 }
 
 impl Solver {
-    /// A solve path of `config.pool_size` threads whose answers are kept in `cache`.
     pub fn new(config: &EngineConfig, metrics: Metrics, cache: Arc<dyn ResultCache>) -> Self {
         let budget = Budget::split(config.memory_budget);
         Solver {
@@ -109,7 +96,7 @@ impl Solver {
             points: Arc::new(PointMemo::new(budget.points, config.cache_ttl)),
             cache_hits: metrics.counter(names::CACHE_HITS, &[]),
             cache_misses: metrics.counter(names::CACHE_MISSES, &[]),
-            jobs_running: metrics.gauge(names::JOBS_RUNNING),
+            jobs_running: metrics.gauge(names::JOBS_RUNNING, &[]),
             solve_durations: SolveDurations::new(metrics.clone()),
             metrics,
         }
@@ -119,15 +106,15 @@ impl Solver {
         &self.metrics
     }
 
-    /// The cached answer to an input seen before (`text`: its kind and compact JSON), found
-    /// without validating the input again; `None` if it was not seen or its answer expired.
+    /// The cached answer to the input `text` (its kind and compact JSON) if it was seen
+    /// before, found without validating it again.
     pub(super) async fn cached_input(&self, text: &str) -> Option<Arc<Solved>> {
         let key = self.input_keys.get(text)?;
         self.cached(&key).await
     }
 
-    /// Remembers that the input `text` (as for [`Solver::cached_input`]) is a valid job
-    /// with cache key `key`, if it was seen before ([`Doorkeeper`]).
+    /// Remembers that the valid input `text` has the cache key `key`, if it was seen before
+    /// ([`Doorkeeper`]).
     pub(super) fn remember_input(&self, text: String, key: String) {
         if self.doorkeeper.seen_before(&text) {
             self.input_keys.insert(text, key.into());
@@ -143,20 +130,18 @@ impl Solver {
         solved
     }
 
-    /// Keeps `solved` in the cache.
     pub(super) async fn keep(&self, solved: Arc<Solved>) {
         self.cache.insert(solved).await;
     }
 
-    /// Keeps `solved`, the result of the fleet's job `job`, in the cache (see
-    /// [`ResultCache::insert_result_of`]).
+    /// See [`ResultCache::insert_result_of`].
     pub(super) async fn keep_result_of(&self, solved: Arc<Solved>, job: uuid::Uuid) {
         self.cache.insert_result_of(solved, job).await;
     }
 
-    /// Solves `keyed` by `deadline` (keeping the answer as `cache` says), or takes its
-    /// answer from the cache. Identical concurrent calls share one solve (in a fleet, one
-    /// across processes). With no solver thread free the call is refused at once.
+    /// Solves `keyed` by `deadline`, or takes its answer from the cache. Identical concurrent
+    /// calls share one solve (in a fleet, one across processes). With no solver thread free
+    /// the call is refused at once.
     pub async fn solve_by(
         self: &Arc<Self>,
         keyed: Keyed,
@@ -190,8 +175,7 @@ impl Solver {
         }
     }
 
-    /// Solves `keyed` now, this process holding the fleet's claim on it, and keeps the
-    /// answer if `cache` says so.
+    /// Solves `keyed` now, this process holding the fleet's claim on it.
     async fn solve_claimed(
         &self,
         keyed: Keyed,
@@ -207,15 +191,14 @@ impl Solver {
         let solved = self
             .execute(permit, keyed, control, false)
             .await
-            .map_err(|stopped| stopped.into_parts().0)?;
+            .map_err(|stopped| stopped.error)?;
         if cache == CacheUse::Keep {
             self.keep(solved.clone()).await;
         }
         Ok(solved)
     }
 
-    /// Waits for a solver thread's permit and `bytes` of working memory (first come, first
-    /// served).
+    /// Waits for a solver thread and `bytes` of working memory (first come, first served).
     pub(super) async fn permit(&self, bytes: u64) -> Permit {
         self.pool.acquire(bytes).await
     }
@@ -231,10 +214,9 @@ impl Solver {
         Running(self.jobs_running.clone())
     }
 
-    /// Solves `keyed` holding `permit` (on a blocking thread, or here if it is small),
-    /// renders its answer, and records the solve. With `keep` (an asynchronous job's
-    /// result, kept for its retention) the answer is rendered in every form now
-    /// ([`Solved::kept`]), and a job stopped before its end keeps what it finished.
+    /// Solves `keyed` holding `permit`, renders its answer, and records the solve. With
+    /// `keep` (an asynchronous job's result, kept for its retention) the answer is rendered
+    /// in every form now ([`Solved::kept`]), and a stopped job keeps what it finished.
     pub(super) async fn execute(
         &self,
         permit: Permit,
@@ -273,16 +255,10 @@ impl Solver {
             Pool::run(permit, control, solve).await
         }
         .unwrap_or_else(|e| Err(Stopped::from(e)));
-        let outcome = match &result {
+        let outcome = match result.as_ref().map_err(|stopped| &stopped.error) {
             Ok(_) => "succeeded",
-            Err(Stopped {
-                error: JobError::Cancelled,
-                ..
-            }) => "cancelled",
-            Err(Stopped {
-                error: JobError::DeadlineExceeded,
-                ..
-            }) => "deadline_exceeded",
+            Err(JobError::Cancelled) => "cancelled",
+            Err(JobError::DeadlineExceeded) => "deadline_exceeded",
             Err(_) => "failed",
         };
         self.solve_durations
@@ -291,7 +267,6 @@ impl Solver {
     }
 }
 
-/// A job counted as running ([`Solver::running`]) until dropped.
 pub(super) struct Running(Gauge);
 
 impl Drop for Running {

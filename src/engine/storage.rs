@@ -16,15 +16,12 @@ use super::store::{JobStore, MemoryJobStore};
 pub struct Storage {
     pub cache: Arc<dyn ResultCache>,
     pub jobs: Arc<dyn JobStore>,
-    /// The fleet the engine works in, if any ([`super::fleet`]): its jobs then run on the
-    /// fleet's work stream, not in this process's tasks.
+    /// The fleet, if any: jobs then run on its work stream, not in this process's tasks.
     pub fleet: Option<Arc<Shared>>,
 }
 
 impl Storage {
-    /// In this process's memory, within `config`'s bounds, and its database of saved
-    /// analyses (which keeps the results beyond the memory budget too, if it is a file): the
-    /// default. Fails if the database cannot be opened.
+    /// In this process's memory and its database of saved analyses: the default.
     pub fn in_process(config: &EngineConfig) -> Result<Storage, ArchiveError> {
         let budget = Budget::split(config.memory_budget);
         let archive = Archive::open(&config.database, config.history_retention)?;
@@ -41,8 +38,7 @@ impl Storage {
         })
     }
 
-    /// In the fleet of `fleet`: this process's memory in front of Redis for answers, Redis
-    /// for jobs and their work.
+    /// In `fleet`: this process's memory in front of Redis for answers, Redis for jobs.
     pub fn in_fleet(config: &EngineConfig, fleet: FleetConfig) -> Result<Storage, LinkError> {
         let fleet = Arc::new(Fleet::open(fleet)?);
         let l1 = MemoryCache::for_engine(config);

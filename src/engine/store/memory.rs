@@ -1,31 +1,21 @@
-//! One process's job records in memory, bounded in count and in the bytes of their results:
-//! a result beyond its share of the memory budget is kept in the database of saved analyses
-//! instead (when that is a file), and a job for whose result there is no room is refused
-//! when it is submitted, never after its work.
+//! One process's job records in memory, bounded in count and in the bytes of their results.
 
 use std::collections::{HashMap, VecDeque};
-use std::sync::{Mutex, MutexGuard};
+use std::sync::Mutex;
 use std::time::{Duration, SystemTime};
 
 use uuid::Uuid;
 
 use super::record::{JobRecord, JobResult, JobState, Refusal};
 use crate::engine::clock::age;
+use crate::engine::lock;
 
 /// Where a job's result will be kept.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Place {
     Memory,
-    /// The database of saved analyses (every finished job's result is saved there; one kept
-    /// there only is read from there).
+    /// The database of saved analyses (which saves every finished job's result anyway).
     Database,
-}
-
-/// Room made for a result not in yet.
-#[derive(Clone, Copy, Debug)]
-struct Reservation {
-    bytes: u64,
-    place: Place,
 }
 
 /// The records of one process's jobs, at most `max_jobs` of them, with the results of those
@@ -45,23 +35,21 @@ pub struct MemoryJobStore {
 #[derive(Debug, Default)]
 struct Records {
     jobs: HashMap<Uuid, JobRecord>,
-    /// Room made for the results of jobs not finished yet.
-    reserved: HashMap<Uuid, Reservation>,
-    /// Finished jobs, oldest first (ids may have been forgotten since).
+    /// Room made (bytes, and where) for the results of jobs not finished yet.
+    reserved: HashMap<Uuid, (u64, Place)>,
+    /// Finished jobs, oldest first (some may be forgotten since).
     finished: VecDeque<Uuid>,
     /// Bytes held and made room for in memory.
     memory: u64,
 }
 
 impl Records {
-    /// Adds `bytes` held in `place` (nothing, in the database).
     fn hold(&mut self, place: Place, bytes: u64) {
         if place == Place::Memory {
             self.memory += bytes;
         }
     }
 
-    /// Takes `bytes` held in `place` back.
     fn free(&mut self, place: Place, bytes: u64) {
         if place == Place::Memory {
             self.memory = self.memory.saturating_sub(bytes);
@@ -74,12 +62,11 @@ impl Records {
                 self.free(Place::Memory, result.weight());
             }
         }
-        if let Some(r) = self.reserved.remove(id) {
-            self.free(r.place, r.bytes);
+        if let Some((bytes, place)) = self.reserved.remove(id) {
+            self.free(place, bytes);
         }
     }
 
-    /// Forgets the jobs past their retention.
     fn purge(&mut self, retention: Duration, now: SystemTime) -> usize {
         let expired: Vec<Uuid> = self
             .jobs
@@ -95,8 +82,7 @@ impl Records {
         expired.len()
     }
 
-    /// How long until the oldest finished job expires (and makes room), at most
-    /// `retention`.
+    /// How long until the oldest finished job expires (and makes room), at most `retention`.
     fn next_expiry(&self, retention: Duration, now: SystemTime) -> Duration {
         self.finished
             .iter()
@@ -108,9 +94,6 @@ impl Records {
 }
 
 impl MemoryJobStore {
-    /// A store that forgets a job `retention` after it finished, keeps at most `max_jobs`
-    /// records and `result_bytes` of their results in memory, and leaves results beyond that
-    /// to the database if `database` (a file) can hold them.
     pub fn new(retention: Duration, max_jobs: usize, result_bytes: u64, database: bool) -> Self {
         MemoryJobStore {
             records: Mutex::default(),
@@ -121,12 +104,7 @@ impl MemoryJobStore {
         }
     }
 
-    fn records(&self) -> MutexGuard<'_, Records> {
-        self.records.lock().unwrap_or_else(|p| p.into_inner())
-    }
-
-    /// Room for a result of `bytes` in `records`: in memory if it fits there, else in the
-    /// database, if it is a file.
+    /// Room for a result of `bytes`: in memory if it fits there, else in a file database.
     fn room(&self, records: &Records, bytes: u64) -> Result<Place, Refusal> {
         if records.memory.saturating_add(bytes) <= self.result_bytes {
             return Ok(Place::Memory);
@@ -154,9 +132,9 @@ impl MemoryJobStore {
         })
     }
 
-    /// Keeps job `id`'s result as `stored` (in the database) instead of in memory.
+    /// Keeps job `id`'s result as `stored` in the database instead of in memory.
     pub fn store_result(&self, id: Uuid, stored: JobResult) {
-        let mut records = self.records();
+        let mut records = lock(&self.records);
         let Some(record) = records.jobs.get_mut(&id) else {
             return;
         };
@@ -164,29 +142,11 @@ impl MemoryJobStore {
         record.state = record.state.clone().with_result(stored);
         records.free(Place::Memory, held);
     }
-}
 
-/// What [`MemoryJobStore::update`] did.
-#[derive(Clone, Copy, Debug)]
-pub struct Updated {
-    /// When the job finished, once it has (now, if memory forgot the job).
-    pub finished_at: Option<SystemTime>,
-    /// Where room was made for its result.
-    pub place: Place,
-}
-
-/// `n` bytes in MB, for people.
-fn megabytes(n: u64) -> String {
-    format!("{:.1} MB", n as f64 / 1e6)
-}
-
-/// The in-memory half of [`super::local::LocalJobStore`]: the [`JobStore`] calls that it
-/// answers alone.
-impl MemoryJobStore {
     pub async fn insert(&self, record: JobRecord) -> Result<(), Refusal> {
         let result_bytes = record.result_bytes;
         let now = SystemTime::now();
-        let mut records = self.records();
+        let mut records = lock(&self.records);
         records.purge(self.retention, now);
         if records.jobs.len() >= self.max_jobs {
             return Err(Refusal::Full {
@@ -200,19 +160,13 @@ impl MemoryJobStore {
         }
         let place = self.room(&records, result_bytes)?;
         records.hold(place, result_bytes);
-        records.reserved.insert(
-            record.id,
-            Reservation {
-                bytes: result_bytes,
-                place,
-            },
-        );
+        records.reserved.insert(record.id, (result_bytes, place));
         records.jobs.insert(record.id, record);
         Ok(())
     }
 
     pub async fn get(&self, id: Uuid) -> Option<JobRecord> {
-        let mut records = self.records();
+        let mut records = lock(&self.records);
         let record = records.jobs.get(&id)?;
         if record.expired(self.retention, SystemTime::now()) {
             records.forget(&id);
@@ -221,41 +175,29 @@ impl MemoryJobStore {
         Some(record.clone())
     }
 
-    /// Moves job `id` to `state`; returns, once finished, when it finished (now, if memory
-    /// forgot the job), and where room was made for its result (the database: the caller
-    /// moves it there, [`MemoryJobStore::store_result`], once saved).
-    pub async fn update(&self, id: Uuid, state: JobState, done: usize) -> Updated {
-        self.update_at(id, state, done, SystemTime::now()).await
-    }
-
-    /// [`MemoryJobStore::update`], a job finishing now taken to have finished at `now`.
-    pub async fn update_at(
-        &self,
-        id: Uuid,
-        state: JobState,
-        done: usize,
-        now: SystemTime,
-    ) -> Updated {
+    /// Moves job `id` to `state`, a job finishing now taken to have finished at `now`;
+    /// returns where room was made for its result (the database: the caller moves it there,
+    /// [`MemoryJobStore::store_result`], once saved).
+    pub async fn update(&self, id: Uuid, state: JobState, done: usize, now: SystemTime) -> Place {
         let finishing = state.status().is_finished();
-        let mut records = self.records();
+        let mut records = lock(&self.records);
         // The room made for the result, taken once: by the update that finishes the job.
         let reservation = finishing.then(|| records.reserved.remove(&id)).flatten();
-        if let Some(r) = reservation {
-            records.free(r.place, r.bytes);
+        if let Some((bytes, place)) = reservation {
+            records.free(place, bytes);
             if let Some(result) = state.result() {
                 records.hold(Place::Memory, result.weight());
-                if result.weight() > r.bytes {
+                if result.weight() > bytes {
                     tracing::warn!(
-                        %id, estimate = r.bytes, weight = result.weight(),
+                        %id, estimate = bytes, weight = result.weight(),
                         "a result weighs more than the room made for it"
                     );
                 }
             }
         }
-        let place = reservation.map_or(Place::Memory, |r| r.place);
+        let place = reservation.map_or(Place::Memory, |(_, place)| place);
         let Some(record) = records.jobs.get_mut(&id) else {
-            let finished_at = finishing.then_some(now);
-            return Updated { finished_at, place };
+            return place;
         };
         let finished = finishing && record.finished_at.is_none();
         if finished {
@@ -263,28 +205,31 @@ impl MemoryJobStore {
         }
         record.state = state;
         record.done = done;
-        let finished_at = record.finished_at;
         if finished {
             records.finished.push_back(id);
         }
-        Updated { finished_at, place }
+        place
     }
 
     pub async fn remove(&self, id: Uuid) {
-        self.records().forget(&id);
+        lock(&self.records).forget(&id);
     }
 
-    /// Marks job `id` as kept in memory only (its end could not be saved for good), or no
-    /// longer.
+    /// Marks job `id` as kept in memory only (its end could not be saved), or no longer.
     pub fn mark_unsaved(&self, id: Uuid, unsaved: bool) {
-        if let Some(record) = self.records().jobs.get_mut(&id) {
+        if let Some(record) = lock(&self.records).jobs.get_mut(&id) {
             record.unsaved = unsaved;
         }
     }
 
     pub async fn purge_expired(&self) -> usize {
-        self.records().purge(self.retention, SystemTime::now())
+        lock(&self.records).purge(self.retention, SystemTime::now())
     }
+}
+
+/// `n` bytes in MB, for people.
+fn megabytes(n: u64) -> String {
+    format!("{:.1} MB", n as f64 / 1e6)
 }
 
 #[cfg(test)]
@@ -292,74 +237,52 @@ mod tests {
     use std::sync::Arc;
 
     use super::*;
+    use crate::engine::archive::{Archive, IN_MEMORY};
     use crate::engine::cache::Solved;
     use crate::job::registry::KindName;
-    use crate::job::Work;
-    use crate::render::{Answer, Column, Output, Table, UnitTable};
-    use crate::{described, unit_table};
-    use serde::Serialize;
+    use crate::job::{RollingJob, Work};
 
-    described! {
-        #[derive(Debug, PartialEq, Serialize)]
-        struct Blob {
-            text: String => [],
+    /// A result whose JSON and CSV take `bytes` together, as a job keeps it.
+    fn kept(bytes: usize) -> JobState {
+        let (kind, half) = (KindName::of::<RollingJob>(), vec![b'x'; bytes / 2]);
+        let solved = Solved::rendered("k".into(), kind, half.clone().into(), half.into());
+        JobState::Succeeded(JobResult::Ready(Arc::new(solved)))
+    }
+
+    /// A job just accepted whose result may take `bytes`.
+    fn record(bytes: u64) -> JobRecord {
+        let kind = KindName::of::<RollingJob>();
+        JobRecord::queued(Uuid::new_v4(), kind, Work::Known(1), "k").holding(bytes)
+    }
+
+    /// Inserts `n` jobs whose results may take `bytes`, ending each in `end` if given.
+    async fn admit(
+        store: &MemoryJobStore,
+        n: usize,
+        bytes: u64,
+        end: Option<JobState>,
+    ) -> Vec<Uuid> {
+        let mut ids = Vec::new();
+        for _ in 0..n {
+            let record = record(bytes);
+            ids.push(record.id);
+            store.insert(record).await.unwrap();
+            if let Some(end) = end.clone() {
+                store
+                    .update(ids[ids.len() - 1], end, 1, SystemTime::now())
+                    .await;
+            }
         }
-    }
-
-    impl Output for Blob {
-        const UNITS: &'static UnitTable = unit_table!(Blob);
-        fn table(&self) -> Table {
-            Table::new(
-                &[Column::text("text", |b: &Blob, text| {
-                    text.push_str(&b.text)
-                })],
-                [self],
-            )
-        }
-    }
-
-    /// A result whose JSON and CSV take about `bytes` together, as a job keeps it.
-    fn kept(key: &str, bytes: usize) -> JobResult {
-        let blob = Blob {
-            text: "x".repeat(bytes / 2),
-        };
-        let solved = Solved::new(
-            key.to_string(),
-            KindName::of::<crate::job::RollingJob>(),
-            Answer::new(blob),
-        )
-        .unwrap();
-        JobResult::Ready(Arc::new(solved.kept().unwrap()))
-    }
-
-    fn record() -> JobRecord {
-        JobRecord::queued(
-            Uuid::new_v4(),
-            KindName::of::<crate::job::RollingJob>(),
-            Work::Known(1),
-            "k",
-        )
-    }
-
-    /// Finishes job `id` with a result of `bytes`.
-    async fn succeed(store: &MemoryJobStore, id: Uuid, bytes: usize) {
-        store
-            .update(id, JobState::Succeeded(kept("k", bytes)), 1)
-            .await;
+        ids
     }
 
     #[tokio::test]
     async fn a_result_is_kept_whole_for_its_retention_and_a_job_without_room_is_refused_before_its_work(
     ) {
         let store = MemoryJobStore::new(Duration::from_secs(60), 100, 10_000, false);
-        let mut ids = Vec::new();
-        for _ in 0..3 {
-            let r = record();
-            ids.push(r.id);
-            store.insert(r.holding(3_000)).await.unwrap();
-        }
+        let ids = admit(&store, 3, 3_000, None).await;
         // Room for three results of 3 kB is made: a fourth does not fit, now.
-        match store.insert(record().holding(3_000)).await {
+        match store.insert(record(3_000)).await {
             Err(Refusal::Full { what, retry_after }) => {
                 assert!(
                     what.contains("in memory (the database is in memory too"),
@@ -371,14 +294,14 @@ mod tests {
         }
         // Too large for an empty store: said so, with both numbers.
         assert_eq!(
-            store.insert(record().holding(20_000)).await,
+            store.insert(record(20_000)).await,
             Err(Refusal::TooLarge {
                 needed: 20_000,
                 limit: 10_000
             })
         );
         for id in &ids {
-            succeed(&store, *id, 2_500).await;
+            store.update(*id, kept(2_500), 1, SystemTime::now()).await;
         }
         // Every result is still there, whole.
         for id in &ids {
@@ -386,92 +309,62 @@ mod tests {
             assert!(matches!(state, JobState::Succeeded(JobResult::Ready(_))));
         }
         // A result that weighs less than its room gives the rest back: one more 1 kB job fits.
-        store.insert(record().holding(1_000)).await.unwrap();
+        store.insert(record(1_000)).await.unwrap();
         // Forgetting a job makes room.
         store.remove(ids[0]).await;
-        store.insert(record().holding(3_000)).await.unwrap();
+        store.insert(record(3_000)).await.unwrap();
     }
 
     #[tokio::test]
     async fn results_beyond_the_memory_budget_are_left_to_a_file_database() {
         let store = MemoryJobStore::new(Duration::from_secs(60), 100, 4_000, true);
-        let (small, large) = (record(), record());
+        let (small, large) = (record(3_000), record(100_000));
         let (small_id, large_id) = (small.id, large.id);
-        store.insert(small.holding(3_000)).await.unwrap();
-        store.insert(large.holding(100_000)).await.unwrap();
-        let small_end = JobState::Succeeded(kept("k", 2_000));
-        assert_eq!(
-            store.update(small_id, small_end, 1).await.place,
-            Place::Memory
-        );
-        let large_end = JobState::Succeeded(kept("k", 90_000));
-        assert_eq!(
-            store.update(large_id, large_end, 1).await.place,
-            Place::Database
-        );
+        store.insert(small).await.unwrap();
+        store.insert(large).await.unwrap();
+        let now = SystemTime::now();
+        let small_end = store.update(small_id, kept(2_000), 1, now).await;
+        assert_eq!(small_end, Place::Memory);
+        let large_end = store.update(large_id, kept(90_000), 1, now).await;
+        assert_eq!(large_end, Place::Database);
         // Once saved there, memory holds the small result alone: room for another.
         let JobState::Succeeded(large) = store.get(large_id).await.unwrap().state else {
             panic!("the large job did not succeed");
         };
-        store.store_result(large_id, stored(&large));
+        let archive = Archive::open(IN_MEMORY, Duration::from_secs(60)).unwrap();
+        store.store_result(large_id, archive.saved(large_id, &large));
         assert!(matches!(
             store.get(large_id).await.unwrap().state,
             JobState::Succeeded(JobResult::Stored(_))
         ));
-        assert!(store.records().memory < 4_000, "{}", store.records().memory);
-        store.insert(record().holding(1_500)).await.unwrap();
-    }
-
-    /// `result` as a store outside memory keeps it.
-    fn stored(result: &JobResult) -> JobResult {
-        struct Nowhere;
-        #[async_trait::async_trait]
-        impl super::super::ResultPlace for Nowhere {
-            async fn body(&self, _: &str) -> std::io::Result<bytes::Bytes> {
-                Ok(bytes::Bytes::new())
-            }
-        }
-        let stored = super::super::StoredResult::new(
-            result.key().to_string(),
-            KindName::of::<crate::job::RollingJob>(),
-            result.complete(),
-            Arc::new(Nowhere),
-        );
-        JobResult::Stored(Arc::new(stored))
+        let memory = lock(&store.records).memory;
+        assert!(memory < 4_000, "{memory}");
+        store.insert(record(1_500)).await.unwrap();
     }
 
     #[tokio::test]
     async fn at_most_max_jobs_records_are_kept_and_more_are_refused_until_one_is_forgotten() {
         let store = MemoryJobStore::new(Duration::from_secs(60), 3, 1 << 20, false);
-        let mut ids = Vec::new();
-        for _ in 0..3 {
-            let r = record();
-            ids.push(r.id);
-            store.insert(r.holding(100)).await.unwrap();
-            let cancelled = JobState::Cancelled { partial: None };
-            store.update(ids[ids.len() - 1], cancelled, 0).await;
-        }
+        let cancelled = JobState::Cancelled { partial: None };
+        let ids = admit(&store, 3, 100, Some(cancelled)).await;
         assert!(matches!(
-            store.insert(record().holding(100)).await,
+            store.insert(record(100)).await,
             Err(Refusal::Full { .. })
         ));
         for id in &ids {
             assert!(store.get(*id).await.is_some());
         }
         store.remove(ids[0]).await;
-        store.insert(record().holding(100)).await.unwrap();
+        store.insert(record(100)).await.unwrap();
     }
 
     #[tokio::test]
     async fn expired_jobs_make_room() {
         let store = MemoryJobStore::new(Duration::from_millis(20), 1, 1 << 20, false);
-        let first = record();
-        let id = first.id;
-        store.insert(first.holding(100)).await.unwrap();
-        succeed(&store, id, 50).await;
-        assert!(store.insert(record().holding(100)).await.is_err());
+        let id = admit(&store, 1, 100, Some(kept(50))).await[0];
+        assert!(store.insert(record(100)).await.is_err());
         tokio::time::sleep(Duration::from_millis(30)).await;
-        store.insert(record().holding(100)).await.unwrap();
+        store.insert(record(100)).await.unwrap();
         assert!(store.get(id).await.is_none());
     }
 }

@@ -1,7 +1,6 @@
 //! Asynchronous jobs' records: what a client polling a job sees, kept for a retention time
-//! after the job finishes, then forgotten. The words of a record ([`record`]), the seam a
-//! store plugs into ([`JobStore`]: this process's ([`super::local`]) or the fleet's), and the
-//! in-memory store in front of this process's database ([`memory`]).
+//! after the job finishes. [`JobStore`] is the seam this process's store
+//! ([`super::local`]) and the fleet's plug into.
 
 pub mod memory;
 pub mod record;
@@ -18,28 +17,23 @@ pub use record::{
 /// Where the records of asynchronous jobs are kept.
 #[async_trait]
 pub trait JobStore: Send + Sync {
-    /// Records a job just accepted, whose result will take at most its `result_bytes`: room
-    /// is made for it now, so that the result is kept for its retention once the work is
-    /// done, or the job is refused before any work.
+    /// Records a job just accepted: room is made now for its `result_bytes`, so that the
+    /// result is kept for its retention, or the job is refused before any work.
     async fn insert(&self, record: JobRecord) -> Result<(), Refusal>;
     /// The job `id`, unless unknown or expired.
     async fn get(&self, id: Uuid) -> Option<JobRecord>;
-    /// Moves the job `id` to `state` with `done` units of work done; a finished state
-    /// starts its retention.
+    /// Moves the job `id` to `state`; a finished state starts its retention.
     async fn update(&self, id: Uuid, state: JobState, done: usize);
-    /// Forgets the job `id`.
     async fn remove(&self, id: Uuid);
     /// Forgets the jobs past their retention; returns how many.
     async fn purge_expired(&self) -> usize;
-    /// The jobs of `listing`'s owner, newest first, filtered and paged; an error says why
-    /// the store cannot be read.
+    /// The jobs of `listing`'s owner, newest first, filtered and paged.
     async fn list(&self, listing: &Listing) -> Result<Page, Unreadable>;
-    /// The newest job that succeeded on the input whose hash is `input_hash`; an error says
-    /// why the store cannot be read.
+    /// The newest job that succeeded on the input whose hash is `input_hash`.
     async fn with_input(&self, input_hash: &str) -> Result<Option<JobRecord>, Unreadable>;
 
-    /// Whether every process of the fleet shares the store (so any of them answers for any
-    /// job, and a job unknown to it is unknown to all).
+    /// Whether every process of the fleet shares the store (a job unknown to it is unknown
+    /// to all).
     fn shared(&self) -> bool {
         false
     }

@@ -1,6 +1,5 @@
-//! The words of asynchronous jobs' records: a job's status and state, where its result is,
-//! who owns it, and how the stores list and refuse them. A record holds no live handle: the
-//! cancel flag and the progress count of a running job stay with the process that runs it.
+//! The words of asynchronous jobs' records. A record holds no live handle: the cancel flag
+//! and the progress count of a running job stay with the process that runs it.
 
 use std::io;
 use std::sync::Arc;
@@ -33,7 +32,7 @@ pub enum JobStatus {
 }
 
 impl JobStatus {
-    /// Every status, in the order of a job's life (for parsing and for errors naming them).
+    /// Every status, in the order of a job's life.
     pub const ALL: [JobStatus; 6] = [
         JobStatus::Queued,
         JobStatus::Running,
@@ -43,7 +42,6 @@ impl JobStatus {
         JobStatus::Interrupted,
     ];
 
-    /// The status named `text` (as [`JobStatus::as_str`] writes it).
     pub fn parse(text: &str) -> Option<JobStatus> {
         JobStatus::ALL.into_iter().find(|s| s.as_str() == text)
     }
@@ -60,13 +58,7 @@ impl JobStatus {
     }
 
     pub fn is_finished(self) -> bool {
-        matches!(
-            self,
-            JobStatus::Succeeded
-                | JobStatus::Failed
-                | JobStatus::Cancelled
-                | JobStatus::Interrupted
-        )
+        !matches!(self, JobStatus::Queued | JobStatus::Running)
     }
 }
 
@@ -76,13 +68,11 @@ pub enum JobState {
     Queued,
     Running,
     Succeeded(JobResult),
-    /// Failed; a job that keeps partial work (a sweep past its deadline) keeps what it
-    /// finished.
+    /// Failed; a job that keeps partial work (a sweep past its deadline) keeps what it did.
     Failed {
         error: JobError,
         partial: Option<JobResult>,
     },
-    /// Cancelled; with what it finished, for a job that keeps partial work.
     Cancelled {
         partial: Option<JobResult>,
     },
@@ -90,8 +80,8 @@ pub enum JobState {
 }
 
 impl JobState {
-    /// Logs that the job ended in this state: an internal failure as an error with its
-    /// cause, which its clients are not shown.
+    /// Logs the job's end: an internal failure as an error with its cause (not shown to
+    /// clients).
     pub fn log_end(&self, id: impl std::fmt::Display) {
         match self {
             JobState::Failed {
@@ -113,8 +103,7 @@ impl JobState {
         }
     }
 
-    /// The state of a job read back from a store as its `status`, its `result` if one was
-    /// stored, and its `error` (read only for a failed job).
+    /// The state of a job read back from a store (its `error` is read for a failed job only).
     pub fn restored(
         status: JobStatus,
         result: Option<JobResult>,
@@ -138,7 +127,6 @@ impl JobState {
         }
     }
 
-    /// A failure that kept nothing.
     pub fn failed(error: JobError) -> JobState {
         JobState::Failed {
             error,
@@ -155,7 +143,6 @@ impl JobState {
         }
     }
 
-    /// The same state with its result replaced by `result`.
     pub fn with_result(self, result: JobResult) -> JobState {
         match self {
             JobState::Succeeded(_) => JobState::Succeeded(result),
@@ -177,12 +164,9 @@ pub struct JobRecord {
     pub id: Uuid,
     /// The job's kind (its name on the wire, and what draws its answer).
     pub kind: KindName,
-    /// The work the job takes.
     pub work: Work,
-    /// Where it is in its life: queued, running, or ended with its result or error.
     pub state: JobState,
-    /// Work done when the record was last written (a running job's own count is live in
-    /// the process that runs it).
+    /// Work done when last written (a running job's own count is live where it runs).
     pub done: usize,
     /// The hash of the job's canonical input (its cache key): equal inputs, equal answers.
     pub input_hash: String,
@@ -190,18 +174,15 @@ pub struct JobRecord {
     pub owner: Option<Owner>,
     /// When it was accepted (wall clock: it is shown, and compared across processes).
     pub submitted_at: SystemTime,
-    /// When it finished, once it has.
     pub finished_at: Option<SystemTime>,
-    /// Bytes its answer may take, at most: the room made for it when it was accepted, held
-    /// for its retention.
+    /// Bytes its answer may take, at most: room made at its acceptance, held for its retention.
     pub result_bytes: u64,
-    /// Whether its end could not be saved where the store keeps jobs for good (a database
-    /// that cannot be written): it is then kept in memory only, and says so.
+    /// Whether its end could not be saved for good (then memory alone keeps it, and says so).
     pub unsaved: bool,
 }
 
 impl JobRecord {
-    /// A job just accepted, whose id is `id`, on the input whose hash is `input_hash`.
+    /// A job just accepted.
     pub fn queued(id: Uuid, kind: KindName, work: Work, input_hash: &str) -> JobRecord {
         JobRecord {
             id,
@@ -218,12 +199,10 @@ impl JobRecord {
         }
     }
 
-    /// The same record, owned by `owner`.
     pub fn owned_by(self, owner: Option<Owner>) -> JobRecord {
         JobRecord { owner, ..self }
     }
 
-    /// The same record, its answer taking at most `result_bytes`.
     pub fn holding(self, result_bytes: u64) -> JobRecord {
         JobRecord {
             result_bytes,
@@ -252,18 +231,15 @@ impl JobRecord {
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]
 pub struct Owner(String);
 
-/// The prefix of a tenant's stored form.
 const TENANT: &str = "key:";
 
 impl Owner {
-    /// The owner holding `token` (checked by the caller).
     pub fn of_token(token: &str) -> Owner {
         use sha2::{Digest, Sha256};
         let digest = Sha256::digest(token.as_bytes());
         Owner(digest.iter().map(|b| format!("{b:02x}")).collect())
     }
 
-    /// The tenant of the API keys named `name`.
     pub fn of_tenant(name: &str) -> Owner {
         Owner(format!("{TENANT}{name}"))
     }
@@ -273,7 +249,6 @@ impl Owner {
         self.0.starts_with(TENANT)
     }
 
-    /// An owner as stored.
     pub fn stored(hash: String) -> Owner {
         Owner(hash)
     }
@@ -296,7 +271,6 @@ pub struct Listing {
     pub limit: usize,
 }
 
-/// A page of an owner's jobs.
 #[derive(Clone, Debug, Default)]
 pub struct Page {
     pub jobs: Vec<JobRecord>,
@@ -305,8 +279,7 @@ pub struct Page {
 }
 
 impl Page {
-    /// The page `listing` asks for, out of `matching` (every job passing its filters,
-    /// newest first).
+    /// The page `listing` asks for, out of `matching` (newest first).
     pub fn of(matching: Vec<JobRecord>, listing: &Listing) -> Page {
         let total = matching.len();
         let jobs = matching
@@ -323,25 +296,19 @@ impl Page {
 pub enum Refusal {
     /// It holds as much as it may for jobs within their retention; room is made as they
     /// expire (the first in `retry_after`) or are deleted.
-    Full {
-        /// What is full, in words, with the numbers.
-        what: String,
-        retry_after: Duration,
-    },
+    Full { what: String, retry_after: Duration },
     /// Where it keeps jobs for good cannot be written now (a full disk, a database removed
     /// or damaged): the job is refused rather than accepted and lost.
     Unwritable { why: String },
     /// The job's result would not fit even in an empty store.
     TooLarge {
-        /// Bytes the result may take.
         needed: u64,
         /// Bytes the store can hold for one result.
         limit: u64,
     },
 }
 
-/// Where a result kept outside this process's memory is: the fleet's Redis, or the database
-/// of saved analyses.
+/// Where a result kept outside this process's memory is (Redis, the database).
 #[async_trait]
 pub trait ResultPlace: Send + Sync {
     /// The answer as JSON (`json`) or CSV (`csv`).
@@ -352,9 +319,7 @@ pub trait ResultPlace: Send + Sync {
 /// a client asking for it gets the one form it asks for.
 #[derive(Clone)]
 pub struct StoredResult {
-    /// The job's cache key.
     pub key: String,
-    /// The job's kind (which draws its picture).
     pub kind: KindName,
     /// Whether the answer is whole (see [`Solved::complete`]).
     pub complete: bool,
@@ -376,7 +341,6 @@ impl StoredResult {
         }
     }
 
-    /// The answer as JSON (`json`) or CSV (`csv`).
     pub async fn body(&self, field: &str) -> io::Result<Bytes> {
         self.place.body(field).await
     }
@@ -391,8 +355,7 @@ impl std::fmt::Debug for StoredResult {
     }
 }
 
-/// Where a job's result is: in memory, or stored (in the fleet's Redis or the database of
-/// saved analyses).
+/// Where a job's result is: in memory, or stored.
 #[derive(Clone, Debug)]
 pub enum JobResult {
     Ready(Arc<Solved>),
@@ -410,12 +373,8 @@ pub enum Unreadable {
 }
 
 impl JobResult {
-    /// Whether the answer is whole (else what a stopped job finished).
     pub fn complete(&self) -> bool {
-        match self {
-            JobResult::Ready(solved) => solved.complete,
-            JobResult::Stored(stored) => stored.complete,
-        }
+        self.about().2
     }
 
     /// How stores name the result's completeness: `whole` or `partial`.
@@ -427,8 +386,7 @@ impl JobResult {
         }
     }
 
-    /// The answer's JSON and CSV (a CSV rendered now is rendered off the async threads: a
-    /// large sweep's takes tens of milliseconds).
+    /// The answer's JSON and CSV (a CSV is rendered off the async threads: tens of ms).
     pub async fn bodies(&self) -> io::Result<(Bytes, Bytes)> {
         match self {
             JobResult::Ready(solved) => {
@@ -445,19 +403,19 @@ impl JobResult {
         }
     }
 
-    /// The kind of job whose answer it is (which draws its picture).
     pub fn kind(&self) -> KindName {
-        match self {
-            JobResult::Ready(solved) => solved.kind,
-            JobResult::Stored(stored) => stored.kind,
-        }
+        self.about().1
     }
 
-    /// The answer's cache key.
     pub fn key(&self) -> &str {
+        self.about().0
+    }
+
+    /// The answer's cache key, its kind, and whether it is whole.
+    fn about(&self) -> (&str, KindName, bool) {
         match self {
-            JobResult::Ready(solved) => &solved.key,
-            JobResult::Stored(stored) => &stored.key,
+            JobResult::Ready(s) => (&s.key, s.kind, s.complete),
+            JobResult::Stored(s) => (&s.key, s.kind, s.complete),
         }
     }
 
