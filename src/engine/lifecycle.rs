@@ -279,6 +279,11 @@ impl Lifecycle {
                 lock(&lifecycle.uncollected).insert(id, lifecycle.config.max_jobs);
                 lock(&lifecycle.live).remove(&id);
                 lifecycle.jobs.update(id, state, done).await;
+                // Its end saved where the next process reads it: a drain begun while it ran
+                // owes its client nothing more (one Ctrl-C waited out its timeout for it).
+                if lifecycle.kept_for_good(id).await {
+                    lock(&lifecycle.owed).remove(&id);
+                }
                 live.status.send_replace(status);
             }
             .instrument(span),
@@ -443,6 +448,14 @@ impl Lifecycle {
             false => lock(&self.uncollected).ids.iter().copied().collect(),
         };
         lock(&self.owed).extend(unfinished.into_iter().chain(uncollected));
+    }
+
+    /// Whether job `id` is kept where the next process reads it (a database file that can
+    /// be written, its end saved there).
+    async fn kept_for_good(&self, id: Uuid) -> bool {
+        self.jobs.durable()
+            && self.jobs.problem().is_none()
+            && self.jobs.get(id).await.is_some_and(|r| !r.unsaved)
     }
 
     /// A client read the job `id` finished: it owes its client nothing more.

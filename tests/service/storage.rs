@@ -222,47 +222,55 @@ fn a_damaged_database_is_refused_at_start_saying_how_to_go_on() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-/// A job finished before the shutdown and never read is in the database, for the next
-/// process to give: the drain does not wait out its timeout for its client (it did).
+/// A job finished before the shutdown, or during it, and never read is in the database, for
+/// the next process to give: the drain does not wait out its timeout for its client (it did
+/// for the first, and, issue 52, for the second: one Ctrl-C waited 30 s).
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn the_drain_does_not_wait_for_unread_jobs_the_database_keeps() {
-    let dir = scratch("unread");
-    let database = dir.join("analyses.db");
-    let http = Client::new();
-    let port = free_port();
-    let child = thirdbody()
-        .args(["serve", "--bind", &format!("127.0.0.1:{port}")])
-        .arg("--database")
-        .arg(&database)
-        .args(["--shutdown-timeout", "10m"])
-        .stdout(Stdio::null())
-        .stderr(Stdio::null())
-        .spawn()
-        .unwrap();
-    let mut server = Process(child);
-    let base = answering(&http, port).await;
-    let (status, view) = submit(&http, &base, &job(0)).await;
-    assert_eq!(status, StatusCode::ACCEPTED, "{view}");
-    let id = view["id"].as_str().unwrap().to_string();
-    // Finished, as the log of its end shows to a reader of the database after a restart;
-    // not read by its client here.
-    let start = Instant::now();
-    tokio::time::sleep(Duration::from_millis(200)).await;
-    server.sigterm();
-    let exited = loop {
-        if let Some(status) = server.0.try_wait().unwrap() {
-            break status;
+    // A continuum sweep runs for a good part of a second: still running at the SIGTERM.
+    let running = json!({"kind": "sweep", "input": {"base": {"layer": {"model": "continuum"}},
+        "vary": {"load": ["0.5 nN", "0.6 nN", "0.7 nN", "0.8 nN", "0.9 nN", "1 nN"]}}});
+    for (name, job, before) in [("unread", job(0), 200), ("running", running, 0)] {
+        let dir = scratch(name);
+        let database = dir.join("analyses.db");
+        let http = Client::new();
+        let port = free_port();
+        let child = thirdbody()
+            .args(["serve", "--bind", &format!("127.0.0.1:{port}")])
+            .arg("--database")
+            .arg(&database)
+            .args(["--shutdown-timeout", "10m"])
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .spawn()
+            .unwrap();
+        let mut server = Process(child);
+        let base = answering(&http, port).await;
+        let (status, view) = submit(&http, &base, &job).await;
+        assert_eq!(status, StatusCode::ACCEPTED, "{view}");
+        let id = view["id"].as_str().unwrap().to_string();
+        if name == "running" {
+            assert_eq!(view["status"], "queued", "{view}");
         }
-        // Far below the drain's bound of ten minutes, far above what exiting takes.
-        assert!(
-            start.elapsed() < Duration::from_secs(60),
-            "the drain waited for the unread job"
-        );
-        tokio::time::sleep(Duration::from_millis(20)).await;
-    };
-    assert!(exited.success(), "{exited}");
-    let (_server, base) = serve(&http, &database).await;
-    let read = finished(&http, &base, &id).await;
-    assert_eq!(read["status"], "succeeded", "{read}");
-    let _ = std::fs::remove_dir_all(&dir);
+        // Not read by its client here.
+        let start = Instant::now();
+        tokio::time::sleep(Duration::from_millis(before)).await;
+        server.sigterm();
+        let exited = loop {
+            if let Some(status) = server.0.try_wait().unwrap() {
+                break status;
+            }
+            // Far below the drain's bound of ten minutes, far above what exiting takes.
+            assert!(
+                start.elapsed() < Duration::from_secs(60),
+                "the drain waited for the {name} job"
+            );
+            tokio::time::sleep(Duration::from_millis(20)).await;
+        };
+        assert!(exited.success(), "{exited}");
+        let (_server, base) = serve(&http, &database).await;
+        let read = finished(&http, &base, &id).await;
+        assert_eq!(read["status"], "succeeded", "{name}: {read}");
+        let _ = std::fs::remove_dir_all(&dir);
+    }
 }
