@@ -192,12 +192,17 @@ try {
   const plot = `${area("sweep", "picture")} svg.plot`;
   const lines = await page.locator(`${plot} path.series`).count();
   if (lines !== 10) fail(`the sweep's plot draws ${lines} lines, not one per load (10)`);
+  // The legend writes each load in one unit, the largest's (0.5 nN, not 500 pN).
+  const names = await page.$$eval(`${plot} path.series`, (paths) => paths.map((p) => p.dataset.name));
+  if (names[0] !== "load = 0.5 nN" || names.some((n) => !n.endsWith(" nN"))) fail(`the sweep's legend reads ${names}`);
   await page.selectOption(`${area("sweep", "picture")} select[name='y']`, "contact_area");
   await page.selectOption(`${area("sweep", "picture")} select[name='x']`, "load");
   const yLabel = await page.locator(`${plot} .y-label`).textContent();
   if (yLabel !== "contact_area [nm²]") fail(`the plot's y axis reads ${yLabel}`);
   const perSpeed = await page.locator(`${plot} path.series`).count();
   if (perSpeed !== 20) fail(`against the load the plot draws ${perSpeed} lines, not one per speed (20)`);
+  const speedNames = await page.$$eval(`${plot} path.series`, (paths) => paths.map((p) => p.dataset.name));
+  if (speedNames[0] !== "velocity = 0 nm/s") fail(`the legend's first speed reads ${speedNames[0]}`);
   if (!(await page.locator(`${area("sweep", "picture")} .colour-bar`).count())) fail("20 lines are not told by a colour bar");
   // Hover reads the nearest point with its units.
   const dot = await page.locator(`${plot} circle.point`).nth(5).boundingBox();

@@ -70,6 +70,11 @@ function withUnit(value, unit) {
   return `${Number(shown.toPrecision(4))}${name ? " " + name : ""}`;
 }
 
+/** `value` in the unit `[size, name]` ([`scaleFor`]), to four digits: 0.5 nN. */
+function inScale(value, [size, name]) {
+  return `${Number((value / size).toPrecision(4))}${name ? " " + name : ""}`;
+}
+
 /** The labels of the plot's axes, under it and up its left side, into `g`. */
 function axisLabels(g, xText, yText) {
   const { width, height, left, right, top, bottom } = PLOT;
@@ -225,6 +230,12 @@ class SweepPlot {
       for (let i = 0; i < u.length; i++) if (u[i] !== v[i]) return u[i] - v[i];
       return 0;
     });
+    // Each varied input in one unit across the legend, its largest value's: 0.5 nN beside
+    // 2 nN (not 500 pN), 0 nm/s beside 4 nm/s (not 0 m/s).
+    const scales = Object.fromEntries(others.map((path) => {
+      const largest = kept.reduce((most, p) => Math.max(most, Math.abs(valueAt(p, path)) || 0), 0);
+      return [path, scaleFor(largest, this.units[path])];
+    }));
     linePlotsDrawn += 1;
     const clip = element("clipPath", { id: `plot-clip-${linePlotsDrawn}` });
     clip.append(element("rect", { x: PLOT.left, y: PLOT.top, width: PLOT.width - PLOT.left - PLOT.right, height: PLOT.height - PLOT.top - PLOT.bottom }));
@@ -235,7 +246,7 @@ class SweepPlot {
     order.forEach((key, i) => {
       const colour = sequential(order.length === 1 ? 0.35 : i / (order.length - 1));
       const series = groups.get(key).slice().sort((a, b) => valueAt(a, x) - valueAt(b, x));
-      const label = others.map((path) => `${path} = ${withUnit(valueAt(series[0], path), this.units[path])}`).join(", ") || y;
+      const label = others.map((path) => `${path} = ${inScale(valueAt(series[0], path), scales[path])}`).join(", ") || y;
       if (series.length > 1) {
         const d = series.map((p, k) => `${k ? "L" : "M"}${px(valueAt(p, x)).toFixed(1)},${py(valueAt(p, y)).toFixed(1)}`).join("");
         layer.append(element("path", { class: "series", d, fill: "none", stroke: colour, "stroke-width": 2, "data-name": label }));
