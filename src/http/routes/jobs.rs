@@ -185,24 +185,30 @@ pub async fn status(_: AcceptsJson, FoundJob(record): FoundJob) -> Json<JobView>
     responses((status = 200, description = "The job after the cancel", body = JobView),
         NotTheOwner, InvalidParameters, NotFound, Gone, NotAcceptable)
 )]
-pub async fn cancel(
-    State(state): State<AppState>,
-    _: AcceptsJson,
-    ChangeableJob(record): ChangeableJob,
-) -> Result<Json<JobView>, ApiError> {
-    let record = state
-        .engine()
-        .jobs
-        .cancel(record.id)
-        .await
-        .unwrap_or(record);
-    Ok(Json(JobView::of(&record)))
+pub async fn cancel(_: AcceptsJson, job: ChangeableJob) -> Json<JobView> {
+    job.change(false).await
 }
 
 /// The job of the path, which the request may change (cancel or delete): its owner's (the
 /// same API key's tenant, or the same owner's token) or an admin's; a job without an owner
 /// is anyone's who holds its id.
-pub struct ChangeableJob(JobRecord);
+pub struct ChangeableJob {
+    record: JobRecord,
+    engine: Arc<Engine>,
+}
+
+impl ChangeableJob {
+    /// Cancels the job, and with `delete` forgets it; the job as it ended (as it was, if it
+    /// was gone meanwhile).
+    async fn change(self, delete: bool) -> Json<JobView> {
+        let (jobs, id) = (&self.engine.jobs, self.record.id);
+        let ended = match delete {
+            true => jobs.delete(id).await,
+            false => jobs.cancel(id).await,
+        };
+        Json(JobView::of(&ended.unwrap_or(self.record)))
+    }
+}
 
 impl FromRequestParts<AppState> for ChangeableJob {
     type Rejection = ApiError;
@@ -211,7 +217,8 @@ impl FromRequestParts<AppState> for ChangeableJob {
         let OwnerHeader(token) = OwnerHeader::from_request_parts(parts, state).await?;
         let FoundJob(record) = FoundJob::from_request_parts(parts, state).await?;
         if Caller::of(&parts.extensions).may_change(record.owner.as_ref(), token) {
-            return Ok(ChangeableJob(record));
+            let engine = state.engine().clone();
+            return Ok(ChangeableJob { record, engine });
         }
         Err(ApiError::forbidden(format!(
             "job {} was submitted with an owner's token: only a request with the same \
@@ -252,18 +259,8 @@ pub struct OwnerParam {
     responses((status = 200, description = "The job as it ended, now forgotten", body = JobView),
         NotTheOwner, InvalidParameters, NotFound, Gone, NotAcceptable)
 )]
-pub async fn delete(
-    State(state): State<AppState>,
-    _: AcceptsJson,
-    ChangeableJob(record): ChangeableJob,
-) -> Result<Json<JobView>, ApiError> {
-    let record = state
-        .engine()
-        .jobs
-        .delete(record.id)
-        .await
-        .unwrap_or(record);
-    Ok(Json(JobView::of(&record)))
+pub async fn delete(_: AcceptsJson, job: ChangeableJob) -> Json<JobView> {
+    job.change(true).await
 }
 
 /// A finished job's answer.

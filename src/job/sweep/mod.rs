@@ -299,16 +299,7 @@ impl Kind for SweepJob {
                     );
                     control.map_each(&contacts, on_refusal, |p| SweepPoint::new(p, &kept(p)?))
                 };
-                let name = |i: usize| {
-                    let p = &contacts[i];
-                    format!(
-                        "R = {}, P = {}, V = {}",
-                        quantity(p.radius, "m"),
-                        quantity(p.load, "N"),
-                        quantity(p.velocity, "m/s")
-                    )
-                };
-                let swept = refused_at(swept, first, on_refusal, name);
+                let swept = refused_at(swept, first, on_refusal, |i| contact_name(&contacts[i]));
                 let stop = swept.stopped.clone();
                 let (rows, summary) = rows::rows(&contacts, swept, first, Subject::Particle);
                 (SweepPoints::Rolling(rows), summary, stop)
@@ -330,16 +321,7 @@ impl Kind for SweepJob {
                 let swept = control.map_each(&systems, on_refusal, |p| {
                     ThreeBodySweepPoint::new(p, &kept(p)?)
                 });
-                let name = |i: usize| {
-                    let system = &systems[i];
-                    let operating = match system.operating {
-                        OperatingPoint::Separation(d) => format!("d = {}", quantity(d, "m")),
-                        OperatingPoint::TotalLoad(w) => format!("W = {}", quantity(w, "N")),
-                        OperatingPoint::ParticleLoad(p) => format!("P = {}", quantity(p, "N")),
-                    };
-                    format!("{operating}, V = {}", quantity(system.velocity, "m/s"))
-                };
-                let swept = refused_at(swept, first, on_refusal, name);
+                let swept = refused_at(swept, first, on_refusal, |i| system_name(&systems[i]));
                 let stop = swept.stopped.clone();
                 let (rows, summary) = rows::rows(&systems, swept, first, Subject::System);
                 (SweepPoints::ThreeBody(rows), summary, stop)
@@ -396,6 +378,23 @@ fn part<T>(mut points: Vec<T>, range: Range<usize>) -> Result<Vec<T>, JobError> 
     }
     points.truncate(range.end);
     Ok(points.split_off(range.start))
+}
+
+/// A rolling point by its inputs, for messages: `R = 25 nm, P = 1 mN, V = 4 nm/s`.
+fn contact_name(p: &Rolling) -> String {
+    let (r, load, v) = (p.radius, p.load, p.velocity);
+    let [r, load, v] = [(r, "m"), (load, "N"), (v, "m/s")].map(|(x, unit)| quantity(x, unit));
+    format!("R = {r}, P = {load}, V = {v}")
+}
+
+/// A three-body point by its operating point and speed, for messages: `W = 1 mN, V = 4 nm/s`.
+fn system_name(system: &ThreeBody) -> String {
+    let operating = match system.operating {
+        OperatingPoint::Separation(d) => format!("d = {}", quantity(d, "m")),
+        OperatingPoint::TotalLoad(w) => format!("W = {}", quantity(w, "N")),
+        OperatingPoint::ParticleLoad(p) => format!("P = {}", quantity(p, "N")),
+    };
+    format!("{operating}, V = {}", quantity(system.velocity, "m/s"))
 }
 
 /// The error of point `index` of a sweep, whose inputs are `name`, said so.
