@@ -443,15 +443,15 @@ impl RedisJobStore {
         };
         // A result of a cancelled or failed job is what it finished before it stopped.
         let result = || match form.as_str() {
-            form @ ("whole" | "partial") => Some(JobResult::Stored(Arc::new(StoredResult::new(
-                text("key"),
+            form @ ("whole" | "partial") => Some(JobResult::Stored(Arc::new(StoredResult {
+                key: text("key"),
                 kind,
-                form == "whole",
-                Arc::new(InRedis {
+                complete: form == "whole",
+                place: Arc::new(InRedis {
                     fleet: self.fleet.clone(),
                     id,
                 }),
-            )))),
+            }))),
             _ => None,
         };
         let state = JobState::restored(status, result(), || {
