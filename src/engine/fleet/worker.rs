@@ -8,7 +8,6 @@ use std::ops::Range;
 use std::sync::{Arc, Mutex, MutexGuard};
 use std::time::{Duration, Instant};
 
-use bytes::Bytes;
 use futures_util::future::OptionFuture;
 use redis::streams::{
     StreamAutoClaimOptions, StreamAutoClaimReply, StreamClaimOptions, StreamId, StreamReadOptions,
@@ -346,7 +345,7 @@ impl Worker {
             }
             // Stopped by the drain: handed back at once, its delivery not counted.
             Err(JobError::Cancelled) if self.draining.is_cancelled() => {
-                hand_back(shared, entry).await;
+                hand_back(shared, entry).await
             }
             Err(JobError::Cancelled) => acknowledge(&shared.fleet, entry).await,
             Err(e) => {
@@ -364,13 +363,10 @@ impl Worker {
         };
         match parts::assemble(keyed.meta(), &all) {
             Ok(assembled) => {
-                let solved = Arc::new(Solved::rendered(
-                    keyed.key().to_string(),
-                    keyed.job().kind(),
-                    Bytes::from(assembled.json),
-                    Bytes::from(assembled.csv),
-                ));
-                self.succeed(entry, keyed, solved, runnable.parts).await;
+                let (json, csv) = (assembled.json.into(), assembled.csv.into());
+                let solved = Solved::rendered(keyed.key().into(), keyed.job().kind(), json, csv);
+                self.succeed(entry, keyed, Arc::new(solved), runnable.parts)
+                    .await;
             }
             Err(e) => {
                 self.finish(entry, JobState::failed(e), None).await;
