@@ -129,18 +129,6 @@ impl Rows {
         w.write_all(if list { b"]" } else { b"}" })
     }
 
-    /// Before a field or an element: a comma unless it is the first, and a new line when
-    /// indenting.
-    fn next<W: ?Sized + Write>(&mut self, w: &mut W, first: bool) -> io::Result<()> {
-        if !first {
-            w.write_all(b",")?;
-        }
-        if self.inline == 0 {
-            self.newline(w)?;
-        }
-        Ok(())
-    }
-
     fn newline<W: ?Sized + Write>(&self, w: &mut W) -> io::Result<()> {
         w.write_all(b"\n")?;
         for _ in 0..self.level {
@@ -161,8 +149,15 @@ macro_rules! container {
             self.close(w, $list)
         }
 
+        /// A comma unless first, and a new line when indenting.
         fn $before<W: ?Sized + Write>(&mut self, w: &mut W, first: bool) -> io::Result<()> {
-            self.next(w, first)
+            if !first {
+                w.write_all(b",")?;
+            }
+            if self.inline == 0 {
+                self.newline(w)?;
+            }
+            Ok(())
         }
 
         fn $after<W: ?Sized + Write>(&mut self, _: &mut W) -> io::Result<()> {
