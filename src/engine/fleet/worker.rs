@@ -5,7 +5,7 @@
 
 use std::collections::HashMap;
 use std::ops::Range;
-use std::sync::{Arc, Mutex, MutexGuard};
+use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 use futures_util::future::OptionFuture;
@@ -22,6 +22,7 @@ use uuid::Uuid;
 use super::store::{RedisJobStore, Runnable};
 use super::{keys, placement, Failure, Fleet, Link};
 use crate::engine::cache::Solved;
+use crate::engine::lock;
 use crate::engine::metrics as names;
 use crate::engine::pool::Pool;
 use crate::engine::solver::Solver;
@@ -56,7 +57,7 @@ impl Shared {
     /// Learns the cost per point of `class`, and tells the fleet, which splits jobs by it.
     async fn learn(&self, class: &'static str, took: Duration, points: usize) {
         let rate = {
-            let mut rates = self.rates.lock().unwrap_or_else(|p| p.into_inner());
+            let mut rates = lock(&self.rates);
             let rate = placement::learn(rates.get(class).copied(), took, points);
             rates.insert(class, rate);
             rate
@@ -78,13 +79,9 @@ impl Shared {
         self.fleet.jobs.pipe(&pipe).await
     }
 
-    fn running(&self) -> MutexGuard<'_, HashMap<String, Arc<Control>>> {
-        self.running.lock().unwrap_or_else(|p| p.into_inner())
-    }
-
     /// Stops every entry this process is solving; unacknowledged, another process takes them.
     pub fn interrupt(&self) {
-        for control in self.running().values() {
+        for control in lock(&self.running).values() {
             control.cancel();
         }
     }
@@ -179,7 +176,7 @@ impl Worker {
             return;
         };
         let control = Arc::new(self.solver.control(runnable.deadline));
-        shared.running().insert(entry.id.clone(), control.clone());
+        lock(&shared.running).insert(entry.id.clone(), control.clone());
         // Kept through assembly: the last part's entry stays pending until its job is stored.
         let beat = heartbeat(shared.clone(), entry.clone(), control.clone());
         let _heartbeat = AbortOnDropHandle::new(tokio::spawn(beat));
@@ -189,7 +186,7 @@ impl Worker {
         }
         let started = Instant::now();
         let result = self.solve(&entry, &keyed, &control).await;
-        shared.running().remove(&entry.id);
+        lock(&shared.running).remove(&entry.id);
         self.count(&entry, &keyed, &result, started.elapsed());
         self.settle(&entry, &keyed, &runnable, &control, result)
             .await;
