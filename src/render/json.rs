@@ -21,11 +21,7 @@ pub(super) fn write<T: Serialize + ?Sized>(
     pretty: bool,
 ) -> Result<Vec<u8>, RenderError> {
     let last = LAST.get();
-    let room = if pretty {
-        64 << 10
-    } else {
-        last + last / 16 + 64
-    };
+    let room = if pretty { 1 << 16 } else { last * 17 / 16 + 64 };
     let mut json = Vec::with_capacity(room);
     // Rows inside a one-line container write serde_json's compact text.
     let rows = Rows {
