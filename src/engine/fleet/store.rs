@@ -218,13 +218,8 @@ impl RedisJobStore {
             // As long as a job of this process may be kept; a job's end sets its retention.
             .pexpire(&keys.deliveries, millis(self.lifetime) as i64)
             .ignore();
-        type Fields = (
-            Option<String>,
-            Option<String>,
-            Option<String>,
-            Option<u64>,
-            Option<usize>,
-        );
+        type Text = Option<String>;
+        type Fields = (Text, Text, Text, Option<u64>, Option<usize>);
         let (fields, deliveries): (Fields, u64) = self.fleet.jobs.pipe(&pipe).await?;
         let (Some(status), Some(wire), Some(key), Some(deadline), Some(parts)) = fields else {
             return Ok((None, deliveries));
@@ -339,14 +334,8 @@ impl RedisJobStore {
             whole = result.form();
         }
         let [record, result, parts, deliveries] = job.all();
-        let all = [
-            record,
-            result,
-            parts,
-            deliveries,
-            &job.staged,
-            &keys::input(key),
-        ];
+        let input = keys::input(key);
+        let all = [record, result, parts, deliveries, &job.staged, &input];
         eval(&mut pipe, UPDATE, &all)
             .arg(state.status().as_str())
             .arg(done.map(|n| n.to_string()).unwrap_or_default())
