@@ -253,6 +253,7 @@ impl Worker {
         let _running = self.solver.running();
         let part = entry.part.clone();
         let (solving, meta, key) = keyed.clone().into_parts();
+        let kind = solving.kind();
         let kept = |solved: Solved| {
             solved
                 .kept()
@@ -261,18 +262,14 @@ impl Worker {
         };
         Pool::run(permit, control.clone(), move |control| match part {
             None => match solving.run_keeping(meta, control) {
-                Ok(answer) => Ok(Outcome::Whole(kept(Solved::new(
-                    key,
-                    solving.kind(),
-                    answer,
-                )?)?)),
+                Ok(answer) => Ok(Outcome::Whole(kept(Solved::new(key, kind, answer)?)?)),
                 // What a job past its deadline finished is kept with its failure.
                 Err(Unfinished {
                     error: error @ JobError::DeadlineExceeded,
                     partial: Some(answer),
                 }) => Ok(Outcome::Stopped(
                     error,
-                    kept(Solved::partial(key, solving.kind(), answer)?)?,
+                    kept(Solved::partial(key, kind, answer)?)?,
                 )),
                 Err(unfinished) => Err(unfinished.error),
             },
