@@ -15,7 +15,7 @@ use uuid::Uuid;
 use super::keys::{GROUP, STREAM};
 use super::link::{eval, DELETE_IF_HELD};
 use super::{keys, worker, Failure, Fleet};
-use crate::engine::clock::{from_unix_millis, millis, unix_millis};
+use crate::engine::clock::{age, from_unix_millis, millis, unix_millis};
 use crate::engine::store::{
     JobRecord, JobResult, JobState, JobStatus, JobStore, Listing, Owner, Page, Refusal,
     ResultPlace, StoredResult, Unreadable,
@@ -181,10 +181,7 @@ impl RedisJobStore {
             // ms keep their order; places of jobs older than a job may be kept are dropped.
             let list = keys::owner(owner.as_str());
             let micros = |t: Duration| u64::try_from(t.as_micros()).unwrap_or(u64::MAX);
-            let since_epoch = record
-                .submitted_at
-                .duration_since(std::time::UNIX_EPOCH)
-                .unwrap_or_default();
+            let since_epoch = age(std::time::UNIX_EPOCH, record.submitted_at);
             let (score, oldest) = (
                 micros(since_epoch),
                 micros(since_epoch.saturating_sub(self.lifetime)),
