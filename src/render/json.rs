@@ -101,30 +101,6 @@ struct Rows {
 }
 
 impl Rows {
-    fn open<W: ?Sized + Write>(&mut self, w: &mut W, list: bool) -> io::Result<()> {
-        if self.inline > 0 || self.lists.last() == Some(&true) {
-            self.inline += 1;
-        } else {
-            self.level += 1;
-            self.lists.push(list);
-            self.has_value = false;
-        }
-        w.write_all(if list { b"[" } else { b"{" })
-    }
-
-    fn close<W: ?Sized + Write>(&mut self, w: &mut W, list: bool) -> io::Result<()> {
-        if self.inline > 0 {
-            self.inline -= 1;
-        } else {
-            self.level -= 1;
-            self.lists.pop();
-            if self.has_value {
-                self.newline(w)?;
-            }
-        }
-        w.write_all(if list { b"]" } else { b"}" })
-    }
-
     fn newline<W: ?Sized + Write>(&self, w: &mut W) -> io::Result<()> {
         w.write_all(b"\n")?;
         for _ in 0..self.level {
@@ -138,11 +114,27 @@ impl Rows {
 macro_rules! container {
     ($list:literal, $begin:ident, $end:ident, $before:ident, $after:ident) => {
         fn $begin<W: ?Sized + Write>(&mut self, w: &mut W) -> io::Result<()> {
-            self.open(w, $list)
+            if self.inline > 0 || self.lists.last() == Some(&true) {
+                self.inline += 1;
+            } else {
+                self.level += 1;
+                self.lists.push($list);
+                self.has_value = false;
+            }
+            w.write_all(if $list { b"[" } else { b"{" })
         }
 
         fn $end<W: ?Sized + Write>(&mut self, w: &mut W) -> io::Result<()> {
-            self.close(w, $list)
+            if self.inline > 0 {
+                self.inline -= 1;
+            } else {
+                self.level -= 1;
+                self.lists.pop();
+                if self.has_value {
+                    self.newline(w)?;
+                }
+            }
+            w.write_all(if $list { b"]" } else { b"}" })
         }
 
         /// A comma unless first, and a new line when indenting.
