@@ -11,6 +11,7 @@ use std::time::{Duration, Instant};
 use tokio::sync::OwnedMutexGuard;
 
 use super::error::EngineError;
+use super::fleet::link::DELETE_IF_HELD;
 use super::fleet::Fleet;
 use super::lock;
 
@@ -20,10 +21,6 @@ const LEASE: Duration = Duration::from_secs(10);
 
 /// How long an admission waits for another process's turn before it is refused.
 const PATIENCE: Duration = Duration::from_secs(5);
-
-/// Frees the lock only if it is still its holder's (a lease may have passed to another).
-const RELEASE: &str = "if redis.call('GET', KEYS[1]) == ARGV[1] then \
-                       return redis.call('DEL', KEYS[1]) else return 0 end";
 
 #[derive(Default)]
 pub struct Admissions {
@@ -44,7 +41,7 @@ impl Drop for Turn {
             return;
         };
         runtime.spawn(async move {
-            let script = redis::Script::new(RELEASE);
+            let script = redis::Script::new(DELETE_IF_HELD);
             let released = fleet
                 .jobs
                 .script::<i64>(&script, &[&key], &[token.as_bytes()])

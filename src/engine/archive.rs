@@ -114,7 +114,12 @@ impl Archive {
             archive: self.clone(),
             id,
         });
-        JobResult::Stored(Arc::new(StoredResult::new(key, kind, whole, saved)))
+        JobResult::Stored(Arc::new(StoredResult {
+            key,
+            kind,
+            complete: whole,
+            place: saved,
+        }))
     }
 
     /// Whether the database is a file (it outlives the process).

@@ -158,10 +158,8 @@ pub struct MemoryCache {
 impl MemoryCache {
     /// The cache of an engine with `config`: its share of the memory budget, its TTL.
     pub fn for_engine(config: &super::config::EngineConfig) -> Self {
-        MemoryCache::new(
-            budget::Budget::split(config.memory_budget).answers,
-            config.cache_ttl,
-        )
+        let answers = budget::Budget::split(config.memory_budget).answers;
+        MemoryCache::new(answers, config.cache_ttl)
     }
 
     pub fn new(max_bytes: u64, ttl: Duration) -> Self {

@@ -5,9 +5,7 @@ use std::time::{Duration, SystemTime};
 
 /// `time` in milliseconds since the Unix epoch: how times are stored and shared.
 pub fn unix_millis(time: SystemTime) -> u64 {
-    let since = time
-        .duration_since(std::time::UNIX_EPOCH)
-        .unwrap_or_default();
+    let since = age(std::time::UNIX_EPOCH, time);
     u64::try_from(since.as_millis()).unwrap_or(u64::MAX)
 }
 

@@ -90,7 +90,7 @@ mod tests {
 
     /// Another process's id is ours too, but not issued here.
     #[test]
-    fn an_id_is_a_version_7_uuid_with_its_time_tag_and_check() {
+    fn an_id_is_a_version_7_uuid_with_its_time_tag_and_a_check_strangers_fail() {
         let (ids, other) = (JobIds::default(), JobIds::default());
         let before = unix_millis(SystemTime::now());
         let id = ids.next();
@@ -103,16 +103,12 @@ mod tests {
         let id = other.next();
         assert!(is_ours(id));
         assert!(!ids.issued_here(id));
-    }
-
-    #[test]
-    fn a_random_or_mistyped_id_is_not_ours() {
+        // A random or mistyped id is not ours.
         assert!(!is_ours(Uuid::nil()));
         assert!(!is_ours(
             "00000000-0000-4000-8000-000000000000".parse().unwrap()
         ));
         // A digit mistyped passes once in 65,536, as a random 16-bit check would.
-        let ids = JobIds::default();
         let mistyped = (0..1000)
             .filter(|i| {
                 let mut bytes = *ids.next().as_bytes();

@@ -67,10 +67,7 @@ impl PointCounts {
             });
         }
         let shared = match &self.fleet {
-            Some(fleet) => {
-                self.charge_fleet(fleet, tenant, window, points, limit)
-                    .await
-            }
+            Some(fleet) => charge_fleet(fleet, tenant, window, points, limit).await,
             None => None,
         };
         match shared.unwrap_or_else(|| self.charge_here(tenant, window, points, limit)) {
@@ -130,30 +127,27 @@ impl PointCounts {
         count.1 += points;
         Ok(())
     }
+}
 
-    /// In the fleet's Redis (added, then taken back if over the limit); `None` if it cannot
-    /// be reached (this process then counts alone: a quota is not a reason to refuse work).
-    async fn charge_fleet(
-        &self,
-        fleet: &Fleet,
-        tenant: &str,
-        window: u64,
-        points: u64,
-        limit: u64,
-    ) -> Option<Result<(), u64>> {
-        let key = key(tenant, window);
-        let used = add(fleet, &key, i64::try_from(points).unwrap_or(i64::MAX)).await?;
-        // A count trued up below nought (a refund that passed a later charge) is nought.
-        let used = u64::try_from(used).unwrap_or(0);
-        if used <= limit {
-            return Some(Ok(()));
-        }
-        let _ = fleet
-            .jobs
-            .query::<i64>(&redis::Cmd::decr(&key, points))
-            .await;
-        Some(Err(used - points))
+/// In the fleet's Redis (added, then taken back if over the limit); `None` if it cannot be
+/// reached (this process then counts alone: a quota is not a reason to refuse work).
+async fn charge_fleet(
+    fleet: &Fleet,
+    tenant: &str,
+    window: u64,
+    points: u64,
+    limit: u64,
+) -> Option<Result<(), u64>> {
+    let key = key(tenant, window);
+    let used = add(fleet, &key, i64::try_from(points).unwrap_or(i64::MAX)).await?;
+    // A count trued up below nought (a refund that passed a later charge) is nought.
+    let used = u64::try_from(used).unwrap_or(0);
+    if used <= limit {
+        return Some(Ok(()));
     }
+    let give_back = redis::Cmd::decr(&key, points);
+    let _ = fleet.jobs.query::<i64>(&give_back).await;
+    Some(Err(used - points))
 }
 
 fn key(tenant: &str, window: u64) -> String {

@@ -29,10 +29,7 @@ pub enum CacheStatus {
 
 impl CacheStatus {
     pub fn as_str(self) -> &'static str {
-        match self {
-            CacheStatus::Hit => "hit",
-            CacheStatus::Miss => "miss",
-        }
+        ["hit", "miss"][self as usize]
     }
 }
 

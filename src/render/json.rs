@@ -21,11 +21,7 @@ pub(super) fn write<T: Serialize + ?Sized>(
     pretty: bool,
 ) -> Result<Vec<u8>, RenderError> {
     let last = LAST.get();
-    let room = if pretty {
-        64 << 10
-    } else {
-        last + last / 16 + 64
-    };
+    let room = if pretty { 1 << 16 } else { last * 17 / 16 + 64 };
     let mut json = Vec::with_capacity(room);
     // Rows inside a one-line container write serde_json's compact text.
     let rows = Rows {
@@ -105,42 +101,6 @@ struct Rows {
 }
 
 impl Rows {
-    fn open<W: ?Sized + Write>(&mut self, w: &mut W, list: bool) -> io::Result<()> {
-        if self.inline > 0 || self.lists.last() == Some(&true) {
-            self.inline += 1;
-        } else {
-            self.level += 1;
-            self.lists.push(list);
-            self.has_value = false;
-        }
-        w.write_all(if list { b"[" } else { b"{" })
-    }
-
-    fn close<W: ?Sized + Write>(&mut self, w: &mut W, list: bool) -> io::Result<()> {
-        if self.inline > 0 {
-            self.inline -= 1;
-        } else {
-            self.level -= 1;
-            self.lists.pop();
-            if self.has_value {
-                self.newline(w)?;
-            }
-        }
-        w.write_all(if list { b"]" } else { b"}" })
-    }
-
-    /// Before a field or an element: a comma unless it is the first, and a new line when
-    /// indenting.
-    fn next<W: ?Sized + Write>(&mut self, w: &mut W, first: bool) -> io::Result<()> {
-        if !first {
-            w.write_all(b",")?;
-        }
-        if self.inline == 0 {
-            self.newline(w)?;
-        }
-        Ok(())
-    }
-
     fn newline<W: ?Sized + Write>(&self, w: &mut W) -> io::Result<()> {
         w.write_all(b"\n")?;
         for _ in 0..self.level {
@@ -154,15 +114,38 @@ impl Rows {
 macro_rules! container {
     ($list:literal, $begin:ident, $end:ident, $before:ident, $after:ident) => {
         fn $begin<W: ?Sized + Write>(&mut self, w: &mut W) -> io::Result<()> {
-            self.open(w, $list)
+            if self.inline > 0 || self.lists.last() == Some(&true) {
+                self.inline += 1;
+            } else {
+                self.level += 1;
+                self.lists.push($list);
+                self.has_value = false;
+            }
+            w.write_all(if $list { b"[" } else { b"{" })
         }
 
         fn $end<W: ?Sized + Write>(&mut self, w: &mut W) -> io::Result<()> {
-            self.close(w, $list)
+            if self.inline > 0 {
+                self.inline -= 1;
+            } else {
+                self.level -= 1;
+                self.lists.pop();
+                if self.has_value {
+                    self.newline(w)?;
+                }
+            }
+            w.write_all(if $list { b"]" } else { b"}" })
         }
 
+        /// A comma unless first, and a new line when indenting.
         fn $before<W: ?Sized + Write>(&mut self, w: &mut W, first: bool) -> io::Result<()> {
-            self.next(w, first)
+            if !first {
+                w.write_all(b",")?;
+            }
+            if self.inline == 0 {
+                self.newline(w)?;
+            }
+            Ok(())
         }
 
         fn $after<W: ?Sized + Write>(&mut self, _: &mut W) -> io::Result<()> {

@@ -411,6 +411,7 @@ impl Chart {
     fn write_axes(&self, svg: &mut String, frame: &Frame) {
         let (sx, sy) = (&frame.sx, &frame.sy);
         let (left, right, top, bottom) = (sx.from, sx.to, sy.to, sy.from);
+        let name = |axis: &Axis, unit| escape(&with_unit(axis.quantity.replace('_', " "), unit));
         let _ = write!(
             svg,
             r##"<rect x="{left}" y="{top}" width="{}" height="{}" fill="none" stroke="#444444"/>"##,
@@ -431,10 +432,7 @@ impl Chart {
             r#"<text class="label" x="{:.1}" y="{:.1}" text-anchor="middle">{}</text></g>"#,
             (left + right) / 2.0,
             HEIGHT - 15.0,
-            escape(&with_unit(
-                self.x.quantity.replace('_', " "),
-                &frame.units.0
-            ))
+            name(&self.x, &frame.units.0)
         );
         svg.push_str(r#"<g class="axis y">"#);
         let (tick, text) = (left - 5.0, left - 8.0);
@@ -450,10 +448,7 @@ impl Chart {
         let _ = write!(
             svg,
             r#"<text class="label" x="{cx}" y="{cy}" text-anchor="middle" transform="rotate(-90 {cx} {cy})">{}</text></g>"#,
-            escape(&with_unit(
-                self.y.quantity.replace('_', " "),
-                &frame.units.1
-            ))
+            name(&self.y, &frame.units.1)
         );
     }
 }
@@ -735,11 +730,7 @@ fn write_legend(svg: &mut String, entries: &[Entry], notes: &[String]) {
 /// How many of `count` rows to write in `room`: all if they fit, else one fewer, the last row
 /// then saying how many more there are.
 fn kept(count: usize, room: usize) -> usize {
-    if count > room {
-        room.saturating_sub(1)
-    } else {
-        count
-    }
+    count.min(room.saturating_sub(usize::from(count > room)))
 }
 
 #[cfg(test)]
@@ -892,17 +883,14 @@ mod tests {
     }
 
     #[test]
-    fn ticks_are_round_and_cover_the_range() {
+    fn ticks_are_round_cover_the_range_and_are_labelled_apart() {
         assert_eq!(
             ticks(0.0, 1.0),
             vec![0.0, 0.2, 0.4, 0.6000000000000001, 0.8, 1.0]
         );
         let t = ticks(-5.6, 5.6);
         assert!(t.contains(&0.0) && t.len() >= 4 && t.len() <= 8, "{t:?}");
-    }
-
-    #[test]
-    fn tick_labels_tell_every_tick_apart() {
+        // Their labels tell every tick apart.
         assert_eq!(labels(&[0.02, 0.022, 0.024]), ["0.02", "0.022", "0.024"]);
         let small = ticks(1.05e-6, 1.65e-6);
         let said = labels(&small);

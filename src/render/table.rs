@@ -310,12 +310,10 @@ mod tests {
     fn a_number_repeated_down_a_column_is_written_as_it_was() {
         let xs = [0.1, 0.1, -0.0, 0.0, 0.0, 1e-9, 0.1, 0.1];
         let rows: Vec<Row> = xs.iter().map(|&x| Row(x, "l")).collect();
-        let expected: String = std::iter::once("index,x [m],label\n".to_string())
-            .chain(
-                xs.iter()
-                    .map(|x| format!("7,{},\"l\"\n", format_number(*x))),
-            )
-            .collect();
+        let lines = xs
+            .iter()
+            .map(|x| format!("7,{},\"l\"\n", format_number(*x)));
+        let expected = "index,x [m],label\n".to_string() + &lines.collect::<String>();
         assert_eq!(csv(&COLUMNS, &rows).as_deref(), Some(expected.as_str()));
         assert!(expected.contains("7,-0,\"l\"\n7,0,"));
         let twice = [

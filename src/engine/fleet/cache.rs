@@ -7,7 +7,6 @@ use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use async_trait::async_trait;
-use bytes::Bytes;
 use redis::{Cmd, ExistenceCheck, Script, SetExpiry, SetOptions};
 use uuid::Uuid;
 
@@ -78,12 +77,7 @@ impl TieredCache {
             }
             _ => return None,
         };
-        let solved = Arc::new(Solved::rendered(
-            key.to_string(),
-            kind,
-            Bytes::from(json),
-            Bytes::from(csv),
-        ));
+        let solved = Arc::new(Solved::rendered(key.into(), kind, json.into(), csv.into()));
         self.l1.insert(solved.clone()).await;
         Some(solved)
     }

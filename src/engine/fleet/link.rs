@@ -347,7 +347,7 @@ pub(super) fn eval<'a>(pipe: &'a mut Pipeline, script: &str, keys: &[&str]) -> &
 }
 
 /// Deletes KEYS[1] only if it still holds ARGV[1] (it may have been taken over since).
-pub(super) const DELETE_IF_HELD: &str = r#"
+pub(crate) const DELETE_IF_HELD: &str = r#"
 if redis.call('GET', KEYS[1]) == ARGV[1] then return redis.call('DEL', KEYS[1]) end
 return 0
 "#;

@@ -49,19 +49,13 @@ pub fn learn(before: Option<f64>, took: Duration, points: usize) -> f64 {
 mod tests {
     use super::*;
 
+    /// A job that is not a sweep is one entry, and so is a cheap sweep; an unmeasured one
+    /// splits into parts of the default size.
     #[test]
-    fn a_job_that_is_not_a_sweep_is_one_entry() {
+    fn only_a_sweep_worth_it_or_unmeasured_splits() {
         assert!(plan(None, Some(1.0), 250).is_empty());
-    }
-
-    #[test]
-    fn an_unmeasured_sweep_splits_into_parts_of_the_default_size() {
         assert_eq!(plan(Some(600), None, 250), vec![0..250, 250..500, 500..600]);
         assert!(plan(Some(250), None, 250).is_empty());
-    }
-
-    #[test]
-    fn a_cheap_sweep_is_solved_whole() {
         // 10,000 rolling points at 6 µs: 60 ms in all.
         assert!(plan(Some(10_000), Some(6e-6), 250).is_empty());
     }

@@ -15,7 +15,7 @@ use uuid::Uuid;
 use super::keys::{GROUP, STREAM};
 use super::link::{eval, DELETE_IF_HELD};
 use super::{keys, worker, Failure, Fleet};
-use crate::engine::clock::{from_unix_millis, millis, unix_millis};
+use crate::engine::clock::{age, from_unix_millis, millis, unix_millis};
 use crate::engine::store::{
     JobRecord, JobResult, JobState, JobStatus, JobStore, Listing, Owner, Page, Refusal,
     ResultPlace, StoredResult, Unreadable,
@@ -181,10 +181,7 @@ impl RedisJobStore {
             // ms keep their order; places of jobs older than a job may be kept are dropped.
             let list = keys::owner(owner.as_str());
             let micros = |t: Duration| u64::try_from(t.as_micros()).unwrap_or(u64::MAX);
-            let since_epoch = record
-                .submitted_at
-                .duration_since(std::time::UNIX_EPOCH)
-                .unwrap_or_default();
+            let since_epoch = age(std::time::UNIX_EPOCH, record.submitted_at);
             let (score, oldest) = (
                 micros(since_epoch),
                 micros(since_epoch.saturating_sub(self.lifetime)),
@@ -218,13 +215,8 @@ impl RedisJobStore {
             // As long as a job of this process may be kept; a job's end sets its retention.
             .pexpire(&keys.deliveries, millis(self.lifetime) as i64)
             .ignore();
-        type Fields = (
-            Option<String>,
-            Option<String>,
-            Option<String>,
-            Option<u64>,
-            Option<usize>,
-        );
+        type Text = Option<String>;
+        type Fields = (Text, Text, Text, Option<u64>, Option<usize>);
         let (fields, deliveries): (Fields, u64) = self.fleet.jobs.pipe(&pipe).await?;
         let (Some(status), Some(wire), Some(key), Some(deadline), Some(parts)) = fields else {
             return Ok((None, deliveries));
@@ -339,14 +331,8 @@ impl RedisJobStore {
             whole = result.form();
         }
         let [record, result, parts, deliveries] = job.all();
-        let all = [
-            record,
-            result,
-            parts,
-            deliveries,
-            &job.staged,
-            &keys::input(key),
-        ];
+        let input = keys::input(key);
+        let all = [record, result, parts, deliveries, &job.staged, &input];
         eval(&mut pipe, UPDATE, &all)
             .arg(state.status().as_str())
             .arg(done.map(|n| n.to_string()).unwrap_or_default())
@@ -443,15 +429,15 @@ impl RedisJobStore {
         };
         // A result of a cancelled or failed job is what it finished before it stopped.
         let result = || match form.as_str() {
-            form @ ("whole" | "partial") => Some(JobResult::Stored(Arc::new(StoredResult::new(
-                text("key"),
+            form @ ("whole" | "partial") => Some(JobResult::Stored(Arc::new(StoredResult {
+                key: text("key"),
                 kind,
-                form == "whole",
-                Arc::new(InRedis {
+                complete: form == "whole",
+                place: Arc::new(InRedis {
                     fleet: self.fleet.clone(),
                     id,
                 }),
-            )))),
+            }))),
             _ => None,
         };
         let state = JobState::restored(status, result(), || {

@@ -5,10 +5,9 @@
 
 use std::collections::HashMap;
 use std::ops::Range;
-use std::sync::{Arc, Mutex, MutexGuard};
+use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
-use bytes::Bytes;
 use futures_util::future::OptionFuture;
 use redis::streams::{
     StreamAutoClaimOptions, StreamAutoClaimReply, StreamClaimOptions, StreamId, StreamReadOptions,
@@ -23,6 +22,7 @@ use uuid::Uuid;
 use super::store::{RedisJobStore, Runnable};
 use super::{keys, placement, Failure, Fleet, Link};
 use crate::engine::cache::Solved;
+use crate::engine::lock;
 use crate::engine::metrics as names;
 use crate::engine::pool::Pool;
 use crate::engine::solver::Solver;
@@ -57,7 +57,7 @@ impl Shared {
     /// Learns the cost per point of `class`, and tells the fleet, which splits jobs by it.
     async fn learn(&self, class: &'static str, took: Duration, points: usize) {
         let rate = {
-            let mut rates = self.rates.lock().unwrap_or_else(|p| p.into_inner());
+            let mut rates = lock(&self.rates);
             let rate = placement::learn(rates.get(class).copied(), took, points);
             rates.insert(class, rate);
             rate
@@ -79,13 +79,9 @@ impl Shared {
         self.fleet.jobs.pipe(&pipe).await
     }
 
-    fn running(&self) -> MutexGuard<'_, HashMap<String, Arc<Control>>> {
-        self.running.lock().unwrap_or_else(|p| p.into_inner())
-    }
-
     /// Stops every entry this process is solving; unacknowledged, another process takes them.
     pub fn interrupt(&self) {
-        for control in self.running().values() {
+        for control in lock(&self.running).values() {
             control.cancel();
         }
     }
@@ -180,7 +176,7 @@ impl Worker {
             return;
         };
         let control = Arc::new(self.solver.control(runnable.deadline));
-        shared.running().insert(entry.id.clone(), control.clone());
+        lock(&shared.running).insert(entry.id.clone(), control.clone());
         // Kept through assembly: the last part's entry stays pending until its job is stored.
         let beat = heartbeat(shared.clone(), entry.clone(), control.clone());
         let _heartbeat = AbortOnDropHandle::new(tokio::spawn(beat));
@@ -190,7 +186,7 @@ impl Worker {
         }
         let started = Instant::now();
         let result = self.solve(&entry, &keyed, &control).await;
-        shared.running().remove(&entry.id);
+        lock(&shared.running).remove(&entry.id);
         self.count(&entry, &keyed, &result, started.elapsed());
         self.settle(&entry, &keyed, &runnable, &control, result)
             .await;
@@ -257,6 +253,7 @@ impl Worker {
         let _running = self.solver.running();
         let part = entry.part.clone();
         let (solving, meta, key) = keyed.clone().into_parts();
+        let kind = solving.kind();
         let kept = |solved: Solved| {
             solved
                 .kept()
@@ -265,18 +262,14 @@ impl Worker {
         };
         Pool::run(permit, control.clone(), move |control| match part {
             None => match solving.run_keeping(meta, control) {
-                Ok(answer) => Ok(Outcome::Whole(kept(Solved::new(
-                    key,
-                    solving.kind(),
-                    answer,
-                )?)?)),
+                Ok(answer) => Ok(Outcome::Whole(kept(Solved::new(key, kind, answer)?)?)),
                 // What a job past its deadline finished is kept with its failure.
                 Err(Unfinished {
                     error: error @ JobError::DeadlineExceeded,
                     partial: Some(answer),
                 }) => Ok(Outcome::Stopped(
                     error,
-                    kept(Solved::partial(key, solving.kind(), answer)?)?,
+                    kept(Solved::partial(key, kind, answer)?)?,
                 )),
                 Err(unfinished) => Err(unfinished.error),
             },
@@ -346,7 +339,7 @@ impl Worker {
             }
             // Stopped by the drain: handed back at once, its delivery not counted.
             Err(JobError::Cancelled) if self.draining.is_cancelled() => {
-                hand_back(shared, entry).await;
+                hand_back(shared, entry).await
             }
             Err(JobError::Cancelled) => acknowledge(&shared.fleet, entry).await,
             Err(e) => {
@@ -364,13 +357,10 @@ impl Worker {
         };
         match parts::assemble(keyed.meta(), &all) {
             Ok(assembled) => {
-                let solved = Arc::new(Solved::rendered(
-                    keyed.key().to_string(),
-                    keyed.job().kind(),
-                    Bytes::from(assembled.json),
-                    Bytes::from(assembled.csv),
-                ));
-                self.succeed(entry, keyed, solved, runnable.parts).await;
+                let (json, csv) = (assembled.json.into(), assembled.csv.into());
+                let solved = Solved::rendered(keyed.key().into(), keyed.job().kind(), json, csv);
+                self.succeed(entry, keyed, Arc::new(solved), runnable.parts)
+                    .await;
             }
             Err(e) => {
                 self.finish(entry, JobState::failed(e), None).await;

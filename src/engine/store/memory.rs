@@ -265,13 +265,12 @@ mod tests {
         let mut ids = Vec::new();
         for _ in 0..n {
             let record = record(bytes);
-            ids.push(record.id);
+            let id = record.id;
             store.insert(record).await.unwrap();
             if let Some(end) = end.clone() {
-                store
-                    .update(ids[ids.len() - 1], end, 1, SystemTime::now())
-                    .await;
+                store.update(id, end, 1, SystemTime::now()).await;
             }
+            ids.push(id);
         }
         ids
     }

@@ -323,24 +323,10 @@ pub struct StoredResult {
     pub kind: KindName,
     /// Whether the answer is whole (see [`Solved::complete`]).
     pub complete: bool,
-    place: Arc<dyn ResultPlace>,
+    pub place: Arc<dyn ResultPlace>,
 }
 
 impl StoredResult {
-    pub fn new(
-        key: String,
-        kind: KindName,
-        complete: bool,
-        place: Arc<dyn ResultPlace>,
-    ) -> StoredResult {
-        StoredResult {
-            key,
-            kind,
-            complete,
-            place,
-        }
-    }
-
     pub async fn body(&self, field: &str) -> io::Result<Bytes> {
         self.place.body(field).await
     }
