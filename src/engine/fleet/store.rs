@@ -9,12 +9,12 @@ use std::time::{Duration, Instant, SystemTime};
 
 use async_trait::async_trait;
 use bytes::Bytes;
-use redis::Cmd;
+use redis::{Cmd, Pipeline};
 use uuid::Uuid;
 
 use super::keys::{GROUP, STREAM};
 use super::link::{eval, DELETE_IF_HELD};
-use super::{keys, worker, Failure, Fleet};
+use super::{keys, Failure, Fleet};
 use crate::engine::clock::{age, from_unix_millis, millis, unix_millis};
 use crate::engine::store::{
     JobRecord, JobResult, JobState, JobStatus, JobStore, Listing, Owner, Page, Refusal,
@@ -144,10 +144,10 @@ impl RedisJobStore {
             .arg(deadline + millis(self.retention))
             .ignore();
         if parts.is_empty() {
-            worker::add_entry(&mut pipe, record.id, None);
+            add_entry(&mut pipe, record.id, None);
         }
         for part in parts.iter().enumerate() {
-            worker::add_entry(&mut pipe, record.id, Some(part));
+            add_entry(&mut pipe, record.id, Some(part));
         }
         self.fleet.jobs.pipe::<()>(&pipe).await
     }
@@ -611,4 +611,15 @@ impl From<Failure> for Unreadable {
     fn from(e: Failure) -> Unreadable {
         Unreadable::Redis(e.why)
     }
+}
+
+/// Adds to `pipe` a stream entry for `job` or its part (index and points): [`super::worker`]'s `Entry::read`.
+pub(super) fn add_entry(pipe: &mut Pipeline, job: Uuid, part: Option<(usize, &Range<usize>)>) {
+    let mut fields = vec![("job", job.to_string())];
+    if let Some((index, range)) = part {
+        fields.push(("part", index.to_string()));
+        fields.push(("start", range.start.to_string()));
+        fields.push(("end", range.end.to_string()));
+    }
+    pipe.xadd(keys::STREAM, "*", &fields).ignore();
 }

@@ -19,7 +19,7 @@ use tokio_util::sync::CancellationToken;
 use tokio_util::task::AbortOnDropHandle;
 use uuid::Uuid;
 
-use super::store::{RedisJobStore, Runnable};
+use super::store::{self, RedisJobStore, Runnable};
 use super::{keys, placement, Failure, Fleet, Link};
 use crate::engine::cache::Solved;
 use crate::engine::lock;
@@ -471,17 +471,6 @@ async fn acknowledge(fleet: &Fleet, entry: &Entry) {
     }
 }
 
-/// Adds to `pipe` a stream entry for `job` or its part (index and points): [`Entry::read`].
-pub(super) fn add_entry(pipe: &mut Pipeline, job: Uuid, part: Option<(usize, &Range<usize>)>) {
-    let mut fields = vec![("job", job.to_string())];
-    if let Some((index, range)) = part {
-        fields.push(("part", index.to_string()));
-        fields.push(("start", range.start.to_string()));
-        fields.push(("end", range.end.to_string()));
-    }
-    pipe.xadd(keys::STREAM, "*", &fields).ignore();
-}
-
 /// Hands `entry`, stopped by a drain, back at once: a new entry with the same work replaces
 /// it (no wait for the idle bound) and its delivery is taken back; the parts in stay.
 async fn hand_back(shared: &Shared, entry: &Entry) {
@@ -492,7 +481,7 @@ async fn hand_back(shared: &Shared, entry: &Entry) {
     let mut pipe = redis::pipe();
     acknowledged(pipe.atomic(), entry);
     let part = entry.part.as_ref().map(|(index, range)| (*index, range));
-    add_entry(&mut pipe, entry.job, part);
+    store::add_entry(&mut pipe, entry.job, part);
     match shared.fleet.jobs.pipe::<()>(&pipe).await {
         Ok(()) => tracing::info!(job = %entry.job, part = entry.part_name(), "handed a part back"),
         Err(e) => tracing::warn!(error = %e, "a part was not handed back: it is taken over later"),
