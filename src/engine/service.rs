@@ -15,7 +15,7 @@ use super::error::EngineError;
 use super::fleet::Fleet;
 use super::lifecycle::{Lifecycle, OnEnd};
 use super::metrics::{self as names, Metrics};
-use super::quota::{Charge, Exceeded, PointCounts};
+use super::quota::{Charge, PointCounts};
 use super::solver::{CacheStatus, CacheUse, Solver};
 use super::storage::Storage;
 use super::store::{JobRecord, JobStatus, Listing, Owner};
@@ -29,7 +29,8 @@ pub struct Engine {
     solve_deadline: Duration,
     pub solver: Arc<Solver>,
     pub jobs: Arc<Lifecycle>,
-    points: Arc<PointCounts>,
+    /// The points each tenant asked for this minute: their quota's count.
+    pub points: Arc<PointCounts>,
     admissions: Admissions,
     fleet: Option<Arc<Fleet>>,
 }
@@ -70,14 +71,6 @@ impl Engine {
     /// admissions before, in this process and across a fleet ([`Admissions`]).
     pub async fn turn(&self, tenant: &str) -> Result<Turn, EngineError> {
         self.admissions.turn(tenant, self.fleet.as_ref()).await
-    }
-
-    /// Charges `points` to `tenant`, unless its points this minute (fleet-wide in a fleet)
-    /// would pass `limit`; the window charged, for a later true-up or refund ([`Charge`]).
-    pub async fn charge(&self, tenant: &str, points: u64, limit: u64) -> Result<u64, Exceeded> {
-        self.points
-            .charge(tenant, points, limit, std::time::SystemTime::now())
-            .await
     }
 
     /// The jobs of `owner` not finished yet (queued or running), as the job store lists them.
@@ -169,14 +162,6 @@ impl Engine {
             self.points.refund(charge).await;
         }
         record.map_err(|e| self.refused(e))
-    }
-
-    pub async fn true_up(&self, charge: &Charge, took: Duration) {
-        self.points.true_up(charge, took).await;
-    }
-
-    pub async fn refund(&self, charge: &Charge) {
-        self.points.refund(charge).await;
     }
 
     fn admit(&self) -> Result<(), EngineError> {

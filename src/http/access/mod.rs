@@ -258,7 +258,12 @@ pub async fn charge_all(
     if points == 0 {
         return Ok(None);
     }
-    let (used, retry_after) = match state.engine().charge(&tenant, points, limit).await {
+    let (used, retry_after) = match state
+        .engine()
+        .points
+        .charge(&tenant, points, limit, SystemTime::now())
+        .await
+    {
         Ok(window) => {
             return Ok(Some(Charge {
                 tenant,

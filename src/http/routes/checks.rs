@@ -90,7 +90,11 @@ pub async fn run(
         reports.push(offload(&state, size, judge).await?);
     }
     if let Some(charge) = charged {
-        state.engine().true_up(&charge, started.elapsed()).await;
+        state
+            .engine()
+            .points
+            .true_up(&charge, started.elapsed())
+            .await;
     }
     Ok(respond(Report::new(reports), xml))
 }

@@ -358,7 +358,7 @@ impl SolveRequest {
         };
         let (solved, cache) = match (answered, charged) {
             (Err(refused), Some(charge)) if refused_before_work(&refused) => {
-                state.engine().refund(&charge).await;
+                state.engine().points.refund(&charge).await;
                 return Err(refused);
             }
             (answered, charge) => {
@@ -368,7 +368,7 @@ impl SolveRequest {
                         CacheStatus::Miss => started.elapsed(),
                         CacheStatus::Hit => std::time::Duration::ZERO,
                     };
-                    state.engine().true_up(&charge, took).await;
+                    state.engine().points.true_up(&charge, took).await;
                 }
                 (solved, cache)
             }
