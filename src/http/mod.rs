@@ -30,6 +30,7 @@ use axum::{middleware, Router};
 use metrics_exporter_prometheus::{PrometheusBuilder, PrometheusHandle};
 use tokio::net::TcpListener;
 use tokio_util::sync::CancellationToken;
+use tower::layer::layer_fn;
 use tower::ServiceBuilder;
 use tower_http::catch_panic::CatchPanicLayer;
 use tower_http::compression::{CompressionLayer, CompressionLevel};
@@ -46,7 +47,7 @@ pub use server::ConnectionLimits;
 use crate::engine::metrics::Metrics;
 use crate::engine::{Engine, Storage};
 
-use request_id::{RequestIdLayer, X_REQUEST_ID};
+use request_id::{RequestId, X_REQUEST_ID};
 /// How often metrics histograms are drained and expired jobs forgotten.
 const HOUSEKEEPING_INTERVAL: Duration = Duration::from_secs(5);
 /// How often the API keys' file is read again (a revoked key stops working within this).
@@ -161,7 +162,7 @@ pub fn app(state: AppState) -> Router {
     // each response leaves through the problem mapping (inside CORS, so that errors carry
     // CORS headers too).
     let layers = ServiceBuilder::new()
-        .layer(RequestIdLayer)
+        .layer(layer_fn(|inner| RequestId { inner }))
         .layer(
             TraceLayer::new_for_http()
                 .make_span_with(observe::request_span)
@@ -171,7 +172,13 @@ pub fn app(state: AppState) -> Router {
                         .latency_unit(LatencyUnit::Micros),
                 ),
         )
-        .layer(stack::ObservedLayer(state.clone()))
+        .layer(layer_fn({
+            let state = state.clone();
+            move |inner| stack::Observed {
+                state: state.clone(),
+                inner,
+            }
+        }))
         .option_layer(cors(&config.cors_origins))
         .map_response(weaken_compressed_etag)
         // gzip for a client that accepts it (the default predicate leaves out small bodies,
@@ -186,10 +193,16 @@ pub fn app(state: AppState) -> Router {
             config.request_timeout,
         ))
         .layer(DefaultBodyLimit::max(config.body_limit))
-        .layer(stack::AdmittedLayer(state.clone()));
+        .layer(layer_fn({
+            let state = state.clone();
+            move |inner| stack::Admitted {
+                state: state.clone(),
+                inner,
+            }
+        }));
     api.merge(SwaggerUi::new("/docs").url("/openapi.json", spec))
         .merge(dashboard::router())
-        .route_layer(observe::TagRouteLayer)
+        .route_layer(layer_fn(|inner| observe::TagRoute { inner }))
         .fallback(not_found)
         .layer(layers)
         .with_state(state)

@@ -11,7 +11,7 @@ use axum::extract::{MatchedPath, Request};
 use axum::http::{header, Method};
 use axum::response::{IntoResponse, Response};
 use metrics::{Counter, Histogram};
-use tower::{Layer, Service};
+use tower::Service;
 use tracing::Span;
 
 use super::error::{too_large, ApiError};
@@ -64,21 +64,9 @@ pub fn request_span(request: &Request) -> Span {
 ///
 /// A tower layer rather than an `axum::middleware::from_fn`, which clones the route below
 /// it and boxes two things on every request.
-#[derive(Clone, Copy, Debug, Default)]
-pub struct TagRouteLayer;
-
-impl<S> Layer<S> for TagRouteLayer {
-    type Service = TagRoute<S>;
-
-    fn layer(&self, inner: S) -> TagRoute<S> {
-        TagRoute { inner }
-    }
-}
-
-/// See [`TagRouteLayer`].
 #[derive(Clone, Debug)]
 pub struct TagRoute<S> {
-    inner: S,
+    pub inner: S,
 }
 
 impl<S> Service<Request> for TagRoute<S>

@@ -13,7 +13,7 @@ use std::pin::Pin;
 use std::task::{Context, Poll};
 
 use axum::http::{HeaderName, HeaderValue, Request, Response};
-use tower::{Layer, Service};
+use tower::Service;
 use uuid::Uuid;
 
 /// The request id header, set by the client or by the service.
@@ -38,21 +38,9 @@ fn new_id() -> HeaderValue {
 }
 
 /// Gives every request and its answer a request id.
-#[derive(Clone, Copy, Debug, Default)]
-pub struct RequestIdLayer;
-
-impl<S> Layer<S> for RequestIdLayer {
-    type Service = RequestId<S>;
-
-    fn layer(&self, inner: S) -> RequestId<S> {
-        RequestId { inner }
-    }
-}
-
-/// See [`RequestIdLayer`].
 #[derive(Clone, Debug)]
 pub struct RequestId<S> {
-    inner: S,
+    pub inner: S,
 }
 
 impl<S, ReqBody, ResBody> Service<Request<ReqBody>> for RequestId<S>

@@ -13,7 +13,7 @@ use axum::extract::Request;
 use axum::http::Response as HttpResponse;
 use axum::response::{IntoResponse, Response};
 use futures_util::future::{ready, Either, Ready};
-use tower::{Layer, Service};
+use tower::Service;
 
 use super::{access, error, observe, AppState};
 
@@ -23,24 +23,9 @@ type Answer<F> = Either<Ready<Result<Response, Infallible>>, F>;
 /// Counts and times every request ([`observe::Timing`]), and refuses a cross-origin
 /// preflight this service does not allow ([`access::refuse_foreign_preflight`]).
 #[derive(Clone)]
-pub struct ObservedLayer(pub AppState);
-
-impl<S> Layer<S> for ObservedLayer {
-    type Service = Observed<S>;
-
-    fn layer(&self, inner: S) -> Observed<S> {
-        Observed {
-            state: self.0.clone(),
-            inner,
-        }
-    }
-}
-
-/// See [`ObservedLayer`].
-#[derive(Clone)]
 pub struct Observed<S> {
-    state: AppState,
-    inner: S,
+    pub state: AppState,
+    pub inner: S,
 }
 
 impl<S, B> Service<Request> for Observed<S>
@@ -80,24 +65,9 @@ where
 /// ([`observe::declared_overflow`]), rather than reading it up to the limit first; then
 /// lets the request in if its caller may do what it asks ([`access::refuse_or_admit`]).
 #[derive(Clone)]
-pub struct AdmittedLayer(pub AppState);
-
-impl<S> Layer<S> for AdmittedLayer {
-    type Service = Admitted<S>;
-
-    fn layer(&self, inner: S) -> Admitted<S> {
-        Admitted {
-            state: self.0.clone(),
-            inner,
-        }
-    }
-}
-
-/// See [`AdmittedLayer`].
-#[derive(Clone)]
 pub struct Admitted<S> {
-    state: AppState,
-    inner: S,
+    pub state: AppState,
+    pub inner: S,
 }
 
 impl<S> Service<Request> for Admitted<S>
