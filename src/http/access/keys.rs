@@ -266,7 +266,7 @@ pub fn issue(
 }
 
 /// Adds `entry` (as [`issue`] made it) to the keys file at `path`, made if it does not exist:
-/// the whole file is checked as `serve` reads it, then written beside it and renamed over it,
+/// the file with it is checked as `serve` reads it, then written beside it and renamed over it,
 /// so that a running service never reads half of it.
 pub fn append(path: &std::path::Path, entry: &str) -> Result<(), KeysError> {
     let shown = path.display().to_string();
@@ -280,7 +280,7 @@ pub fn append(path: &std::path::Path, entry: &str) -> Result<(), KeysError> {
             })
         }
     };
-    Ring::parse(&text)?;
+    // Checked whole once the entry is in: a file `serve` refuses stays refused, untouched.
     let mut file: serde_json::Value = serde_json::from_str(&text).map_err(KeysError::Json)?;
     let entry: serde_json::Value = serde_json::from_str(entry).map_err(KeysError::Json)?;
     if let Some(keys) = file["keys"].as_array_mut() {

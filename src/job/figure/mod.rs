@@ -186,12 +186,17 @@ impl Output for FigureOutput {
     /// One row per point: the series' index and legend, then x and y in the axes' units, then
     /// the conditions its series holds fixed (R, P, V) as columns of their own.
     fn table(&self) -> Table {
-        fn columns<'a>() -> [Column<FigureRow<'a>>; 7] {
+        fn columns<'a>() -> [Column<FigureRow<'a>>; 4] {
             [
                 Column::count("series", |r| r.series),
                 Column::text("label", |r, text| text.push_str(&r.of.label)),
                 Column::number("x", "", |r| r.point[0]),
                 Column::number("y", "", |r| r.point[1]),
+            ]
+        }
+        /// What a curve holds fixed, but for the x axis's quantity, which varies along it.
+        fn conditions<'a>() -> [Column<FigureRow<'a>>; 3] {
+            [
                 Column::optional("radius", "m", |r| r.of.radius),
                 Column::optional("load", "N", |r| r.of.load),
                 Column::number("velocity", "m/s", |r| r.of.velocity),
@@ -209,18 +214,10 @@ impl Output for FigureOutput {
                 })
             })
             .collect();
-        // A condition that varies along the curves (the x axis's) is in the x column alone.
-        let fixed =
-            |read: fn(&SeriesOutput) -> Option<f64>| self.series.iter().all(|s| read(s).is_some());
+        let conditions = conditions().into_iter();
         let columns: Vec<Column<FigureRow>> = columns()
             .into_iter()
-            .enumerate()
-            .filter(|(i, _)| match i {
-                4 => fixed(|s| s.radius),
-                5 => fixed(|s| s.load),
-                _ => true,
-            })
-            .map(|(_, c)| c)
+            .chain(conditions.filter(|c| c.name != self.x.quantity))
             .collect();
         let mut table = Table::new(&columns, &rows);
         table.rename(2, &self.x.quantity, &self.x.unit);

@@ -5,6 +5,7 @@
 use std::collections::BTreeMap;
 
 use serde::Deserialize;
+use serde_json::Value;
 
 use crate::job::input::LayerModel;
 use crate::job::picture::{shown, symbol, Picture, PictureError};
@@ -20,50 +21,27 @@ use crate::render::svg::{Axis, Chart, Layer};
 #[derive(Deserialize)]
 pub struct SweepPicture {
     points: Rows,
-    meta: Option<SweepMeta>,
+    meta: Option<Value>,
 }
 
-/// What the picture says of a sweep's `meta`: a rolling sweep's layer law, and on the
-/// continuum its worst error in the area.
-#[derive(Deserialize)]
-struct SweepMeta {
-    input: Option<SweepAsked>,
-    verification: Option<Verified>,
-}
-
-#[derive(Deserialize)]
-struct SweepAsked {
-    base: Option<BaseAsked>,
-}
-
-#[derive(Deserialize)]
-struct BaseAsked {
-    layer: Option<LayerAsked>,
-}
-
-#[derive(Deserialize)]
-struct LayerAsked {
-    model: Option<LayerModel>,
-}
-
-#[derive(Deserialize)]
-struct Verified {
-    contact_area_error: Option<f64>,
-}
-
-impl SweepMeta {
-    /// The note naming the law of a rolling sweep's layer (and the continuum's error in A).
-    fn law(&self) -> Option<String> {
-        // A three-body system's layer names no model (its contact law is its own field).
-        let model = self.input.as_ref()?.base.as_ref()?.layer.as_ref()?.model?;
-        Some(match model {
-            LayerModel::Local => "layer: local law (the paper's)".to_string(),
-            LayerModel::Continuum => match self.verification.as_ref()?.contact_area_error {
+/// The note naming the layer law of a rolling sweep whose `meta` is `meta` (on the
+/// continuum, with its worst error in A); none for a three-body sweep, whose layer names no
+/// model (its contact law is a field of its own).
+fn law(meta: &Value) -> Option<String> {
+    let model = meta.pointer("/input/base/layer/model")?;
+    Some(match LayerModel::deserialize(model).ok()? {
+        LayerModel::Local => "layer: local law (the paper's)".to_string(),
+        LayerModel::Continuum => {
+            let verification = meta.get("verification")?;
+            match verification
+                .get("contact_area_error")
+                .and_then(Value::as_f64)
+            {
                 Some(error) => format!("layer: continuum, A within ±{:.2} %", 100.0 * error),
                 None => "layer: continuum".to_string(),
-            },
-        })
-    }
+            }
+        }
+    })
 }
 
 /// The rows of either kind, as the output writes them.
@@ -271,7 +249,7 @@ impl Picture for SweepPicture {
         }
         let layers = layers(curves);
         // Short lines: they stand under the legend.
-        let mut notes: Vec<String> = self.meta.and_then(|m| m.law()).into_iter().collect();
+        let mut notes: Vec<String> = self.meta.as_ref().and_then(law).into_iter().collect();
         if unanswered > 0 {
             notes.push(format!("{unanswered} of {} points not drawn:", rows.len()));
             notes.push("refused, or not solved".to_string());
