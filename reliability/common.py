@@ -125,6 +125,23 @@ def latency_line(name, seconds):
     )
 
 
+def run_for(seconds, threads, stop, sample=None, every=1.0):
+    """Starts `threads`, lets them run `seconds` (calling `sample` every `every` seconds if
+    given, and returning what it gave), then sets `stop` and waits for them to end."""
+    for t in threads:
+        t.start()
+    samples = []
+    end = time.time() + seconds
+    while time.time() < end:
+        time.sleep(every if sample else max(0.0, end - time.time()))
+        if sample:
+            samples.append(sample())
+    stop.set()
+    for t in threads:
+        t.join()
+    return samples
+
+
 def probe_health(port, stop, latencies, failures, every=0.1):
     """Asks /healthz every `every` seconds on a new connection until `stop` is set, adding
     each answer's seconds to `latencies` and each failure's error name to `failures`."""

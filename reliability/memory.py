@@ -7,9 +7,8 @@ import collections
 import json
 import sys
 import threading
-import time
 
-from common import Server, request, supports
+from common import Server, request, run_for, supports
 
 SECONDS = float(sys.argv[1]) if len(sys.argv) > 1 else 60
 BUDGET = 8 << 20
@@ -58,16 +57,7 @@ with Server(budget_flag, str(BUDGET), "--max-queued-jobs", "64") as server:
     start_rss = server.rss_mib()
     threads = [threading.Thread(target=distinct, args=(n,)) for n in range(4)]
     threads += [threading.Thread(target=same) for _ in range(4)]
-    for t in threads:
-        t.start()
-    samples = []
-    end = time.time() + SECONDS
-    while time.time() < end:
-        time.sleep(1)
-        samples.append(server.rss_mib())
-    stop.set()
-    for t in threads:
-        t.join()
+    samples = run_for(SECONDS, threads, stop, server.rss_mib)
     print(f"memory: {budget_flag} {BUDGET >> 20} MiB, {SECONDS:.0f} s of submissions")
     print(
         f"RSS: start {start_rss:.0f} MiB, max {max(samples):.0f} MiB, "

@@ -10,7 +10,7 @@ import sys
 import threading
 import time
 
-from common import Server, latency_line, request
+from common import Server, latency_line, request, run_for
 
 SECONDS = float(sys.argv[1]) if len(sys.argv) > 1 else 30
 CORES = os.cpu_count() or 1
@@ -68,12 +68,7 @@ with Server() as server:
     threads += [threading.Thread(target=hostile) for _ in range(2)]
     threads.append(threading.Thread(target=prober))
     threads.append(threading.Thread(target=sampler, args=(server,)))
-    for t in threads:
-        t.start()
-    time.sleep(SECONDS)
-    stop.set()
-    for t in threads:
-        t.join()
+    run_for(SECONDS, threads, stop)
     alive = server.proc.poll() is None
     print(f"overload: {CORES} cores, {10 * CORES} solving clients, 2 hostile, {SECONDS:.0f} s")
     print(latency_line("/healthz", health))

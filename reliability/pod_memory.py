@@ -17,7 +17,7 @@ import time
 
 import yaml
 
-from common import ROOT, Server, free_port, request
+from common import ROOT, Server, free_port, request, run_for
 
 SECONDS = float(sys.argv[1]) if len(sys.argv) > 1 else 60
 
@@ -111,16 +111,7 @@ try:
         threads += [threading.Thread(target=sweeps, args=(n,)) for n in range(2)]
         threads += [threading.Thread(target=bodies) for _ in range(2)]
         threads += [threading.Thread(target=checks)]
-        for t in threads:
-            t.start()
-        samples = []
-        end = time.time() + SECONDS
-        while time.time() < end:
-            time.sleep(0.2)
-            samples.append(server.rss_mib())
-        stop.set()
-        for t in threads:
-            t.join()
+        samples = run_for(SECONDS, threads, stop, server.rss_mib, every=0.2)
         print(f"pod memory: {' '.join(flags)}, on Redis, {SECONDS:.0f} s of mixed load")
         print(
             f"RSS: start {start_rss:.0f} MiB, max {max(samples):.0f} MiB, "

@@ -9,7 +9,7 @@ import sys
 import threading
 import time
 
-from common import Server, latency_line, probe_health
+from common import Server, latency_line, probe_health, run_for
 
 SECONDS = float(sys.argv[1]) if len(sys.argv) > 1 else 40
 SLOW = 1100
@@ -62,12 +62,7 @@ with Server(preexec=limit_files) as server:
         threading.Thread(target=slow_client),
         threading.Thread(target=probe_health, args=(port, stop, health, failures)),
     ]
-    for t in threads:
-        t.start()
-    time.sleep(SECONDS)
-    stop.set()
-    for t in threads:
-        t.join()
+    run_for(SECONDS, threads, stop)
     held.sort()
     median = held[len(held) // 2] if held else float("nan")
     print(f"slowloris: {SLOW} slow connections, server limited to 1024 files, {SECONDS:.0f} s")

@@ -28,6 +28,12 @@ pub struct Axis {
     pub unit: &'static str,
 }
 
+impl Axis {
+    const fn new(quantity: &'static str, unit: &'static str) -> Axis {
+        Axis { quantity, unit }
+    }
+}
+
 /// One curve of a figure.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Series {
@@ -62,22 +68,10 @@ pub struct Plan {
     layout: Layout,
 }
 
-const LOAD_AXIS: Axis = Axis {
-    quantity: "load",
-    unit: "N",
-};
-const RADIUS_AXIS: Axis = Axis {
-    quantity: "radius",
-    unit: "m",
-};
-const AREA_AXIS: Axis = Axis {
-    quantity: "contact_area",
-    unit: "m²",
-};
-const FRICTION_AXIS: Axis = Axis {
-    quantity: "friction_coefficient",
-    unit: "",
-};
+const LOAD_AXIS: Axis = Axis::new("load", "N");
+const RADIUS_AXIS: Axis = Axis::new("radius", "m");
+const AREA_AXIS: Axis = Axis::new("contact_area", "m²");
+const FRICTION_AXIS: Axis = Axis::new("friction_coefficient", "");
 
 /// What a figure plots against what, and over which series.
 #[derive(Clone, Debug)]
@@ -170,14 +164,8 @@ impl Layout {
         let (title, x, y, series) = match number {
             3 => (
                 "Contact region a(y) ≤ x ≤ b(y), R = 25 nm, P = 1 nN, V = 0, 2, 3, 4 nm/s",
-                Axis {
-                    quantity: "x",
-                    unit: "m",
-                },
-                Axis {
-                    quantity: "y",
-                    unit: "m",
-                },
+                Axis::new("x", "m"),
+                Axis::new("y", "m"),
                 CONTOUR_SPEEDS.iter().map(|&v| Curve::contour(v)).collect(),
             ),
             4 => (

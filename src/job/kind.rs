@@ -17,9 +17,8 @@ use utoipa::openapi::{Ref, RefOr, Schema};
 use utoipa::{PartialSchema, ToSchema};
 
 use super::meta::{Canonical, InputWarning, Meta, References};
-use super::picture::{draw, Picture};
 use super::{Control, JobError, Limits};
-use crate::render::{Answer, Draw, Output, UnitTable};
+use crate::render::{draw, Answer, Draw, Output, UnitTable};
 
 /// Schemas as utoipa collects them: (name, schema).
 pub(super) type Schemas = Vec<(String, RefOr<Schema>)>;
@@ -166,10 +165,6 @@ pub trait Kind: fmt::Debug + Send + Sync + Sized + 'static {
     /// between units of work, and counts them there.
     fn run(&self, meta: Meta, control: &Control) -> Result<Self::Output, JobError>;
 
-    /// What the picture of an answer of this kind is drawn from, read back from the
-    /// answer's JSON (so that an answer made in another process is drawn the same).
-    type Picture: Picture;
-
     /// The number of points the job splits into, for a job whose answer is one row per
     /// point, `{"points": [...], "meta": {...}}` (a sweep): parts of it can then be solved
     /// apart, by other processes, and assembled ([`super::parts`]). `None`: solved whole.
@@ -249,7 +244,7 @@ impl Registered {
         Registered {
             name: K::NAME,
             validate: validate::<K>,
-            picture: draw::<K::Picture>,
+            picture: draw::<<K::Output as Output>::Picture>,
             input_schema: <K::Input as ToSchema>::name,
             output_schema: output_schema::<K>,
             output_name: <K::Output as ToSchema>::name,
@@ -306,7 +301,7 @@ impl KindName {
         self.0.name
     }
 
-    /// How an answer of this kind is drawn ([`Kind::Picture`], drawn by [`super::picture::draw`]).
+    /// How an answer of this kind is drawn ([`Output::Picture`], drawn by [`crate::render::draw`]).
     pub fn picture(self) -> Draw {
         self.0.picture
     }
@@ -364,10 +359,10 @@ impl From<JobError> for Unfinished {
 /// The answer of `output`, or the partial answer of an unfinished run.
 fn answer<K: Kind>(output: K::Output) -> Result<Answer, Unfinished> {
     match K::unfinished(&output) {
-        None => Ok(Answer::new(output).drawn_by(draw::<K::Picture>)),
+        None => Ok(Answer::new(output)),
         Some(error) => Err(Unfinished {
             error,
-            partial: Some(Answer::new(output).drawn_by(draw::<K::Picture>)),
+            partial: Some(Answer::new(output)),
         }),
     }
 }

@@ -1,32 +1,17 @@
 //! What every kind's picture shares. A kind draws its answer from a typed view of the
-//! answer's JSON ([`Picture`]: the parts of the output it shows, as the output's own types),
+//! answer's JSON ([`crate::render::Picture`]: the parts of the output it shows, as the output's own types),
 //! read back from the JSON, so that an answer solved in another process, or assembled from
 //! parts, is drawn exactly as one solved here.
 
-use serde::de::DeserializeOwned;
 use serde::Deserialize;
 use serde_json::Value;
 
 use super::{Kind, Limits};
 use crate::model::text::quantity_to;
-use crate::render::svg::Chart;
 use crate::render::RenderError;
 
 /// Why an answer cannot be drawn: it is not the answer of the kind asked (a fault of ours).
 pub type PictureError = RenderError;
-
-/// The parts of an answer a kind's picture shows, read from the answer's JSON.
-pub trait Picture: DeserializeOwned {
-    /// The picture.
-    fn chart(self) -> Result<Chart, PictureError>;
-}
-
-/// The picture of the answer whose JSON is `json`, drawn as `P`.
-pub fn draw<P: Picture>(json: &[u8]) -> Result<Chart, PictureError> {
-    let picture: P =
-        serde_json::from_slice(json).map_err(|e| RenderError::new(format!("the answer: {e}")))?;
-    picture.chart()
-}
 
 /// An answer's `meta`, for its input: the canonical input of a job of kind `K`.
 #[derive(Deserialize)]

@@ -13,6 +13,7 @@ mod table;
 use std::any::{Any, TypeId};
 use std::fmt;
 
+use serde::de::DeserializeOwned;
 use serde::{Serialize, Serializer};
 use serde_json::value::RawValue;
 
@@ -117,6 +118,10 @@ pub trait Output: Serialize + fmt::Debug + Send + Sync + 'static {
     /// `static` ([`Fixed`]), so that its JSON is rendered once.
     const UNITS: &'static UnitTable;
 
+    /// What the answer's picture is drawn from, read back from its JSON (so that an answer
+    /// made in another process, or assembled from parts, is drawn the same).
+    type Picture: Picture;
+
     /// The answer as one table, its columns declared once by the output.
     fn table(&self) -> Table;
 
@@ -131,6 +136,20 @@ pub trait Output: Serialize + fmt::Debug + Send + Sync + 'static {
     fn notice(&self) -> Option<String> {
         None
     }
+}
+
+/// The parts of an answer its picture shows: a typed view of the answer's JSON (the
+/// output's own types), read back from the JSON.
+pub trait Picture: DeserializeOwned {
+    /// The picture.
+    fn chart(self) -> Result<svg::Chart, RenderError>;
+}
+
+/// The picture of the answer whose JSON is `json`, drawn as `P`.
+pub fn draw<P: Picture>(json: &[u8]) -> Result<svg::Chart, RenderError> {
+    let picture: P =
+        serde_json::from_slice(json).map_err(|e| RenderError::new(format!("the answer: {e}")))?;
+    picture.chart()
 }
 
 /// What [`Answer`] needs of an output, object-safe.
@@ -169,17 +188,11 @@ pub type Draw = fn(&[u8]) -> Result<svg::Chart, RenderError>;
 
 /// The answer to any job, whatever its kind, and how to draw it.
 #[derive(Debug)]
-pub struct Answer(Box<dyn Render>, Option<Draw>);
+pub struct Answer(Box<dyn Render>, Draw);
 
 impl Answer {
     pub fn new<T: Output>(output: T) -> Answer {
-        Answer(Box::new(output), None)
-    }
-
-    /// The same answer, drawn by `draw` as SVG.
-    pub fn drawn_by(mut self, draw: Draw) -> Answer {
-        self.1 = Some(draw);
-        self
+        Answer(Box::new(output), draw::<T::Picture>)
     }
 
     /// The answer in `format`: compact JSON, CSV, or its picture.
@@ -187,11 +200,8 @@ impl Answer {
         match format {
             Format::Json => self.0.json(false),
             Format::Svg => {
-                let draw = self
-                    .1
-                    .ok_or_else(|| RenderError::new("this answer has no picture"))?;
                 let json = self.0.json(false)?;
-                draw_svg(draw, &json).map(String::into_bytes)
+                draw_svg(self.1, &json).map(String::into_bytes)
             }
             Format::Csv => self
                 .0
@@ -288,8 +298,19 @@ mod tests {
         }
     }
 
+    /// The picture of an output drawn nowhere in these tests.
+    #[derive(serde::Deserialize)]
+    struct Undrawn {}
+
+    impl Picture for Undrawn {
+        fn chart(self) -> Result<svg::Chart, RenderError> {
+            Err(RenderError::new("not drawn in these tests"))
+        }
+    }
+
     impl Output for Point {
         const UNITS: &'static UnitTable = unit_table!(Point);
+        type Picture = Undrawn;
 
         /// The columns its fields declare.
         fn table(&self) -> Table {
@@ -322,6 +343,7 @@ mod tests {
 
     impl Output for Holder {
         const UNITS: &'static UnitTable = unit_table!(Holder);
+        type Picture = Undrawn;
 
         fn table(&self) -> Table {
             const COLUMNS: [Column<f64>; 1] = [Column::number("x", "m", |x| *x)];

@@ -10,11 +10,11 @@ use serde_json::{json, Value};
 use thirdbody::engine::metrics::Metrics;
 use thirdbody::engine::store::JobStatus;
 use thirdbody::engine::{self, Engine, EngineConfig};
-use thirdbody::job::picture::Picture;
 use thirdbody::job::{
     Control, Job, JobError, Kind, Limits, Meta, References, Validated, Work, ROLLING_REFERENCES,
 };
 use thirdbody::render::svg::{Axis, Chart, Layer};
+use thirdbody::render::Picture;
 use thirdbody::render::{Column, Format, Output, RenderError, Table, UnitTable};
 use thirdbody::unit_table;
 use utoipa::ToSchema;
@@ -36,6 +36,7 @@ thirdbody::described! {
 
 impl Output for CountdownOutput {
     const UNITS: &'static UnitTable = unit_table!(CountdownOutput);
+    type Picture = CountdownPicture;
 
     fn table(&self) -> Table {
         Table::new(
@@ -82,7 +83,6 @@ impl Kind for Countdown {
     const NAME: &'static str = "countdown";
     type Input = CountdownInput;
     type Output = CountdownOutput;
-    type Picture = CountdownPicture;
 
     fn validate(input: Value, _limits: &Limits) -> Result<Validated<Self>, JobError> {
         let steps = input["steps"].as_u64().unwrap_or(1);

@@ -5,7 +5,7 @@
 use serde_json::{json, Value};
 use thirdbody::job::figure::FigurePicture;
 use thirdbody::job::fit::FitPicture;
-use thirdbody::job::picture::{draw, shown, Picture};
+use thirdbody::job::picture::shown;
 use thirdbody::job::rolling::RollingPicture;
 use thirdbody::job::sweep::SweepPicture;
 use thirdbody::job::three_body::ThreeBodyPicture;
@@ -13,6 +13,7 @@ use thirdbody::job::{Control, Job, Limits};
 use thirdbody::render::svg::Chart;
 use thirdbody::render::svg::{Layer, HEATMAP_CELLS};
 use thirdbody::render::Format;
+use thirdbody::render::{draw, Picture};
 
 /// The answer to `job` as JSON and as SVG.
 fn solve(job: Value) -> (Value, String) {

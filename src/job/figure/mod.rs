@@ -54,12 +54,11 @@ impl FigureJob {
 impl Kind for FigureJob {
     const NAME: &'static str = "figure";
     type Input = FigureInput;
-    type Picture = FigurePicture;
     type Output = FigureOutput;
 
     fn validate(input: Value, _limits: &Limits) -> Result<Validated<Self>, JobError> {
-        let input: FigureInput = input::deserialize(input, "")?;
-        FigureJob::new(input.number).map(Validated::from)
+        let number = input::deserialize::<FigureInput>(input, "")?.number;
+        FigureJob::new(number).map(Validated::from)
     }
 
     fn canonical(&self) -> Value {
@@ -182,6 +181,7 @@ struct FigureRow<'a> {
 impl Output for FigureOutput {
     /// The points are in the units of the axes, which the answer names.
     const UNITS: &'static UnitTable = unit_table!(FigureOutput);
+    type Picture = FigurePicture;
 
     /// One row per point: the series' index and legend, then x and y in the axes' units, then
     /// the conditions its series holds fixed (R, P, V) as columns of their own.

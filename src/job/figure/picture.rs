@@ -4,8 +4,9 @@
 use serde::Deserialize;
 
 use super::{AxisOutput, SeriesOutput};
-use crate::job::picture::{Picture, PictureError};
+use crate::job::picture::PictureError;
 use crate::render::svg::{Axis, Chart, Layer};
+use crate::render::Picture;
 
 /// What the picture shows of a figure: all of it but its `meta`.
 #[derive(Deserialize)]

@@ -79,7 +79,6 @@ pub struct FitJob {
 impl Kind for FitJob {
     const NAME: &'static str = "fit";
     type Input = FitInput;
-    type Picture = FitPicture;
     type Output = FitOutput;
 
     fn validate(value: Value, limits: &Limits) -> Result<Validated<Self>, JobError> {

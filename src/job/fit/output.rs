@@ -9,6 +9,7 @@ use serde::{Deserialize, Serialize};
 use utoipa::ToSchema;
 
 use super::input::MeasuredQuantity;
+use super::FitPicture;
 use crate::job::{JobError, Meta};
 use crate::model::fit::FitParameter;
 use crate::render::{fields, Column, Output, Table, UnitTable};
@@ -286,6 +287,7 @@ described! {
 impl Output for FitOutput {
     /// `radius` and `load` for a particle's points, `total_load` for a system's.
     const UNITS: &'static UnitTable = unit_table!(FitOutput);
+    type Picture = FitPicture;
 
     /// One row per measured point: measured, fitted and residual in the unit of `quantity`
     /// (`m^2` for contact_area, a plain number for friction_coefficient).

@@ -10,9 +10,10 @@ use serde::Deserialize;
 
 use super::input::MeasuredQuantity;
 use super::output::{Conditions, Curve, Residual};
-use crate::job::picture::{shown, symbol, Picture, PictureError};
+use crate::job::picture::{shown, symbol, PictureError};
 use crate::model::fit::FitParameter;
 use crate::render::svg::{Axis, Chart, Layer};
+use crate::render::Picture;
 
 /// What the picture shows of a fit.
 #[derive(Deserialize)]

@@ -152,7 +152,6 @@ impl RollingJob {
 impl Kind for RollingJob {
     const NAME: &'static str = "rolling";
     type Input = RollingInput;
-    type Picture = RollingPicture;
     type Output = RollingOutput;
 
     /// On the continuum, a job whose answer would pass the grid's cap is refused here.
@@ -748,6 +747,7 @@ impl RollingOutput {
 
 impl Output for RollingOutput {
     const UNITS: &'static UnitTable = unit_table!(RollingOutput);
+    type Picture = RollingPicture;
 
     /// One row: the contact's conditions and integrals, as a sweep's row.
     fn table(&self) -> Table {

@@ -6,8 +6,9 @@ use serde::Deserialize;
 
 use super::{BoundaryOutput, ContactOutput, PressureOutput, RollingJob};
 use crate::job::input::LayerModel;
-use crate::job::picture::{shown, Asked, Picture, PictureError};
+use crate::job::picture::{shown, Asked, PictureError};
 use crate::render::svg::{Axis, Chart, Layer};
+use crate::render::Picture;
 
 /// What the picture shows of a rolling answer.
 #[derive(Deserialize)]

@@ -149,7 +149,6 @@ impl SweepJob {
 impl Kind for SweepJob {
     const NAME: &'static str = "sweep";
     type Input = SweepInput;
-    type Picture = SweepPicture;
     type Output = SweepOutput;
 
     fn validate(value: Value, limits: &Limits) -> Result<Validated<Self>, JobError> {
@@ -704,6 +703,7 @@ impl Output for SweepOutput {
     /// The points of a rolling sweep or of a three-body sweep (a sweep's own answer lists
     /// its kind's alone: [`Kind::answer_units`]).
     const UNITS: &'static UnitTable = unit_table!(SweepOutput);
+    type Picture = SweepPicture;
 
     /// How many points the model refused, and how to fail the sweep instead.
     fn notice(&self) -> Option<String> {

@@ -8,13 +8,14 @@ use serde::Deserialize;
 use serde_json::Value;
 
 use crate::job::input::LayerModel;
-use crate::job::picture::{shown, symbol, Picture, PictureError};
+use crate::job::picture::{shown, symbol, PictureError};
 use crate::job::points::PointStatus;
 use crate::job::rolling::ContactOutput;
 use crate::job::three_body::{operating_units, ThreeBodyResult};
 use crate::model::text::prefixed;
 use crate::model::Parameter;
 use crate::render::svg::{Axis, Chart, Layer};
+use crate::render::Picture;
 
 /// What the picture shows of a sweep: its rows, and which law of the layer answered them
 /// with what error.

@@ -439,7 +439,6 @@ impl ThreeBodyJob {
 impl Kind for ThreeBodyJob {
     const NAME: &'static str = "three_body";
     type Input = ThreeBodyInput;
-    type Picture = ThreeBodyPicture;
     type Output = ThreeBodyOutput;
 
     /// On the continuum, a system one of whose layer curves' nodes would pass the grid's
@@ -837,6 +836,7 @@ impl ThreeBodyOutput {
 
 impl Output for ThreeBodyOutput {
     const UNITS: &'static UnitTable = unit_table!(ThreeBodyOutput);
+    type Picture = ThreeBodyPicture;
 
     /// One row: the system's operating point, speed and mean diameter and its results, as a
     /// sweep's row.

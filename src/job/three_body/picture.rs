@@ -5,10 +5,11 @@
 use serde::Deserialize;
 
 use super::{ThreeBodyJob, ThreeBodyResult};
-use crate::job::picture::{shown, Asked, Picture, PictureError};
+use crate::job::picture::{shown, Asked, PictureError};
 use crate::model::text::count;
 use crate::model::three_body::LayerContact;
 use crate::render::svg::{Axis, Chart, Layer};
+use crate::render::Picture;
 
 /// What the picture shows of a three-body answer.
 #[derive(Deserialize)]
