@@ -186,31 +186,25 @@ async fn a_continuum_job_beyond_its_grid_is_refused_naming_the_field_and_its_ran
             problem(app.post("/v1/rolling", &json!({"layer": layer})).await, 422).await
         }
     };
+    // The field refused (the first error's), and the range it is answered in.
+    let refused_range = |refusal: Value, field: &str| {
+        assert_eq!(refusal["errors"][0]["field"], field, "{refusal}");
+        refusal["errors"][0]["allowed"]
+            .as_str()
+            .unwrap()
+            .to_string()
+    };
     let fast = refusal(json!({"relaxation_time": 1e-30})).await;
-    assert_eq!(
-        fast["errors"][0]["field"], "layer.relaxation_time",
-        "{fast}"
-    );
-    let allowed = fast["errors"][0]["allowed"].as_str().unwrap();
+    let allowed = refused_range(fast, "layer.relaxation_time");
     assert!(
         allowed.starts_with("at least 2.59 ms with the other inputs as given (T_ε/T_σ at most 19"),
         "{allowed}"
     );
     let slow = refusal(json!({"retardation_time": 1e30})).await;
-    assert_eq!(
-        slow["errors"][0]["field"], "layer.retardation_time",
-        "{slow}"
-    );
-    assert!(slow["errors"][0]["allowed"]
-        .as_str()
-        .unwrap()
-        .starts_with("at most 9.7"));
+    let allowed = refused_range(slow, "layer.retardation_time");
+    assert!(allowed.starts_with("at most 9.7"), "{allowed}");
     let squeezed = refusal(json!({"thickness": "1 pm", "poisson_ratio": 0.49})).await;
-    assert_eq!(
-        squeezed["errors"][0]["field"], "layer.thickness",
-        "{squeezed}"
-    );
-    let allowed = squeezed["errors"][0]["allowed"].as_str().unwrap();
+    let allowed = refused_range(squeezed, "layer.thickness");
     assert!(
         allowed.contains("or ν at most 0.4 (the thin-layer path)"),
         "{allowed}"

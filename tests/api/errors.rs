@@ -5,7 +5,8 @@ use serde_json::{json, Value};
 use std::time::Duration;
 
 use crate::helpers::{
-    long_sweep, problem, problem_type, spawn_app, spawn_app_adjusted, spawn_app_on_disk, within,
+    assert_detail_says, long_sweep, problem, problem_type, spawn_app, spawn_app_adjusted,
+    spawn_app_on_disk, within,
 };
 
 #[tokio::test]
@@ -136,8 +137,7 @@ async fn unknown_routes_jobs_and_figures_are_404_and_wrong_methods_405() {
     ] {
         let unknown = problem(app.get(path).await, 404).await;
         assert_eq!(unknown["type"], problem_type("not-found"), "{path}");
-        let detail = unknown["detail"].as_str().unwrap();
-        assert!(detail.contains("no run of this service issued"), "{detail}");
+        assert_detail_says(&unknown, "no run of this service issued");
     }
     // One that an earlier run gave out: its unfinished jobs were interrupted by its
     // shutdown (here, another service in this test, standing for the earlier run).
@@ -152,8 +152,7 @@ async fn unknown_routes_jobs_and_figures_are_404_and_wrong_methods_405() {
     let location = app.submit(&job).await;
     app.delete(&location).await;
     let deleted = problem(app.get(&location).await, 404).await;
-    let detail = deleted["detail"].as_str().unwrap();
-    assert!(detail.contains("deleted, or it expired"), "{detail}");
+    assert_detail_says(&deleted, "deleted, or it expired");
     let response = app.get("/v1/rolling").await;
     assert_eq!(response.headers()["allow"], "POST");
     let not_allowed = problem(response, 405).await;
@@ -167,12 +166,9 @@ async fn unknown_routes_jobs_and_figures_are_404_and_wrong_methods_405() {
 #[tokio::test]
 async fn a_full_pool_is_429_at_once_and_a_full_job_queue_too() {
     let app = spawn_app_on_disk(&[
-        "--pool-size",
-        "1",
-        "--max-sweep-points",
-        "1000000",
-        "--max-queued-jobs",
-        "1",
+        "--pool-size=1",
+        "--max-sweep-points=1000000",
+        "--max-queued-jobs=1",
     ])
     .await;
     // One long job takes the only solver thread...

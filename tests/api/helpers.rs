@@ -378,6 +378,12 @@ pub async fn problem(response: Response, status: u16) -> Value {
     problem
 }
 
+/// Asserts that a problem's `detail` says `part`.
+pub fn assert_detail_says(problem: &Value, part: &str) {
+    let detail = problem["detail"].as_str().unwrap();
+    assert!(detail.contains(part), "{detail}");
+}
+
 /// The type URI of the problem named `name`.
 pub fn problem_type(name: &str) -> String {
     format!("tag:thirdbody,2026:problems/{name}")

@@ -9,8 +9,8 @@ use reqwest::Method;
 use serde_json::{json, Value};
 
 use crate::helpers::{
-    long_sweep, problem, problem_type, retry_after, spawn_app, spawn_app_adjusted,
-    spawn_app_on_disk, within, Events, TestApp,
+    assert_detail_says, long_sweep, problem, problem_type, retry_after, spawn_app,
+    spawn_app_adjusted, spawn_app_on_disk, within, Events, TestApp,
 };
 
 /// `n` seconds.
@@ -422,12 +422,9 @@ async fn asynchronous_jobs_leave_a_solver_thread_to_synchronous_requests() {
 #[tokio::test]
 async fn a_shutdown_finishes_the_accepted_jobs_and_keeps_answering_their_clients() {
     let mut app = spawn_app(&[
-        "--pool-size",
-        "1",
-        "--max-sweep-points",
-        "1000000",
-        "--shutdown-timeout",
-        "1m",
+        "--pool-size=1",
+        "--max-sweep-points=1000000",
+        "--shutdown-timeout=1m",
     ])
     .await;
     // A job finished before the shutdown that its client has not read yet...
@@ -468,8 +465,7 @@ async fn a_shutdown_finishes_the_accepted_jobs_and_keeps_answering_their_clients
 /// longer than that.
 async fn running_past_the_bound(shutdown_timeout: &str) -> (TestApp, String) {
     let app = spawn_app_on_disk(&[
-        "--max-sweep-points",
-        "1000000",
+        "--max-sweep-points=1000000",
         "--shutdown-timeout",
         shutdown_timeout,
     ])
@@ -530,12 +526,9 @@ async fn a_job_that_could_not_end_within_its_deadline_behind_the_queue_is_refuse
     // 3 s deadline failed it on a busy one), and the big job takes twice the deadline and
     // more on the fastest.
     let app = spawn_app_on_disk(&[
-        "--pool-size",
-        "2",
-        "--job-deadline",
-        "6s",
-        "--max-sweep-points",
-        "100000",
+        "--pool-size=2",
+        "--job-deadline=6s",
+        "--max-sweep-points=100000",
     ])
     .await;
     // A job of 1,000 points (~0.3 s) teaches the service what such points cost.
@@ -557,11 +550,7 @@ async fn a_job_that_could_not_end_within_its_deadline_behind_the_queue_is_refuse
     assert!(wait >= 3, "Retry-After {wait}");
     let refusal = problem(answer, 429).await;
     assert_eq!(refusal["type"], problem_type("overloaded"));
-    let detail = refusal["detail"].as_str().unwrap();
-    assert!(
-        detail.contains("past its deadline of 6 s (--job-deadline)"),
-        "{detail}"
-    );
+    assert_detail_says(&refusal, "past its deadline of 6 s (--job-deadline)");
     // A synchronous solve is not held up; once the big job ends, the next is accepted.
     assert_eq!(app.post("/v1/rolling", &json!({})).await.status(), 200);
     let cancel = app.post(&format!("{big}/cancel"), &json!({})).await;

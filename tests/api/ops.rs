@@ -127,12 +127,9 @@ async fn the_served_spec_is_the_committed_one_and_the_docs_are_served() {
 #[tokio::test]
 async fn on_shutdown_a_running_job_finishes_before_the_server_exits() {
     let mut app = spawn_app_on_disk(&[
-        "--pool-size",
-        "1",
-        "--max-sweep-points",
-        "1000000",
-        "--shutdown-timeout",
-        "10m",
+        "--pool-size=1",
+        "--max-sweep-points=1000000",
+        "--shutdown-timeout=10m",
     ])
     .await;
     // The job followed waits behind a blocker until it is seen queued, so it is sure to

@@ -6,7 +6,7 @@ use std::io::Read;
 
 use serde_json::{json, Value};
 
-use crate::helpers::{long_sweep, problem, problem_type, spawn_app, within};
+use crate::helpers::{assert_detail_says, long_sweep, problem, problem_type, spawn_app, within};
 
 /// A rolling sweep of `n` × 100 points, each a table look-up.
 fn sweep(n: usize) -> Value {
@@ -174,11 +174,7 @@ async fn a_job_whose_result_cannot_be_kept_is_refused_at_submission_never_after_
     assert!(retry.is_ok_and(|s| (1..=900).contains(&s)));
     let full = problem(full, 503).await;
     assert_eq!(full["type"], problem_type("results-full"));
-    let detail = full["detail"].as_str().unwrap();
-    assert!(
-        detail.contains("this job's result may take up to"),
-        "{detail}"
-    );
+    assert_detail_says(&full, "this job's result may take up to");
     // The first result is still there, whole.
     let kept = app.get(&format!("{first}/result")).await;
     assert_eq!(kept.status(), 200);

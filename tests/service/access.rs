@@ -296,13 +296,17 @@ async fn tenants_hold_across_a_fleet_on_a_redis_with_a_password() {
     let (_three, three_log) = start("serve", redis, Some(port), &["--redis-url", &wrong]);
     let three = answering(&http, port).await;
     let start_at = Instant::now();
+    // Each role's link finds the refusal on its own probe: wait for both.
     let ready = loop {
         let ready = get_json(&http, format!("{three}/readyz")).await;
-        if ready["status"] == "degraded" || start_at.elapsed() > PATIENCE {
+        let denied = ["cache", "jobs"].map(|role| ready["redis"][role] == "denied");
+        if denied == [true; 2] || start_at.elapsed() > PATIENCE {
             break ready;
         }
         tokio::time::sleep(Duration::from_millis(100)).await;
     };
+    assert_eq!(ready["status"], "degraded", "{ready}");
+    assert_eq!(ready["redis"]["cache"], "denied", "{ready}");
     assert_eq!(ready["redis"]["jobs"], "denied", "{ready}");
     let reasons = ready["reasons"].to_string();
     assert!(

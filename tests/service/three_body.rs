@@ -380,13 +380,9 @@ fn a_job_naming_only_the_operating_point_is_valid_and_canonical() {
         text["meta"]["input"]["operating"],
         json!({"total_load": 1e-3})
     );
-    assert_eq!(text["meta"]["verification"]["converged"], json!(true));
-    assert!(
-        text["meta"]["verification"]["layer_table_error"]
-            .as_f64()
-            .unwrap()
-            < 1e-12
-    );
+    let verification = &text["meta"]["verification"];
+    assert_eq!(verification["converged"], json!(true));
+    assert!(verification["layer_table_error"].as_f64().unwrap() < 1e-12);
     assert!(!text.to_string().contains("null"));
     assert_eq!(text["meta"]["references"].as_array().unwrap().len(), 5);
     for key in [
