@@ -196,6 +196,48 @@ fn slow_rolling_shifts_the_pressure_by_the_layers_lag() {
     );
 }
 
+/// Slower still the lag is a fraction of a pixel, which the grid cannot place (issue 47: at
+/// 0.02 nm/s it gave x_p = 0.51 pm for a lag of 8 pm, and claimed ±0.45 pm): the answer
+/// weighs in the first-order limit, so μ_r is V (T_ε − T_σ)/R within 1 % there, inside its
+/// reported error; and x_p/lag moves smoothly with V, from that limit to the grid's
+/// answer, with no step between speeds 10 % apart up to 1.2 nm/s, where the grid's weight
+/// has long taken over (the grid's alone went from 0.06 to 0.82 of the lag between 0.02 and
+/// 0.1 nm/s).
+#[test]
+fn very_slow_rolling_has_the_first_order_limit_and_x_p_is_smooth_in_v() {
+    let d = Rolling::default();
+    let lag = |v: f64| v * (d.layer.retardation_time - d.layer.relaxation_time);
+    let at = |velocity: f64| {
+        answer(&Rolling {
+            velocity,
+            ..Rolling::default()
+        })
+    };
+    let slow = at(2e-11);
+    let mu_r = lag(2e-11) / d.radius;
+    assert!(
+        off(slow.rolling_resistance_coefficient, mu_r) < 0.01,
+        "μ_r = {:e}, the limit {mu_r:e}",
+        slow.rolling_resistance_coefficient
+    );
+    let error = slow.verification.errors.pressure_centre_shift;
+    assert!((slow.pressure_centre_shift - lag(2e-11)).abs() <= error);
+    assert!(error < 0.01 * lag(2e-11), "{error:e}");
+    let mut last = (1.0, 1e-11);
+    let mut v = 1e-11;
+    while v < 1.2e-9 {
+        v *= 1.1;
+        let ratio = at(v).pressure_centre_shift / lag(v);
+        assert!(
+            (ratio - last.0).abs() < 0.03 && ratio <= 1.0,
+            "x_p/lag {} at {:e} m/s, then {ratio} at {v:e}",
+            last.0,
+            last.1
+        );
+        last = (ratio, v);
+    }
+}
+
 /// Between the limits: A falls with V, from the relaxed contact towards the instantaneous
 /// one, beyond the answers' errors; the contact and its pressure lie ahead of the centre.
 #[test]
