@@ -3,8 +3,11 @@
 //! pixel is the half-space's in closed form (a uniformly loaded rectangle, Love 1929) plus
 //! the layer's correction sampled at the pixels' distance (smooth where the pixel is much
 //! smaller than the layer). The convolution is free, not periodic: the kernel and the
-//! pressures are zero-padded to twice the grid (Hockney), so no image of the load acts.
+//! pressures are zero-padded (Hockney) to at least twice the grid, so no image of the load
+//! acts, and to lengths of small prime factors, which rustfft transforms fastest
+//! ([`padded`]).
 
+use std::cell::RefCell;
 use std::f64::consts::PI;
 use std::sync::Arc;
 
@@ -45,64 +48,144 @@ impl Grid {
     }
 }
 
+/// The lengths (mx, my) of the padded convolution of an nx × ny grid: mx along x (complex
+/// FFTs), my along y (real FFTs). Pixels at most n − 1 apart meet, so a circular
+/// convolution of any length m ≥ 2n − 1 is the free one. Exactly 2n often carries a large
+/// prime (104 = 8·13, 152 = 8·19, 232 = 8·29, 376 = 8·47 on the default and four-term
+/// answers' grids), where rustfft takes two to five times the instructions per point (at
+/// 108, 160, 240, 378: 24 to 33 a point, against 50 to 163); so each length is twice
+/// the least number ≥ n with no prime factor above 7. Twice: a real FFT of even length is
+/// a complex one of half of it, and rustfft's odd lengths cost half as much again per point
+/// (375 against 378).
+fn padded(grid: Grid) -> (usize, usize) {
+    (2 * smooth(grid.nx), 2 * smooth(grid.ny))
+}
+
+/// The least number ≥ `n` (and ≥ 1) with no prime factor above 7.
+fn smooth(n: usize) -> usize {
+    let is_smooth = |m: usize| [2, 3, 5, 7].iter().fold(m, |r, p| strip(r, *p)) == 1;
+    (n.max(1)..)
+        .find(|m| is_smooth(*m))
+        .expect("a power of two lies ahead")
+}
+
+/// `m` with every factor `p` divided out.
+fn strip(mut m: usize, p: usize) -> usize {
+    while m % p == 0 {
+        m /= p;
+    }
+    m
+}
+
 /// The deflection of the layer's surface under pixel pressures on a [`Grid`].
 pub struct Influence {
     grid: Grid,
+    /// The padded length along x ([`padded`]).
+    mx: usize,
     /// The kernel at offset zero.
     own: f64,
-    /// The spectrum of the zero-padded kernel, (ny + 1) columns of 2nx.
+    /// The spectrum of the zero-padded kernel, (my/2 + 1) columns of mx, over mx·my: the
+    /// inverse transforms' scale taken once here rather than at every convolution.
     kernel: Vec<Complex<f64>>,
     rows: Arc<dyn RealToComplex<f64>>,
     rows_back: Arc<dyn ComplexToReal<f64>>,
     columns: Arc<dyn Fft<f64>>,
     columns_back: Arc<dyn Fft<f64>>,
+    /// The buffers of a convolution, kept for the next: an answer convolves hundreds of
+    /// times, and clearing them afresh was a tenth of its instructions. (A cell, so an
+    /// influence convolves on one thread at a time; each march builds its own.)
+    buffers: RefCell<Buffers>,
+}
+
+/// The working arrays of one convolution ([`Influence::forward`], [`Influence::backward`]).
+struct Buffers {
+    /// The 2-D spectrum, column by column: (my/2 + 1) columns of mx.
+    spectrum: Vec<Complex<f64>>,
+    /// A padded row, real (my values) and as its half spectrum (my/2 + 1).
+    real: Vec<f64>,
+    complex: Vec<Complex<f64>>,
+    /// Scratch enough for any of the four transforms.
+    scratch: Vec<Complex<f64>>,
 }
 
 impl Influence {
     /// The influence on `grid` on `layer`, stopped when `stop` says so (its kernel takes
     /// about a tenth of a second on the largest grid).
     pub fn new(layer: &Layer, grid: Grid, stop: Stop) -> Result<Influence, ModelError> {
-        let (mx, my) = (2 * grid.nx, 2 * grid.ny);
+        let (mx, my) = padded(grid);
+        let half = my / 2 + 1;
         let mut real = RealFftPlanner::<f64>::new();
         let mut complex = FftPlanner::<f64>::new();
+        let (rows, rows_back) = (real.plan_fft_forward(my), real.plan_fft_inverse(my));
+        let (columns, columns_back) = (complex.plan_fft_forward(mx), complex.plan_fft_inverse(mx));
+        let scratch = [
+            rows.get_scratch_len(),
+            rows_back.get_scratch_len(),
+            columns.get_inplace_scratch_len(),
+            columns_back.get_inplace_scratch_len(),
+        ]
+        .into_iter()
+        .max()
+        .unwrap_or(0);
+        let zero = Complex::default();
         let mut influence = Influence {
             grid,
+            mx,
             own: 0.0,
             kernel: Vec::new(),
-            rows: real.plan_fft_forward(my),
-            rows_back: real.plan_fft_inverse(my),
-            columns: complex.plan_fft_forward(mx),
-            columns_back: complex.plan_fft_inverse(mx),
+            rows,
+            rows_back,
+            columns,
+            columns_back,
+            buffers: RefCell::new(Buffers {
+                spectrum: vec![zero; half * mx],
+                real: vec![0.0; my],
+                complex: vec![zero; half],
+                scratch: vec![zero; scratch],
+            }),
         };
         let h = grid.pixel;
         let correction = correction(layer, &grid, stop)?;
         let e_star = contact_modulus(layer);
-        // The kernel at every offset, wrapped: offset −k sits at index m − k.
-        let offset = |i: usize, n: usize| {
+        // The kernel at every offset, wrapped: offset −d sits at index m − d. Pixels meet
+        // at offsets below n alone; the indices from n to m − n meet no pressure, and stay
+        // zero.
+        let distance = |i: usize, n: usize, m: usize| {
             if i < n {
-                i as f64
+                Some(i)
+            } else if i > m - n {
+                Some(m - i)
             } else {
-                i as f64 - 2.0 * n as f64
+                None
             }
         };
         let rule = pixel_rule(h, layer.thickness);
         // The kernel is even in x and y: computed once per distance, placed four times.
-        let mut quarter = Vec::with_capacity((grid.nx + 1) * (grid.ny + 1));
-        for i in 0..=grid.nx {
+        let mut quarter = Vec::with_capacity(grid.nx * grid.ny);
+        for i in 0..grid.nx {
             stop.check()?;
-            quarter.extend((0..=grid.ny).map(|j| {
+            quarter.extend((0..grid.ny).map(|j| {
                 pixel_response(i as f64 * h, j as f64 * h, h, e_star, &correction, &rule)
             }));
         }
         let mut kernel = vec![0.0; mx * my];
         for i in 0..mx {
+            let Some(di) = distance(i, grid.nx, mx) else {
+                continue;
+            };
             for j in 0..my {
-                let (di, dj) = (offset(i, grid.nx).abs(), offset(j, grid.ny).abs());
-                kernel[i * my + j] = quarter[di as usize * (grid.ny + 1) + dj as usize];
+                if let Some(dj) = distance(j, grid.ny, my) {
+                    kernel[i * my + j] = quarter[di * grid.ny + dj];
+                }
             }
         }
         influence.own = kernel[0];
-        influence.kernel = influence.forward(&kernel, my, mx);
+        let scale = 1.0 / (mx * my) as f64;
+        let mut buffers = influence.buffers.borrow_mut();
+        influence.forward(&kernel, my, mx, &mut buffers);
+        let spectrum = buffers.spectrum.iter().map(|k| k * scale).collect();
+        drop(buffers);
+        influence.kernel = spectrum;
         Ok(influence)
     }
 
@@ -119,69 +202,70 @@ impl Influence {
     /// The deflection at every pixel's centre under `pressure` (over the grid).
     pub fn deflect(&self, pressure: &[f64]) -> Vec<f64> {
         let Grid { nx, ny, .. } = self.grid;
-        let (mx, my) = (2 * nx, 2 * ny);
-        let mut spectrum = self.forward(pressure, ny, nx);
-        for (s, k) in spectrum.iter_mut().zip(&self.kernel) {
+        let mut buffers = self.buffers.borrow_mut();
+        self.forward(pressure, ny, nx, &mut buffers);
+        for (s, k) in buffers.spectrum.iter_mut().zip(&self.kernel) {
             *s *= k;
         }
-        let mut deflection = self.backward(spectrum);
-        let scale = 1.0 / (mx * my) as f64;
-        deflection.iter_mut().for_each(|w| *w *= scale);
-        deflection
+        self.backward(&mut buffers)
     }
 
-    /// The 2-D spectrum of a 2nx × 2ny real array given by its first `filled` rows of
-    /// `width` values each (the rest zero): real FFTs along rows, then complex FFTs along
-    /// the ny + 1 columns; stored column by column.
-    fn forward(&self, data: &[f64], width: usize, filled: usize) -> Vec<Complex<f64>> {
-        let Grid { nx, ny, .. } = self.grid;
-        let (mx, my) = (2 * nx, 2 * ny);
-        let half = ny + 1;
-        let mut by_column = vec![Complex::default(); half * mx];
-        let mut row = vec![0.0; my];
-        let mut out = vec![Complex::default(); half];
-        let mut scratch = self.rows.make_scratch_vec();
+    /// The 2-D spectrum of an mx × my real array given by its first `filled` rows of
+    /// `width` values each (the rest zero), into `buffers.spectrum`: real FFTs along rows,
+    /// then complex FFTs along the my/2 + 1 columns; stored column by column.
+    fn forward(&self, data: &[f64], width: usize, filled: usize, buffers: &mut Buffers) {
+        let mx = self.mx;
+        let Buffers {
+            spectrum,
+            real,
+            complex,
+            scratch,
+        } = buffers;
         for i in 0..filled {
-            row[..width].copy_from_slice(&data[i * width..(i + 1) * width]);
-            row[width..].fill(0.0);
+            // The row is the transform's scratch: padded afresh every time.
+            real[..width].copy_from_slice(&data[i * width..(i + 1) * width]);
+            real[width..].fill(0.0);
             self.rows
-                .process_with_scratch(&mut row, &mut out, &mut scratch)
+                .process_with_scratch(real, complex, scratch)
                 .expect("buffers sized for the plan");
-            for (j, value) in out.iter().enumerate() {
-                by_column[j * mx + i] = *value;
+            for (j, value) in complex.iter().enumerate() {
+                spectrum[j * mx + i] = *value;
             }
         }
-        // Every column at once (they lie end to end), with one scratch buffer.
-        let mut scratch = vec![Complex::default(); self.columns.get_inplace_scratch_len()];
-        self.columns
-            .process_with_scratch(&mut by_column, &mut scratch);
-        by_column
+        // The rows past `filled` are zero, and so is their transform.
+        for column in spectrum.chunks_exact_mut(mx) {
+            column[filled..].fill(Complex::default());
+        }
+        // Every column at once (they lie end to end).
+        self.columns.process_with_scratch(spectrum, scratch);
     }
 
-    /// The inverse of [`Influence::forward`] on the grid's first nx rows and ny columns
-    /// (the deflection is wanted only there), unscaled (4 nx ny times the array).
-    fn backward(&self, mut by_column: Vec<Complex<f64>>) -> Vec<f64> {
+    /// The inverse of [`Influence::forward`] on `buffers.spectrum` (which it overwrites),
+    /// on the grid's first nx rows and ny columns (the deflection is wanted only there),
+    /// unnormalised (mx·my times the array: the kernel's spectrum carries the 1/(mx·my)).
+    fn backward(&self, buffers: &mut Buffers) -> Vec<f64> {
         let Grid { nx, ny, .. } = self.grid;
-        let (mx, my) = (2 * nx, 2 * ny);
-        let half = ny + 1;
-        let mut scratch = vec![Complex::default(); self.columns_back.get_inplace_scratch_len()];
-        self.columns_back
-            .process_with_scratch(&mut by_column, &mut scratch);
-        let mut data = vec![0.0; nx * ny];
-        let mut row = vec![Complex::default(); half];
-        let mut out = vec![0.0; my];
-        let mut scratch = self.rows_back.make_scratch_vec();
+        let mx = self.mx;
+        let Buffers {
+            spectrum,
+            real,
+            complex,
+            scratch,
+        } = buffers;
+        self.columns_back.process_with_scratch(spectrum, scratch);
+        let mut data = Vec::with_capacity(nx * ny);
+        let last = complex.len() - 1;
         for i in 0..nx {
-            for (j, value) in row.iter_mut().enumerate() {
-                *value = by_column[j * mx + i];
+            for (j, value) in complex.iter_mut().enumerate() {
+                *value = spectrum[j * mx + i];
             }
             // The transform of a real array: its zero and Nyquist terms are real.
-            row[0].im = 0.0;
-            row[ny].im = 0.0;
+            complex[0].im = 0.0;
+            complex[last].im = 0.0;
             self.rows_back
-                .process_with_scratch(&mut row, &mut out, &mut scratch)
+                .process_with_scratch(complex, real, scratch)
                 .expect("buffers sized for the plan");
-            data[i * ny..(i + 1) * ny].copy_from_slice(&out[..ny]);
+            data.extend_from_slice(&real[..ny]);
         }
         data
     }
@@ -315,6 +399,71 @@ mod tests {
         );
         let far = rectangle(300.0, 400.0, c);
         assert!((far * 500.0 / (4.0 * c * c) - 1.0).abs() < 1e-6, "{far}");
+    }
+
+    /// Every padded length is even, has no prime factor above 7, is at least twice its
+    /// side (so no image of the load acts), and is the least such.
+    #[test]
+    fn the_padded_lengths_are_even_and_7_smooth() {
+        let smooth = |m: usize| {
+            let mut rest = m;
+            for p in [2, 3, 5, 7] {
+                while rest % p == 0 {
+                    rest /= p;
+                }
+            }
+            rest == 1
+        };
+        for n in 1..=600 {
+            let (mx, my) = padded(Grid {
+                nx: n,
+                ny: n + 1,
+                pixel: 1.0,
+            });
+            for (m, n) in [(mx, n), (my, n + 1)] {
+                assert!(m % 2 == 0 && smooth(m) && m >= 2 * n, "{n} pixels: {m}");
+                let shorter = (2 * n..m).find(|k| k % 2 == 0 && smooth(*k));
+                assert!(shorter.is_none(), "{n} pixels: {m}, not {shorter:?}");
+            }
+        }
+        // The default and four-term answers' fine grids: 104 = 8·13 and 376 = 8·47 passed
+        // over.
+        let fine = |nx, ny| padded(Grid { nx, ny, pixel: 1.0 });
+        assert_eq!(fine(112, 52), (224, 108));
+        assert_eq!(fine(188, 56), (378, 112));
+    }
+
+    /// On a grid padded to neither twice its sides nor a power of two (13 × 11 pixels in
+    /// 28 × 24), the convolution of a pressure on every pixel is the direct O(n²) sum over
+    /// pixels: the wrapped kernel follows the padded length.
+    #[test]
+    fn on_the_smooth_padding_the_convolution_is_the_direct_sum() {
+        let layer = Layer::default();
+        let (nx, ny, h) = (13, 11, 1e-9);
+        let grid = Grid { nx, ny, pixel: h };
+        assert_eq!(padded(grid), (28, 24));
+        let influence = Influence::new(&layer, grid, Stop::NEVER).unwrap();
+        let pressure: Vec<f64> = (0..nx * ny)
+            .map(|k| 1.0 + ((k * 7919) % 101) as f64 / 50.0)
+            .collect();
+        let w = influence.deflect(&pressure);
+        let e_star = contact_modulus(&layer);
+        let corr = correction(&layer, &grid, Stop::NEVER).unwrap();
+        let rule = pixel_rule(h, layer.thickness);
+        let single = |di: usize, dj: usize| {
+            pixel_response(di as f64 * h, dj as f64 * h, h, e_star, &corr, &rule)
+        };
+        for (i, j) in (0..nx).flat_map(|i| (0..ny).map(move |j| (i, j))) {
+            let direct: f64 = (0..nx)
+                .flat_map(|a| (0..ny).map(move |b| (a, b)))
+                .map(|(a, b)| single(i.abs_diff(a), j.abs_diff(b)) * pressure[a * ny + b])
+                .sum();
+            let got = w[i * ny + j];
+            assert!(
+                (got / direct - 1.0).abs() < 1e-12,
+                "({i}, {j}): {got:e} vs {direct:e}"
+            );
+        }
     }
 
     /// The padded convolution is the direct sum over pixels, with no image of the load.
