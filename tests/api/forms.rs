@@ -49,6 +49,28 @@ async fn every_job_answer_comes_as_csv_when_asked() {
         .collect();
     assert_eq!(row[4], json["contact_area"].as_f64().unwrap());
     assert_eq!(row[9], json["friction_coefficient"].as_f64().unwrap());
+    // The bound of A's error is the continuum's column (issue 47): empty on the local law,
+    // whose quadrature error bounds every row alike.
+    let header: Vec<&str> = text.lines().next().unwrap().split(',').collect();
+    let column = header.iter().position(|h| *h == "contact_area_error");
+    let cell = text.lines().nth(1).unwrap().split(',').nth(column.unwrap());
+    assert_eq!(cell, Some(""));
+    let continuum = json!({"layer": {"model": "continuum"}});
+    let csv_text = app
+        .post_with("/v1/rolling", &csv, &continuum)
+        .await
+        .text()
+        .await
+        .unwrap();
+    let json: Value = app.post_json("/v1/rolling", &continuum).await;
+    let cell = csv_text
+        .lines()
+        .nth(1)
+        .unwrap()
+        .split(',')
+        .nth(column.unwrap());
+    let bound = &json["meta"]["verification"]["contact_area_error"];
+    assert_eq!(cell.unwrap().parse::<f64>().ok(), bound.as_f64());
 }
 
 #[tokio::test]

@@ -373,3 +373,38 @@ async fn a_huge_bad_cell_is_echoed_cut() {
     );
     assert_eq!(body["detail"], error["message"]);
 }
+
+/// Issue 47: a lab's Young's modulus E is read as the constrained modulus E_L the layer law
+/// takes, E_L = E(1 − ν)/((1 + ν)(1 − 2ν)) (docs/model.md §8): E = 1 GPa at ν = 0.25 is
+/// E_L = 1.2 GPa, the same job (one canonical input, one cache key, one answer) on both
+/// laws. Both moduli at once are refused, naming the field.
+#[tokio::test]
+async fn a_youngs_modulus_is_the_constrained_modulus_it_makes() {
+    let app = spawn_app(&[]).await;
+    for model in ["local", "continuum"] {
+        let youngs = json!({"model": model, "youngs_modulus": "1 GPa", "poisson_ratio": 0.25});
+        let constrained = json!({"model": model, "elastic_modulus": 1.2e9, "poisson_ratio": 0.25});
+        let (a, b) = (
+            rolling(&app, youngs).await,
+            rolling(&app, constrained).await,
+        );
+        assert_eq!(a["meta"]["input_hash"], b["meta"]["input_hash"], "{model}");
+        assert_eq!(a["meta"]["input"]["layer"]["elastic_modulus"], json!(1.2e9));
+        assert_same(&a, &b, 0.0);
+    }
+    let both = json!({"layer": {"elastic_modulus": "3 GPa", "youngs_modulus": "2 GPa"}});
+    let refused = problem(app.post("/v1/rolling", &both).await, 422).await;
+    assert_eq!(
+        refused["errors"][0]["field"], "layer.youngs_modulus",
+        "{refused}"
+    );
+    let allowed = refused["errors"][0]["allowed"].as_str().unwrap();
+    assert!(allowed.contains("absent with elastic_modulus"), "{allowed}");
+    let bad = json!({"layer": {"youngs_modulus": "-2 GPa"}});
+    let refused = problem(app.post("/v1/rolling", &bad).await, 422).await;
+    assert_eq!(
+        refused["errors"][0]["field"], "layer.youngs_modulus",
+        "{refused}"
+    );
+    assert_eq!(refused["errors"][0]["value"], "-2 GPa", "{refused}");
+}

@@ -22,6 +22,10 @@ use super::thin::thin_error;
 use crate::limits::ElasticContact;
 use crate::{ModelError, Rolling, RollingSolution, SolveOptions, Stop};
 
+/// §8's tolerances on an answer's relative error: 1 % in A, 0.5 % in δ (rolling and at rest).
+pub const AREA_TOLERANCE: f64 = 0.01;
+pub const PENETRATION_TOLERANCE: f64 = 0.005;
+
 /// The march stops when a step changes the pressure by less than this share of its sum
 /// (it then lies within about ten times that of its steady state).
 const TOLERANCE: f64 = 1e-5;

@@ -15,6 +15,14 @@ pub fn young_modulus(layer: &Layer) -> f64 {
     layer.elastic_modulus * (1.0 + nu) * (1.0 - 2.0 * nu) / (1.0 - nu)
 }
 
+/// E_L, the oedometric (constrained) modulus of a layer of Young's modulus E and Poisson
+/// ratio ν: E_L = E (1 − ν)/((1 + ν)(1 − 2ν)), the inverse of [`young_modulus`] (for a
+/// layer given by a lab's E rather than E_L).
+pub fn constrained_modulus(youngs_modulus: f64, poisson_ratio: f64) -> f64 {
+    let nu = poisson_ratio;
+    youngs_modulus * (1.0 - nu) / ((1.0 + nu) * (1.0 - 2.0 * nu))
+}
+
 /// E* = E/(1 − ν²), the plane-strain modulus of the layer against a rigid sphere.
 pub fn contact_modulus(layer: &Layer) -> f64 {
     let nu = layer.poisson_ratio;

@@ -24,10 +24,12 @@ mod thin;
 
 pub use answer::{
     area_floor, solve, solve_at, ContinuumVerification, GridUsed, QuantityErrors, AREA_SCATTER,
-    EDGE_BIAS,
+    AREA_TOLERANCE, EDGE_BIAS, PENETRATION_TOLERANCE,
 };
 pub use axisymmetric::{static_contact, StaticContinuum};
-pub use compliance::{contact_modulus, layer_correction, layer_factor, young_modulus};
+pub use compliance::{
+    constrained_modulus, contact_modulus, layer_correction, layer_factor, young_modulus,
+};
 pub use curve::PenetrationCurve;
 pub use grid::{Grid, Influence};
 pub use plan::{

@@ -568,7 +568,7 @@ function accuracy(answer) {
   const how = v.method === "grid"
     ? `on a ${v.grid.length} × ${v.grid.width} grid, ${Math.round(v.grid.pixels_across)} pixels across the contact`
     : "by the local law, which a layer this thin follows";
-  const within = v.within_tolerance ? "" : " (less exact than 1 % in A)";
+  const within = v.within_tolerance ? "" : " (bounds beyond §8's tolerance of 1 % in A, 0.5 % in δ)";
   return ` Layer as a continuum, ${how}: A within ±${percent(v.contact_area_error)}, δ within ±${percent(v.penetration_error)}${within}.`;
 }
 

@@ -8,6 +8,7 @@ use serde_json::json;
 use super::units::{is_bare_number, names_celsius, parse_quantity, Dimension, UnitError};
 use super::{field, Checker, Quantity};
 use crate::job::echoed;
+use crate::model::continuum::constrained_modulus;
 use crate::model::spectrum::{wlf_decades, Terms, MAX_TERMS};
 use crate::model::{Layer, Parameter};
 use crate::render::format_number;
@@ -56,8 +57,14 @@ pub struct WlfInput {
 pub struct LayerInput {
     /// How the layer gives way: `local` (default, the paper's law) or `continuum`.
     pub model: Option<LayerModel>,
-    /// E_L, relaxed longitudinal modulus (Pa; default 3 GPa); with a Prony series its E_∞.
+    /// E_L, the relaxed constrained (oedometric, longitudinal) modulus, not Young's E (Pa;
+    /// default 3 GPa); with a Prony series its E_∞. It is the paper's spring constant per
+    /// thickness, k = E_L/H.
     pub elastic_modulus: Option<Quantity>,
+    /// E, the relaxed Young's modulus (Pa), instead of `elastic_modulus`: a DMA's or a
+    /// datasheet's modulus, read as E_L = E (1 − ν)/((1 + ν)(1 − 2ν)) (1.6 E at ν = 0.35;
+    /// docs/model.md §8). Not with `elastic_modulus`.
+    pub youngs_modulus: Option<Quantity>,
     /// H, layer thickness (m; default 100 nm).
     pub thickness: Option<Quantity>,
     /// ν, Poisson ratio (dimensionless; default 0.35).
@@ -86,11 +93,7 @@ impl LayerInput {
     pub fn read(&self, checker: &mut Checker) -> Layer {
         let input = self;
         let d = Layer::default();
-        let elastic_modulus = checker.quantity(
-            field!(input.elastic_modulus),
-            Parameter::ElasticModulus,
-            d.elastic_modulus,
-        );
+        let modulus = self.modulus(checker, d.elastic_modulus);
         let thickness =
             checker.quantity(field!(input.thickness), Parameter::Thickness, d.thickness);
         let poisson_ratio = checker.quantity(
@@ -98,6 +101,7 @@ impl LayerInput {
             Parameter::PoissonRatio,
             d.poisson_ratio,
         );
+        let elastic_modulus = modulus(poisson_ratio);
         let layer = match self.series(checker) {
             Some(terms) => {
                 for (field, given) in [
@@ -132,6 +136,32 @@ impl LayerInput {
             Some(decades) => layer.with_times_scaled(10f64.powf(decades)),
             None => layer,
         }
+    }
+
+    /// E_L as given: `elastic_modulus`, or `youngs_modulus` converted with ν (the returned
+    /// function's argument, read after it). A Young's modulus is checked at its own field,
+    /// as sent.
+    fn modulus(&self, checker: &mut Checker, default: f64) -> impl Fn(f64) -> f64 {
+        let input = self;
+        // Read only when it is the modulus given: the field the model's errors then name.
+        let youngs = match (&self.elastic_modulus, &self.youngs_modulus) {
+            (Some(_), Some(given)) => {
+                let allowed = "absent with elastic_modulus (one modulus: E_L, constrained, \
+                               or E, Young's)";
+                checker.invalid("youngs_modulus", given.sent(), allowed);
+                None
+            }
+            (None, Some(_)) => {
+                checker.optional(field!(input.youngs_modulus), Parameter::ElasticModulus)
+            }
+            (_, None) => None,
+        };
+        let given = checker.quantity(
+            field!(input.elastic_modulus),
+            Parameter::ElasticModulus,
+            default,
+        );
+        move |poisson_ratio| youngs.map_or(given, |e| constrained_modulus(e, poisson_ratio))
     }
 
     /// The Prony series (E_j, τ_j) given as `prony` or `prony_csv`, if any; a term out of
