@@ -220,15 +220,10 @@ impl Lifecycle {
     /// A place in this process's queue for `keyed`, and its turn in the backlog.
     fn take_place(&self, keyed: &Keyed) -> Result<Ticket, EngineError> {
         let max = self.config.max_queued_jobs;
-        if self
-            .queued
-            .fetch_update(Ordering::SeqCst, Ordering::SeqCst, |n| {
-                (n < max).then_some(n + 1)
-            })
-            .is_err()
-        {
-            return Err(EngineError::Overloaded);
-        }
+        let room = |n| (n < max).then_some(n + 1);
+        self.queued
+            .fetch_update(Ordering::SeqCst, Ordering::SeqCst, room)
+            .map_err(|_| EngineError::Overloaded)?;
         let work = keyed.job().work();
         self.backlog
             .admit(keyed.job().cost_class(), work.units())

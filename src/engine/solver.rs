@@ -121,10 +121,7 @@ impl Solver {
     /// The cached answer under `key`, counted as a hit.
     pub async fn cached(&self, key: &str) -> Option<Arc<Solved>> {
         let solved = self.cache.get(key).await;
-        if solved.is_some() {
-            self.cache_hits.increment(1);
-        }
-        solved
+        solved.inspect(|_| self.cache_hits.increment(1))
     }
 
     pub(super) async fn keep(&self, solved: Arc<Solved>) {

@@ -99,14 +99,11 @@ struct Entry {
 impl Entry {
     fn read(entry: &StreamId) -> Option<Entry> {
         let number = |name: &str| entry.get::<usize>(name);
-        let part = match (number("part"), number("start"), number("end")) {
-            (Some(index), Some(start), Some(end)) => Some((index, start..end)),
-            _ => None,
-        };
+        let part = || Some((number("part")?, number("start")?..number("end")?));
         Some(Entry {
             id: entry.id.clone(),
             job: entry.get::<String>("job")?.parse().ok()?,
-            part,
+            part: part(),
         })
     }
 
