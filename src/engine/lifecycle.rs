@@ -520,7 +520,7 @@ impl Lifecycle {
                 () = live.cancel.cancelled() => Err(live.stopped(None)),
                 permits = async {
                     let slot = self.job_slots.clone().acquire_owned().await;
-                    (slot, self.solver.permit(keyed.job().cost().bytes).await)
+                    (slot, self.solver.pool.acquire(keyed.job().cost().bytes).await)
                 } => Ok(permits),
             },
         };
@@ -556,7 +556,7 @@ impl Lifecycle {
         // guard goes with this function.
         match result {
             Ok(solved) => {
-                self.solver.keep(solved.clone()).await;
+                self.solver.cache.insert(solved.clone()).await;
                 JobState::Succeeded(JobResult::Ready(solved))
             }
             Err(Stopped { error, partial }) => {

@@ -246,7 +246,7 @@ impl Worker {
         keyed: &Keyed,
         control: &Arc<Control>,
     ) -> Result<Outcome, JobError> {
-        let permit = self.solver.permit(keyed.job().cost().bytes).await;
+        let permit = self.solver.pool.acquire(keyed.job().cost().bytes).await;
         let _running = self.solver.running();
         let part = entry.part.clone();
         let (solving, meta, key) = keyed.clone().into_parts();
@@ -374,7 +374,7 @@ impl Worker {
         };
         let state = JobState::Succeeded(JobResult::Ready(solved.clone()));
         if self.finish(entry, state, Some(total)).await {
-            self.solver.keep_result_of(solved, entry.job).await;
+            self.solver.cache.insert_result_of(solved, entry.job).await;
         }
     }
 
