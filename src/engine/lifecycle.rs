@@ -150,12 +150,12 @@ impl Lifecycle {
         tokio::spawn(async move { watcher.watch().await });
         let slots = share_with_requests.then(|| self.job_slots.clone());
         for _ in 0..loops.max(1) {
-            let worker = Worker::new(
-                self.solver.clone(),
-                shared.clone(),
-                slots.clone(),
-                self.draining.clone(),
-            );
+            let worker = Worker {
+                solver: self.solver.clone(),
+                shared: shared.clone(),
+                slots: slots.clone(),
+                draining: self.draining.clone(),
+            };
             self.tracker.spawn(worker.run());
         }
     }

@@ -125,27 +125,13 @@ enum Outcome {
 /// One worker of the fleet's stream: the solve path, the fleet, the job slots it shares with
 /// synchronous requests (if any), and the drain's signal, at which it stops taking entries.
 pub struct Worker {
-    solver: Arc<Solver>,
-    shared: Arc<Shared>,
-    slots: Option<Arc<Semaphore>>,
-    draining: CancellationToken,
+    pub solver: Arc<Solver>,
+    pub shared: Arc<Shared>,
+    pub slots: Option<Arc<Semaphore>>,
+    pub draining: CancellationToken,
 }
 
 impl Worker {
-    pub fn new(
-        solver: Arc<Solver>,
-        shared: Arc<Shared>,
-        slots: Option<Arc<Semaphore>>,
-        draining: CancellationToken,
-    ) -> Worker {
-        Worker {
-            solver,
-            shared,
-            slots,
-            draining,
-        }
-    }
-
     pub async fn run(self) {
         let mut looked_for_orphans = Instant::now();
         let waiting = match self.shared.fleet.jobs.dedicated() {
