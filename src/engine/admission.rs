@@ -11,7 +11,6 @@ use std::time::{Duration, Instant};
 use tokio::sync::OwnedMutexGuard;
 
 use super::error::EngineError;
-use super::fleet::link::DELETE_IF_HELD;
 use super::fleet::Fleet;
 use super::lock;
 
@@ -41,12 +40,7 @@ impl Drop for Turn {
             return;
         };
         runtime.spawn(async move {
-            let script = redis::Script::new(DELETE_IF_HELD);
-            let released = fleet
-                .jobs
-                .script::<i64>(&script, &[&key], &[token.as_bytes()])
-                .await;
-            if let Err(e) = released {
+            if let Err(e) = fleet.jobs.delete_if_held(&key, &token).await {
                 tracing::warn!(error = %e.why, "a tenant's admission lock waits out its lease");
             }
         });

@@ -13,10 +13,9 @@ use std::collections::HashMap;
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
+use super::fleet::placement::learn;
 use super::lock;
 
-/// Weight of the latest job in a class's learned rate.
-const LEARNING: f64 = 0.5;
 /// Jobs shorter than this teach nothing: their time is mostly the fixed cost of a job, which
 /// spread over few units would overstate the cost of a big job of the class (and short
 /// jobs delay no one much).
@@ -103,10 +102,9 @@ impl Ticket {
         if units == 0 || took < TEACHES {
             return;
         }
-        let observed = took.as_secs_f64() / units as f64;
-        let mut accepted = lock(&self.backlog.accepted);
-        let rate = accepted.rates.entry(self.class).or_insert(observed);
-        *rate += LEARNING * (observed - *rate);
+        let rates = &mut lock(&self.backlog.accepted).rates;
+        let rate = learn(rates.get(self.class).copied(), took, units);
+        rates.insert(self.class, rate);
     }
 }
 

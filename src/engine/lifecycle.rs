@@ -150,12 +150,12 @@ impl Lifecycle {
         tokio::spawn(async move { watcher.watch().await });
         let slots = share_with_requests.then(|| self.job_slots.clone());
         for _ in 0..loops.max(1) {
-            let worker = Worker::new(
-                self.solver.clone(),
-                shared.clone(),
-                slots.clone(),
-                self.draining.clone(),
-            );
+            let worker = Worker {
+                solver: self.solver.clone(),
+                shared: shared.clone(),
+                slots: slots.clone(),
+                draining: self.draining.clone(),
+            };
             self.tracker.spawn(worker.run());
         }
     }
@@ -220,15 +220,10 @@ impl Lifecycle {
     /// A place in this process's queue for `keyed`, and its turn in the backlog.
     fn take_place(&self, keyed: &Keyed) -> Result<Ticket, EngineError> {
         let max = self.config.max_queued_jobs;
-        if self
-            .queued
-            .fetch_update(Ordering::SeqCst, Ordering::SeqCst, |n| {
-                (n < max).then_some(n + 1)
-            })
-            .is_err()
-        {
-            return Err(EngineError::Overloaded);
-        }
+        let room = |n| (n < max).then_some(n + 1);
+        self.queued
+            .fetch_update(Ordering::SeqCst, Ordering::SeqCst, room)
+            .map_err(|_| EngineError::Overloaded)?;
         let work = keyed.job().work();
         self.backlog
             .admit(keyed.job().cost_class(), work.units())
@@ -525,7 +520,7 @@ impl Lifecycle {
                 () = live.cancel.cancelled() => Err(live.stopped(None)),
                 permits = async {
                     let slot = self.job_slots.clone().acquire_owned().await;
-                    (slot, self.solver.permit(keyed.job().cost().bytes).await)
+                    (slot, self.solver.pool.acquire(keyed.job().cost().bytes).await)
                 } => Ok(permits),
             },
         };
@@ -561,7 +556,7 @@ impl Lifecycle {
         // guard goes with this function.
         match result {
             Ok(solved) => {
-                self.solver.keep(solved.clone()).await;
+                self.solver.cache.insert(solved.clone()).await;
                 JobState::Succeeded(JobResult::Ready(solved))
             }
             Err(Stopped { error, partial }) => {

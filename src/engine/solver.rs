@@ -61,8 +61,8 @@ impl From<JobError> for Stopped {
 
 /// The solver threads, the answers and what is remembered between requests.
 pub struct Solver {
-    pool: Pool,
-    cache: Arc<dyn ResultCache>,
+    pub(super) pool: Pool,
+    pub(super) cache: Arc<dyn ResultCache>,
     coalescer: Coalescer,
     /// Valid inputs' text (kind and compact JSON) → cache key: a repeat is not validated again.
     input_keys: Bounded<Arc<str>>,
@@ -121,19 +121,7 @@ impl Solver {
     /// The cached answer under `key`, counted as a hit.
     pub async fn cached(&self, key: &str) -> Option<Arc<Solved>> {
         let solved = self.cache.get(key).await;
-        if solved.is_some() {
-            self.cache_hits.increment(1);
-        }
-        solved
-    }
-
-    pub(super) async fn keep(&self, solved: Arc<Solved>) {
-        self.cache.insert(solved).await;
-    }
-
-    /// See [`ResultCache::insert_result_of`].
-    pub(super) async fn keep_result_of(&self, solved: Arc<Solved>, job: uuid::Uuid) {
-        self.cache.insert_result_of(solved, job).await;
+        solved.inspect(|_| self.cache_hits.increment(1))
     }
 
     /// Solves `keyed` by `deadline`, or takes its answer from the cache. Identical concurrent
@@ -190,14 +178,9 @@ impl Solver {
             .await
             .map_err(|stopped| stopped.error)?;
         if cache == CacheUse::Keep {
-            self.keep(solved.clone()).await;
+            self.cache.insert(solved.clone()).await;
         }
         Ok(solved)
-    }
-
-    /// Waits for a solver thread and `bytes` of working memory (first come, first served).
-    pub(super) async fn permit(&self, bytes: u64) -> Permit {
-        self.pool.acquire(bytes).await
     }
 
     /// The control of a job run by this engine: one thread, `deadline`, the point memo.

@@ -199,10 +199,7 @@ impl Answer {
     pub fn render(&self, format: Format) -> Result<Vec<u8>, RenderError> {
         match format {
             Format::Json => self.0.json(false),
-            Format::Svg => {
-                let json = self.0.json(false)?;
-                draw_svg(self.1, &json).map(String::into_bytes)
-            }
+            Format::Svg => draw_svg(self.1, &self.0.json(false)?).map(String::into_bytes),
             Format::Csv => self
                 .0
                 .csv()
@@ -241,10 +238,7 @@ impl Answer {
 /// not finite) equals none.
 impl PartialEq for Answer {
     fn eq(&self, other: &Answer) -> bool {
-        match (self.0.json(false), other.0.json(false)) {
-            (Ok(a), Ok(b)) => a == b,
-            _ => false,
-        }
+        matches!((self.0.json(false), other.0.json(false)), (Ok(a), Ok(b)) if a == b)
     }
 }
 

@@ -581,7 +581,13 @@ async fn a_worker_on_its_own_takes_a_job_from_the_stream_and_stores_its_answer()
 
     let draining = CancellationToken::new();
     let shared = Arc::new(Shared::new(fleet, store.clone()));
-    let worker = tokio::spawn(Worker::new(solver, shared, None, draining.clone()).run());
+    let worker = Worker {
+        solver,
+        shared,
+        slots: None,
+        draining: draining.clone(),
+    };
+    let worker = tokio::spawn(worker.run());
     let start = Instant::now();
     let answered = loop {
         let now = store

@@ -7,10 +7,10 @@ use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use async_trait::async_trait;
-use redis::{Cmd, ExistenceCheck, Script, SetExpiry, SetOptions};
+use redis::{Cmd, ExistenceCheck, SetExpiry, SetOptions};
 use uuid::Uuid;
 
-use super::link::{eval, DELETE_IF_HELD};
+use super::link::eval;
 use super::{keys, Fleet, Health};
 use crate::engine::cache::{Claim, MemoryCache, ResultCache, Solved};
 use crate::engine::clock::millis;
@@ -188,9 +188,9 @@ impl ResultCache for TieredCache {
     async fn release(&self, key: &str) {
         let link = &self.fleet.cache;
         if link.is_quick() {
-            let (release, claim) = (Script::new(DELETE_IF_HELD), keys::solving(key));
-            let consumer = self.fleet.consumer.as_bytes();
-            let _ = link.script::<i64>(&release, &[&claim], &[consumer]).await;
+            let _ = link
+                .delete_if_held(&keys::solving(key), &self.fleet.consumer)
+                .await;
         }
     }
 }

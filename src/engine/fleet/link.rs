@@ -9,7 +9,7 @@ use std::time::{Duration, Instant};
 
 use metrics::Gauge;
 use redis::aio::{ConnectionManager, ConnectionManagerConfig};
-use redis::{Cmd, FromRedisValue, Pipeline, RedisError, Script};
+use redis::{Cmd, FromRedisValue, Pipeline, RedisError};
 
 /// A call that takes longer is a failure: Redis answers in well under a millisecond.
 const CALL_TIMEOUT: Duration = Duration::from_secs(1);
@@ -258,17 +258,11 @@ impl Link {
             .await
     }
 
-    pub async fn script<T: FromRedisValue>(
-        &self,
-        script: &Script,
-        keys: &[&str],
-        args: &[&[u8]],
-    ) -> Result<T, Failure> {
-        let mut invocation = script.key(keys);
-        invocation.arg(args);
-        let invocation = &invocation;
-        self.call(|mut c| async move { invocation.invoke_async(&mut c).await })
-            .await
+    /// Deletes `key` only if it still holds `value` ([`DELETE_IF_HELD`]).
+    pub async fn delete_if_held(&self, key: &str, value: &str) -> Result<(), Failure> {
+        let mut pipe = redis::pipe();
+        eval(&mut pipe, DELETE_IF_HELD, &[key]).arg(value).ignore();
+        self.pipe(&pipe).await
     }
 
     /// Pings the server until dropped, so that its health is known without calls to make,
@@ -347,7 +341,7 @@ pub(super) fn eval<'a>(pipe: &'a mut Pipeline, script: &str, keys: &[&str]) -> &
 }
 
 /// Deletes KEYS[1] only if it still holds ARGV[1] (it may have been taken over since).
-pub(crate) const DELETE_IF_HELD: &str = r#"
+pub(super) const DELETE_IF_HELD: &str = r#"
 if redis.call('GET', KEYS[1]) == ARGV[1] then return redis.call('DEL', KEYS[1]) end
 return 0
 "#;

@@ -15,7 +15,7 @@ pub const WHOLE_BELOW: Duration = Duration::from_millis(150);
 pub const PART_SECONDS: f64 = 0.025;
 /// How long a learned rate is kept without news (a fleet's code and machines change).
 pub const RATE_TTL: Duration = Duration::from_secs(24 * 3600);
-/// Weight of the latest part in a class's learned rate.
+/// Weight of the latest part (or job) in a class's learned rate.
 pub const LEARNING: f64 = 0.5;
 
 /// The parts of a sweep of `points` points at `rate` seconds each (`None`: not measured yet,
@@ -36,7 +36,7 @@ pub fn plan(points: Option<usize>, rate: Option<f64>, default_points: usize) -> 
     }
 }
 
-/// The rate learned from a part of `points` points solved in `took`, given the one before.
+/// The rate learned from a part or a job of `points` points solved in `took`, given the last.
 pub fn learn(before: Option<f64>, took: Duration, points: usize) -> f64 {
     let now = took.as_secs_f64() / points.max(1) as f64;
     match before {

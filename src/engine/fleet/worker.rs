@@ -99,14 +99,11 @@ struct Entry {
 impl Entry {
     fn read(entry: &StreamId) -> Option<Entry> {
         let number = |name: &str| entry.get::<usize>(name);
-        let part = match (number("part"), number("start"), number("end")) {
-            (Some(index), Some(start), Some(end)) => Some((index, start..end)),
-            _ => None,
-        };
+        let part = || Some((number("part")?, number("start")?..number("end")?));
         Some(Entry {
             id: entry.id.clone(),
             job: entry.get::<String>("job")?.parse().ok()?,
-            part,
+            part: part(),
         })
     }
 
@@ -128,27 +125,13 @@ enum Outcome {
 /// One worker of the fleet's stream: the solve path, the fleet, the job slots it shares with
 /// synchronous requests (if any), and the drain's signal, at which it stops taking entries.
 pub struct Worker {
-    solver: Arc<Solver>,
-    shared: Arc<Shared>,
-    slots: Option<Arc<Semaphore>>,
-    draining: CancellationToken,
+    pub solver: Arc<Solver>,
+    pub shared: Arc<Shared>,
+    pub slots: Option<Arc<Semaphore>>,
+    pub draining: CancellationToken,
 }
 
 impl Worker {
-    pub fn new(
-        solver: Arc<Solver>,
-        shared: Arc<Shared>,
-        slots: Option<Arc<Semaphore>>,
-        draining: CancellationToken,
-    ) -> Worker {
-        Worker {
-            solver,
-            shared,
-            slots,
-            draining,
-        }
-    }
-
     pub async fn run(self) {
         let mut looked_for_orphans = Instant::now();
         let waiting = match self.shared.fleet.jobs.dedicated() {
@@ -249,7 +232,7 @@ impl Worker {
         keyed: &Keyed,
         control: &Arc<Control>,
     ) -> Result<Outcome, JobError> {
-        let permit = self.solver.permit(keyed.job().cost().bytes).await;
+        let permit = self.solver.pool.acquire(keyed.job().cost().bytes).await;
         let _running = self.solver.running();
         let part = entry.part.clone();
         let (solving, meta, key) = keyed.clone().into_parts();
@@ -377,7 +360,7 @@ impl Worker {
         };
         let state = JobState::Succeeded(JobResult::Ready(solved.clone()));
         if self.finish(entry, state, Some(total)).await {
-            self.solver.keep_result_of(solved, entry.job).await;
+            self.solver.cache.insert_result_of(solved, entry.job).await;
         }
     }
 

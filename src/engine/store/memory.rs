@@ -1,6 +1,6 @@
 //! One process's job records in memory, bounded in count and in the bytes of their results.
 
-use std::collections::{HashMap, VecDeque};
+use std::collections::HashMap;
 use std::sync::Mutex;
 use std::time::{Duration, SystemTime};
 
@@ -37,8 +37,6 @@ struct Records {
     jobs: HashMap<Uuid, JobRecord>,
     /// Room made (bytes, and where) for the results of jobs not finished yet.
     reserved: HashMap<Uuid, (u64, Place)>,
-    /// Finished jobs, oldest first (some may be forgotten since).
-    finished: VecDeque<Uuid>,
     /// Bytes held and made room for in memory.
     memory: u64,
 }
@@ -77,16 +75,14 @@ impl Records {
         for id in &expired {
             self.forget(id);
         }
-        let Records { jobs, finished, .. } = self;
-        finished.retain(|id| jobs.contains_key(id));
         expired.len()
     }
 
     /// How long until the oldest finished job expires (and makes room), at most `retention`.
     fn next_expiry(&self, retention: Duration, now: SystemTime) -> Duration {
-        self.finished
-            .iter()
-            .filter_map(|id| self.jobs.get(id)?.finished_at)
+        self.jobs
+            .values()
+            .filter_map(|record| record.finished_at)
             .map(|t| retention.saturating_sub(age(t, now)))
             .min()
             .unwrap_or(retention)
@@ -199,15 +195,11 @@ impl MemoryJobStore {
         let Some(record) = records.jobs.get_mut(&id) else {
             return place;
         };
-        let finished = finishing && record.finished_at.is_none();
-        if finished {
-            record.finished_at = Some(now);
+        if finishing {
+            record.finished_at.get_or_insert(now);
         }
         record.state = state;
         record.done = done;
-        if finished {
-            records.finished.push_back(id);
-        }
         place
     }
 

@@ -326,12 +326,6 @@ pub struct StoredResult {
     pub place: Arc<dyn ResultPlace>,
 }
 
-impl StoredResult {
-    pub async fn body(&self, field: &str) -> io::Result<Bytes> {
-        self.place.body(field).await
-    }
-}
-
 impl std::fmt::Debug for StoredResult {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("StoredResult")
@@ -383,9 +377,10 @@ impl JobResult {
                     .map_err(|e| io::Error::other(e.to_string()))?;
                 Ok((solved.json().clone(), csv))
             }
-            JobResult::Stored(stored) => {
-                Ok((stored.body("json").await?, stored.body("csv").await?))
-            }
+            JobResult::Stored(stored) => Ok((
+                stored.place.body("json").await?,
+                stored.place.body("csv").await?,
+            )),
         }
     }
 

@@ -237,6 +237,7 @@ impl Answering {
             return Err(std::io::Error::other("the result is not in Redis"));
         };
         stored
+            .place
             .body(if format == Format::Csv { "csv" } else { "json" })
             .await
     }
