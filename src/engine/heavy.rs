@@ -24,6 +24,17 @@ pub async fn run<T: Send + 'static>(
     .await
 }
 
+/// Puts the calling thread at the lowest priority (nice 19): a thread lent to a running
+/// job ([`crate::job::Control::with_lent_threads`]) beside the solver threads the pool
+/// counts, which takes a core only when neither requests nor counted solves want it.
+pub fn lent_thread() {
+    // SAFETY: as in lower_priority.
+    #[cfg(target_os = "linux")]
+    unsafe {
+        libc::setpriority(libc::PRIO_PROCESS, libc::gettid() as libc::id_t, 19);
+    }
+}
+
 /// Lowers the calling thread's priority, once per thread (a thread cannot raise it again
 /// without privileges, and need not). On Linux the nice value is the calling thread's own
 /// (NPTL), not the process's; a thread starts with its creator's.

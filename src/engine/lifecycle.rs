@@ -530,6 +530,17 @@ impl Lifecycle {
             Ok(permits) => permits,
             Err(state) => return state,
         };
+        // Beside its permit, threads while cores are idle, as many as its units can use (a
+        // sweep's points) and no more than the pool's other threads: one `serve` then solves
+        // a sweep on every core, as the command line does (held until the job ends).
+        let job = keyed.job();
+        let more = job
+            .work()
+            .units()
+            .min(self.config.pool_size)
+            .saturating_sub(1);
+        let lent = self.solver.pool.lend(more, job.cost().bytes);
+        live.control.set_threads(1 + lent.threads);
         // Counted as running before anyone can read it so: a client that saw the job
         // running and then reads the gauge finds it counted.
         let _running = self.solver.running();

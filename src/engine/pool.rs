@@ -70,6 +70,25 @@ impl Pool {
         }
     }
 
+    /// Threads to lend a running job beside its permit, at most `threads`, each with
+    /// `bytes` of working memory, as much as is free now (never waiting). They are counted
+    /// in memory only: a lent thread runs at the lowest priority
+    /// ([`super::heavy::lent_thread`]), so requests and counted solves keep their cores.
+    pub fn lend(&self, threads: usize, bytes: u64) -> Lent {
+        let kib = self.kib(bytes);
+        let mut memory = Vec::new();
+        while memory.len() < threads && kib > 0 {
+            match self.memory.clone().try_acquire_many_owned(kib) {
+                Ok(permit) => memory.push(permit),
+                Err(_) => break,
+            }
+        }
+        Lent {
+            threads: if kib == 0 { threads } else { memory.len() },
+            _memory: memory,
+        }
+    }
+
     /// Runs `work` holding `permit` on a [`super::heavy`] thread, in the caller's span. If the
     /// caller stops waiting (a client hung up, a request timed out), `control` is cancelled:
     /// the solver stops at its next check instead of burning a core for nobody.
@@ -88,6 +107,13 @@ impl Pool {
         guard.0 = None;
         result.map_err(|e| JobError::Internal(format!("the solver thread failed: {e}")))?
     }
+}
+
+/// Threads lent to a running job ([`Pool::lend`]), and their memory until dropped.
+#[derive(Debug)]
+pub struct Lent {
+    pub threads: usize,
+    _memory: Vec<OwnedSemaphorePermit>,
 }
 
 /// Cancels a job when the future waiting for it is dropped before it finished.
@@ -126,5 +152,22 @@ mod tests {
         );
         drop(alone);
         assert!(pool.try_acquire(10 << 20).is_some());
+    }
+
+    /// Threads are lent while their memory fits beside the solves', never past it; a job
+    /// that holds little memory gets them all.
+    #[test]
+    fn lent_threads_hold_memory_within_the_share() {
+        let pool = Pool::new(2, 10 << 20);
+        let running = pool.try_acquire(4 << 20).expect("room for 4 MiB");
+        let lent = pool.lend(3, 4 << 20);
+        assert_eq!(lent.threads, 1, "4 + 4 MiB fit in 10, not 4 + 8");
+        assert!(
+            pool.try_acquire(4 << 20).is_none(),
+            "the lent memory is held"
+        );
+        drop(lent);
+        assert_eq!(pool.lend(3, 0).threads, 3);
+        drop(running);
     }
 }

@@ -183,9 +183,12 @@ impl Solver {
         Ok(solved)
     }
 
-    /// The control of a job run by this engine: one thread, `deadline`, the point memo.
+    /// The control of a job run by this engine: one thread (lent more while cores are idle,
+    /// at the lowest priority), `deadline`, the point memo.
     pub(super) fn control(&self, deadline: Instant) -> Control {
-        Control::new(Some(deadline), 1).with_memo(self.points.clone())
+        Control::new(Some(deadline), 1)
+            .with_memo(self.points.clone())
+            .with_lent_threads(super::heavy::lent_thread)
     }
 
     /// Counts a job as running (the `jobs_running` gauge) until the guard is dropped.

@@ -72,7 +72,11 @@ pub struct Control {
     done: AtomicUsize,
     /// Units recalled from the memo rather than solved.
     recalled: AtomicUsize,
-    threads: usize,
+    /// Threads the job may use; the engine lends a running job more while cores are idle.
+    threads: AtomicUsize,
+    /// Called on each thread past the first that [`Control::map_each`] starts (the engine
+    /// lowers its priority: a lent thread takes only a core nobody else wants).
+    lent_thread: Option<fn()>,
     memo: Option<Arc<dyn Memo>>,
 }
 
@@ -91,9 +95,26 @@ impl Control {
             deadline,
             done: AtomicUsize::new(0),
             recalled: AtomicUsize::new(0),
-            threads: threads.max(1),
+            threads: AtomicUsize::new(threads.max(1)),
+            lent_thread: None,
             memo: None,
         }
+    }
+
+    /// The same control, calling `start` on each thread past the first it runs items on.
+    pub fn with_lent_threads(mut self, start: fn()) -> Self {
+        self.lent_thread = Some(start);
+        self
+    }
+
+    /// The threads the job may use.
+    pub fn threads(&self) -> usize {
+        self.threads.load(Ordering::Relaxed)
+    }
+
+    /// Lets the job use `threads` threads from its next [`Control::map_each`] on.
+    pub fn set_threads(&self, threads: usize) {
+        self.threads.store(threads.max(1), Ordering::Relaxed);
     }
 
     /// The same control, keeping solved units in `memo` ([`Control::kept`]).
@@ -258,12 +279,21 @@ impl Control {
             }
             solved
         };
-        let threads = self.threads.min(items.len()).max(1);
+        let threads = self.threads().min(items.len()).max(1);
         let solved: Vec<(usize, Result<R, E>)> = if threads == 1 {
             worker()
         } else {
             thread::scope(|s| {
-                let handles: Vec<_> = (0..threads).map(|_| s.spawn(worker)).collect();
+                let start = |k: usize| {
+                    let (worker, lent) = (&worker, self.lent_thread.filter(|_| k > 0));
+                    move || {
+                        if let Some(start) = lent {
+                            start();
+                        }
+                        worker()
+                    }
+                };
+                let handles: Vec<_> = (0..threads).map(|k| s.spawn(start(k))).collect();
                 handles
                     .into_iter()
                     .flat_map(|h| h.join().unwrap_or_default())

@@ -8,7 +8,7 @@ use std::time::{Duration, Instant};
 use serde::{Deserialize, Serialize};
 use serde_json::{json, Value};
 use thirdbody::engine::metrics::Metrics;
-use thirdbody::engine::store::JobStatus;
+use thirdbody::engine::store::{JobState, JobStatus};
 use thirdbody::engine::{self, Engine, EngineConfig};
 use thirdbody::job::{
     Control, Job, JobError, Kind, Limits, Meta, References, Validated, Work, ROLLING_REFERENCES,
@@ -19,17 +19,20 @@ use thirdbody::render::{Column, Format, Output, RenderError, Table, UnitTable};
 use thirdbody::unit_table;
 use utoipa::ToSchema;
 
-/// A scratch kind that cannot tell its work in advance (as an iterative fit): it counts
-/// `steps` units of work, a millisecond each, checking its control between them.
+/// A scratch kind that cannot tell its work in advance (as an iterative fit), or with
+/// `known` can (as a sweep's points): it counts `steps` units of work, a millisecond each,
+/// checking its control between them, and says how many threads it was let use.
 #[derive(Debug, PartialEq)]
 struct Countdown {
     steps: usize,
+    known: bool,
 }
 
 thirdbody::described! {
     #[derive(Debug, PartialEq, Serialize, ToSchema)]
     struct CountdownOutput {
         steps: usize => [unit ""],
+        threads: usize => [unit ""],
         meta: Meta => [],
     }
 }
@@ -87,11 +90,15 @@ impl Kind for Countdown {
     fn validate(input: Value, _limits: &Limits) -> Result<Validated<Self>, JobError> {
         let steps = input["steps"].as_u64().unwrap_or(1);
         let steps = usize::try_from(steps).unwrap_or(usize::MAX);
-        Ok(Countdown { steps }.into())
+        let known = input["known"].as_bool().unwrap_or(false);
+        Ok(Countdown { steps, known }.into())
     }
 
     fn canonical(&self) -> Value {
-        json!({ "steps": self.steps })
+        match self.known {
+            true => json!({ "steps": self.steps, "known": true }),
+            false => json!({ "steps": self.steps }),
+        }
     }
 
     fn references(&self) -> &'static References {
@@ -99,7 +106,10 @@ impl Kind for Countdown {
     }
 
     fn work(&self) -> Work {
-        Work::Unknown
+        match self.known {
+            true => Work::Known(self.steps),
+            false => Work::Unknown,
+        }
     }
 
     fn run(&self, meta: Meta, control: &Control) -> Result<CountdownOutput, JobError> {
@@ -110,14 +120,19 @@ impl Kind for Countdown {
         }
         Ok(CountdownOutput {
             steps: self.steps,
+            threads: control.threads(),
             meta,
         })
     }
 }
 
 fn engine() -> Arc<Engine> {
+    engine_of(1)
+}
+
+fn engine_of(pool_size: usize) -> Arc<Engine> {
     let config = EngineConfig {
-        pool_size: 1,
+        pool_size,
         solve_deadline: Duration::from_secs(30),
         job_deadline: Duration::from_secs(60),
         max_queued_jobs: 4,
@@ -133,7 +148,10 @@ fn engine() -> Arc<Engine> {
 
 #[test]
 fn a_kind_of_unknown_size_runs_and_stops_on_cancel_and_deadline() {
-    let job = Job::new(Countdown { steps: 5 });
+    let job = Job::new(Countdown {
+        steps: 5,
+        known: false,
+    });
     assert_eq!(job.kind(), "countdown");
     assert_eq!(job.work(), Work::Unknown);
     let answer = engine::run(&job, &Control::new(None, 1)).unwrap();
@@ -141,7 +159,10 @@ fn a_kind_of_unknown_size_runs_and_stops_on_cancel_and_deadline() {
     assert_eq!(out.steps, 5);
     assert_eq!(out.meta.input.get(), json!({"steps": 5}).to_string());
 
-    let long = Job::new(Countdown { steps: 1_000_000 });
+    let long = Job::new(Countdown {
+        steps: 1_000_000,
+        known: false,
+    });
     let late = Control::new(Some(Instant::now() + Duration::from_millis(20)), 1);
     assert_eq!(engine::run(&long, &late), Err(JobError::DeadlineExceeded));
     assert!(late.done() > 0 && late.done() < 1_000);
@@ -155,7 +176,15 @@ fn a_kind_of_unknown_size_runs_and_stops_on_cancel_and_deadline() {
 async fn the_engine_runs_an_unregistered_kind_reports_its_progress_and_cancels_it() {
     let engine = engine();
     let record = engine
-        .submit(Job::new(Countdown { steps: 1_000_000 }).keyed(), None, None)
+        .submit(
+            Job::new(Countdown {
+                steps: 1_000_000,
+                known: false,
+            })
+            .keyed(),
+            None,
+            None,
+        )
         .await
         .unwrap();
     assert_eq!(
@@ -183,13 +212,45 @@ async fn the_engine_runs_an_unregistered_kind_reports_its_progress_and_cancels_i
     );
 
     let short = engine
-        .submit(Job::new(Countdown { steps: 30 }).keyed(), None, None)
+        .submit(
+            Job::new(Countdown {
+                steps: 30,
+                known: false,
+            })
+            .keyed(),
+            None,
+            None,
+        )
         .await
         .unwrap();
     let mut status = engine.jobs.watch(short.id).unwrap();
     status.wait_for(|s| s.is_finished()).await.unwrap();
     let done = engine.jobs.job(short.id).await.unwrap();
     assert_eq!((done.state.status(), done.done), (JobStatus::Succeeded, 30));
+}
+
+/// Issue 47: a job whose units can be spread (a sweep's points) is lent the pool's other
+/// threads while it runs, so that one `serve` solves it on every core as the command line
+/// does; one that cannot (a fit) keeps its one; a pool of one lends none.
+#[tokio::test]
+async fn a_job_of_many_units_is_lent_the_pools_other_threads() {
+    for (pool, known, threads) in [(2, true, 2), (2, false, 1), (1, true, 1), (3, true, 3)] {
+        let engine = engine_of(pool);
+        let job = Job::new(Countdown { steps: 5, known }).keyed();
+        let record = engine.submit(job, None, None).await.unwrap();
+        let mut status = engine.jobs.watch(record.id).unwrap();
+        status.wait_for(|s| s.is_finished()).await.unwrap();
+        let done = engine.jobs.job(record.id).await.unwrap();
+        let JobState::Succeeded(result) = done.state else {
+            panic!("{:?}", done.state);
+        };
+        let (json, _) = result.bodies().await.unwrap();
+        let answer: Value = serde_json::from_slice(&json).unwrap();
+        assert_eq!(
+            answer["threads"], threads,
+            "a pool of {pool}, known: {known}"
+        );
+    }
 }
 
 fn job(value: Value) -> Job {
