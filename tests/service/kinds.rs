@@ -8,7 +8,7 @@ use std::time::{Duration, Instant};
 use serde::{Deserialize, Serialize};
 use serde_json::{json, Value};
 use thirdbody::engine::metrics::Metrics;
-use thirdbody::engine::store::{JobState, JobStatus};
+use thirdbody::engine::store::{JobRecord, JobState, JobStatus};
 use thirdbody::engine::{self, Engine, EngineConfig};
 use thirdbody::job::{
     Control, Job, JobError, Kind, Limits, Meta, References, Validated, Work, ROLLING_REFERENCES,
@@ -148,10 +148,7 @@ fn engine_of(pool_size: usize) -> Arc<Engine> {
 
 #[test]
 fn a_kind_of_unknown_size_runs_and_stops_on_cancel_and_deadline() {
-    let job = Job::new(Countdown {
-        steps: 5,
-        known: false,
-    });
+    let job = countdown(5, false);
     assert_eq!(job.kind(), "countdown");
     assert_eq!(job.work(), Work::Unknown);
     let answer = engine::run(&job, &Control::new(None, 1)).unwrap();
@@ -159,10 +156,7 @@ fn a_kind_of_unknown_size_runs_and_stops_on_cancel_and_deadline() {
     assert_eq!(out.steps, 5);
     assert_eq!(out.meta.input.get(), json!({"steps": 5}).to_string());
 
-    let long = Job::new(Countdown {
-        steps: 1_000_000,
-        known: false,
-    });
+    let long = countdown(1_000_000, false);
     let late = Control::new(Some(Instant::now() + Duration::from_millis(20)), 1);
     assert_eq!(engine::run(&long, &late), Err(JobError::DeadlineExceeded));
     assert!(late.done() > 0 && late.done() < 1_000);
@@ -176,15 +170,7 @@ fn a_kind_of_unknown_size_runs_and_stops_on_cancel_and_deadline() {
 async fn the_engine_runs_an_unregistered_kind_reports_its_progress_and_cancels_it() {
     let engine = engine();
     let record = engine
-        .submit(
-            Job::new(Countdown {
-                steps: 1_000_000,
-                known: false,
-            })
-            .keyed(),
-            None,
-            None,
-        )
+        .submit(countdown(1_000_000, false).keyed(), None, None)
         .await
         .unwrap();
     assert_eq!(
@@ -211,22 +197,21 @@ async fn the_engine_runs_an_unregistered_kind_reports_its_progress_and_cancels_i
         cancel.elapsed()
     );
 
-    let short = engine
-        .submit(
-            Job::new(Countdown {
-                steps: 30,
-                known: false,
-            })
-            .keyed(),
-            None,
-            None,
-        )
-        .await
-        .unwrap();
-    let mut status = engine.jobs.watch(short.id).unwrap();
-    status.wait_for(|s| s.is_finished()).await.unwrap();
-    let done = engine.jobs.job(short.id).await.unwrap();
+    let done = finished(&engine, countdown(30, false)).await;
     assert_eq!((done.state.status(), done.done), (JobStatus::Succeeded, 30));
+}
+
+/// A countdown of `steps`, its work known in advance or not.
+fn countdown(steps: usize, known: bool) -> Job {
+    Job::new(Countdown { steps, known })
+}
+
+/// Submits `job` to `engine` and waits for its end: its record then.
+async fn finished(engine: &Engine, job: Job) -> JobRecord {
+    let record = engine.submit(job.keyed(), None, None).await.unwrap();
+    let mut status = engine.jobs.watch(record.id).unwrap();
+    status.wait_for(|s| s.is_finished()).await.unwrap();
+    engine.jobs.job(record.id).await.unwrap()
 }
 
 /// Issue 47: a job whose units can be spread (a sweep's points) is lent the pool's other
@@ -235,12 +220,7 @@ async fn the_engine_runs_an_unregistered_kind_reports_its_progress_and_cancels_i
 #[tokio::test]
 async fn a_job_of_many_units_is_lent_the_pools_other_threads() {
     for (pool, known, threads) in [(2, true, 2), (2, false, 1), (1, true, 1), (3, true, 3)] {
-        let engine = engine_of(pool);
-        let job = Job::new(Countdown { steps: 5, known }).keyed();
-        let record = engine.submit(job, None, None).await.unwrap();
-        let mut status = engine.jobs.watch(record.id).unwrap();
-        status.wait_for(|s| s.is_finished()).await.unwrap();
-        let done = engine.jobs.job(record.id).await.unwrap();
+        let done = finished(&engine_of(pool), countdown(5, known)).await;
         let JobState::Succeeded(result) = done.state else {
             panic!("{:?}", done.state);
         };

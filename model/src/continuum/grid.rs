@@ -245,27 +245,22 @@ impl Influence {
     /// unnormalised (mx·my times the array: the kernel's spectrum carries the 1/(mx·my)).
     fn backward(&self, buffers: &mut Buffers) -> Vec<f64> {
         let Grid { nx, ny, .. } = self.grid;
-        let mx = self.mx;
-        let Buffers {
-            spectrum,
-            real,
-            complex,
-            scratch,
-        } = buffers;
-        self.columns_back.process_with_scratch(spectrum, scratch);
+        let (mx, b) = (self.mx, buffers);
+        self.columns_back
+            .process_with_scratch(&mut b.spectrum, &mut b.scratch);
         let mut data = Vec::with_capacity(nx * ny);
-        let last = complex.len() - 1;
+        let last = b.complex.len() - 1;
         for i in 0..nx {
-            for (j, value) in complex.iter_mut().enumerate() {
-                *value = spectrum[j * mx + i];
+            for (j, value) in b.complex.iter_mut().enumerate() {
+                *value = b.spectrum[j * mx + i];
             }
             // The transform of a real array: its zero and Nyquist terms are real.
-            complex[0].im = 0.0;
-            complex[last].im = 0.0;
+            b.complex[0].im = 0.0;
+            b.complex[last].im = 0.0;
             self.rows_back
-                .process_with_scratch(complex, real, scratch)
+                .process_with_scratch(&mut b.complex, &mut b.real, &mut b.scratch)
                 .expect("buffers sized for the plan");
-            data.extend_from_slice(&real[..ny]);
+            data.extend_from_slice(&b.real[..ny]);
         }
         data
     }
