@@ -302,7 +302,13 @@ impl Lifecycle {
         if backlog >= self.config.max_queued_jobs.saturating_mul(64) {
             return Err(EngineError::Overloaded);
         }
-        let parts = placement::plan(job.points(), rate, shared.fleet.config.part_points);
+        let estimate = job.cost().seconds() / job.points().unwrap_or(1).max(1) as f64;
+        let parts = placement::plan(
+            job.points(),
+            rate,
+            estimate,
+            shared.fleet.config.part_points,
+        );
         let deadline = std::time::SystemTime::now() + self.config.job_deadline;
         shared
             .store

@@ -67,6 +67,11 @@ const CONTINUUM_POINTS: f64 = 2000.0;
 pub const POINT_TIME: std::time::Duration = std::time::Duration::from_micros(10);
 
 impl Cost {
+    /// The time it is estimated to take on a solver thread, in seconds.
+    pub fn seconds(&self) -> f64 {
+        self.points as f64 * POINT_TIME.as_secs_f64()
+    }
+
     /// `points` of work that holds no memory worth counting.
     pub fn points(points: u64) -> Cost {
         Cost { points, bytes: 0 }
