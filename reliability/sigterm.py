@@ -1,16 +1,23 @@
 """SIGTERM with work in flight: a server with one solver thread takes a long job (running)
 and four short ones (queued behind it), then gets SIGTERM. Every job's client keeps polling
-it until it ends or the server is gone. Prints how many accepted jobs were answered and how
+it until it ends or the server is gone; a client the server left before it read its job asks
+a server started again on the same database of saved analyses (the drain does not wait for
+clients whose jobs that file keeps). Prints how many accepted jobs were answered, and how
 many were lost. Then a job the shutdown timeout cannot fit, polled by five clients once a
 second: prints how many read its fate (`interrupted`) before the port closed.
 Usage: reliability/sigterm.py"""
 
 import json
+import os
+import shutil
 import signal
+import tempfile
 import threading
 import time
 
 from common import Server, request
+
+GONE = "lost (server gone before it answered)"
 
 def fate(port, job_id, every, gone):
     """Polls the job every `every` seconds until it ends; its final status, or `gone`
@@ -26,10 +33,13 @@ def fate(port, job_id, every, gone):
         time.sleep(every)
 
 
-with Server("--pool-size", "1", "--max-sweep-points", "1000000", "--shutdown-timeout", "60s") as server:
+data = tempfile.mkdtemp(prefix="thirdbody-sigterm-")
+database = ("--database", os.path.join(data, "thirdbody.db"))
+with Server("--pool-size", "1", "--max-sweep-points", "1000000", "--shutdown-timeout", "60s",
+            *database) as server:
     port = server.port
-    # Its own rule keeps every point an exact strip solve (not a table look-up): long.
-    long_sweep = {"kind": "sweep", "input": {"base": {"options": {"strips": 128}}, "vary": {
+    # Its own rule keeps every point an exact strip solve (not a table look-up): seconds.
+    long_sweep = {"kind": "sweep", "input": {"base": {"options": {"strips": 1024}}, "vary": {
         "radius": [f"{25 + i} nm" for i in range(20)],
         "load": [f"{1000 + i} pN" for i in range(20)],
         "velocity": [f"{1 + i} nm/s" for i in range(30)]}}}
@@ -43,7 +53,7 @@ with Server("--pool-size", "1", "--max-sweep-points", "1000000", "--shutdown-tim
     final = {}
 
     def follow(job_id):
-        final[job_id] = fate(port, job_id, every=0.05, gone="lost (server gone before it answered)")
+        final[job_id] = fate(port, job_id, every=0.05, gone=GONE)
 
     threads = [threading.Thread(target=follow, args=(i,)) for i in ids]
     for t in threads:
@@ -52,10 +62,18 @@ with Server("--pool-size", "1", "--max-sweep-points", "1000000", "--shutdown-tim
         t.join()
     server.proc.wait(timeout=120)
     exited = time.time() - sent
-    answered = sum(1 for s in final.values() if s == "succeeded")
-    print(f"sigterm: {len(ids)} jobs accepted (1 running, {len(ids) - 1} queued), then SIGTERM")
-    print(f"answered {answered}, lost {len(ids) - answered}: " + ", ".join(sorted(final.values())))
-    print(f"the server exited {exited:.1f} s after SIGTERM, status {server.proc.returncode}")
+    code = server.proc.returncode
+# The jobs the server left before their clients read them, read where the file keeps them.
+left = [job_id for job_id, state in final.items() if state == GONE]
+with Server(*database) as again:
+    for job_id in left:
+        final[job_id] = fate(again.port, job_id, every=0.05, gone=GONE)
+shutil.rmtree(data, ignore_errors=True)
+answered = sum(1 for s in final.values() if s == "succeeded")
+print(f"sigterm: {len(ids)} jobs accepted (1 running, {len(ids) - 1} queued), then SIGTERM")
+print(f"answered {answered}, lost {len(ids) - answered}: " + ", ".join(sorted(final.values())))
+print(f"the server exited {exited:.1f} s after SIGTERM, status {code}; {len(left)} read after "
+      "a restart on the same database")
 
 
 def pollers_of_an_interrupted_job():
