@@ -24,14 +24,17 @@ pub async fn run<T: Send + 'static>(
     .await
 }
 
-/// Puts the calling thread at the lowest priority (nice 19): a thread lent to a running
+/// Puts the calling thread in the idle class (`SCHED_IDLE`): a thread lent to a running
 /// job ([`crate::job::Control::with_lent_threads`]) beside the solver threads the pool
-/// counts, which takes a core only when neither requests nor counted solves want it.
+/// counts, which takes a core only when no other thread wants it, and gives it up at once
+/// when one does.
 pub fn lent_thread() {
-    // SAFETY: as in lower_priority.
+    // SAFETY: gettid takes nothing; sched_setscheduler reads the parameter it is given for
+    // the call's duration; a failure only leaves the thread as it was.
     #[cfg(target_os = "linux")]
     unsafe {
-        libc::setpriority(libc::PRIO_PROCESS, libc::gettid() as libc::id_t, 19);
+        let idle = libc::sched_param { sched_priority: 0 };
+        libc::sched_setscheduler(libc::gettid(), libc::SCHED_IDLE, &idle);
     }
 }
 

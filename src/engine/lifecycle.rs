@@ -537,14 +537,13 @@ impl Lifecycle {
             Err(state) => return state,
         };
         // Beside its permit, threads while cores are idle, as many as its units can use (a
-        // sweep's points) and no more than the pool's other threads: one `serve` then solves
-        // a sweep on every core, as the command line does (held until the job ends).
+        // sweep's points), held until the job ends; one of the pool's threads is always
+        // left to requests. On 2 cores a thread lent beside a running sweep, even in the idle
+        // class, let `/healthz` under hostile slow readers reach 30–55 ms at its slowest
+        // against 1.4–4.3 ms (`reliability/hostile.py slow-readers 8`, 8 runs each).
         let job = keyed.job();
-        let more = job
-            .work()
-            .units()
-            .min(self.config.pool_size)
-            .saturating_sub(1);
+        let free = self.config.pool_size.saturating_sub(1).max(1);
+        let more = job.work().units().min(free).saturating_sub(1);
         let lent = self.solver.pool.lend(more, job.cost().bytes);
         live.control.set_threads(1 + lent.threads);
         // Counted as running before anyone can read it so: a client that saw the job

@@ -214,12 +214,19 @@ async fn finished(engine: &Engine, job: Job) -> JobRecord {
     engine.jobs.job(record.id).await.unwrap()
 }
 
-/// Issue 47: a job whose units can be spread (a sweep's points) is lent the pool's other
-/// threads while it runs, so that one `serve` solves it on every core as the command line
-/// does; one that cannot (a fit) keeps its one; a pool of one lends none.
+/// Issue 47: a job whose units can be spread (a sweep's points) is lent the pool's idle
+/// threads while it runs, all but one, which stays the requests'; one that cannot (a fit)
+/// keeps its one; pools of one and two lend none.
 #[tokio::test]
-async fn a_job_of_many_units_is_lent_the_pools_other_threads() {
-    for (pool, known, threads) in [(2, true, 2), (2, false, 1), (1, true, 1), (3, true, 3)] {
+async fn a_job_of_many_units_is_lent_the_pools_idle_threads_but_one() {
+    let cases = [
+        (4, true, 3),
+        (3, true, 2),
+        (4, false, 1),
+        (2, true, 1),
+        (1, true, 1),
+    ];
+    for (pool, known, threads) in cases {
         let done = finished(&engine_of(pool), countdown(5, known)).await;
         let JobState::Succeeded(result) = done.state else {
             panic!("{:?}", done.state);
