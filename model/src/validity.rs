@@ -4,7 +4,7 @@
 
 use std::f64::consts::PI;
 
-use super::continuum::{static_area, ContinuumVerification, AREA_TOLERANCE, PENETRATION_TOLERANCE};
+use super::continuum::{static_area, ContinuumVerification};
 use super::three_body::{LayerContact, ThreeBody, ThreeBodySolution};
 use super::{Rolling, RollingSolution};
 
@@ -159,14 +159,11 @@ pub fn continuum(rolling: &Rolling, s: &RollingSolution<ContinuumVerification>) 
             (grid.across_at_rest, 1.0),
         ));
     }
-    let e = &s.verification.errors;
-    let share = |area: f64, penetration: f64| {
-        (area / AREA_TOLERANCE).max(penetration / PENETRATION_TOLERANCE)
-    };
+    let (rolling_share, at_rest) = s.verification.errors.tolerance_shares();
     checks.push(Check::new(
         Assumption::Numerical,
-        (share(e.contact_area, e.penetration), 1.0),
-        (share(e.static_contact_area, e.static_penetration), 1.0),
+        (rolling_share, 1.0),
+        (at_rest, 1.0),
     ));
     checks
 }

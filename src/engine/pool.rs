@@ -72,8 +72,8 @@ impl Pool {
 
     /// Threads to lend a running job beside its permit, at most `threads`, each with
     /// `bytes` of working memory, as much as is free now (never waiting). They are counted
-    /// in memory only: a lent thread runs at the lowest priority
-    /// ([`super::heavy::lent_thread`]), so requests and counted solves keep their cores.
+    /// in memory only: a lent thread runs in the idle class ([`super::heavy::lent_thread`]),
+    /// and the caller leaves one of the pool's threads to requests.
     pub fn lend(&self, threads: usize, bytes: u64) -> Lent {
         let kib = self.kib(bytes);
         let mut memory = Vec::new();

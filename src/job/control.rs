@@ -75,7 +75,7 @@ pub struct Control {
     /// Threads the job may use; the engine lends a running job more while cores are idle.
     threads: AtomicUsize,
     /// Called on each thread past the first that [`Control::map_each`] starts (the engine
-    /// lowers its priority: a lent thread takes only a core nobody else wants).
+    /// puts it in the idle class: a lent thread takes only a core nobody else wants).
     lent_thread: Option<fn()>,
     memo: Option<Arc<dyn Memo>>,
 }

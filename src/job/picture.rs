@@ -1,7 +1,7 @@
 //! What every kind's picture shares. A kind draws its answer from a typed view of the
-//! answer's JSON ([`crate::render::Picture`]: the parts of the output it shows, as the output's own types),
-//! read back from the JSON, so that an answer solved in another process, or assembled from
-//! parts, is drawn exactly as one solved here.
+//! answer's JSON ([`crate::render::Picture`]: the parts of the output it shows, as the
+//! output's own types), read back from the JSON, so that an answer solved in another
+//! process, or assembled from parts, is drawn exactly as one solved here.
 
 use serde::Deserialize;
 use serde_json::Value;

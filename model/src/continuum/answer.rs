@@ -23,8 +23,8 @@ use crate::limits::ElasticContact;
 use crate::{ModelError, Rolling, RollingSolution, SolveOptions, Stop};
 
 /// §8's tolerances on an answer's relative error: 1 % in A, 0.5 % in δ (rolling and at rest).
-pub const AREA_TOLERANCE: f64 = 0.01;
-pub const PENETRATION_TOLERANCE: f64 = 0.005;
+const AREA_TOLERANCE: f64 = 0.01;
+const PENETRATION_TOLERANCE: f64 = 0.005;
 
 /// The march stops when a step changes the pressure by less than this share of its sum
 /// (it then lies within about ten times that of its steady state).
@@ -91,6 +91,18 @@ impl QuantityErrors {
         ]
         .into_iter()
         .fold(0.0, f64::max)
+    }
+
+    /// The bounds against §8's tolerances, the larger of A's over 1 % and δ's over 0.5 %:
+    /// rolling, and at rest. At most 1 (both): the answer is known to be as exact as §8 asks.
+    pub fn tolerance_shares(&self) -> (f64, f64) {
+        let share = |area: f64, penetration: f64| {
+            (area / AREA_TOLERANCE).max(penetration / PENETRATION_TOLERANCE)
+        };
+        (
+            share(self.contact_area, self.penetration),
+            share(self.static_contact_area, self.static_penetration),
+        )
     }
 }
 

@@ -24,7 +24,7 @@ mod thin;
 
 pub use answer::{
     area_floor, solve, solve_at, ContinuumVerification, GridUsed, QuantityErrors, AREA_SCATTER,
-    AREA_TOLERANCE, EDGE_BIAS, PENETRATION_TOLERANCE,
+    EDGE_BIAS,
 };
 pub use axisymmetric::{static_contact, StaticContinuum};
 pub use compliance::{

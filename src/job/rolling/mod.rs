@@ -16,7 +16,7 @@ use super::meta::{Canonical, CONTINUUM_REFERENCES, ROLLING_REFERENCES};
 use super::points::{self, PointNotes, PointNotesFields, PointStatus, Row};
 use super::validity::{self, PointValidity, Subject, ValidityOutput};
 use super::{Control, Cost, JobError, Kind, Limits, Meta, References, Validated, Work};
-use crate::model::continuum::{ContinuumVerification, AREA_TOLERANCE, PENETRATION_TOLERANCE};
+use crate::model::continuum::ContinuumVerification;
 use crate::model::rolling::{BoundaryPoint, PressureGrid, Verification};
 use crate::model::tables::{self, Use};
 use crate::model::validity::Check;
@@ -387,7 +387,7 @@ described! {
 impl From<&ContinuumVerification> for ContinuumVerificationOutput {
     fn from(v: &ContinuumVerification) -> Self {
         let e = &v.errors;
-        let within = |errors: [f64; 2], tolerance: f64| errors.iter().all(|e| *e <= tolerance);
+        let (rolling, at_rest) = e.tolerance_shares();
         ContinuumVerificationOutput {
             method: match v.grid {
                 Some(_) => ContinuumMethod::Grid,
@@ -400,8 +400,7 @@ impl From<&ContinuumVerification> for ContinuumVerificationOutput {
             static_penetration_error: e.static_penetration,
             static_contact_area_error: e.static_contact_area,
             domain_error: v.domain_error,
-            within_tolerance: within([e.contact_area, e.static_contact_area], AREA_TOLERANCE)
-                && within([e.penetration, e.static_penetration], PENETRATION_TOLERANCE),
+            within_tolerance: rolling.max(at_rest) <= 1.0,
             grid: v.grid.map(|g| GridOutput {
                 length: g.nx,
                 width: g.ny,
