@@ -125,6 +125,8 @@ pub enum Parameter {
     UpperModulus,
     UpperPoissonRatio,
     UpperHardness,
+    /// τ_u, the shear strength of the particles' contact with the upper surface.
+    UpperShearStrength,
     ParticleModulus,
     ParticlePoissonRatio,
     /// η_s, asperities per unit area.
@@ -176,8 +178,8 @@ impl Parameter {
             | TipRadius | HeightStd | Separation => "m",
             Load | TotalLoad | ParticleLoad => "N",
             Velocity => "m/s",
-            ElasticModulus | UpperModulus | UpperHardness | ParticleModulus | AsperityHardness
-            | PronyModulus => "Pa",
+            ElasticModulus | UpperModulus | UpperHardness | UpperShearStrength
+            | ParticleModulus | AsperityHardness | PronyModulus => "Pa",
             PoissonRatio | UpperPoissonRatio | ParticlePoissonRatio => "",
             RetardationTime | RelaxationTime | PronyTime => "s",
             Temperature | ReferenceTemperature | WlfC2 => "K",
@@ -268,6 +270,7 @@ impl fmt::Display for Parameter {
             Parameter::UpperModulus => "upper surface elastic modulus",
             Parameter::UpperPoissonRatio => "upper surface Poisson ratio",
             Parameter::UpperHardness => "upper surface hardness",
+            Parameter::UpperShearStrength => "upper surface shear strength",
             Parameter::ParticleModulus => "particle elastic modulus",
             Parameter::ParticlePoissonRatio => "particle Poisson ratio",
             Parameter::AsperityDensity => "asperities per unit area",

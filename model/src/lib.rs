@@ -3,11 +3,13 @@
 //! no serde. Everything else in the crate calls into this module.
 
 pub mod continuum;
+pub mod counterface;
 mod error;
 pub mod figures;
 pub mod fit;
 mod layer;
 pub mod limits;
+pub mod motion;
 pub mod quadrature;
 pub mod rolling;
 mod roots;
@@ -28,4 +30,4 @@ pub use rolling::{solve, Rolling, RollingSolution, SolveOptions};
 pub use stop::Stop;
 
 /// Version of the model's numbers: part of every cache key, bumped whenever a result changes.
-pub const MODEL_VERSION: &str = "1.5.1";
+pub const MODEL_VERSION: &str = "1.6.0";

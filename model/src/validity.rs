@@ -5,6 +5,7 @@
 use std::f64::consts::PI;
 
 use super::continuum::{static_area, ContinuumVerification};
+use super::motion::Motion;
 use super::three_body::{LayerContact, ThreeBody, ThreeBodySolution};
 use super::{Rolling, RollingSolution};
 
@@ -50,11 +51,15 @@ pub enum Assumption {
     /// larger of A's error over 1 % and δ's over 0.5 %. Warn above 1: the numbers are
     /// given, less exact than §8 asks, and `meta.verification` says by how much.
     Numerical,
+    /// The particle rolls, as the paper assumes (docs/model.md §11): μ_roll over the weaker
+    /// contact's capacity (three-body: the largest over the sizes in contact). Warn above
+    /// 1: the particle slides there, and its friction is that capacity.
+    PureRolling,
 }
 
 impl Assumption {
     /// Every assumption.
-    pub const ALL: [Assumption; 9] = [
+    pub const ALL: [Assumption; 10] = [
         Assumption::InsideLayer,
         Assumption::Parabolic,
         Assumption::LocalLayer,
@@ -64,6 +69,7 @@ impl Assumption {
         Assumption::ParticlesInContact,
         Assumption::Resolution,
         Assumption::Numerical,
+        Assumption::PureRolling,
     ];
 
     /// The status of `ratio`.
@@ -78,7 +84,7 @@ impl Assumption {
             AsperityGap => (ratio < 3.0, false),
             ParticlesInContact => (ratio < 1.0, false),
             Resolution => (ratio < 24.0, false),
-            Numerical => (ratio > 1.0, false),
+            Numerical | PureRolling => (ratio > 1.0, false),
         };
         if violated {
             Status::Violated
@@ -99,6 +105,19 @@ pub struct Check {
     pub rolling: (f64, f64),
     /// The same for the V = 0 companion.
     pub at_rest: (f64, f64),
+    /// For [`Assumption::PureRolling`]: how the particles move, for the words of a warning.
+    pub motion: Option<Sliding>,
+}
+
+/// How the particles of a pure-rolling check move.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Sliding {
+    /// The particle's (three-body: the one furthest from rolling).
+    pub motion: Motion,
+    /// Three-body: the particles that slide and those in contact.
+    pub particles: Option<(f64, f64)>,
+    /// The friction then transmitted: the particle's, or the system's Σ T/W.
+    pub friction: f64,
 }
 
 impl Check {
@@ -107,6 +126,32 @@ impl Check {
             assumption,
             rolling,
             at_rest,
+            motion: None,
+        }
+    }
+
+    /// Whether the particle of `motion` rolls (docs/model.md §11): μ_roll over the weaker
+    /// capacity; at rest rolling needs nothing.
+    pub fn pure_rolling(motion: &Motion) -> Check {
+        Check::rolling_of(
+            *motion,
+            Sliding {
+                motion: *motion,
+                particles: None,
+                friction: motion.friction,
+            },
+        )
+    }
+
+    fn rolling_of(worst: Motion, sliding: Sliding) -> Check {
+        let weaker = worst.upper_capacity.min(worst.layer_capacity);
+        Check {
+            motion: Some(sliding),
+            ..Check::new(
+                Assumption::PureRolling,
+                (worst.rolling_need, weaker),
+                (0.0, weaker),
+            )
         }
     }
 
@@ -248,6 +293,17 @@ pub fn three_body(system: &ThreeBody, s: &ThreeBodySolution) -> Vec<Check> {
             Assumption::AsperityGap,
             (moving.separation, a.height_std),
             (rest.separation, a.height_std),
+        ));
+    }
+    let motion = &s.motion;
+    if let Some(worst) = motion.furthest {
+        checks.push(Check::rolling_of(
+            worst,
+            Sliding {
+                motion: worst,
+                particles: Some((motion.sliding(), moving.particles_in_contact)),
+                friction: motion.friction,
+            },
         ));
     }
     checks

@@ -9,10 +9,12 @@
 //!     F = (4/3) E* √R δ^{3/2} Φ_P(c),    A = π R δ Φ_A(c).
 //!
 //! Φ_P and Φ_A are tabulated once per (layer, V) from [`super::solve`] at loads spread over
-//! the c a system can reach, and interpolated by cubics in ln c of ln Φ. As c → 0 the contact
-//! is a half-space's (H/c → ∞) and, rolling, the instantaneous one (V T_σ/c → ∞): Φ_P → 1 + κ
-//! (1 at rest) and Φ_A → 1; below the table's first node Φ goes linearly in c to that limit.
-//! Beyond the last node, ln Φ goes on along the last cell's line.
+//! the c a system can reach, and interpolated by cubics in ln c of ln Φ; so is x_p/c, the
+//! centre of pressure that sets the particle's rolling resistance (docs/model.md §11). As
+//! c → 0 the contact is a half-space's (H/c → ∞) and, rolling, the instantaneous one
+//! (V T_σ/c → ∞): Φ_P → 1 + κ (1 at rest), Φ_A → 1 and x_p/c → 0; below the table's first
+//! node each goes linearly in c to that limit. Beyond the last node, each logarithm goes on
+//! along the last cell's line.
 
 use std::f64::consts::PI;
 
@@ -41,14 +43,19 @@ const MOST_DECADES: f64 = 8.0;
 /// δ a minute share of the layer and the contact far smaller than the sphere).
 const REFERENCE_RADIUS: f64 = 1e-3;
 
-/// One node: ln c, ln Φ_P, ln Φ_A, and a bound on the relative error of the curve's F and A
-/// there (the answer's own, then with the interpolation's, [`PenetrationCurve::certify`]).
+/// The share of c below which a node's x_p is taken as that (a rolling answer's x_p is
+/// positive; this keeps its logarithm finite should rounding make it not).
+const LEAST_SHIFT: f64 = 1e-12;
+
+/// One node: ln c; ln Φ_P, ln Φ_A and ln(x_p/c); a bound on the relative error of the
+/// curve's F and A there and one on x_p's (each the answer's own, then with the
+/// interpolation's, [`PenetrationCurve::certify`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct Node {
     ln_c: f64,
-    ln_force: f64,
-    ln_area: f64,
+    ln: [f64; 3],
     error: f64,
+    pressure_error: f64,
 }
 
 /// Φ_P and Φ_A of one layer at one speed (see the module doc).
@@ -58,8 +65,8 @@ pub struct PenetrationCurve {
     velocity: f64,
     /// E* of the layer (Pa).
     modulus: f64,
-    /// ln Φ_P and ln Φ_A as c → 0.
-    limit: (f64, f64),
+    /// ln Φ_P, ln Φ_A and ln(x_p/c) as c → 0.
+    limit: [f64; 3],
     nodes: Vec<Node>,
 }
 
@@ -125,25 +132,32 @@ impl PenetrationCurve {
                 let (radius, delta) = (problem.radius, answer.penetration);
                 let hertz = hertz_force(modulus, radius, delta);
                 let e = answer.verification.errors;
+                let c = (radius * delta).sqrt();
+                let shift = answer.pressure_centre_shift.max(LEAST_SHIFT * c);
                 Node {
-                    ln_c: 0.5 * (radius * delta).ln(),
-                    ln_force: (problem.load / hertz).ln(),
-                    ln_area: (answer.contact_area / (PI * radius * delta)).ln(),
+                    ln_c: c.ln(),
+                    ln: [
+                        (problem.load / hertz).ln(),
+                        (answer.contact_area / (PI * radius * delta)).ln(),
+                        (shift / c).ln(),
+                    ],
                     // Φ_P ∝ δ^{-3/2} at the node's load, and the node's c moves with δ^{1/2}
                     // along a curve of slope at most about 1 in ln–ln: 2 ε_δ in all; Φ_A
-                    // ∝ A/δ, and moves likewise.
+                    // ∝ A/δ, and moves likewise; x_p/c likewise with x_p's own error.
                     error: (2.0 * e.penetration).max(e.contact_area + 1.5 * e.penetration),
+                    pressure_error: e.pressure_centre_shift / shift + e.penetration,
                 }
             })
             .collect();
-        let limit = (
+        let limit = [
             if velocity > 0.0 {
                 layer.stiffening().ln()
             } else {
                 0.0
             },
             0.0,
-        );
+            f64::NEG_INFINITY,
+        ];
         let mut curve = PenetrationCurve {
             layer: *layer,
             velocity,
@@ -194,9 +208,9 @@ impl PenetrationCurve {
 
     /// The error bound below the first node: its own, and the limit's difference from it.
     fn below(&self, first: &Node) -> f64 {
-        let off = (first.ln_force - self.limit.0)
+        let off = (first.ln[0] - self.limit[0])
             .abs()
-            .max((first.ln_area - self.limit.1).abs());
+            .max((first.ln[1] - self.limit[1]).abs());
         first.error + off
     }
 
@@ -222,29 +236,54 @@ impl PenetrationCurve {
         if delta <= 0.0 {
             return (0.0, 0.0);
         }
-        let (ln_force, ln_area) = self.ratios(0.5 * (radius * delta).ln());
+        let [ln_force, ln_area, _] = self.ratios(0.5 * (radius * delta).ln());
         (
             hertz_force(self.modulus, radius, delta) * ln_force.exp(),
             PI * radius * delta * ln_area.exp(),
         )
     }
 
-    /// (ln Φ_P, ln Φ_A) at ln c.
-    fn ratios(&self, ln_c: f64) -> (f64, f64) {
+    /// x_p (m), the centre of pressure of a sphere of radius `radius` pressed to
+    /// penetration `delta` (0 at rest).
+    pub fn pressure_centre(&self, radius: f64, delta: f64) -> f64 {
+        if delta <= 0.0 || self.velocity == 0.0 {
+            return 0.0;
+        }
+        let ln_c = 0.5 * (radius * delta).ln();
+        (self.ratios(ln_c)[2] + ln_c).exp()
+    }
+
+    /// A bound on the relative error of [`PenetrationCurve::pressure_centre`], as
+    /// [`PenetrationCurve::error_at`] bounds the force's and the area's (below the first
+    /// node x_p/c falls to its limit 0, and that node's bound is kept).
+    pub fn pressure_error_at(&self, radius: f64, delta: f64) -> f64 {
+        let ln_c = 0.5 * (radius * delta).ln();
+        let (first, last) = (self.nodes[0], self.nodes[self.nodes.len() - 1]);
+        if ln_c <= first.ln_c {
+            return first.pressure_error;
+        }
+        if ln_c >= last.ln_c {
+            return 2.0 * last.pressure_error;
+        }
+        let cell = self.nodes.partition_point(|node| node.ln_c <= ln_c);
+        self.nodes[cell - 1]
+            .pressure_error
+            .max(self.nodes[cell].pressure_error)
+    }
+
+    /// ln Φ_P, ln Φ_A and ln(x_p/c) at ln c.
+    fn ratios(&self, ln_c: f64) -> [f64; 3] {
         self.ratios_from(&self.nodes, ln_c)
     }
 
-    /// (ln Φ_P, ln Φ_A) at ln c from `nodes` (ascending in c, at least two).
-    fn ratios_from(&self, nodes: &[Node], ln_c: f64) -> (f64, f64) {
+    /// ln Φ_P, ln Φ_A and ln(x_p/c) at ln c from `nodes` (ascending in c, at least two).
+    fn ratios_from(&self, nodes: &[Node], ln_c: f64) -> [f64; 3] {
         let first = nodes[0];
         if ln_c <= first.ln_c {
             // Linear in c from the limit at c = 0 to the first node.
             let t = (ln_c - first.ln_c).exp();
             let blend = |limit: f64, node: f64| (limit.exp() + t * (node.exp() - limit.exp())).ln();
-            return (
-                blend(self.limit.0, first.ln_force),
-                blend(self.limit.1, first.ln_area),
-            );
+            return [0, 1, 2].map(|k| blend(self.limit[k], first.ln[k]));
         }
         let n = nodes.len();
         // The cell holding ln c (the last cell beyond the table), and the four nodes around
@@ -256,17 +295,11 @@ impl PenetrationCurve {
         if ln_c >= nodes[n - 1].ln_c || n < 4 {
             let (a, b) = (nodes[cell], nodes[cell + 1]);
             let t = (ln_c - a.ln_c) / (b.ln_c - a.ln_c);
-            return (
-                a.ln_force + t * (b.ln_force - a.ln_force),
-                a.ln_area + t * (b.ln_area - a.ln_area),
-            );
+            return [0, 1, 2].map(|k| a.ln[k] + t * (b.ln[k] - a.ln[k]));
         }
         let start = cell.saturating_sub(1).min(n - 4);
         let around = &nodes[start..start + 4];
-        (
-            lagrange(around, ln_c, |node| node.ln_force),
-            lagrange(around, ln_c, |node| node.ln_area),
-        )
+        [0, 1, 2].map(|k| lagrange(around, ln_c, |node| node.ln[k]))
     }
 
     /// Adds the interpolation's error to each node's own. It is estimated by leaving each
@@ -277,17 +310,18 @@ impl PenetrationCurve {
     fn certify(&mut self) {
         let nodes = &self.nodes;
         let n = nodes.len();
-        let left_out: Vec<f64> = (1..n - 1)
+        let left_out: Vec<[f64; 3]> = (1..n - 1)
             .map(|i| {
                 let mut others = nodes.clone();
                 let node = others.remove(i);
-                let (f, a) = self.ratios_from(&others, node.ln_c);
-                (f - node.ln_force).abs().max((a - node.ln_area).abs())
+                let interpolated = self.ratios_from(&others, node.ln_c);
+                [0, 1, 2].map(|k| (interpolated[k] - node.ln[k]).abs())
             })
             .collect();
         for i in 0..n {
-            let k = i.clamp(1, n - 2) - 1;
-            self.nodes[i].error += 0.25 * left_out[k];
+            let [force, area, shift] = left_out[i.clamp(1, n - 2) - 1];
+            self.nodes[i].error += 0.25 * force.max(area);
+            self.nodes[i].pressure_error += 0.25 * shift;
         }
     }
 }

@@ -6,47 +6,11 @@ use std::f64::consts::PI;
 use std::sync::Arc;
 
 use crate::continuum::PenetrationCurve;
+use crate::counterface::UpperLaw;
 use crate::limits::hertz_force;
 use crate::roots::brent;
 use crate::similarity::SimilarityTable;
 use crate::ModelError;
-
-/// How the upper surface takes a particle of radius R = x/2.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum UpperLaw {
-    /// Hertz with the composite modulus E_s1a: F = (4/3)E_s1a R^{1/2} ω₁^{3/2}, A₁ = πRω₁.
-    Elastic { modulus: f64 },
-    /// Fully plastic (Horng): A₁ = 2πRω₁ = πxω₁, F = H₁A₁.
-    Plastic { hardness: f64 },
-}
-
-impl UpperLaw {
-    /// Force (N) at interference ω₁.
-    pub fn force(&self, radius: f64, omega: f64) -> f64 {
-        match *self {
-            UpperLaw::Elastic { modulus } => hertz_force(modulus, radius, omega),
-            UpperLaw::Plastic { hardness } => hardness * self.area(radius, omega),
-        }
-    }
-
-    /// Contact area (m²) at interference ω₁.
-    pub fn area(&self, radius: f64, omega: f64) -> f64 {
-        match self {
-            UpperLaw::Elastic { .. } => PI * radius * omega,
-            UpperLaw::Plastic { .. } => 2.0 * PI * radius * omega,
-        }
-    }
-
-    /// The interference ω₁ that carries `force`: the inverse of [`UpperLaw::force`].
-    pub fn interference(&self, radius: f64, force: f64) -> f64 {
-        match *self {
-            UpperLaw::Elastic { modulus } => {
-                (3.0 * force / (4.0 * modulus * radius.sqrt())).powf(2.0 / 3.0)
-            }
-            UpperLaw::Plastic { hardness } => force / (2.0 * PI * radius * hardness),
-        }
-    }
-}
 
 /// How the layer takes a particle of radius R = x/2 (the particle is rigid there).
 #[derive(Clone, Debug)]
@@ -93,6 +57,32 @@ impl LayerLaw {
                 (hertz_force(*modulus, radius, delta), PI * radius * delta)
             }
             LayerLaw::Continuum { curve } => curve.contact(radius, delta),
+        }
+    }
+
+    /// x_p (m), the layer contact's centre of pressure at penetration δ: its rolling
+    /// resistance is x_p/R (docs/model.md §11). Hertz's contact is elastic and symmetric.
+    pub fn pressure_centre(&self, radius: f64, delta: f64) -> f64 {
+        match self {
+            LayerLaw::Kelvin {
+                relaxation_length,
+                table: Some(table),
+                ..
+            } if *relaxation_length > 0.0 && delta > 0.0 => {
+                let half_width = (2.0 * radius * delta).sqrt();
+                half_width * table.ratios(relaxation_length / half_width).pressure_centre
+            }
+            LayerLaw::Kelvin { .. } | LayerLaw::Hertz { .. } => 0.0,
+            LayerLaw::Continuum { curve } => curve.pressure_centre(radius, delta),
+        }
+    }
+
+    /// A bound on the relative error of [`LayerLaw::pressure_centre`]: the continuum
+    /// curve's; the others are the force's and area's (exact, or reported apart).
+    pub fn pressure_error(&self, radius: f64, delta: f64) -> f64 {
+        match self {
+            LayerLaw::Continuum { curve } if delta > 0.0 => curve.pressure_error_at(radius, delta),
+            _ => 0.0,
         }
     }
 
@@ -164,18 +154,6 @@ pub fn squeeze(
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn the_upper_law_inverts() {
-        for upper in [
-            UpperLaw::Elastic { modulus: 2.3e11 },
-            UpperLaw::Plastic { hardness: 2e9 },
-        ] {
-            let omega = 3e-11;
-            let force = upper.force(25e-9, omega);
-            assert!((upper.interference(25e-9, force) / omega - 1.0).abs() < 1e-14);
-        }
-    }
 
     #[test]
     fn two_hertz_contacts_split_the_interference_in_closed_form() {

@@ -15,14 +15,18 @@ mod distribution;
 mod solver;
 mod state;
 mod system;
+mod traction;
 
+pub use crate::counterface::{UpperContact, UpperLaw, UpperSurface};
 pub use asperities::{Asperities, Zmc};
-pub use contact::{squeeze, LayerLaw, Squeeze, UpperLaw};
+pub use contact::{squeeze, LayerLaw, Squeeze};
 pub use curves::LayerCurves;
 pub use distribution::Diameters;
 pub use solver::{solve, solve_with};
-pub use state::{Areas, ContactState, Loads, ThreeBodySolution, ThreeBodyVerification};
+pub use state::{
+    Areas, ContactState, Loads, ModeChange, SystemMotion, ThreeBodySolution, ThreeBodyVerification,
+};
 pub use system::{
     LayerContact, OperatingKind, OperatingPoint, Particle, ThreeBody, ThreeBodyOptions,
-    UpperContact, UpperSurface, DEFAULT_DIAMETER_NODES, MAX_DIAMETER_NODES,
+    DEFAULT_DIAMETER_NODES, MAX_DIAMETER_NODES,
 };

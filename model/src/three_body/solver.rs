@@ -4,10 +4,15 @@
 use std::sync::Arc;
 
 use super::asperities::Zmc;
-use super::contact::{squeeze, LayerLaw, UpperLaw};
+use super::contact::{squeeze, LayerLaw};
 use super::curves::LayerCurves;
-use super::state::{Areas, ContactState, Loads, ThreeBodySolution, ThreeBodyVerification};
-use super::system::{LayerContact, OperatingPoint, ThreeBody, ThreeBodyOptions, UpperContact};
+use super::state::{
+    Areas, ContactState, Loads, SystemMotion, ThreeBodySolution, ThreeBodyVerification,
+};
+use super::system::{LayerContact, OperatingPoint, ThreeBody, ThreeBodyOptions};
+use super::traction::Population;
+use crate::counterface::UpperLaw;
+use crate::motion::{Mode, Motion};
 use crate::quadrature::{gauss_legendre, GaussRule};
 use crate::roots::brent;
 use crate::similarity::SimilarityTable;
@@ -17,7 +22,7 @@ use crate::{ModelError, Stop};
 
 /// The substitution x = d + (x_max − d)τ⁴ turns the (x − d)^{3/2} edge of the integrands
 /// into τ⁶: smooth enough for Gauss–Legendre to converge fast.
-const EDGE_POWER: i32 = 4;
+pub(super) const EDGE_POWER: i32 = 4;
 
 /// Solves the three-body system (docs/model.md §4); with the `continuum` layer contact,
 /// its curves are built here, to the end ([`LayerCurves::build`]; [`solve_with`] takes them
@@ -56,18 +61,23 @@ pub fn solve_with(
     } else {
         (state, iterations, residual)
     };
-    let quadrature_error_estimate = rolling.diameter_error(&state, options.diameter_nodes)?;
+    let (motion, coarse_traction) = rolling.motion(&state, options.diameter_nodes)?;
+    let quadrature_error_estimate = rolling
+        .diameter_error(&state, options.diameter_nodes)?
+        .max(relative_change(coarse_traction, motion.particle_traction));
+    let layer_contact_error = (system.layer_contact == LayerContact::Continuum)
+        .then(|| layer_contact_error(system, &state, &static_state, &motion));
     let solution = ThreeBodySolution {
         rolling: state,
         static_state,
+        motion,
         verification: ThreeBodyVerification {
             diameter_nodes: options.diameter_nodes,
             separation_iterations: iterations,
             load_residual: residual,
             quadrature_error_estimate,
             layer_table_error,
-            layer_contact_error: (system.layer_contact == LayerContact::Continuum)
-                .then(|| layer_contact_error(system, &state, &static_state)),
+            layer_contact_error,
             converged: true,
         },
     };
@@ -141,15 +151,23 @@ fn layer_laws(
     })
 }
 
-/// The continuum contacts' bound on the error of A_s2a and W_a, with rolling and at rest,
-/// the worse. At a given load the force's error moves the separation, and the areas follow
-/// the load (A_s2a grows about as W does): the two errors add.
-fn layer_contact_error(system: &ThreeBody, state: &ContactState, resting: &ContactState) -> f64 {
-    let bound = |s: &ContactState| match system.operating {
-        OperatingPoint::Separation(_) => s.layer_error,
-        _ => s.layer_error + s.layer_load_error,
+/// The continuum contacts' bound on the error of A_s2a, W_a and Σ T, with rolling and at
+/// rest, the worse. At a given load the force's error moves the separation, and the areas
+/// and forces follow the load (A_s2a grows about as W does): the two errors add.
+fn layer_contact_error(
+    system: &ThreeBody,
+    state: &ContactState,
+    resting: &ContactState,
+    motion: &SystemMotion,
+) -> f64 {
+    let moved = |s: &ContactState| match system.operating {
+        OperatingPoint::Separation(_) => 0.0,
+        _ => s.layer_load_error,
     };
-    bound(state).max(bound(resting))
+    let bound = |s: &ContactState| s.layer_error + moved(s);
+    bound(state)
+        .max(bound(resting))
+        .max(motion.traction_error + moved(state))
 }
 
 /// Refuses to hand out a non-finite number (serde_json would write it as a silent `null`).
@@ -173,6 +191,8 @@ fn ensure_finite(solution: &ThreeBodySolution) -> Result<(), ModelError> {
         .chain([
             verification.load_residual,
             verification.quadrature_error_estimate,
+            solution.motion.friction,
+            solution.motion.particle_traction,
         ])
         .all(f64::is_finite)
     {
@@ -181,6 +201,15 @@ fn ensure_finite(solution: &ThreeBodySolution) -> Result<(), ModelError> {
         Err(ModelError::NotRepresentable {
             what: "a result of this three-body job".to_string(),
         })
+    }
+}
+
+/// |a/b − 1|, or 0 where b is.
+fn relative_change(a: f64, b: f64) -> f64 {
+    if b == 0.0 {
+        0.0
+    } else {
+        (a / b - 1.0).abs()
     }
 }
 
@@ -206,9 +235,6 @@ impl<'a> Model<'a> {
     fn new(system: &'a ThreeBody, layer_law: LayerLaw, nodes: usize) -> Self {
         let upper = &system.upper;
         let layer = &system.layer;
-        let upper_modulus = 1.0
-            / (compliance(upper.elastic_modulus, upper.poisson_ratio)
-                + Self::particle_compliance(system));
         let pair_modulus = 1.0
             / (compliance(upper.elastic_modulus, upper.poisson_ratio)
                 + compliance(layer.elastic_modulus, layer.poisson_ratio));
@@ -219,12 +245,7 @@ impl<'a> Model<'a> {
         };
         Model {
             system,
-            upper: match (upper.contact, upper.hardness) {
-                (UpperContact::Plastic, Some(hardness)) => UpperLaw::Plastic { hardness },
-                _ => UpperLaw::Elastic {
-                    modulus: upper_modulus,
-                },
-            },
+            upper: upper.law(Self::particle_compliance(system)),
             layer: layer_law,
             zmc: system
                 .asperities
@@ -341,14 +362,56 @@ impl<'a> Model<'a> {
             ..self.clone()
         };
         let check = coarse.state(state.separation)?;
-        let change = |a: f64, b: f64| if b == 0.0 { 0.0 } else { (a / b - 1.0).abs() };
         Ok([
-            change(check.areas.particle_upper, state.areas.particle_upper),
-            change(check.areas.particle_layer, state.areas.particle_layer),
-            change(check.loads.particles, state.loads.particles),
+            relative_change(check.areas.particle_upper, state.areas.particle_upper),
+            relative_change(check.areas.particle_layer, state.areas.particle_layer),
+            relative_change(check.loads.particles, state.loads.particles),
         ]
         .into_iter()
         .fold(0.0, f64::max))
+    }
+
+    /// How the particles move at `state`'s separation (docs/model.md §11), their size sum
+    /// under the model's nodes on each piece between changes of mode (the friction adds
+    /// the asperities' τ_s A_s1s2 to the particles' Σ T, over W), and Σ T with half the
+    /// `nodes`.
+    fn motion(
+        &self,
+        state: &ContactState,
+        nodes: usize,
+    ) -> Result<(SystemMotion, f64), ModelError> {
+        let separation = state.separation;
+        let (tau_a, tau_s) = self.shear_strengths;
+        let tau_u = self.system.upper.shear_strength();
+        let population = Population {
+            diameters: &self.system.diameters,
+            separation,
+            count: self.system.nominal_area * self.system.areal_density,
+            particle: |diameter: f64| {
+                let s = squeeze(&self.upper, &self.layer, diameter, diameter - separation)?;
+                let radius = 0.5 * diameter;
+                let shift = self.layer.pressure_centre(radius, s.layer_penetration);
+                let motion = Motion::new(
+                    0.0,
+                    shift / radius,
+                    tau_u * s.upper_area / s.force,
+                    tau_a * s.layer_area / s.force,
+                );
+                // Rolling, T = F x_p/2R; sliding, τA (the upper A₁ ∝ F^{2/3}).
+                let error = match motion.mode {
+                    Mode::Rolls => {
+                        s.layer_error + self.layer.pressure_error(radius, s.layer_penetration)
+                    }
+                    _ => s.layer_error,
+                };
+                Ok((motion, s.force, error))
+            },
+        };
+        let coarse = gauss_legendre((nodes / 2).max(2));
+        let (mut motion, coarse_traction) = population.motion(&self.nodes, &coarse)?;
+        motion.friction =
+            (motion.particle_traction + tau_s * state.areas.surface_surface) / state.loads.total;
+        Ok((motion, coarse_traction))
     }
 
     /// The state at the operating point, the iterations of its separation root, and the

@@ -1,5 +1,7 @@
 //! What a three-body solve answers: the system's state at the operating point, with rolling
-//! and at rest, and how far it can be trusted.
+//! and at rest, how its particles move, and how far it can be trusted.
+
+use crate::motion::{Mode, Motion};
 
 /// Real contact areas (m²).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -75,12 +77,55 @@ pub struct ThreeBodyVerification {
     pub quadrature_error_estimate: f64,
     /// Relative error of the `kelvin_layer` table against direct solves, when one is used.
     pub layer_table_error: Option<f64>,
-    /// For the `continuum` layer contact: a bound on the relative error of A_s2a and W_a
-    /// from the continuum contacts (their curves' errors, weighted over the sizes; at a
-    /// given load, the load's error added, which moves the separation), with and without
-    /// rolling, the worse.
+    /// For the `continuum` layer contact: a bound on the relative error of A_s2a, W_a and
+    /// the particles' Σ T from the continuum contacts (their curves' errors, weighted over
+    /// the sizes; at a given load, the load's error added, which moves the separation), with
+    /// and without rolling, the worse.
     pub layer_contact_error: Option<f64>,
     pub converged: bool,
+}
+
+/// How the particles in contact move at the job's speed (docs/model.md §11): each size at
+/// its own load rolls, or slides at its weaker contact.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SystemMotion {
+    /// (Σ T + τ_s A_s1s2)/W: the system's friction with each particle transmitting the
+    /// tangential force its motion gives (eq. 12's μ assumes every particle slides on the
+    /// layer).
+    pub friction: f64,
+    /// Σ T (N), the particles' tangential forces.
+    pub particle_traction: f64,
+    /// A bound on the relative error of Σ T from the layer contacts' law (0 for the closed
+    /// forms; the continuum's force, area and centre of pressure, weighted over the sizes).
+    pub traction_error: f64,
+    /// Particles that roll.
+    pub rolling: f64,
+    /// Particles that slide on the layer.
+    pub sliding_at_layer: f64,
+    /// Particles that slide against the upper surface.
+    pub sliding_at_upper: f64,
+    /// Where the mode changes, in ascending diameter.
+    pub changes: Vec<ModeChange>,
+    /// The particle in contact furthest from rolling (the largest μ_roll over its weaker
+    /// capacity); `None` with no particle in contact.
+    pub furthest: Option<Motion>,
+}
+
+/// A diameter where the particles' mode changes.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ModeChange {
+    /// x (m).
+    pub diameter: f64,
+    /// The mode of the particles just smaller, and of those just larger.
+    pub below: Mode,
+    pub above: Mode,
+}
+
+impl SystemMotion {
+    /// Particles that slide, at either contact.
+    pub fn sliding(&self) -> f64 {
+        self.sliding_at_layer + self.sliding_at_upper
+    }
 }
 
 /// The three-body system with rolling (at the job's V) and without (V = 0).
@@ -88,5 +133,7 @@ pub struct ThreeBodyVerification {
 pub struct ThreeBodySolution {
     pub rolling: ContactState,
     pub static_state: ContactState,
+    /// How the particles move with rolling.
+    pub motion: SystemMotion,
     pub verification: ThreeBodyVerification,
 }

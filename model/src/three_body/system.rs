@@ -4,6 +4,7 @@
 
 use super::asperities::Asperities;
 use super::distribution::Diameters;
+use crate::counterface::UpperSurface;
 use crate::text::quantity;
 use crate::{Layer, OptionError, Parameter, ParameterError, Quadrature, SolveOption};
 
@@ -12,40 +13,6 @@ use crate::{Layer, OptionError, Parameter, ParameterError, Quadrature, SolveOpti
 pub const DEFAULT_DIAMETER_NODES: usize = 48;
 /// Largest number of diameter nodes offered.
 pub const MAX_DIAMETER_NODES: usize = 1024;
-
-/// How the upper surface deforms where a particle presses into it.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum UpperContact {
-    /// Hertz (docs/model.md §4, default).
-    #[default]
-    Elastic,
-    /// Fully plastic at the surface's hardness (Horng's option).
-    Plastic,
-}
-
-/// The rigid-backed upper surface.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct UpperSurface {
-    /// E₁ (Pa).
-    pub elastic_modulus: f64,
-    /// ν₁.
-    pub poisson_ratio: f64,
-    pub contact: UpperContact,
-    /// H₁ (Pa), needed for plastic contact.
-    pub hardness: Option<f64>,
-}
-
-impl Default for UpperSurface {
-    /// Steel: 210 GPa, ν = 0.3 (docs/model.md §5).
-    fn default() -> Self {
-        UpperSurface {
-            elastic_modulus: 210e9,
-            poisson_ratio: 0.3,
-            contact: UpperContact::Elastic,
-            hardness: None,
-        }
-    }
-}
 
 /// The particles' material; rigid by default.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -165,6 +132,7 @@ impl ThreeBody {
     pub fn violations(&self) -> Vec<ParameterError> {
         use Parameter::*;
         let mut errors = Parameter::check_all(self.ranged());
+        errors.extend(self.upper.violations());
         errors.extend(self.layer.violations());
         let diameters_valid = !errors.iter().any(|e| {
             matches!(
@@ -175,13 +143,6 @@ impl ThreeBody {
         // Bounds derived from an invalid mean or deviation say nothing more.
         if diameters_valid {
             errors.extend(self.diameter_bounds_violation());
-        }
-        if self.upper.contact == UpperContact::Plastic && self.upper.hardness.is_none() {
-            errors.push(ParameterError {
-                parameter: UpperHardness,
-                value: f64::NAN,
-                allowed: "a hardness (Pa) for plastic contact".to_string(),
-            });
         }
         errors
     }
@@ -198,12 +159,9 @@ impl ThreeBody {
             (MaxDiameter, d.max),
             (ArealDensity, self.areal_density),
             (NominalArea, self.nominal_area),
-            (UpperModulus, self.upper.elastic_modulus),
-            (UpperPoissonRatio, self.upper.poisson_ratio),
             (ParticlePoissonRatio, self.particle.poisson_ratio),
             (Velocity, self.velocity),
         ];
-        checks.extend(self.upper.hardness.map(|h| (UpperHardness, h)));
         checks.extend(self.particle.elastic_modulus.map(|e| (ParticleModulus, e)));
         if let Some(a) = &self.asperities {
             checks.extend([

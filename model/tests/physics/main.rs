@@ -4,6 +4,7 @@
 mod continuum;
 mod continuum_rolling;
 mod honest_edges;
+mod motion;
 mod numerical_honesty;
 mod prony;
 mod reference_table;

@@ -2,6 +2,8 @@
 //! contact is the single-particle continuum answer, through the layer's curve.
 
 use thirdbody_model::continuum::{self, PenetrationCurve};
+use thirdbody_model::counterface::UpperSurface;
+use thirdbody_model::motion::{self, Mode};
 use thirdbody_model::three_body::{
     self, squeeze, LayerContact, LayerCurves, LayerLaw, OperatingPoint, ThreeBody,
     ThreeBodyOptions, UpperLaw,
@@ -109,6 +111,23 @@ fn particles_of_one_size_give_the_single_particle_friction() {
         off <= error + single.verification.errors.contact_area,
         "{off:.2e}"
     );
+    // Its particles move as the single particle does (docs/model.md §11): on the
+    // continuum they slide at the layer, with the single particle's friction.
+    let m = motion::particle(
+        25e-9,
+        mean_load,
+        single.rolling_resistance_coefficient,
+        single.contact_area,
+        tau,
+        &UpperSurface::default(),
+    );
+    assert_eq!(m.mode, Mode::SlidesAtLayer);
+    assert_eq!(s.motion.furthest.unwrap().mode, m.mode);
+    let off = (s.motion.friction / m.friction - 1.0).abs();
+    assert!(
+        off <= error + single.verification.errors.contact_area,
+        "{off:.2e}"
+    );
     let local = three_body::solve(
         &ThreeBody {
             layer_contact: LayerContact::KelvinLayer,
@@ -173,5 +192,13 @@ fn the_curve_interpolates_direct_solves() {
             (area / direct.contact_area - 1.0).abs() <= bound,
             "A at P = {load:e}"
         );
+        // The centre of pressure, which sets a particle's rolling resistance (§11).
+        let e = direct.verification.errors;
+        let shift = direct.pressure_centre_shift;
+        let bound = curve.pressure_error_at(25e-9, direct.penetration)
+            + e.pressure_centre_shift / shift
+            + e.penetration;
+        let off = (curve.pressure_centre(25e-9, direct.penetration) / shift - 1.0).abs();
+        assert!(off <= bound, "x_p at P = {load:e}: {off:.2e} > {bound:.2e}");
     }
 }
