@@ -7,6 +7,7 @@ use utoipa::ToSchema;
 
 use super::JobError;
 use crate::described;
+use crate::model::motion::Mode;
 use crate::model::text::{count, quantity};
 use crate::model::validity::{Assumption, Check, Status};
 use crate::render::{Fixed, Text};
@@ -27,8 +28,8 @@ described! {
     #[derive(Clone, Debug, PartialEq, Serialize, ToSchema)]
     pub struct AssumptionOutput {
         /// `inside_layer`, `parabolic_sphere`, `local_layer`, `adhesive_friction`,
-        /// `surfaces_apart`, `asperity_gap`, `particles_in_contact` or (the layer as a
-        /// continuum) `resolution` and `numerical`.
+        /// `surfaces_apart`, `asperity_gap`, `particles_in_contact`, `pure_rolling` or (the
+        /// layer as a continuum) `resolution` and `numerical`.
         pub name: &'static str => [],
         /// The assumption in words.
         #[schema(value_type = String)]
@@ -406,7 +407,7 @@ impl Described {
 }
 
 /// Each assumption described, in the order of [`Assumption::ALL`].
-static DESCRIBED: [Described; 9] = [
+static DESCRIBED: [Described; 10] = [
     Described::new(
         "inside_layer",
         "the sphere stays inside the layer: the rigid base is never reached",
@@ -461,6 +462,14 @@ static DESCRIBED: [Described; 9] = [
         "the answer is as exact as docs/model.md §8 asks: 1 % in A (and μ), 0.5 % in δ",
         "reported error / tolerance, the larger of A's and δ's",
         "warn above 1",
+    ),
+    Described::new(
+        "pure_rolling",
+        "the particles roll, as the paper assumes: both contacts transmit the tangential \
+         force rolling needs (docs/model.md §11)",
+        "tangential force rolling needs / the most the weaker contact transmits (three-body: \
+         the particle furthest from rolling)",
+        "warn above 1 (the particle slides at the weaker contact)",
     ),
 ];
 
@@ -587,6 +596,43 @@ fn note(check: &Check, subject: Subject) -> String {
              the numbers are less exact than that, by the bounds in `meta.verification`",
             significant(value)
         ),
+        PureRolling => sliding(check, subject),
+    }
+}
+
+/// Why a pure-rolling check warns: which contact gives way, by how much, and the friction
+/// the particles then transmit.
+fn sliding(check: &Check, subject: Subject) -> String {
+    let Some(sliding) = check.motion else {
+        return String::new();
+    };
+    let m = &sliding.motion;
+    let (contact, slides) = match m.mode {
+        Mode::SlidesAtUpper => ("upper surface", "against the upper surface"),
+        _ => ("layer", "on the layer"),
+    };
+    let share = format!(
+        "its contact with the {contact} can transmit only {} % of the tangential force \
+         rolling needs ({} against μ_roll = (μ_r,upper + μ_r,layer)/2 = {})",
+        significant(100.0 / check.ratio()),
+        significant(check.rolling.1),
+        significant(m.rolling_need),
+    );
+    match (subject, sliding.particles) {
+        (Subject::System, Some((slide, all))) => format!(
+            "{} of the {} in contact slide instead of rolling; the one furthest from rolling \
+             slides {slides}: {share}. With each particle's own motion the system's friction \
+             is {} (`motion.friction`), not eq. 12's (docs/model.md §11)",
+            count(slide, "", "").trim_end(),
+            count(all, "particle", "particles"),
+            significant(sliding.friction),
+        ),
+        _ => format!(
+            "the particle slides {slides} instead of rolling: {share}. Its friction is then \
+             that capacity, {} (`motion.friction`), where the paper assumes it rolls \
+             (docs/model.md §11)",
+            significant(sliding.friction),
+        ),
     }
 }
 
@@ -618,7 +664,7 @@ fn violation(check: &Check, subject: Subject) -> String {
             length(value)
         ),
         LocalLayer | AdhesiveFriction | AsperityGap | ParticlesInContact | Resolution
-        | Numerical => note(check, subject),
+        | Numerical | PureRolling => note(check, subject),
     };
     format!("{when}{cause}{rest}")
 }

@@ -37,8 +37,23 @@ async fn the_default_job_on_the_continuum_answers_with_its_own_error() {
             "parabolic_sphere",
             "adhesive_friction",
             "resolution",
-            "numerical"
+            "numerical",
+            "pure_rolling"
         ]
+    );
+    // It slides at the layer (docs/model.md §11): μ_roll 0.0131 against the layer's 0.00913,
+    // and the pure-rolling row warns, naming the contact and the friction it transmits.
+    let motion = &body["motion"];
+    assert_eq!(motion["mode"], "slides_at_layer");
+    assert_eq!(motion["friction"], body["friction_coefficient"]);
+    let rolling = &meta["validity"]["assumptions"][5];
+    assert_eq!(rolling["status"], "warn");
+    let ratio = motion["rolling_need"].as_f64().unwrap() / motion["friction"].as_f64().unwrap();
+    assert!((rolling["value"].as_f64().unwrap() / ratio - 1.0).abs() < 1e-12);
+    let note = rolling["note"].as_str().unwrap();
+    assert!(
+        note.contains("slides on the layer") && note.contains("69.6 %"),
+        "{note}"
     );
     // Its error is within §8's tolerance: the numerical row says by how much, and is ok.
     let numerical = &meta["validity"]["assumptions"][4];

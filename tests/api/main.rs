@@ -15,6 +15,7 @@ mod jobs;
 #[path = "../shared/json.rs"]
 mod json;
 mod limits;
+mod motion;
 mod ops;
 mod pictures;
 mod prony;

@@ -93,6 +93,11 @@ try {
   await page.waitForSelector(`${area("rolling", "picture")} svg .series`);
   const mu = await page.locator(`${area("rolling", "table")} tr`, { hasText: "friction_coefficient" }).first().textContent();
   if (!/0\.0947/.test(mu)) fail(`the default friction coefficient is shown as ${mu}`);
+  // How it moves (docs/model.md §11): it rolls, and its own friction is μ_roll.
+  const mode = await page.locator(`${area("rolling", "table")} tr`, { hasText: "motion.mode" }).first().textContent();
+  if (!/rolls/.test(mode)) fail(`the default particle's motion reads ${mode}`);
+  const own = await page.locator(`${area("rolling", "table")} tr`, { hasText: "motion.friction" }).first().textContent();
+  if (!/0\.02138/.test(own)) fail(`the default particle's own friction reads ${own}`);
   await page.screenshot({ path: `${shots}/rolling.png`, fullPage: true });
 
   // An error after a success: the message names the field, and the old answer is gone.
@@ -114,6 +119,10 @@ try {
   await page.waitForFunction((s) => document.querySelector(s).textContent.includes("continuum"), area("rolling", "status"));
   const continuumArea = await page.locator(`${area("rolling", "table")} tr`, { hasText: "contact_area" }).first().textContent();
   if (!/8\.[1-4]\d*\s*nm²/.test(continuumArea)) fail(`the continuum's contact area is shown as ${continuumArea}`);
+  const slides = await page.locator(`${area("rolling", "table")} tr`, { hasText: "motion.mode" }).first().textContent();
+  if (!/slides_at_layer/.test(slides)) fail(`on the continuum the particle's motion reads ${slides}`);
+  const warned = await page.locator(area("rolling", "warnings")).textContent();
+  if (!/slides on the layer/.test(warned)) fail(`the pure-rolling warning reads ${warned}`);
   if (await page.locator("#form-rolling [aria-invalid], #form-rolling .field-error").count()) fail("the load stays marked invalid after a success");
   await page.screenshot({ path: `${shots}/rolling-continuum.png`, fullPage: true });
 
@@ -138,6 +147,11 @@ try {
   await page.getByRole("tab", { name: "Three-body system" }).click();
   await page.locator("#form-three-body").getByRole("button", { name: "Solve" }).click();
   await page.waitForFunction((s) => (document.querySelector(`${s} svg title`) || {}).textContent?.startsWith("Three-body"), area("three-body", "picture"));
+  // The particles that roll and those that slide (docs/model.md §11), shaded apart on its
+  // picture, and the system's own friction beside eq. 12's.
+  const populations = await page.locator(`${area("three-body", "picture")} svg`).textContent();
+  if (!/in contact: rolls/.test(populations) || !/in contact: slides/.test(populations)) fail(`the three-body picture's populations: ${populations.slice(0, 300)}`);
+  if (!(await page.locator(`${area("three-body", "table")} tr`, { hasText: "motion.friction" }).count())) fail("the three-body table has no motion.friction");
   await page.screenshot({ path: `${shots}/three-body.png`, fullPage: true });
   const localMu = await page.locator(`${area("three-body", "table")} tr`, { hasText: "friction_coefficient" }).first().textContent();
   // Each quantity in the unit of its magnitude: W = 0.99999…e-3 N is 1 mN (not 1000 µN), and
@@ -311,6 +325,7 @@ try {
     && [...document.querySelectorAll(`${s} .table tr`)].some((r) => r.textContent.startsWith("loads.asperities")), area("three-body"), { timeout: 30000 });
   const asperityLoad = await page.locator(`${area("three-body", "table")} tr`, { hasText: "loads.asperities" }).first().textContent();
   if (!/[1-9]/.test(asperityLoad)) fail(`the asperities carry no load: ${asperityLoad}`);
+
 
   // Copy as Python: a script that posts the form's body as it is.
   await page.getByRole("tab", { name: "Rolling contact" }).click();

@@ -251,19 +251,49 @@ fn a_sweep_draws_the_points_it_answered_and_counts_those_it_did_not() {
     );
 }
 
+/// The particles in contact shaded by how they move (docs/model.md §11): at 1 mN the
+/// smallest roll, the middle ones slide against the steel, the largest on the layer, each
+/// population between the separation and the diameters where the mode changes.
 #[test]
 fn a_three_body_system_shades_the_particles_in_contact_and_splits_the_area() {
     let (answer, svg) = solve(json!({"kind": "three_body",
         "input": {"operating": {"total_load": "1 mN"}}}));
     let (series, _) = parts(&svg);
-    assert_eq!(series[0], "diameters");
-    assert_eq!(series[1], "in contact (x > d)");
+    assert_eq!(
+        series[..4],
+        [
+            "diameters",
+            "in contact: rolls",
+            "in contact: slides on upper",
+            "in contact: slides on layer"
+        ]
+    );
     let chart = chart::<ThreeBodyPicture>(&answer);
-    let Layer::Area { outline, .. } = &chart.layers[1] else {
-        panic!()
-    };
     let separation = answer["separation"].as_f64().unwrap();
-    assert!(outline.iter().all(|p| p.0 >= separation));
+    let changes: Vec<f64> = answer["motion"]["changes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| c["diameter"].as_f64().unwrap())
+        .collect();
+    let edges: Vec<f64> = [separation]
+        .into_iter()
+        .chain(changes)
+        .chain([65e-9])
+        .collect();
+    for (i, piece) in edges.windows(2).enumerate() {
+        let Layer::Area { outline, .. } = &chart.layers[1 + i] else {
+            panic!()
+        };
+        let (lo, hi) = (piece[0], piece[1]);
+        assert!(
+            outline.iter().all(|p| lo <= p.0 && p.0 <= hi),
+            "{lo:e}..{hi:e}"
+        );
+        assert_eq!(outline.first().unwrap().0, lo);
+        assert_eq!(outline.last().unwrap().0, hi);
+    }
+    assert!(svg.contains("35,600 roll, 18,900 slide"), "{svg}");
     assert!(svg.contains("particle diameter [nm]") && svg.contains("particle–upper: 100.0 %"));
     // The count as a person reads it, not 5.4450e4.
     assert!(

@@ -327,6 +327,9 @@ function rows(answer, units, prefix = "") {
     if (typeof value === "number") {
       const [size, unit] = scaleFor(value || largest[units[path]], units[path]);
       out.push([path, Number((value / size).toPrecision(6)), unit]);
+    } else if (typeof value === "string" && path.endsWith(".mode")) {
+      // A word the answer gives among its numbers: how the particle moves.
+      out.push([path, value, ""]);
     } else if (Array.isArray(value) && value.length === 2 && value.every((v) => typeof v === "number")) {
       // A range (a fit's 95 % interval, its bounds): both ends in the unit of the larger.
       // A list's unit is named by its path with `[]`.
@@ -390,7 +393,8 @@ function showPoints(area, answer) {
       if (statusColumn) row.insertCell().textContent = point.status + (point.reason ? `: ${point.reason}` : "");
       for (const c of columns) {
         const value = valueAt(point, c);
-        row.insertCell().textContent = typeof value === "number" ? Number((value / scales[c][0]).toPrecision(6)) : "";
+        const cell = typeof value === "number" ? Number((value / scales[c][0]).toPrecision(6)) : value;
+        row.insertCell().textContent = cell ?? "";
       }
     }
     if (order.length > SHOWN_POINTS) {

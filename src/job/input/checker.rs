@@ -435,8 +435,8 @@ fn implausible(parameter: Parameter, x: f64) -> Option<String> {
         | HeightStd | Separation => (0.0, 1e-3, Some("nm")),
         Load | ParticleLoad => (0.0, 1.0, Some("nN")),
         Velocity => (0.0, 1.0, Some("nm/s")),
-        ElasticModulus | UpperModulus | ParticleModulus | UpperHardness | AsperityHardness
-        | PronyModulus => (1e3, 1e12, None),
+        ElasticModulus | UpperModulus | ParticleModulus | UpperHardness | UpperShearStrength
+        | AsperityHardness | PronyModulus => (1e3, 1e12, None),
         RetardationTime | RelaxationTime | PronyTime => (0.0, 1e6, Some("ms")),
         PoissonRatio | UpperPoissonRatio | ParticlePoissonRatio | ArealDensity | NominalArea
         | AsperityDensity | TotalLoad | Kappa | Stiffness | FrictionCoefficient | ContactArea

@@ -13,6 +13,7 @@ mod json;
 mod layer;
 mod quadrature;
 pub mod units;
+mod upper;
 
 use std::fmt;
 
@@ -30,6 +31,7 @@ pub use checker::{parameters_read, Checker};
 pub use json::parse;
 pub use layer::{LayerInput, LayerModel};
 pub use quadrature::QuadratureKind;
+pub use upper::{UpperContactKind, UpperSurfaceInput};
 
 use super::JobError;
 

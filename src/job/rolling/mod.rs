@@ -10,13 +10,17 @@ use serde::{Deserialize, Serialize};
 use serde_json::Value;
 use utoipa::ToSchema;
 
-use super::input::{self, field, Checker, LayerInput, LayerModel, QuadratureKind, Quantity};
+use super::input::{
+    self, field, Checker, LayerInput, LayerModel, QuadratureKind, Quantity, UpperSurfaceInput,
+};
 use super::kind::SMALL_ANSWER;
 use super::meta::{Canonical, CONTINUUM_REFERENCES, ROLLING_REFERENCES};
 use super::points::{self, PointNotes, PointNotesFields, PointStatus, Row};
 use super::validity::{self, PointValidity, Subject, ValidityOutput};
 use super::{Control, Cost, JobError, Kind, Limits, Meta, References, Validated, Work};
 use crate::model::continuum::ContinuumVerification;
+use crate::model::counterface::UpperSurface;
+use crate::model::motion::{self, Mode, Motion};
 use crate::model::rolling::{BoundaryPoint, PressureGrid, Verification};
 use crate::model::tables::{self, Use};
 use crate::model::validity::Check;
@@ -41,6 +45,9 @@ pub struct RollingInput {
     pub velocity: Option<Quantity>,
     /// The viscoelastic layer (default: docs/model.md §5).
     pub layer: Option<LayerInput>,
+    /// The counterface the particle rolls against (default steel, 210 GPa, ν = 0.3): with
+    /// the layer, it decides whether the particle rolls or slides (docs/model.md §11).
+    pub upper_surface: Option<UpperSurfaceInput>,
     /// Quadrature and extra outputs.
     pub options: Option<OptionsInput>,
 }
@@ -87,6 +94,8 @@ impl OptionsInput {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RollingJob {
     pub rolling: Rolling,
+    /// The counterface: whether the particle rolls (docs/model.md §11).
+    pub upper: UpperSurface,
     pub options: SolveOptions,
     /// How the layer gives way.
     pub law: LayerModel,
@@ -103,12 +112,15 @@ impl RollingJob {
             velocity: checker.quantity(field!(input.velocity), Parameter::Velocity, d.velocity),
             layer: checker.nested(field!(input.layer), |c, layer| layer.read(c)),
         };
+        let upper = checker.nested(field!(input.upper_surface), |c, u| u.read(c));
         let options = checker.nested(field!(input.options), |c, o| o.read(c));
         checker.parameters(rolling.violations());
+        checker.parameters(upper.violations());
         checker.options(options.violations());
         let law = input.layer.as_ref().and_then(|l| l.model);
         RollingJob {
             rolling,
+            upper,
             options,
             law: law.unwrap_or_default(),
         }
@@ -144,6 +156,7 @@ impl RollingJob {
             load: Quantity::si(r.load),
             velocity: Quantity::si(r.velocity),
             layer: Some(LayerInput::of(&r.layer, Some(self.law))),
+            upper_surface: Some(UpperSurfaceInput::of(&self.upper)),
             options: Some(OptionsInput::of(&self.options)),
         }
     }
@@ -230,7 +243,7 @@ impl Kind for RollingJob {
         // Strip sums, never a table: a single answer's digits must not depend on which tables
         // earlier jobs of the process built (issue 52).
         let solution = control.solve(|stop| self.solve(&self.rolling, Use::Exact, stop))?;
-        RollingOutput::new(&self.rolling, &solution, meta)
+        RollingOutput::new(&self.rolling, &self.upper, &solution, meta)
     }
 }
 
@@ -250,10 +263,79 @@ described! {
         pub pressure_centre_shift: f64 => [number "m"],
         /// x_p/R (dimensionless).
         pub rolling_resistance_coefficient: f64 => [number ""],
-        /// μ = τ_a A/P (eq. 12; dimensionless).
+        /// μ = τ_a A/P (eq. 12; dimensionless): the paper's adhesive friction, the most
+        /// the layer contact transmits. The particle's own friction, rolling or sliding,
+        /// is `motion.friction`.
         pub friction_coefficient: f64 => [number ""],
+        /// Whether the particle rolls or slides, and the friction it then transmits
+        /// (docs/model.md §11).
+        pub motion: MotionOutput => [nested "motion_"],
         /// The same particle at V = 0.
         pub r#static: StaticOutput => [nested "static_"],
+    }
+}
+
+described! {
+    /// Roll or slide (docs/model.md §11): moments about the particle's centre give
+    /// 2RT = P(x_p,upper + x_p,layer), so rolling needs the tangential force per load
+    /// μ_roll = (μ_r,upper + μ_r,layer)/2; each contact transmits at most τ A/P. The
+    /// particle rolls iff both can; otherwise it slides at the weaker.
+    #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, ToSchema)]
+    pub struct MotionOutput {
+        /// `rolls`, `slides_at_layer` or `slides_at_upper`.
+        pub mode: MotionMode => [],
+        /// μ_roll, the tangential force per load that rolling needs (dimensionless).
+        pub rolling_need: f64 => [number ""],
+        /// τ_u A_u/P, the most the contact with the upper surface transmits
+        /// (dimensionless).
+        pub upper_capacity: f64 => [number ""],
+        /// τ_a A/P, the most the layer contact transmits: eq. 12's μ (dimensionless).
+        pub layer_capacity: f64 => [number ""],
+        /// T/P, the particle's friction: μ_roll when it rolls, the weaker capacity when it
+        /// slides (dimensionless).
+        pub friction: f64 => [number ""],
+    }
+}
+
+/// How a particle moves between the two surfaces.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, ToSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum MotionMode {
+    Rolls,
+    SlidesAtLayer,
+    SlidesAtUpper,
+}
+
+impl MotionMode {
+    /// The mode as the JSON writes it.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            MotionMode::Rolls => "rolls",
+            MotionMode::SlidesAtLayer => "slides_at_layer",
+            MotionMode::SlidesAtUpper => "slides_at_upper",
+        }
+    }
+}
+
+impl From<&Motion> for MotionOutput {
+    fn from(m: &Motion) -> Self {
+        MotionOutput {
+            mode: m.mode.into(),
+            rolling_need: m.rolling_need,
+            upper_capacity: m.upper_capacity,
+            layer_capacity: m.layer_capacity,
+            friction: m.friction,
+        }
+    }
+}
+
+impl From<Mode> for MotionMode {
+    fn from(mode: Mode) -> Self {
+        match mode {
+            Mode::Rolls => MotionMode::Rolls,
+            Mode::SlidesAtLayer => MotionMode::SlidesAtLayer,
+            Mode::SlidesAtUpper => MotionMode::SlidesAtUpper,
+        }
     }
 }
 
@@ -486,18 +568,33 @@ pub enum Solved {
 }
 
 impl Solved {
-    /// The assumptions measured on it (docs/model.md §7, §8).
-    fn checks(&self, rolling: &Rolling) -> Vec<Check> {
-        match self {
+    /// The assumptions measured on it (docs/model.md §7, §8), and whether it rolls
+    /// against `upper` (§11).
+    fn checks(&self, rolling: &Rolling, upper: &UpperSurface) -> Vec<Check> {
+        let mut checks = match self {
             Solved::Local(s) => model::validity::rolling(rolling, s),
             Solved::Continuum(s) => model::validity::continuum(rolling, s),
-        }
+        };
+        checks.push(Check::pure_rolling(&self.motion(rolling, upper)));
+        checks
     }
 
-    fn contact(&self) -> ContactOutput {
+    /// Whether the particle rolls or slides between `upper` and the layer (§11).
+    fn motion(&self, rolling: &Rolling, upper: &UpperSurface) -> Motion {
+        let (resistance, area) = match self {
+            Solved::Local(s) => (s.rolling_resistance_coefficient, s.contact_area),
+            Solved::Continuum(s) => (s.rolling_resistance_coefficient, s.contact_area),
+        };
+        let layer = &rolling.layer;
+        let tau = layer.interfacial_shear_strength();
+        motion::particle(rolling.radius, rolling.load, resistance, area, tau, upper)
+    }
+
+    fn contact(&self, rolling: &Rolling, upper: &UpperSurface) -> ContactOutput {
+        let motion = (&self.motion(rolling, upper)).into();
         match self {
-            Solved::Local(s) => s.into(),
-            Solved::Continuum(s) => s.into(),
+            Solved::Local(s) => ContactOutput::new(s, motion),
+            Solved::Continuum(s) => ContactOutput::new(s, motion),
         }
     }
 
@@ -537,8 +634,9 @@ impl From<&Verification> for VerificationOutput {
     }
 }
 
-impl<V> From<&RollingSolution<V>> for ContactOutput {
-    fn from(s: &RollingSolution<V>) -> Self {
+impl ContactOutput {
+    /// The integrals of `s`, with how the particle moves.
+    fn new<V>(s: &RollingSolution<V>, motion: MotionOutput) -> Self {
         ContactOutput {
             penetration: s.penetration,
             contact_area: s.contact_area,
@@ -547,6 +645,7 @@ impl<V> From<&RollingSolution<V>> for ContactOutput {
             pressure_centre_shift: s.pressure_centre_shift,
             rolling_resistance_coefficient: s.rolling_resistance_coefficient,
             friction_coefficient: s.friction_coefficient,
+            motion,
             r#static: StaticOutput {
                 penetration: s.static_contact.penetration,
                 contact_area: s.static_contact.contact_area,
@@ -588,12 +687,18 @@ described! {
 }
 
 impl SweepPoint {
-    /// The row of `rolling`, solved as `solution`, unless the model's domain excludes it.
-    pub fn new(rolling: &Rolling, solution: &Solved) -> Result<Self, JobError> {
-        let validity = PointValidity::assess(solution.checks(rolling), Subject::Particle)?;
+    /// The row of `rolling` against `upper`, solved as `solution`, unless the model's domain
+    /// excludes it.
+    pub fn new(
+        rolling: &Rolling,
+        upper: &UpperSurface,
+        solution: &Solved,
+    ) -> Result<Self, JobError> {
+        let checks = solution.checks(rolling, upper);
+        let validity = PointValidity::assess(checks, Subject::Particle)?;
         Ok(SweepPoint::answered(
             rolling,
-            solution.contact(),
+            solution.contact(rolling, upper),
             solution.verification(),
             validity,
         ))
@@ -615,10 +720,18 @@ impl SweepPoint {
         row
     }
 
-    /// The CSV columns of rolling contacts: the fields', then the status and the note.
+    /// The CSV columns of rolling contacts: the fields', the particle's motion, then the
+    /// status and the note.
     pub fn columns() -> &'static [Column<SweepPoint>] {
-        static COLUMNS: LazyLock<Vec<Column<SweepPoint>>> =
-            LazyLock::new(|| points::columns(fields::columns::<SweepPoint>()));
+        static COLUMNS: LazyLock<Vec<Column<SweepPoint>>> = LazyLock::new(|| {
+            let mut columns = fields::columns::<SweepPoint>();
+            columns.push(Column::text("motion_mode", |row: &SweepPoint, text| {
+                if let Some(contact) = &row.contact {
+                    text.push_str(contact.motion.mode.as_str());
+                }
+            }));
+            points::columns(columns)
+        });
         &COLUMNS
     }
 }
@@ -733,12 +846,17 @@ described! {
 }
 
 impl RollingOutput {
-    /// The answer for `rolling`, solved as `solution`, with `meta`, the job's [`Meta`];
-    /// refused where the model's domain excludes it.
-    pub fn new(rolling: &Rolling, solution: &Solved, meta: Meta) -> Result<Self, JobError> {
-        let checks = solution.checks(rolling);
+    /// The answer for `rolling` against `upper`, solved as `solution`, with `meta`, the
+    /// job's [`Meta`]; refused where the model's domain excludes it.
+    pub fn new(
+        rolling: &Rolling,
+        upper: &UpperSurface,
+        solution: &Solved,
+        meta: Meta,
+    ) -> Result<Self, JobError> {
+        let checks = solution.checks(rolling, upper);
         Ok(RollingOutput {
-            contact: solution.contact(),
+            contact: solution.contact(rolling, upper),
             boundary: solution.boundary().iter().map(Into::into).collect(),
             pressure: solution.pressure().map(Into::into),
             meta: RollingMeta {

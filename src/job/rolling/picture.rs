@@ -4,7 +4,7 @@
 
 use serde::Deserialize;
 
-use super::{BoundaryOutput, ContactOutput, PressureOutput, RollingJob};
+use super::{BoundaryOutput, ContactOutput, MotionMode, PressureOutput, RollingJob};
 use crate::job::input::LayerModel;
 use crate::job::picture::{shown, Asked, PictureError};
 use crate::render::svg::{Axis, Chart, Layer};
@@ -68,13 +68,26 @@ impl Picture for RollingPicture {
             shown(rolling.load, "N"),
             shown(contact.friction_coefficient, "")
         );
+        let motion = &contact.motion;
+        let moves = match motion.mode {
+            MotionMode::Rolls => "particle: rolls",
+            MotionMode::SlidesAtLayer => "particle: slides on the layer",
+            MotionMode::SlidesAtUpper => "particle: slides on the upper",
+        };
+        let notes = vec![
+            moves.to_string(),
+            format!("friction {}", shown(motion.friction, "")),
+            format!("rolling needs {}", shown(motion.rolling_need, "")),
+            format!("layer holds {} (μ)", shown(motion.layer_capacity, "")),
+            format!("upper holds {}", shown(motion.upper_capacity, "")),
+        ];
         Ok(Chart {
             title,
             x: Axis::new("x (rolling direction)", "m"),
             y: Axis::new("y", "m"),
             layers,
             equal_aspect: true,
-            notes: Vec::new(),
+            notes,
         })
     }
 }

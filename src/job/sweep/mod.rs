@@ -284,7 +284,9 @@ impl Kind for SweepJob {
                 let solve = |p: &Rolling| base.solve(p, method, Stop::when(&asked));
                 let swept = if method == Use::Build && law == LayerModel::Local {
                     // A point costs a microsecond: cheaper to solve again than to keep.
-                    control.map_each(&contacts, on_refusal, |p| SweepPoint::new(p, &solve(p)?))
+                    control.map_each(&contacts, on_refusal, |p| {
+                        SweepPoint::new(p, &base.upper, &solve(p)?)
+                    })
                 } else {
                     let kept = control.kept(
                         |p| {
@@ -296,7 +298,9 @@ impl Kind for SweepJob {
                         |_| std::mem::size_of::<Solved>(),
                         solve,
                     );
-                    control.map_each(&contacts, on_refusal, |p| SweepPoint::new(p, &kept(p)?))
+                    control.map_each(&contacts, on_refusal, |p| {
+                        SweepPoint::new(p, &base.upper, &kept(p)?)
+                    })
                 };
                 let swept = refused_at(swept, first, on_refusal, |i| contact_name(&contacts[i]));
                 let stop = swept.stopped.clone();

@@ -11,18 +11,18 @@ use serde::{Deserialize, Serialize};
 use serde_json::Value;
 use utoipa::ToSchema;
 
-use super::input::units::Dimension;
-use super::input::{self, field, Checker, LayerInput, LayerModel, QuadratureKind, Quantity};
+use super::input::{
+    self, field, Checker, LayerInput, LayerModel, QuadratureKind, Quantity, UpperSurfaceInput,
+};
 use super::meta::{Canonical, REFERENCES, THREE_BODY_CONTINUUM_REFERENCES};
 use super::points::{self, PointNotes, PointNotesFields, PointStatus, Row};
-use super::rolling::RollingJob;
+use super::rolling::{MotionMode, RollingJob};
 use super::validity::{self, PointValidity, Subject, ValidityOutput};
 use super::{rolling, Control, Cost, JobError, Kind, Limits, Meta, References, Validated, Work};
 use crate::model::continuum::{self, ContinuumVerification, PenetrationCurve};
 use crate::model::three_body::{
     self, Asperities, ContactState, Diameters, LayerContact, LayerCurves, OperatingPoint, Particle,
-    ThreeBody, ThreeBodyOptions, ThreeBodySolution, UpperContact, UpperSurface,
-    DEFAULT_DIAMETER_NODES,
+    SystemMotion, ThreeBody, ThreeBodyOptions, ThreeBodySolution, DEFAULT_DIAMETER_NODES,
 };
 use crate::model::{
     Layer, ModelError, Parameter, Rolling, RollingSolution, SolveOption, SolveOptions, Stop,
@@ -67,27 +67,6 @@ pub struct DistributionInput {
     pub max_diameter: Option<Quantity>,
     /// η_a (m⁻²), default 1e12.
     pub areal_density: Option<Quantity>,
-}
-
-/// The upper surface (default steel, 210 GPa, ν = 0.3, elastic).
-#[derive(Clone, Debug, Default, PartialEq, Deserialize, Serialize, ToSchema)]
-#[serde(deny_unknown_fields)]
-pub struct UpperSurfaceInput {
-    /// E₁ (Pa).
-    pub elastic_modulus: Option<Quantity>,
-    /// ν₁.
-    pub poisson_ratio: Option<Quantity>,
-    pub contact: Option<UpperContactKind>,
-    /// H₁ (Pa), required for plastic contact.
-    pub hardness: Option<Quantity>,
-}
-
-/// Elastic (Hertz) or plastic contact of the particles with the upper surface.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, Serialize, ToSchema)]
-#[serde(rename_all = "lowercase")]
-pub enum UpperContactKind {
-    Elastic,
-    Plastic,
 }
 
 /// The particles' material: rigid unless `elastic_modulus` is given.
@@ -183,51 +162,6 @@ impl DistributionInput {
             defaults.areal_density,
         );
         (diameters, areal_density)
-    }
-}
-
-impl UpperSurfaceInput {
-    fn read(&self, checker: &mut Checker) -> UpperSurface {
-        let input = self;
-        let u0 = UpperSurface::default();
-        let contact = match self.contact {
-            Some(UpperContactKind::Plastic) => UpperContact::Plastic,
-            _ => UpperContact::Elastic,
-        };
-        let upper = UpperSurface {
-            elastic_modulus: checker.quantity(
-                field!(input.elastic_modulus),
-                Parameter::UpperModulus,
-                u0.elastic_modulus,
-            ),
-            poisson_ratio: checker.quantity(
-                field!(input.poisson_ratio),
-                Parameter::UpperPoissonRatio,
-                u0.poisson_ratio,
-            ),
-            contact,
-            hardness: checker.optional(field!(input.hardness), Parameter::UpperHardness),
-        };
-        if contact == UpperContact::Plastic && upper.hardness.is_none() {
-            checker.missing(
-                field!(input.hardness).name,
-                &Dimension::PRESSURE.describe(),
-                "for plastic contact",
-            );
-        }
-        upper
-    }
-
-    fn of(upper: &UpperSurface) -> UpperSurfaceInput {
-        UpperSurfaceInput {
-            elastic_modulus: Quantity::si(upper.elastic_modulus),
-            poisson_ratio: Quantity::si(upper.poisson_ratio),
-            contact: Some(match upper.contact {
-                UpperContact::Elastic => UpperContactKind::Elastic,
-                UpperContact::Plastic => UpperContactKind::Plastic,
-            }),
-            hardness: upper.hardness.and_then(Quantity::si),
-        }
     }
 }
 
@@ -567,6 +501,7 @@ pub fn kept_node(
             // The node as a rolling contact on the continuum: its canonical text.
             let node = RollingJob {
                 rolling: *p,
+                upper: Default::default(),
                 options: SolveOptions::default(),
                 law: LayerModel::Continuum,
             };
@@ -661,13 +596,71 @@ impl From<&ContactState> for StateOutput {
 }
 
 described! {
-    /// μ = (τ_a A_s2a + τ_s A_s1s2)/W without and with rolling.
+    /// μ = (τ_a A_s2a + τ_s A_s1s2)/W without and with rolling: eq. 12 summed, the paper's
+    /// adhesive law (every particle's layer contact transmitting all it can). The system's
+    /// friction with each particle's own motion is `motion.friction` (docs/model.md §11).
     #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, ToSchema)]
     pub struct FrictionOutput {
         /// V = 0 (the job's separation, or its load re-solved at V = 0).
         pub r#static: f64 => [number ""],
         /// At the job's V.
         pub rolling: f64 => [number ""],
+    }
+}
+
+described! {
+    /// Roll or slide, particle by particle (docs/model.md §11): each size, at the load it
+    /// carries, rolls if both its contacts transmit the tangential force rolling needs, and
+    /// slides at the weaker otherwise.
+    #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, ToSchema)]
+    pub struct SystemMotionOutput {
+        /// (Σ T + τ_s A_s1s2)/W: the system's friction, each particle transmitting the
+        /// tangential force T of its own motion (dimensionless).
+        pub friction: f64 => [number ""],
+        /// Σ T, the particles' tangential forces (N).
+        pub particle_traction: f64 => [number "N"],
+        /// Particles in contact that roll (count).
+        pub rolling: f64 => [number ""],
+        /// Particles that slide on the layer (count).
+        pub sliding_at_layer: f64 => [number ""],
+        /// Particles that slide against the upper surface (count).
+        pub sliding_at_upper: f64 => [number ""],
+        /// Where the mode changes, in ascending diameter.
+        pub changes: Vec<ModeChangeOutput> => [each],
+    }
+}
+
+described! {
+    /// A diameter where the particles' mode changes.
+    #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, ToSchema)]
+    pub struct ModeChangeOutput {
+        /// x (m).
+        pub diameter: f64 => [unit "m"],
+        /// The mode of the particles just smaller.
+        pub below: MotionMode => [],
+        /// The mode of the particles just larger.
+        pub above: MotionMode => [],
+    }
+}
+
+impl From<&SystemMotion> for SystemMotionOutput {
+    fn from(m: &SystemMotion) -> Self {
+        SystemMotionOutput {
+            friction: m.friction,
+            particle_traction: m.particle_traction,
+            rolling: m.rolling,
+            sliding_at_layer: m.sliding_at_layer,
+            sliding_at_upper: m.sliding_at_upper,
+            changes: m
+                .changes
+                .iter()
+                .map(|change| ModeChangeOutput {
+                    diameter: change.diameter,
+                    below: change.below.into(),
+                    above: change.above.into(),
+                })
+                .collect(),
+        }
     }
 }
 
@@ -690,16 +683,17 @@ described! {
         pub separation_iterations: u32 => [unit ""],
         /// Relative residual of the operating load at the returned separation.
         pub relative_load_residual: f64 => [unit ""],
-        /// Largest relative change of areas and loads with half the diameter nodes.
+        /// Largest relative change of areas, loads and the particles' Σ T with half the
+        /// diameter nodes.
         pub quadrature_error_estimate: f64 => [unit ""],
         /// Relative error of the kelvin_layer table against direct solves (when used).
         #[serde(default, skip_serializing_if = "Option::is_none")]
         pub layer_table_error: Option<f64> => [unit ""],
         /// On the continuum layer contact: a bound on the relative error of the particles'
-        /// layer areas and loads from the continuum contacts (each contact's discretisation
-        /// error and its curve's interpolation, weighted over the sizes; at a given load the
-        /// load's error added, as it moves the separation), with and without rolling, the
-        /// worse.
+        /// layer areas and loads, and of their tangential forces (`motion`), from the
+        /// continuum contacts (each contact's discretisation error and its curve's
+        /// interpolation, weighted over the sizes; at a given load the load's error added,
+        /// as it moves the separation), with and without rolling, the worse.
         #[serde(default, skip_serializing_if = "Option::is_none")]
         pub layer_contact_error: Option<f64> => [unit ""],
         pub converged: bool => [],
@@ -740,6 +734,8 @@ described! {
         #[serde(flatten)]
         pub state: StateOutput => [flatten],
         pub friction_coefficient: FrictionOutput => [nested "friction_"],
+        /// How the particles move with rolling, and the friction they then transmit.
+        pub motion: SystemMotionOutput => [nested "motion_"],
         /// Means per particle in contact; absent when no particle is in contact (the
         /// asperities carry the load alone).
         #[serde(skip_serializing_if = "Option::is_none")]
@@ -757,6 +753,7 @@ impl From<&ThreeBodySolution> for ThreeBodyResult {
                 r#static: s.static_state.friction_coefficient,
                 rolling: s.rolling.friction_coefficient,
             },
+            motion: (&s.motion).into(),
             per_particle: s.rolling.mean_area().zip(s.rolling.mean_load()).map(
                 |(mean_area, mean_load)| PerParticleOutput {
                     mean_area,

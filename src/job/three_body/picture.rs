@@ -4,8 +4,9 @@
 
 use serde::Deserialize;
 
-use super::{ThreeBodyJob, ThreeBodyResult};
+use super::{SystemMotionOutput, ThreeBodyJob, ThreeBodyResult};
 use crate::job::picture::{shown, Asked, PictureError};
+use crate::job::rolling::MotionMode;
 use crate::model::text::count;
 use crate::model::three_body::LayerContact;
 use crate::render::svg::{Axis, Chart, Layer};
@@ -40,15 +41,6 @@ impl Picture for ThreeBodyPicture {
             .map(|x| (x, density(x)))
             .collect();
         let top = curve.iter().map(|p| p.1).fold(0.0, f64::max);
-        let mut shaded: Vec<(f64, f64)> = curve
-            .iter()
-            .copied()
-            .filter(|p| p.0 >= separation)
-            .collect();
-        if let (Some(&(first, _)), Some(&(last, _))) = (shaded.first(), shaded.last()) {
-            shaded.insert(0, (first, 0.0));
-            shaded.push((last, 0.0));
-        }
         let areas = &state.areas;
         let share = |name: &str, a: f64| {
             let percent = if areas.total > 0.0 {
@@ -61,14 +53,22 @@ impl Picture for ThreeBodyPicture {
         let mut layers = vec![Layer::Line {
             name: "diameters".to_string(),
             group: "diameters".to_string(),
-            points: curve,
+            points: curve.clone(),
             dashed: false,
         }];
-        if shaded.len() > 2 {
-            layers.push(Layer::Area {
-                name: "in contact (x > d)".to_string(),
-                outline: shaded,
-            });
+        // The particles in contact (x > d), shaded by how they move (docs/model.md §11).
+        let motion = &self.result.motion;
+        for (from, to, mode) in populations(motion, separation.max(d.min), d.max) {
+            let inside = |x: f64| (from..=to).contains(&x);
+            let mut outline = vec![(from, 0.0), (from, density(from))];
+            outline.extend(curve.iter().copied().filter(|p| inside(p.0)));
+            outline.extend([(to, density(to)), (to, 0.0)]);
+            if to > from {
+                layers.push(Layer::Area {
+                    name: format!("in contact: {}", moves(mode)),
+                    outline,
+                });
+            }
         }
         layers.push(Layer::Line {
             name: format!("separation d = {}", shown(separation, "m")),
@@ -86,6 +86,16 @@ impl Picture for ThreeBodyPicture {
             layers,
             equal_aspect: false,
             notes: vec![
+                format!(
+                    "{} roll, {} slide",
+                    count(motion.rolling, "", "").trim_end(),
+                    count(motion.sliding_at_layer + motion.sliding_at_upper, "", "").trim_end(),
+                ),
+                format!(
+                    "friction {} (eq. 12: {})",
+                    shown(motion.friction, ""),
+                    shown(self.result.friction_coefficient.rolling, ""),
+                ),
                 format!("real contact area {}", shown(areas.total, "m^2")),
                 share("particle–upper", areas.particle_upper),
                 share("surface–surface", areas.surface_surface),
@@ -93,6 +103,36 @@ impl Picture for ThreeBodyPicture {
                 format!("layer: {}", law_name(system.layer_contact)),
             ],
         })
+    }
+}
+
+/// The diameters in contact, from `from` to `to`, in pieces of one mode each: split where
+/// the mode changes; without a change, of the mode that has particles.
+fn populations(motion: &SystemMotionOutput, from: f64, to: f64) -> Vec<(f64, f64, MotionMode)> {
+    let only = if motion.rolling > 0.0 {
+        MotionMode::Rolls
+    } else if motion.sliding_at_layer > 0.0 {
+        MotionMode::SlidesAtLayer
+    } else {
+        MotionMode::SlidesAtUpper
+    };
+    let first = motion.changes.first().map_or(only, |c| c.below);
+    let mut pieces = Vec::new();
+    let (mut start, mut mode) = (from, first);
+    for change in &motion.changes {
+        pieces.push((start, change.diameter, mode));
+        (start, mode) = (change.diameter, change.above);
+    }
+    pieces.push((start, to, mode));
+    pieces
+}
+
+/// How particles of `mode` move, in a user's words.
+fn moves(mode: MotionMode) -> &'static str {
+    match mode {
+        MotionMode::Rolls => "rolls",
+        MotionMode::SlidesAtLayer => "slides on layer",
+        MotionMode::SlidesAtUpper => "slides on upper",
     }
 }
 
