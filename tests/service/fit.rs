@@ -10,9 +10,10 @@ use std::time::{Duration, Instant};
 
 use serde_json::{json, Value};
 use thirdbody::job::{Control, Job, JobError, Limits};
+use thirdbody::model::counterface::UpperSurface;
 use thirdbody::model::fit::{Law, Measured, Point, Setting};
 use thirdbody::model::three_body::{OperatingPoint, ThreeBody, ThreeBodyOptions};
-use thirdbody::model::{Layer, Stop};
+use thirdbody::model::{solve, Layer, Rolling, SolveOptions, Stop};
 use thirdbody::render::Format;
 
 /// The answer to the fit `input`, as JSON.
@@ -28,6 +29,7 @@ fn model(layer: &Layer, measured: Measured, radius: f64, load: f64, speed: f64) 
         setting: Setting::Particle {
             radius: radius * 1e-9,
             load: load * 1e-9,
+            upper: Default::default(),
         },
         velocity: speed * 1e-9,
         measured,
@@ -341,6 +343,85 @@ fn bounds_hold() {
     );
 }
 
+/// The particle's own friction (docs/model.md §11) measured at eleven speeds and two loads,
+/// noiseless, against a glass counterface: the particle rolls at some and slides on the
+/// glass at others, and the fit gives back both times to 1e-6 (with its counterface in the
+/// forward model: against steel the same data fit other times).
+#[test]
+fn noiseless_particle_friction_gives_back_both_times() {
+    let truth = Layer::default();
+    let glass = UpperSurface {
+        elastic_modulus: 70e9,
+        poisson_ratio: 0.22,
+        shear_strength: Some(10e6),
+        ..UpperSurface::default()
+    };
+    let mut modes = Vec::new();
+    let series: Vec<Value> = [0.6, 1.4]
+        .iter()
+        .map(|&load| {
+            let points: Vec<Value> = SPEEDS[1..]
+                .iter()
+                .map(|&v| {
+                    let point = Point {
+                        setting: Setting::Particle {
+                            radius: 25e-9,
+                            load: load * 1e-9,
+                            upper: glass,
+                        },
+                        velocity: v * 1e-9,
+                        measured: Measured::ParticleFriction,
+                    };
+                    let value = point.value(&truth, Law::Local, Stop::NEVER).unwrap();
+                    let rolling = Rolling {
+                        radius: 25e-9,
+                        load: load * 1e-9,
+                        velocity: v * 1e-9,
+                        layer: truth,
+                    };
+                    let s = solve(&rolling, &SolveOptions::default()).unwrap();
+                    // It rolls where its friction is what rolling needs.
+                    modes.push(value == 0.5 * s.rolling_resistance_coefficient);
+                    json!({"velocity": format!("{v} nm/s"), "value": value})
+                })
+                .collect();
+            json!({"radius": "25 nm", "load": format!("{load} nN"), "quantity": "particle_friction",
+                   "upper_surface": {"elastic_modulus": "70 GPa", "poisson_ratio": 0.22,
+                                     "shear_strength": "10 MPa"},
+                   "points": points})
+        })
+        .collect();
+    assert!(modes.contains(&true) && modes.contains(&false), "{modes:?}");
+    let input = json!({
+        "layer": {"relaxation_time": "30 ms", "retardation_time": "1 s"},
+        "series": series,
+        "parameters": {"relaxation_time": {}, "retardation_time": {}}});
+    let answer = fit(input.clone()).unwrap();
+    for (name, expected) in [
+        ("relaxation_time", truth.relaxation_time),
+        ("retardation_time", truth.retardation_time),
+    ] {
+        let got = value(&answer, name);
+        assert!(
+            (got / expected - 1.0).abs() < 1e-6,
+            "{name}: {got} vs {expected}"
+        );
+    }
+    let residual = &answer["residuals"][0]["particle_friction"];
+    assert!(residual["measured"].is_number(), "{residual}");
+    // The counterface is part of the input: without it (steel) the same data fit worse.
+    let mut on_steel = input;
+    for s in on_steel["series"].as_array_mut().unwrap() {
+        s.as_object_mut().unwrap().remove("upper_surface");
+    }
+    let steel = fit(on_steel).unwrap();
+    assert!(
+        steel["chi_squared"].as_f64().unwrap() > 1e-6,
+        "{}",
+        steel["chi_squared"]
+    );
+}
+
 /// The field errors of a fit refused as invalid.
 fn refused(input: Value) -> Vec<(String, String)> {
     match fit(input) {
@@ -406,6 +487,22 @@ fn bad_data_get_problems_that_name_the_field() {
         errors[0].1.contains("for every point or for none"),
         "{errors:?}"
     );
+    // The particle's own friction at rest: it transmits none there.
+    let errors = refused(
+        json!({"series": [{"quantity": "particle_friction", "points": [
+        {"velocity": 0, "value": 0.02}, {"velocity": "2 nm/s", "value": 0.02},
+        {"velocity": "3 nm/s", "value": 0.02}]}], "parameters": {"relaxation_time": {}}}),
+    );
+    assert_eq!(errors[0].0, "series[0].points[0].velocity", "{errors:?}");
+    assert!(errors[0].1.contains("particle_friction"), "{errors:?}");
+    // A system's area, and a counterface beside a system that has its own.
+    let errors = refused(json!({"series": [{"system": {}, "quantity": "contact_area",
+        "upper_surface": {}, "points": [{"total_load": "1 mN", "value": 1e-12}]}],
+        "parameters": {"relaxation_time": {}}}));
+    let fields: Vec<&str> = errors.iter().map(|e| e.0.as_str()).collect();
+    for field in ["series[0].quantity", "series[0].upper_surface"] {
+        assert!(fields.contains(&field), "{field} not in {errors:?}");
+    }
     // No series, no parameter.
     let errors = refused(json!({"parameters": {}}));
     let fields: Vec<&str> = errors.iter().map(|e| e.0.as_str()).collect();

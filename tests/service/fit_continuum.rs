@@ -25,6 +25,7 @@ fn friction(layer: &Layer, radius: f64, load: f64, speed: f64) -> f64 {
         setting: Setting::Particle {
             radius: radius * 1e-9,
             load: load * 1e-9,
+            upper: Default::default(),
         },
         velocity: speed * 1e-9,
         measured: Measured::FrictionCoefficient,

@@ -20,6 +20,8 @@
 //! (at fixed κ), κ, E_L and H, four more solves (two at rest, where the times have no effect).
 
 use super::super::continuum;
+use super::super::counterface::UpperSurface;
+use super::super::motion;
 use super::super::tables::{self, Use};
 use super::super::three_body::{
     self, LayerContact, LayerCurves, OperatingPoint, ThreeBody, ThreeBodyOptions,
@@ -50,13 +52,16 @@ impl Law {
     }
 }
 
-/// What was measured at a point./// What was measured at a point.
+/// What was measured at a point.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Measured {
     /// μ (eq. 12).
     FrictionCoefficient,
     /// A (m²).
     ContactArea,
+    /// The friction the particles really transmit (docs/model.md §11): a particle's T/P,
+    /// rolling or sliding, or a system's (Σ T + τ_s A_s1s2)/W.
+    ParticleFriction,
 }
 
 /// Where the measured particles roll.
@@ -65,10 +70,15 @@ pub enum Measured {
 #[allow(clippy::large_enum_variant)]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Setting {
-    /// One particle of radius R (m) under load P (N).
-    Particle { radius: f64, load: f64 },
+    /// One particle of radius R (m) under load P (N), against the counterface `upper`
+    /// (which matters only to the particle's friction, [`Measured::ParticleFriction`]).
+    Particle {
+        radius: f64,
+        load: f64,
+        upper: UpperSurface,
+    },
     /// A three-body system at total load W (N); its layer, speed and operating point are the
-    /// fit's. Only its friction coefficient is measured.
+    /// fit's. Its friction coefficient is measured (eq. 12's, or the particles' own).
     System {
         system: ThreeBody,
         options: ThreeBodyOptions,
@@ -127,16 +137,24 @@ impl Point {
     }
 
     /// The solves a value with its sensitivities takes ([`Point::value_and_sensitivity`]):
-    /// the value's, and for a particle one each for its speed and κ when it rolls and its
-    /// thickness on the continuum; for a system one each for E_L and H, and T_σ and κ when
-    /// it rolls.
+    /// the value's, and for a particle's area or eq. 12's μ one each for its speed and κ
+    /// when it rolls and its thickness on the continuum; by differences (a system, a
+    /// particle's own friction) one each for E_L and H, and T_σ and κ when it rolls.
     pub fn solves_with_sensitivity(&self, law: Law) -> u64 {
         let rolls = u64::from(self.velocity > 0.0);
-        match (self.setting, law.at(&self.setting)) {
-            (Setting::Particle { .. }, Law::Local) => 1 + 2 * rolls,
-            (Setting::Particle { .. }, Law::Continuum) => 2 + 2 * rolls,
-            (Setting::System { .. }, _) => 3 + 2 * rolls,
+        match (self.structured_setting(), law.at(&self.setting)) {
+            (true, Law::Local) => 1 + 2 * rolls,
+            (true, Law::Continuum) => 2 + 2 * rolls,
+            (false, _) => 3 + 2 * rolls,
         }
+    }
+
+    /// Whether the value has the similarity structure of the module doc: a particle's
+    /// area or eq. 12's μ. A particle's own friction holds μ_roll = x_p/2R, of another
+    /// structure, and the upper contact's capacity, of none.
+    fn structured_setting(&self) -> bool {
+        matches!(self.setting, Setting::Particle { .. })
+            && self.measured != Measured::ParticleFriction
     }
 
     /// The model's value of what was measured, on `layer` under `law`.
@@ -152,9 +170,10 @@ impl Point {
         stop: Stop,
     ) -> Result<(f64, Sensitivity), ModelError> {
         let y = self.value(layer, law, stop)?;
-        let sensitivity = match self.setting {
-            Setting::Particle { .. } => self.structured(layer, y, law, stop)?,
-            Setting::System { .. } => self.differenced(layer, y, law, stop)?,
+        let sensitivity = if self.structured_setting() {
+            self.structured(layer, y, law, stop)?
+        } else {
+            self.differenced(layer, y, law, stop)?
         };
         Ok((y, sensitivity))
     }
@@ -189,7 +208,7 @@ impl Point {
             }
         };
         let tau = match self.measured {
-            Measured::FrictionCoefficient => 1.0,
+            Measured::FrictionCoefficient | Measured::ParticleFriction => 1.0,
             Measured::ContactArea => 0.0,
         };
         Ok(Sensitivity {
@@ -259,7 +278,11 @@ impl Point {
 
     fn solve(&self, layer: &Layer, velocity: f64, law: Law, stop: Stop) -> Result<f64, ModelError> {
         match self.setting {
-            Setting::Particle { radius, load } => {
+            Setting::Particle {
+                radius,
+                load,
+                upper,
+            } => {
                 let rolling = Rolling {
                     radius,
                     load,
@@ -267,26 +290,30 @@ impl Point {
                     layer: *layer,
                 };
                 let options = SolveOptions::integrals_only(Quadrature::default());
-                let (area, friction) = match law {
+                // A, and x_p/R (0 at rest).
+                let (area, resistance) = match law {
                     Law::Local => {
                         let s = tables::solve(&rolling, &options, Use::Exact)?;
-                        (s.contact_area, s.friction_coefficient)
+                        (s.contact_area, s.rolling_resistance_coefficient)
                     }
                     // At rest the table of the axisymmetric solver's areas: within 0.5 % of
                     // it, smooth in the parameters and 160 ns, where the grid is within
                     // 0.7 %, moves in steps and takes 5 ms (the solver itself, 20 ms).
                     Law::Continuum if velocity == 0.0 => {
-                        let area = continuum::static_area(radius, load, layer);
-                        (area, layer.interfacial_shear_strength() * area / load)
+                        (continuum::static_area(radius, load, layer), 0.0)
                     }
                     Law::Continuum => {
                         let s = continuum::solve(&rolling, &options, stop)?;
-                        (s.contact_area, s.friction_coefficient)
+                        (s.contact_area, s.rolling_resistance_coefficient)
                     }
                 };
+                let tau = layer.interfacial_shear_strength();
                 Ok(match self.measured {
-                    Measured::FrictionCoefficient => friction,
+                    Measured::FrictionCoefficient => tau * area / load,
                     Measured::ContactArea => area,
+                    Measured::ParticleFriction => {
+                        motion::particle(radius, load, resistance, area, tau, &upper).friction
+                    }
                 })
             }
             Setting::System {
@@ -308,9 +335,11 @@ impl Point {
                     LayerContact::Continuum => Some(LayerCurves::build(&system, stop)?),
                     _ => None,
                 };
-                Ok(three_body::solve_with(&system, &options, curves.as_ref())?
-                    .rolling
-                    .friction_coefficient)
+                let solution = three_body::solve_with(&system, &options, curves.as_ref())?;
+                Ok(match self.measured {
+                    Measured::ParticleFriction => solution.motion.friction,
+                    _ => solution.rolling.friction_coefficient,
+                })
             }
         }
     }
@@ -341,6 +370,7 @@ mod tests {
         let particle = Setting::Particle {
             radius: 25e-9,
             load: 1e-9,
+            upper: UpperSurface::default(),
         };
         let system = Setting::System {
             system: ThreeBody::with_defaults(OperatingPoint::TotalLoad(1e-3)),
@@ -351,6 +381,8 @@ mod tests {
             (particle, Measured::FrictionCoefficient, Law::Local, 6e-9),
             (particle, Measured::ContactArea, Law::Local, 6e-9),
             (system, Measured::FrictionCoefficient, Law::Local, 6e-9),
+            (particle, Measured::ParticleFriction, Law::Local, 6e-9),
+            (system, Measured::ParticleFriction, Law::Local, 6e-9),
             (particle, Measured::ContactArea, Law::Continuum, 0.0),
             (particle, Measured::FrictionCoefficient, Law::Continuum, 0.0),
         ] {

@@ -548,6 +548,7 @@ mod tests {
                     setting: Setting::Particle {
                         radius: 25e-9,
                         load: 1e-9,
+                        upper: Default::default(),
                     },
                     velocity: v * 1e-9,
                     measured: Measured::FrictionCoefficient,

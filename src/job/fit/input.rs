@@ -5,8 +5,11 @@ use serde::{Deserialize, Serialize};
 use serde_json::json;
 use utoipa::ToSchema;
 
-use crate::job::input::{field, Checker, Field, LayerInput, LayerModel, Quantity};
+use crate::job::input::{
+    field, Checker, Field, LayerInput, LayerModel, Quantity, UpperSurfaceInput,
+};
 use crate::job::three_body::{OperatingInput, ThreeBodyInput, ThreeBodyJob};
+use crate::model::counterface::UpperSurface;
 use crate::model::fit::{
     Bounds, Datum, FitParameter, Law, Measured, Parameterization, Point, Problem, Setting,
 };
@@ -55,6 +58,10 @@ pub struct SeriesInput {
     pub total_load: Option<Quantity>,
     /// What was measured (default `friction_coefficient`).
     pub quantity: Option<MeasuredQuantity>,
+    /// The counterface of a particle series (default steel), which decides with the layer
+    /// whether the particle rolls: it matters to `particle_friction` only. A `system` has
+    /// its own.
+    pub upper_surface: Option<UpperSurfaceInput>,
     /// The points (at least one).
     pub points: Option<Vec<PointInput>>,
 }
@@ -68,13 +75,18 @@ pub enum MeasuredQuantity {
     FrictionCoefficient,
     /// A (m²).
     ContactArea,
+    /// The friction the particles really transmit (docs/model.md §11), a plain number: a
+    /// particle's T/P, rolling or sliding, or a system's (Σ T + τ_s A_s1s2)/W. Measured
+    /// rolling only (at rest it is 0).
+    ParticleFriction,
 }
 
 impl MeasuredQuantity {
-    /// Both, in the order a residual names them.
-    pub const ALL: [MeasuredQuantity; 2] = [
+    /// Each, in the order a residual names them.
+    pub const ALL: [MeasuredQuantity; 3] = [
         MeasuredQuantity::FrictionCoefficient,
         MeasuredQuantity::ContactArea,
+        MeasuredQuantity::ParticleFriction,
     ];
 
     /// The name on the wire (as serde writes it).
@@ -82,6 +94,7 @@ impl MeasuredQuantity {
         match self {
             MeasuredQuantity::FrictionCoefficient => "friction_coefficient",
             MeasuredQuantity::ContactArea => "contact_area",
+            MeasuredQuantity::ParticleFriction => "particle_friction",
         }
     }
 
@@ -89,6 +102,7 @@ impl MeasuredQuantity {
         match self {
             MeasuredQuantity::FrictionCoefficient => Measured::FrictionCoefficient,
             MeasuredQuantity::ContactArea => Measured::ContactArea,
+            MeasuredQuantity::ParticleFriction => Measured::ParticleFriction,
         }
     }
 
@@ -96,12 +110,15 @@ impl MeasuredQuantity {
         match measured {
             Measured::FrictionCoefficient => MeasuredQuantity::FrictionCoefficient,
             Measured::ContactArea => MeasuredQuantity::ContactArea,
+            Measured::ParticleFriction => MeasuredQuantity::ParticleFriction,
         }
     }
 
     pub fn parameter(self) -> Parameter {
         match self {
-            MeasuredQuantity::FrictionCoefficient => Parameter::FrictionCoefficient,
+            MeasuredQuantity::FrictionCoefficient | MeasuredQuantity::ParticleFriction => {
+                Parameter::FrictionCoefficient
+            }
             MeasuredQuantity::ContactArea => Parameter::ContactArea,
         }
     }
@@ -257,6 +274,7 @@ impl FitInput {
                 SeriesInput {
                     quantity: first.map(|p| MeasuredQuantity::of(p.measured)),
                     system: first.and_then(|p| system_input(&p.setting)),
+                    upper_surface: first.and_then(upper_input),
                     points: Some(points.into_iter().map(PointInput::of).collect()),
                     ..SeriesInput::default()
                 }
@@ -286,13 +304,23 @@ impl PointInput {
             ..PointInput::default()
         };
         match p.setting {
-            Setting::Particle { radius, load } => {
+            Setting::Particle { radius, load, .. } => {
                 input.radius = Quantity::si(radius);
                 input.load = Quantity::si(load);
             }
             Setting::System { total_load, .. } => input.total_load = Quantity::si(total_load),
         }
         input
+    }
+}
+
+/// The counterface of a particle's point, where it matters (its own friction measured).
+fn upper_input(point: Point) -> Option<UpperSurfaceInput> {
+    match point.setting {
+        Setting::Particle { upper, .. } if point.measured == Measured::ParticleFriction => {
+            Some(UpperSurfaceInput::of(&upper))
+        }
+        _ => None,
     }
 }
 
@@ -464,10 +492,16 @@ fn read_one(s: &SeriesInput, c: &mut Checker, data: &mut Vec<Datum>) {
                     "none: a three-body series gives `total_load` instead",
                 );
             }
-            if quantity != MeasuredQuantity::FrictionCoefficient {
-                let allowed = "friction_coefficient: a three-body series measures the system's friction coefficient";
+            if quantity == MeasuredQuantity::ContactArea {
+                let allowed = "friction_coefficient or particle_friction: a three-body series \
+                               measures the system's friction";
                 c.invalid("quantity", json!(quantity), allowed);
             }
+            refuse(
+                c,
+                field!(s.upper_surface),
+                "none: a three-body series' `system` has its own `upper_surface`",
+            );
             let (system, options) = read_system(system, c);
             let total_load = c.optional(field!(s.total_load), Parameter::TotalLoad);
             check_range(c, field!(s.total_load), Parameter::TotalLoad, total_load);
@@ -479,9 +513,12 @@ fn read_one(s: &SeriesInput, c: &mut Checker, data: &mut Vec<Datum>) {
                 field!(s.total_load),
                 "none: only a three-body series (one with a `system`) has a total load",
             );
+            let upper = c.nested(field!(s.upper_surface), |c, u| u.read(c));
+            c.parameters(upper.violations());
             Series::Particle {
                 radius: condition(c, field!(s.radius), Parameter::Radius, d.radius),
                 load: condition(c, field!(s.load), Parameter::Load, d.load),
+                upper,
             }
         }
     };
@@ -497,6 +534,11 @@ fn read_one(s: &SeriesInput, c: &mut Checker, data: &mut Vec<Datum>) {
                 velocity: condition(c, field!(p.velocity), Parameter::Velocity, velocity),
                 measured: quantity.model(),
             };
+            if quantity == MeasuredQuantity::ParticleFriction && point.velocity == 0.0 {
+                let allowed = "> 0 m/s for particle_friction: a particle at rest needs no \
+                               tangential force to roll, and transmits none";
+                c.invalid("velocity", json!(0.0), allowed);
+            }
             let why = "at each measured point";
             let value = c.required(field!(p.value), quantity.parameter(), why);
             check_range(c, field!(p.value), quantity.parameter(), Some(value));
@@ -514,7 +556,11 @@ fn read_one(s: &SeriesInput, c: &mut Checker, data: &mut Vec<Datum>) {
 /// What a series fixes for its points (one per series: its size does not matter).
 #[allow(clippy::large_enum_variant)]
 enum Series {
-    Particle { radius: f64, load: f64 },
+    Particle {
+        radius: f64,
+        load: f64,
+        upper: UpperSurface,
+    },
     System(ThreeBody, ThreeBodyOptions, Option<f64>),
 }
 
@@ -522,7 +568,11 @@ impl Series {
     /// The setting of the point `p` of the series.
     fn of_point(&self, p: &PointInput, c: &mut Checker) -> Setting {
         match *self {
-            Series::Particle { radius, load } => {
+            Series::Particle {
+                radius,
+                load,
+                upper,
+            } => {
                 refuse(
                     c,
                     field!(p.total_load),
@@ -531,6 +581,7 @@ impl Series {
                 Setting::Particle {
                     radius: condition(c, field!(p.radius), Parameter::Radius, radius),
                     load: condition(c, field!(p.load), Parameter::Load, load),
+                    upper,
                 }
             }
             Series::System(system, options, total_load) => {
@@ -616,7 +667,7 @@ fn check_range(c: &mut Checker, field: Field<Quantity>, parameter: Parameter, va
 }
 
 /// Refuses `field` if given: `allowed` says why it may not be.
-fn refuse(c: &mut Checker, field: Field<Quantity>, allowed: &str) {
+fn refuse<T: Serialize>(c: &mut Checker, field: Field<T>, allowed: &str) {
     if let Some(q) = field.value {
         c.invalid(field.name, json!(q), allowed);
     }

@@ -45,7 +45,7 @@ const DRAWING_GRACE: Duration = Duration::from_secs(2);
 /// particle at rest on the continuum is a table's).
 fn solve_cost(point: &Point, layer: &Layer, law: Law) -> Cost {
     match (point.setting, law.at(&point.setting)) {
-        (Setting::Particle { radius, load }, Law::Continuum) if point.velocity > 0.0 => {
+        (Setting::Particle { radius, load, .. }, Law::Continuum) if point.velocity > 0.0 => {
             let rolling = Rolling {
                 radius,
                 load,
@@ -347,7 +347,7 @@ impl FitJob {
                     residual,
                     uncertainty: d.uncertainty,
                 };
-                let (friction_coefficient, contact_area) =
+                let (friction_coefficient, contact_area, particle_friction) =
                     by_quantity(d.point.measured, comparison);
                 rows.push(Residual {
                     series,
@@ -355,6 +355,7 @@ impl FitJob {
                     at: where_measured(&d.point),
                     friction_coefficient,
                     contact_area,
+                    particle_friction,
                     normalized_residual: if residual == 0.0 {
                         0.0
                     } else {
@@ -465,7 +466,7 @@ type Condition = (&'static str, fn(&Point) -> Option<f64>, fn(&mut Point, f64));
 /// Where `point` was measured, as the answer says it.
 fn where_measured(point: &Point) -> Conditions {
     let (radius, load, total_load) = match point.setting {
-        Setting::Particle { radius, load } => (Some(radius), Some(load), None),
+        Setting::Particle { radius, load, .. } => (Some(radius), Some(load), None),
         Setting::System { total_load, .. } => (None, None, Some(total_load)),
     };
     Conditions {
@@ -476,11 +477,13 @@ fn where_measured(point: &Point) -> Conditions {
     }
 }
 
-/// `x` as the friction coefficient or as the contact area, as `measured` says.
-fn by_quantity<T>(measured: fit::Measured, x: T) -> (Option<T>, Option<T>) {
+/// `x` as eq. 12's friction coefficient, the contact area or the particles' own friction,
+/// as `measured` says.
+fn by_quantity<T>(measured: fit::Measured, x: T) -> (Option<T>, Option<T>, Option<T>) {
     match measured {
-        fit::Measured::FrictionCoefficient => (Some(x), None),
-        fit::Measured::ContactArea => (None, Some(x)),
+        fit::Measured::FrictionCoefficient => (Some(x), None, None),
+        fit::Measured::ContactArea => (None, Some(x), None),
+        fit::Measured::ParticleFriction => (None, None, Some(x)),
     }
 }
 
@@ -579,11 +582,12 @@ fn curve(
     let mut curve_points = Vec::with_capacity(grid.len());
     for p in grid {
         let y = control.solve(|stop| p.value(layer, law, stop))?;
-        let (friction_coefficient, contact_area) = by_quantity(p.measured, y);
+        let (friction_coefficient, contact_area, particle_friction) = by_quantity(p.measured, y);
         curve_points.push(CurvePoint {
             at: where_measured(&p),
             friction_coefficient,
             contact_area,
+            particle_friction,
         });
     }
     Ok(Curve {

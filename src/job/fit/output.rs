@@ -131,6 +131,10 @@ described! {
         /// A (m²) measured and fitted, if A was measured.
         #[serde(skip_serializing_if = "Option::is_none")]
         pub contact_area: Option<Comparison> => [optional in "m^2"],
+        /// The particles' own friction (docs/model.md §11) measured and fitted, if it was
+        /// measured.
+        #[serde(skip_serializing_if = "Option::is_none")]
+        pub particle_friction: Option<Comparison> => [optional in ""],
         /// (fitted − measured)/uncertainty; from the scatter when no uncertainty was given.
         pub normalized_residual: f64 => [unit ""],
     }
@@ -142,6 +146,7 @@ impl CurvePoint {
         match quantity {
             MeasuredQuantity::FrictionCoefficient => self.friction_coefficient,
             MeasuredQuantity::ContactArea => self.contact_area,
+            MeasuredQuantity::ParticleFriction => self.particle_friction,
         }
     }
 }
@@ -152,6 +157,7 @@ impl Residual {
         match quantity {
             MeasuredQuantity::FrictionCoefficient => self.friction_coefficient.as_ref(),
             MeasuredQuantity::ContactArea => self.contact_area.as_ref(),
+            MeasuredQuantity::ParticleFriction => self.particle_friction.as_ref(),
         }
     }
 
@@ -237,6 +243,9 @@ described! {
         /// A (m²), if the series measured A.
         #[serde(skip_serializing_if = "Option::is_none")]
         pub contact_area: Option<f64> => [unit "m^2"],
+        /// The particles' own friction, if the series measured it.
+        #[serde(skip_serializing_if = "Option::is_none")]
+        pub particle_friction: Option<f64> => [unit ""],
     }
 }
 
