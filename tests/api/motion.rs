@@ -128,6 +128,11 @@ async fn a_system_counts_the_particles_that_roll_and_slide() {
     assert!(friction < number(&answer["friction_coefficient"]["rolling"]));
     let changes = motion["changes"].as_array().unwrap();
     assert_eq!(changes[0]["below"], "rolls");
+    // The particle furthest from rolling, the largest, slides on the layer.
+    let furthest = &motion["furthest"];
+    assert_eq!(furthest["mode"], "slides_at_layer");
+    assert_eq!(furthest["friction"], furthest["layer_capacity"]);
+    assert!(number(&furthest["rolling_need"]) > number(&furthest["layer_capacity"]));
     let rolling = row(&answer, "pure_rolling");
     assert_eq!(rolling["status"], "warn");
     let note = rolling["note"].as_str().unwrap();

@@ -12,6 +12,7 @@ use serde_json::{json, Value};
 use thirdbody::job::{Control, Job, JobError, Limits};
 use thirdbody::model::counterface::UpperSurface;
 use thirdbody::model::fit::{Law, Measured, Point, Setting};
+use thirdbody::model::motion::{self, Mode};
 use thirdbody::model::three_body::{OperatingPoint, ThreeBody, ThreeBodyOptions};
 use thirdbody::model::{solve, Layer, Rolling, SolveOptions, Stop};
 use thirdbody::render::Format;
@@ -380,8 +381,17 @@ fn noiseless_particle_friction_gives_back_both_times() {
                         layer: truth,
                     };
                     let s = solve(&rolling, &SolveOptions::default()).unwrap();
-                    // It rolls where its friction is what rolling needs.
-                    modes.push(value == 0.5 * s.rolling_resistance_coefficient);
+                    let tau = truth.interfacial_shear_strength();
+                    let resistance = s.rolling_resistance_coefficient;
+                    let m = motion::particle(
+                        25e-9,
+                        load * 1e-9,
+                        resistance,
+                        s.contact_area,
+                        tau,
+                        &glass,
+                    );
+                    modes.push(m.mode == Mode::Rolls);
                     json!({"velocity": format!("{v} nm/s"), "value": value})
                 })
                 .collect();
@@ -503,6 +513,12 @@ fn bad_data_get_problems_that_name_the_field() {
     for field in ["series[0].quantity", "series[0].upper_surface"] {
         assert!(fields.contains(&field), "{field} not in {errors:?}");
     }
+    // The particles' own friction on the hertz contact: nothing to fit there.
+    let errors = refused(json!({"series": [{"system": {"layer_contact": "hertz"},
+        "quantity": "particle_friction", "points": [{"total_load": "1 mN", "value": 0.01}]}],
+        "parameters": {"relaxation_time": {}}}));
+    assert_eq!(errors[0].0, "series[0].quantity", "{errors:?}");
+    assert!(errors[0].1.contains("hertz"), "{errors:?}");
     // No series, no parameter.
     let errors = refused(json!({"parameters": {}}));
     let fields: Vec<&str> = errors.iter().map(|e| e.0.as_str()).collect();

@@ -254,13 +254,17 @@ impl PenetrationCurve {
     }
 
     /// A bound on the relative error of [`PenetrationCurve::pressure_centre`], as
-    /// [`PenetrationCurve::error_at`] bounds the force's and the area's (below the first
-    /// node x_p/c falls to its limit 0, and that node's bound is kept).
+    /// [`PenetrationCurve::error_at`] bounds the force's and the area's. Below the first
+    /// node x_p/c falls linearly in c to its limit 0 (x_p ∝ c² as V T_σ/c → ∞): that node's
+    /// bound, and how far the first cell's slope in ln–ln is from that, carried over the
+    /// distance in ln c.
     pub fn pressure_error_at(&self, radius: f64, delta: f64) -> f64 {
         let ln_c = 0.5 * (radius * delta).ln();
         let (first, last) = (self.nodes[0], self.nodes[self.nodes.len() - 1]);
         if ln_c <= first.ln_c {
-            return first.pressure_error;
+            let next = self.nodes[1];
+            let slope = (next.ln[2] - first.ln[2]) / (next.ln_c - first.ln_c);
+            return first.pressure_error + (slope - 1.0).abs() * (first.ln_c - ln_c);
         }
         if ln_c >= last.ln_c {
             return 2.0 * last.pressure_error;

@@ -18,6 +18,8 @@
 //! A three-body system (docs/model.md §4) mixes particles of every size and the upper surface's
 //! contacts, so it has no such structure: its sensitivities are forward differences in T_σ
 //! (at fixed κ), κ, E_L and H, four more solves (two at rest, where the times have no effect).
+//! So has a particle's own friction (docs/model.md §11): the least of x_p/2R and the two
+//! contacts' capacities, the upper one independent of the layer; it is differenced alike.
 
 use super::super::continuum;
 use super::super::counterface::UpperSurface;
@@ -207,10 +209,8 @@ impl Point {
                 (self.solve(&thicker, self.velocity, law, stop)? / y).ln() / log_step
             }
         };
-        let tau = match self.measured {
-            Measured::FrictionCoefficient | Measured::ParticleFriction => 1.0,
-            Measured::ContactArea => 0.0,
-        };
+        // μ = τ_a A/P carries τ_a ∝ E_L; the area does not.
+        let tau = f64::from(u8::from(self.measured == Measured::FrictionCoefficient));
         Ok(Sensitivity {
             relaxation_time: g,
             kappa: dk,

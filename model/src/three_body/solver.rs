@@ -389,6 +389,11 @@ impl<'a> Model<'a> {
             count: self.system.nominal_area * self.system.areal_density,
             particle: |diameter: f64| {
                 let s = squeeze(&self.upper, &self.layer, diameter, diameter - separation)?;
+                if s.force <= 0.0 {
+                    // Touching, not squeezed (x = d to rounding): no load, nothing to roll.
+                    let idle = Motion::new(0.0, 0.0, f64::INFINITY, f64::INFINITY);
+                    return Ok((idle, 0.0, 0.0));
+                }
                 let radius = 0.5 * diameter;
                 let shift = self.layer.pressure_centre(radius, s.layer_penetration);
                 let motion = Motion::new(

@@ -12,8 +12,9 @@ use crate::quadrature::GaussRule;
 use crate::roots::brent;
 use crate::ModelError;
 
-/// Samples of the sizes in contact between which a change of mode is looked for: a change
-/// and its return within one sample's width (1/64 of the range in τ) would be missed.
+/// Samples of the sizes in contact between which a change of mode is looked for (the
+/// middles of as many cells in τ, and both ends of the range): a change and its return
+/// within one cell (1/64 of the range in τ) would be missed.
 const SCAN: usize = 64;
 
 /// One particle of a given diameter: its balance, the normal force it carries (N), and a
@@ -61,14 +62,20 @@ where
         let span = d.max - self.separation;
         let tau_lo = ((lo - self.separation) / span).powf(1.0 / f64::from(EDGE_POWER));
         let diameter = |tau: f64| self.separation + span * tau.powi(EDGE_POWER);
-        // The mode at the middle of each of SCAN cells in τ, and the cell edges where it
-        // changes, refined to the root of the balance that decides it.
+        // The mode at the middle of each of SCAN cells in τ and at the range's ends (its
+        // lower end only where a particle there is squeezed: above the separation), and
+        // where it changes, refined to the root of the balance that decides it.
         let width = (1.0 - tau_lo) / SCAN as f64;
+        let middles = (0..SCAN).map(|k| tau_lo + (k as f64 + 0.5) * width);
+        let samples = (tau_lo > 0.0)
+            .then_some(tau_lo)
+            .into_iter()
+            .chain(middles)
+            .chain([1.0]);
         let mut breaks = vec![tau_lo];
         let mut modes = Vec::new();
         let mut previous: Option<(f64, Motion)> = None;
-        for k in 0..SCAN {
-            let tau = tau_lo + (k as f64 + 0.5) * width;
+        for tau in samples {
             let (m, ..) = (self.particle)(diameter(tau))?;
             keep_furthest(&mut motion, m);
             if let Some((before, was)) = previous.filter(|(_, was)| was.mode != m.mode) {

@@ -14,7 +14,7 @@ use crate::model::fit::{
     Bounds, Datum, FitParameter, Law, Measured, Parameterization, Point, Problem, Setting,
 };
 use crate::model::text::quantity;
-use crate::model::three_body::{OperatingPoint, ThreeBody, ThreeBodyOptions};
+use crate::model::three_body::{LayerContact, OperatingPoint, ThreeBody, ThreeBodyOptions};
 use crate::model::{Layer, Parameter, Rolling};
 
 /// Input of a fit: measured points of one or more series, and the layer's parameters to
@@ -77,7 +77,7 @@ pub enum MeasuredQuantity {
     ContactArea,
     /// The friction the particles really transmit (docs/model.md §11), a plain number: a
     /// particle's T/P, rolling or sliding, or a system's (Σ T + τ_s A_s1s2)/W. Measured
-    /// rolling only (at rest it is 0).
+    /// rolling only (at rest the particles transmit nothing).
     ParticleFriction,
 }
 
@@ -503,6 +503,14 @@ fn read_one(s: &SeriesInput, c: &mut Checker, data: &mut Vec<Datum>) {
                 "none: a three-body series' `system` has its own `upper_surface`",
             );
             let (system, options) = read_system(system, c);
+            if quantity == MeasuredQuantity::ParticleFriction
+                && system.layer_contact == LayerContact::Hertz
+            {
+                let allowed = "friction_coefficient: on the hertz layer contact a particle \
+                               has no rolling resistance and transmits no tangential force, \
+                               whatever the layer's times (docs/model.md §11)";
+                c.invalid("quantity", json!(quantity), allowed);
+            }
             let total_load = c.optional(field!(s.total_load), Parameter::TotalLoad);
             check_range(c, field!(s.total_load), Parameter::TotalLoad, total_load);
             Series::System(system, options, total_load)
@@ -535,8 +543,9 @@ fn read_one(s: &SeriesInput, c: &mut Checker, data: &mut Vec<Datum>) {
                 measured: quantity.model(),
             };
             if quantity == MeasuredQuantity::ParticleFriction && point.velocity == 0.0 {
-                let allowed = "> 0 m/s for particle_friction: a particle at rest needs no \
-                               tangential force to roll, and transmits none";
+                let allowed = "> 0 m/s for particle_friction: at rest a particle needs no \
+                               tangential force to roll and transmits none (a system's \
+                               friction is then its asperities' alone)";
                 c.invalid("velocity", json!(0.0), allowed);
             }
             let why = "at each measured point";

@@ -16,7 +16,7 @@ use super::input::{
 };
 use super::meta::{Canonical, REFERENCES, THREE_BODY_CONTINUUM_REFERENCES};
 use super::points::{self, PointNotes, PointNotesFields, PointStatus, Row};
-use super::rolling::{MotionMode, RollingJob};
+use super::rolling::{MotionMode, MotionOutput, RollingJob};
 use super::validity::{self, PointValidity, Subject, ValidityOutput};
 use super::{rolling, Control, Cost, JobError, Kind, Limits, Meta, References, Validated, Work};
 use crate::model::continuum::{self, ContinuumVerification, PenetrationCurve};
@@ -627,6 +627,11 @@ described! {
         pub sliding_at_upper: f64 => [number ""],
         /// Where the mode changes, in ascending diameter.
         pub changes: Vec<ModeChangeOutput> => [each],
+        /// The balance of the particle in contact furthest from rolling (the largest need
+        /// over its weaker capacity): its mode, need, capacities and friction. Absent with
+        /// no particle in contact.
+        #[serde(skip_serializing_if = "Option::is_none")]
+        pub furthest: Option<MotionOutput> => [optional nested],
     }
 }
 
@@ -660,6 +665,7 @@ impl From<&SystemMotion> for SystemMotionOutput {
                     above: change.above.into(),
                 })
                 .collect(),
+            furthest: m.furthest.as_ref().map(MotionOutput::from),
         }
     }
 }
