@@ -407,4 +407,22 @@ async fn a_youngs_modulus_is_the_constrained_modulus_it_makes() {
         "{refused}"
     );
     assert_eq!(refused["errors"][0]["value"], "-2 GPa", "{refused}");
+    // A ν out of range is blamed alone, not the modulus it would have converted.
+    let bad_nu = json!({"layer": {"youngs_modulus": "2 GPa", "poisson_ratio": 0.7}});
+    let refused = problem(app.post("/v1/rolling", &bad_nu).await, 422).await;
+    let errors = refused["errors"].as_array().unwrap();
+    assert_eq!(errors.len(), 1, "{refused}");
+    assert_eq!(errors[0]["field"], "layer.poisson_ratio", "{refused}");
+    // An E whose E_L passes double precision is refused at E, saying why.
+    let huge = json!({"layer": {"youngs_modulus": 1e308, "poisson_ratio": 0.49}});
+    let refused = problem(app.post("/v1/rolling", &huge).await, 422).await;
+    assert_eq!(
+        refused["errors"][0]["field"], "layer.youngs_modulus",
+        "{refused}"
+    );
+    let allowed = refused["errors"][0]["allowed"].as_str().unwrap();
+    assert!(
+        allowed.contains("at ν = 0.49") && allowed.contains("E_L"),
+        "{allowed}"
+    );
 }

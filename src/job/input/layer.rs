@@ -10,6 +10,7 @@ use super::{field, Checker, Quantity};
 use crate::job::echoed;
 use crate::model::continuum::constrained_modulus;
 use crate::model::spectrum::{wlf_decades, Terms, MAX_TERMS};
+use crate::model::text::quantity;
 use crate::model::{Layer, Parameter};
 use crate::render::format_number;
 
@@ -93,7 +94,12 @@ impl LayerInput {
     pub fn read(&self, checker: &mut Checker) -> Layer {
         let input = self;
         let d = Layer::default();
-        let modulus = self.modulus(checker, d.elastic_modulus);
+        let youngs = self.youngs(checker);
+        let given = checker.quantity(
+            field!(input.elastic_modulus),
+            Parameter::ElasticModulus,
+            d.elastic_modulus,
+        );
         let thickness =
             checker.quantity(field!(input.thickness), Parameter::Thickness, d.thickness);
         let poisson_ratio = checker.quantity(
@@ -101,7 +107,10 @@ impl LayerInput {
             Parameter::PoissonRatio,
             d.poisson_ratio,
         );
-        let elastic_modulus = modulus(poisson_ratio);
+        let elastic_modulus = match youngs {
+            Some(e) => self.constrained(checker, e, poisson_ratio),
+            None => given,
+        };
         let layer = match self.series(checker) {
             Some(terms) => {
                 for (field, given) in [
@@ -138,13 +147,11 @@ impl LayerInput {
         }
     }
 
-    /// E_L as given: `elastic_modulus`, or `youngs_modulus` converted with ν (the returned
-    /// function's argument, read after it). A Young's modulus is checked at its own field,
-    /// as sent.
-    fn modulus(&self, checker: &mut Checker, default: f64) -> impl Fn(f64) -> f64 {
+    /// E, Young's modulus, when it is the modulus given (`youngs_modulus`, checked at its
+    /// own field as sent, which the model's errors of E_L then name).
+    fn youngs(&self, checker: &mut Checker) -> Option<f64> {
         let input = self;
-        // Read only when it is the modulus given: the field the model's errors then name.
-        let youngs = match (&self.elastic_modulus, &self.youngs_modulus) {
+        match (&self.elastic_modulus, &self.youngs_modulus) {
             (Some(_), Some(given)) => {
                 let allowed = "absent with elastic_modulus (one modulus: E_L, constrained, \
                                or E, Young's)";
@@ -155,13 +162,29 @@ impl LayerInput {
                 checker.optional(field!(input.youngs_modulus), Parameter::ElasticModulus)
             }
             (_, None) => None,
-        };
-        let given = checker.quantity(
-            field!(input.elastic_modulus),
-            Parameter::ElasticModulus,
-            default,
-        );
-        move |poisson_ratio| youngs.map_or(given, |e| constrained_modulus(e, poisson_ratio))
+        }
+    }
+
+    /// E_L from Young's `youngs` at `poisson_ratio` (docs/model.md §8). Not with a ν out of
+    /// range, which is reported at its own field: E is kept as it is, so that it is not
+    /// blamed for ν. An E_L beyond double precision is reported at `youngs_modulus`.
+    fn constrained(&self, checker: &mut Checker, youngs: f64, poisson_ratio: f64) -> f64 {
+        if Parameter::PoissonRatio.check(poisson_ratio).is_err() {
+            return youngs;
+        }
+        let converted = constrained_modulus(youngs, poisson_ratio);
+        if youngs.is_finite() && !converted.is_finite() {
+            let factor = constrained_modulus(1.0, poisson_ratio);
+            let allowed = format!(
+                "at most {} at ν = {poisson_ratio}, where E_L = E(1 − ν)/((1 + ν)(1 − 2ν)) = \
+                 {}·E must be a finite number",
+                quantity(f64::MAX / factor, "Pa"),
+                quantity(factor, "")
+            );
+            checker.out_of_range("youngs_modulus", youngs, "Pa", &allowed);
+            return youngs;
+        }
+        converted
     }
 
     /// The Prony series (E_j, τ_j) given as `prony` or `prony_csv`, if any; a term out of
