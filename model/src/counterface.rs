@@ -74,21 +74,22 @@ impl UpperSurface {
             .unwrap_or(self.elastic_modulus / (2.0 * (1.0 + self.poisson_ratio)) / 1000.0)
     }
 
-    /// (1 − ν₁²)/E₁.
-    pub fn compliance(&self) -> f64 {
-        (1.0 - self.poisson_ratio * self.poisson_ratio) / self.elastic_modulus
-    }
-
     /// How the surface takes a particle whose own compliance (1 − ν_a²)/E_a is
     /// `particle_compliance` (0 when rigid): Hertz with E_s1a, or plastic at H₁.
     pub fn law(&self, particle_compliance: f64) -> UpperLaw {
         match (self.contact, self.hardness) {
             (UpperContact::Plastic, Some(hardness)) => UpperLaw::Plastic { hardness },
             _ => UpperLaw::Elastic {
-                modulus: 1.0 / (self.compliance() + particle_compliance),
+                modulus: 1.0
+                    / (compliance(self.elastic_modulus, self.poisson_ratio) + particle_compliance),
             },
         }
     }
+}
+
+/// (1 − ν²)/E, a body's share of a contact's compliance (1/E* = Σ (1 − ν²)/E).
+pub fn compliance(modulus: f64, poisson_ratio: f64) -> f64 {
+    (1.0 - poisson_ratio * poisson_ratio) / modulus
 }
 
 /// How the upper surface takes a particle of radius R = x/2.

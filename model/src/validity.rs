@@ -133,17 +133,16 @@ impl Check {
     /// Whether the particle of `motion` rolls (docs/model.md §11): μ_roll over the weaker
     /// capacity; at rest rolling needs nothing.
     pub fn pure_rolling(motion: &Motion) -> Check {
-        Check::rolling_of(
-            *motion,
-            Sliding {
-                motion: *motion,
-                particles: None,
-                friction: motion.friction,
-            },
-        )
+        Check::rolling_of(Sliding {
+            motion: *motion,
+            particles: None,
+            friction: motion.friction,
+        })
     }
 
-    fn rolling_of(worst: Motion, sliding: Sliding) -> Check {
+    /// The pure-rolling check of `sliding`'s particle.
+    fn rolling_of(sliding: Sliding) -> Check {
+        let worst = sliding.motion;
         let weaker = worst.upper_capacity.min(worst.layer_capacity);
         Check {
             motion: Some(sliding),
@@ -297,14 +296,11 @@ pub fn three_body(system: &ThreeBody, s: &ThreeBodySolution) -> Vec<Check> {
     }
     let motion = &s.motion;
     if let Some(worst) = motion.furthest {
-        checks.push(Check::rolling_of(
-            worst,
-            Sliding {
-                motion: worst,
-                particles: Some((motion.sliding(), moving.particles_in_contact)),
-                friction: motion.friction,
-            },
-        ));
+        checks.push(Check::rolling_of(Sliding {
+            motion: worst,
+            particles: Some((motion.sliding(), moving.particles_in_contact)),
+            friction: motion.friction,
+        }));
     }
     checks
 }

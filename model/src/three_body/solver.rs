@@ -11,7 +11,7 @@ use super::state::{
 };
 use super::system::{LayerContact, OperatingPoint, ThreeBody, ThreeBodyOptions};
 use super::traction::Population;
-use crate::counterface::UpperLaw;
+use crate::counterface::{compliance, UpperLaw};
 use crate::motion::{Mode, Motion};
 use crate::quadrature::{gauss_legendre, GaussRule};
 use crate::roots::brent;
@@ -211,11 +211,6 @@ fn relative_change(a: f64, b: f64) -> f64 {
     } else {
         (a / b - 1.0).abs()
     }
-}
-
-/// (1 − ν²)/E.
-fn compliance(modulus: f64, poisson_ratio: f64) -> f64 {
-    (1.0 - poisson_ratio * poisson_ratio) / modulus
 }
 
 /// The system at one speed, ready to be evaluated at any separation.

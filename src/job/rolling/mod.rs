@@ -307,6 +307,15 @@ pub enum MotionMode {
 }
 
 impl MotionMode {
+    /// The mode in a picture's few words.
+    pub fn words(self) -> &'static str {
+        match self {
+            MotionMode::Rolls => "rolls",
+            MotionMode::SlidesAtLayer => "slides on layer",
+            MotionMode::SlidesAtUpper => "slides on upper",
+        }
+    }
+
     /// The mode as the JSON writes it.
     pub fn as_str(self) -> &'static str {
         match self {
@@ -568,15 +577,26 @@ pub enum Solved {
 }
 
 impl Solved {
-    /// The assumptions measured on it (docs/model.md §7, §8), and whether it rolls
-    /// against `upper` (§11).
-    fn checks(&self, rolling: &Rolling, upper: &UpperSurface) -> Vec<Check> {
-        let mut checks = match self {
-            Solved::Local(s) => model::validity::rolling(rolling, s),
-            Solved::Continuum(s) => model::validity::continuum(rolling, s),
+    /// Its contact, with how the particle moves against `upper` (§11), and the assumptions
+    /// measured on it (§7, §8, and whether it rolls): the particle's motion found once.
+    fn contact_and_checks(
+        &self,
+        rolling: &Rolling,
+        upper: &UpperSurface,
+    ) -> (ContactOutput, Vec<Check>) {
+        let motion = self.motion(rolling, upper);
+        let (contact, mut checks) = match self {
+            Solved::Local(s) => (
+                ContactOutput::new(s, (&motion).into()),
+                model::validity::rolling(rolling, s),
+            ),
+            Solved::Continuum(s) => (
+                ContactOutput::new(s, (&motion).into()),
+                model::validity::continuum(rolling, s),
+            ),
         };
-        checks.push(Check::pure_rolling(&self.motion(rolling, upper)));
-        checks
+        checks.push(Check::pure_rolling(&motion));
+        (contact, checks)
     }
 
     /// Whether the particle rolls or slides between `upper` and the layer (§11).
@@ -585,17 +605,8 @@ impl Solved {
             Solved::Local(s) => (s.rolling_resistance_coefficient, s.contact_area),
             Solved::Continuum(s) => (s.rolling_resistance_coefficient, s.contact_area),
         };
-        let layer = &rolling.layer;
-        let tau = layer.interfacial_shear_strength();
+        let tau = rolling.layer.interfacial_shear_strength();
         motion::particle(rolling.radius, rolling.load, resistance, area, tau, upper)
-    }
-
-    fn contact(&self, rolling: &Rolling, upper: &UpperSurface) -> ContactOutput {
-        let motion = (&self.motion(rolling, upper)).into();
-        match self {
-            Solved::Local(s) => ContactOutput::new(s, motion),
-            Solved::Continuum(s) => ContactOutput::new(s, motion),
-        }
     }
 
     fn verification(&self) -> ContactVerification {
@@ -694,11 +705,11 @@ impl SweepPoint {
         upper: &UpperSurface,
         solution: &Solved,
     ) -> Result<Self, JobError> {
-        let checks = solution.checks(rolling, upper);
+        let (contact, checks) = solution.contact_and_checks(rolling, upper);
         let validity = PointValidity::assess(checks, Subject::Particle)?;
         Ok(SweepPoint::answered(
             rolling,
-            solution.contact(rolling, upper),
+            contact,
             solution.verification(),
             validity,
         ))
@@ -854,9 +865,9 @@ impl RollingOutput {
         solution: &Solved,
         meta: Meta,
     ) -> Result<Self, JobError> {
-        let checks = solution.checks(rolling, upper);
+        let (contact, checks) = solution.contact_and_checks(rolling, upper);
         Ok(RollingOutput {
-            contact: solution.contact(rolling, upper),
+            contact,
             boundary: solution.boundary().iter().map(Into::into).collect(),
             pressure: solution.pressure().map(Into::into),
             meta: RollingMeta {

@@ -4,7 +4,7 @@
 
 use serde::Deserialize;
 
-use super::{BoundaryOutput, ContactOutput, MotionMode, PressureOutput, RollingJob};
+use super::{BoundaryOutput, ContactOutput, PressureOutput, RollingJob};
 use crate::job::input::LayerModel;
 use crate::job::picture::{shown, Asked, PictureError};
 use crate::render::svg::{Axis, Chart, Layer};
@@ -69,13 +69,8 @@ impl Picture for RollingPicture {
             shown(contact.friction_coefficient, "")
         );
         let motion = &contact.motion;
-        let moves = match motion.mode {
-            MotionMode::Rolls => "particle: rolls",
-            MotionMode::SlidesAtLayer => "particle: slides on the layer",
-            MotionMode::SlidesAtUpper => "particle: slides on the upper",
-        };
         let notes = vec![
-            moves.to_string(),
+            format!("particle: {}", motion.mode.words()),
             format!("friction {}", shown(motion.friction, "")),
             format!("rolling needs {}", shown(motion.rolling_need, "")),
             format!("layer holds {} (μ)", shown(motion.layer_capacity, "")),

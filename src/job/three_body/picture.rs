@@ -65,7 +65,7 @@ impl Picture for ThreeBodyPicture {
             outline.extend([(to, density(to)), (to, 0.0)]);
             if to > from {
                 layers.push(Layer::Area {
-                    name: format!("in contact: {}", moves(mode)),
+                    name: format!("in contact: {}", mode.words()),
                     outline,
                 });
             }
@@ -125,15 +125,6 @@ fn populations(motion: &SystemMotionOutput, from: f64, to: f64) -> Vec<(f64, f64
     }
     pieces.push((start, to, mode));
     pieces
-}
-
-/// How particles of `mode` move, in a user's words.
-fn moves(mode: MotionMode) -> &'static str {
-    match mode {
-        MotionMode::Rolls => "rolls",
-        MotionMode::SlidesAtLayer => "slides on layer",
-        MotionMode::SlidesAtUpper => "slides on upper",
-    }
 }
 
 /// The layer contact law, in a user's words.
